@@ -1,0 +1,49 @@
+"""turntable-pin: error analysis, error allocation and measurement diagnosis of two-axis turntables.
+
+The turntable is a URDF whose joint placements carry its errors; Pinocchio computes the payload
+orientation and the orientation error ``dR = Rd^T Rt``. Angles are radians and lengths metres inside
+the package; names carry the unit where it is not radians.
+"""
+
+from .batch_evaluation import OrientationErrorField, trig_basis
+from .error_parameters import (
+    ANGULAR_ERROR_NAMES,
+    ERROR_DESCRIPTIONS,
+    ERROR_NAMES,
+    TurntableErrors,
+)
+from .exceptions import (
+    IdentifiabilityError,
+    InfeasibleError,
+    InputError,
+    ModelError,
+    TurntablePinError,
+)
+from .small_angle import small_angle_matrix, small_angle_orientation_error, small_angle_rotation
+from .turntable_model import OrientationError, TurntableModel, default_urdf_path, error_placements
+from .urdf_io import YourdfpyTurntable, write_error_urdf
+
+__all__ = [
+    "ANGULAR_ERROR_NAMES",
+    "ERROR_DESCRIPTIONS",
+    "ERROR_NAMES",
+    "IdentifiabilityError",
+    "InfeasibleError",
+    "InputError",
+    "ModelError",
+    "OrientationError",
+    "OrientationErrorField",
+    "TurntableErrors",
+    "TurntableModel",
+    "TurntablePinError",
+    "YourdfpyTurntable",
+    "default_urdf_path",
+    "error_placements",
+    "small_angle_matrix",
+    "small_angle_orientation_error",
+    "small_angle_rotation",
+    "trig_basis",
+    "write_error_urdf",
+]
+
+__version__ = "0.1.0"
