@@ -88,6 +88,26 @@ def _pinv_checked(matrix: np.ndarray, axis: str) -> np.ndarray:
     return np.linalg.pinv(matrix)
 
 
+def _least_squares_batch(design: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Minimum-norm least squares of K systems (K,N,7) x = (K,N).
+
+    Normal equations where ``A^T A`` is well conditioned (4x faster than an SVD per system, and
+    this is the inner loop of the requirement search); the pseudo-inverse where it is not (e.g.
+    a 90-degree grid whose ``ax ay`` column stays zero under some orientation errors).
+    """
+    design_t = design.transpose(0, 2, 1)
+    gram = design_t @ design
+    projected = (design_t @ rhs[..., None])[..., 0]
+    solution = np.empty(projected.shape)
+    good = np.linalg.cond(gram) < 1e8
+    if np.any(good):
+        solution[good] = np.linalg.solve(gram[good], projected[good][..., None])[..., 0]
+    if not np.all(good):
+        bad = ~good
+        solution[bad] = np.einsum("kpn,kn->kp", np.linalg.pinv(design[bad]), rhs[bad])
+    return solution
+
+
 def rate_errors_dph(
     gyrowheel: GyroWheelModel,
     inputs: PositionInputs,
@@ -125,7 +145,7 @@ def rate_errors_dph(
         b2_act = w_act[..., index]
         b1 = b2_act + design_act @ beta
         if definition == "true_coefficients":
-            beta2 = np.einsum("kpn,kn->kp", np.linalg.pinv(design_act), b1 - b2_act)
+            beta2 = _least_squares_batch(design_act, b1 - b2_act)
             dw = b1 - beta2 @ design.T - b2_act
         else:
             beta1 = (b1 - w[:, index]) @ _pinv_checked(design, axis).T

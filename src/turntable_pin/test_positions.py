@@ -73,7 +73,9 @@ class PositionSet:
         phi1 = np.arange(0.0, 360.0 - 1e-9, step1_deg)
         phi2 = np.arange(0.0, 360.0 - 1e-9, step2_deg)
         p1, p2 = np.meshgrid(phi1, phi2, indexing="ij")
-        name = f"grid:{step1_deg:g}" if step2_deg == step1_deg else f"grid:{step1_deg:g}x{step2_deg:g}"
+        name = (
+            f"grid:{step1_deg:g}" if step2_deg == step1_deg else f"grid:{step1_deg:g}x{step2_deg:g}"
+        )
         return cls(deg_to_rad(p1.ravel()), deg_to_rad(p2.ravel()), name)
 
     @classmethod
@@ -95,7 +97,9 @@ class PositionSet:
                 raise InputError(f"positions '{text}': bad grid step") from None
             return cls.grid(step1, step2)
         if text.startswith("grid"):
-            raise InputError(f"positions '{text}': expected grid:STEP or grid:STEP1xSTEP2 (degrees)")
+            raise InputError(
+                f"positions '{text}': expected grid:STEP or grid:STEP1xSTEP2 (degrees)"
+            )
         path = Path(text)
         if not path.exists():
             raise InputError(
@@ -105,8 +109,12 @@ class PositionSet:
 
     def distinct_count(self, decimals: int = 9) -> int:
         """Number of distinct payload orientations (angles taken modulo 360 degrees)."""
-        wrapped = np.round(np.mod(rad_to_deg(np.stack([self.phi1_rad, self.phi2_rad], 1)), 360.0),
-                           decimals) % 360.0
+        wrapped = (
+            np.round(
+                np.mod(rad_to_deg(np.stack([self.phi1_rad, self.phi2_rad], 1)), 360.0), decimals
+            )
+            % 360.0
+        )
         return int(np.unique(wrapped, axis=0).shape[0])
 
     def to_dict(self) -> dict:
@@ -176,4 +184,3 @@ def position_inputs(
         earth_rate_dph=rate @ rotations,
         payload_rotation=rotations,
     )
-
