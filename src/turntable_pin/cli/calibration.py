@@ -1,0 +1,161 @@
+"""``rate-error``, ``requirement``, ``calibrate``: the GyroWheel calibration layer (section 2)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..calibration import calibrate_run
+from ..gyrowheel_model import GyroWheelModel
+from ..orientation_requirement import orientation_requirement
+from ..rate_error import DEFINITIONS, rate_error
+from ..test_positions import PositionSet, position_inputs
+from ..units import deg_to_rad
+from .common import finite_float, print_json
+
+DEFAULT_LATITUDE_DEG = 45.75
+"""Harbin, the paper's authors' city: an assumption, the paper does not state its latitude."""
+
+
+def positive_float(text: str) -> float:
+    """argparse type: a finite number > 0."""
+    value = finite_float(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got '{text}'")
+    return value
+
+
+def _add_setup_options(parser: argparse.ArgumentParser, *, positions: bool = True) -> None:
+    if positions:
+        parser.add_argument(
+            "--positions", default="grid:30", metavar="SCHEME|FILE.csv",
+            help="test positions: grid:STEP (phi1, phi2 in 0, STEP, ... < 360 deg, all pairs), "
+            "grid:STEP1xSTEP2, or a CSV with phi1_deg, phi2_deg (default grid:30)",
+        )  # fmt: skip
+    parser.add_argument(
+        "--latitude-deg", type=finite_float, default=DEFAULT_LATITUDE_DEG,
+        help=f"latitude of the test site, degrees (default {DEFAULT_LATITUDE_DEG}, Harbin)",
+    )  # fmt: skip
+
+
+def _add_model_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--gyrowheel", type=Path, metavar="FILE.yaml",
+        help="drift coefficients {x: {DF, x, y, z, xx, zz, xy}, y: {...}} (default: Table 1)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--exact", action="store_true",
+        help="exact rotation for dR instead of the small-angle matrix of eq. 7",
+    )  # fmt: skip
+    parser.add_argument(
+        "--definition", choices=DEFINITIONS, default=DEFINITIONS[0],
+        help="rate error: b1 - A beta2 - b2' (eq. 13 as printed, default) or b1 - A beta1 - b2'",
+    )  # fmt: skip
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    r = subparsers.add_parser(
+        "rate-error",
+        help="GyroWheel rate-sensing errors caused by an orientation error (eqs. 7-14)",
+        description="Rate-sensing errors dwx, dwy (deg/h, eq. 14) of a multi-position calibration "
+        "whose payload is off by (dpsi, dtheta, dgamma) at every position.",
+    )
+    for name in ("dpsi", "dtheta", "dgamma"):
+        r.add_argument(f"--{name}-deg", type=finite_float, default=0.0, help=f"{name}, degrees")
+    _add_setup_options(r)
+    _add_model_options(r)
+    r.set_defaults(func=run_rate_error)
+
+    q = subparsers.add_parser(
+        "requirement",
+        help="orientation requirement I_psi, I_theta, I_gamma for an accuracy (eqs. 15-16)",
+        description="Largest centred rectangles inside dwx <= w_m over (dpsi, dtheta) and "
+        "dwy <= w_m over (dtheta, dgamma), sharing dtheta; Figures 4 and 5 with --plots.",
+    )
+    q.add_argument(
+        "--accuracy-dph", type=positive_float, default=0.01,
+        help="required calibration accuracy w_m, deg/h (default 0.01)",
+    )  # fmt: skip
+    _add_setup_options(q)
+    _add_model_options(q)
+    q.add_argument("--plots", type=Path, metavar="DIR", help="write Figures 4 and 5 (PNG) here")
+    q.set_defaults(func=run_requirement)
+
+    c = subparsers.add_parser(
+        "calibrate",
+        help="fit the 2 x 7 drift coefficients to a calibration run (eqs. 5-6)",
+        description="Least-squares calibration of a run CSV (phi1_deg, phi2_deg, out_x_dph, "
+        "out_y_dph[, sigma_dph, time_s]): coefficients, standard errors, residuals per position.",
+    )
+    c.add_argument("run", type=Path, metavar="RUN.csv")
+    _add_setup_options(c, positions=False)
+    c.add_argument("--json", action="store_true", help="print one JSON object")
+    c.set_defaults(func=run_calibrate)
+
+
+def _gyrowheel(args: argparse.Namespace) -> GyroWheelModel:
+    return GyroWheelModel.from_yaml(args.gyrowheel) if args.gyrowheel else GyroWheelModel.nominal()
+
+
+def run_rate_error(args: argparse.Namespace) -> int:
+    inputs = position_inputs(PositionSet.parse(args.positions), deg_to_rad(args.latitude_deg))
+    result = rate_error(
+        _gyrowheel(args), inputs,
+        deg_to_rad(args.dpsi_deg), deg_to_rad(args.dtheta_deg), deg_to_rad(args.dgamma_deg),
+        exact=args.exact, definition=args.definition,
+    )  # fmt: skip
+    report = result.to_dict()
+    if args.json:
+        print_json(report)
+        return 0
+    print(
+        f"positions {report['positions']} ({report['n_positions']}), latitude "
+        f"{report['latitude_deg']:g} deg, {'exact rotation' if args.exact else 'eq. 7 dR'}, "
+        f"{args.definition.replace('_', ' ')}"
+    )
+    print(f"dwx = {report['dwx_dph']:.6g} deg/h")
+    print(f"dwy = {report['dwy_dph']:.6g} deg/h")
+    return 0
+
+
+def run_requirement(args: argparse.Namespace) -> int:
+    result = orientation_requirement(
+        args.accuracy_dph, PositionSet.parse(args.positions), deg_to_rad(args.latitude_deg),
+        gyrowheel=_gyrowheel(args), exact=args.exact, definition=args.definition,
+    )  # fmt: skip
+    report = result.to_dict()
+    if args.plots:
+        from ..requirement_plots import write_requirement_figures
+
+        report["plots"] = [str(p) for p in write_requirement_figures(result, args.plots)]
+    if args.json:
+        print_json(report)
+        return 0
+    print(
+        f"accuracy {args.accuracy_dph:g} deg/h, positions {report['positions']} "
+        f"({report['n_positions']}), latitude {report['latitude_deg']:g} deg, "
+        f"{args.definition.replace('_', ' ')}"
+    )
+    for name in ("psi", "theta", "gamma"):
+        print(
+            f"|d{name}| <= I_{name} = {report[f'I_{name}_deg']:.5f} deg "
+            f"({report[f'I_{name}_arcsec']:.2f} arcsec)"
+        )
+    print(f"I_theta set by the {report['binding_plane']} plane")
+    print(
+        f"all three angles at their limits at once: dwx <= {report['box_dwx_dph']:.4g}, "
+        f"dwy <= {report['box_dwy_dph']:.4g} deg/h"
+    )
+    for path in report.get("plots", []):
+        print(f"wrote {path}")
+    return 0
+
+
+def run_calibrate(args: argparse.Namespace) -> int:
+    result = calibrate_run(args.run, deg_to_rad(args.latitude_deg))
+    if args.json:
+        print_json(result.to_dict())
+    else:
+        print(result.report())
+    return 0
