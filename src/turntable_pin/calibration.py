@@ -166,14 +166,18 @@ def check_identifiable(design: np.ndarray, axis: str, positions: PositionSet) ->
     tol = singular[0] * max(design.shape) * np.finfo(float).eps
     rank = int(np.sum(singular > tol))
     if rank < N_COEFFICIENTS:
-        null = vt[-1]
         names = TERM_NAMES[axis]
-        combo = " + ".join(
-            f"{v:.3g}*D{axis}{n}" for v, n in zip(null, names, strict=True) if abs(v) > 1e-6
-        )
+        combos = []
+        for null in vt[rank:]:
+            null = null / np.max(np.abs(null))
+            combos.append(
+                " + ".join(
+                    f"{v:.3g}*D{axis}{n}" for v, n in zip(null, names, strict=True) if abs(v) > 1e-6
+                )
+            )
         raise IdentifiabilityError(
-            f"axis {axis}: the positions give A of rank {rank} < 7; they cannot separate the "
-            f"combination {combo} (choose positions where that regressor varies)"
+            f"axis {axis}: the positions give A of rank {rank} < 7; they cannot determine "
+            f"{'; '.join(combos)} (choose positions where those regressors vary independently)"
         )
     return rank
 
