@@ -63,7 +63,7 @@ def test_user_coefficients_file(tmp_path):
         ("x: {DF: 1, x: 2, y: 3, z: 4, yy: 5, zz: 6, xy: 7}\n"
          "y: {DF: 1, x: 2, y: 3, z: 4, yy: 5, zz: 6, yx: 7}\n", "unknown coefficient(s) ['yy']"),
         ("x: {DF: a, x: 2, y: 3, z: 4, xx: 5, zz: 6, xy: 7}\n"
-         "y: {DF: 1, x: 2, y: 3, z: 4, yy: 5, zz: 6, yx: 7}\n", "coefficient 'DF': expected a number"),
+         "y: {DF: 1, x: 2, y: 3, z: 4, yy: 5, zz: 6, yx: 7}\n", "'DF': expected a number"),
         ("x: {DF: .nan, x: 2, y: 3, z: 4, xx: 5, zz: 6, xy: 7}\n"
          "y: {DF: 1, x: 2, y: 3, z: 4, yy: 5, zz: 6, yx: 7}\n", "expected a finite number"),
         ("only_x: {}\n", "exactly the keys 'x' and 'y'"),
