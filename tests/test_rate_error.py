@@ -13,8 +13,8 @@ from turntable_pin.test_positions import PositionSet, position_inputs
 
 LAT_RAD = np.radians(45.75)
 GYRO = GyroWheelModel.nominal()
-INPUTS = {s: position_inputs(PositionSet.parse(s), LAT_RAD) for s in ("grid:30", "grid:45",
-                                                                       "grid:90", "grid:40")}  # fmt: skip
+SCHEMES = ("grid:30", "grid:45", "grid:90", "grid:40")
+INPUTS = {s: position_inputs(PositionSet.parse(s), LAT_RAD) for s in SCHEMES}
 small = st.floats(-2e-3, 2e-3, allow_nan=False)
 
 
