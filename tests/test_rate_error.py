@@ -174,3 +174,20 @@ def test_calibrated_definition_needs_an_identifying_position_set():
         dw("grid:90", 1e-4, 0, 0, definition="calibrated_coefficients")
     result = rate_error(GYRO, INPUTS["grid:90"], 1e-4, 0, 0)
     assert result.beta1["x"] is None and result.dwx_dph > 0
+
+
+@given(psi=small, theta=small, gamma=small)
+@settings(max_examples=30, deadline=None)
+def test_eq13_on_a_rank_deficient_grid_by_hand(psi, theta, gamma):
+    # grid:90: A has rank 6 and A' is (nearly) rank deficient, so eq. 11 is really solved.
+    inputs = INPUTS["grid:90"]
+    d = np.array([[1, -theta, psi], [theta, 1, -gamma], [-psi, gamma, 1]])
+    a, w = inputs.specific_force_g, inputs.earth_rate_dph
+    result = rate_error(GYRO, inputs, psi, theta, gamma)
+    for k, axis in enumerate("xy"):
+        beta = GYRO.axis(axis).as_array()
+        A, A2 = regressor_matrix(axis, a), regressor_matrix(axis, a @ d)
+        b1 = (w @ d)[:, k] + A2 @ beta
+        beta2 = np.linalg.lstsq(A2, b1 - (w @ d)[:, k], rcond=None)[0]
+        expected = np.max(np.abs(b1 - A @ beta2 - (w @ d)[:, k]))
+        assert getattr(result, f"dw{axis}_dph") == pytest.approx(expected, rel=1e-6, abs=1e-10)

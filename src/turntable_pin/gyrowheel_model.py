@@ -177,11 +177,13 @@ def regressor_matrix(axis: str, specific_force_g) -> np.ndarray:
         Shape S + (7,).
     """
     a = np.asarray(specific_force_g, dtype=float)
-    ax, ay, az = a[..., 0], a[..., 1], a[..., 2]
-    if axis == "x":
-        square = ax * ax
-    elif axis == "y":
-        square = ay * ay
-    else:
+    if axis not in AXES:
         raise InputError(f"unknown GyroWheel axis '{axis}'; expected one of {AXES}")
-    return np.stack([np.ones_like(ax), ax, ay, az, square, az * az, ax * ay], axis=-1)
+    rows = np.empty(a.shape[:-1] + (N_COEFFICIENTS,))
+    rows[..., 0] = 1.0
+    rows[..., 1:4] = a
+    squared = a[..., 0] if axis == "x" else a[..., 1]
+    np.multiply(squared, squared, out=rows[..., 4])
+    np.multiply(a[..., 2], a[..., 2], out=rows[..., 5])
+    np.multiply(a[..., 0], a[..., 1], out=rows[..., 6])
+    return rows

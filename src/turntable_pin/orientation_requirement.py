@@ -43,7 +43,6 @@ PLANES: dict[str, tuple[str, tuple[int, int]]] = {
 """Each plane of Figure 4: the axis whose error is studied and the two angle indices (u, v)."""
 
 _SIGNS = np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]], dtype=float)
-_BISECTIONS = 52
 _MARGIN = 1e-9
 
 
@@ -117,20 +116,48 @@ class PlaneRateError:
         accuracy_dph: float,
         hi_rad: float,
         *,
-        iterations: int = _BISECTIONS,
+        rtol: float = 1e-13,
     ) -> np.ndarray:
         """For each fixed value of the other half-width, the largest half-width along ``along``
-        in ``[0, hi_rad]`` with ``dw <= w_m`` at the corners (vectorised bisection)."""
-        fixed = np.atleast_1d(np.asarray(fixed_rad, float))
+        in ``[0, hi_rad]`` with ``dw <= w_m`` at the corners.
+
+        A vectorised Illinois (modified regula falsi) search on ``dw - w_m``, which is nearly
+        piecewise linear here, with a bisection step every fourth iteration so that the bracket
+        always shrinks. It stops where the bracket is narrower than ``rtol * hi_rad`` or where an
+        admissible point is within ``1e-12 w_m`` of the contour; the admissible end is returned.
+        """
+        fixed = np.atleast_1d(np.asarray(fixed_rad, float)).copy()
+
+        def excess(x, f):
+            return (self(x, f) if along == 0 else self(f, x)) - accuracy_dph
+
         lo = np.zeros_like(fixed)
         hi = np.full_like(fixed, hi_rad)
-        for _ in range(iterations):
-            mid = 0.5 * (lo + hi)
-            value = self(mid, fixed) if along == 0 else self(fixed, mid)
-            ok = value <= accuracy_dph
-            lo = np.where(ok, mid, lo)
-            hi = np.where(ok, hi, mid)
-        return lo
+        g_lo = excess(lo, fixed)
+        g_hi = excess(hi, fixed)
+        result = np.where(g_hi <= 0, hi, lo)
+        active = np.flatnonzero((g_hi > 0) & (g_lo <= 0))
+        last_side = np.zeros(fixed.size, dtype=int)
+        for iteration in range(200):
+            if active.size == 0:
+                break
+            a, b, ga, gb = lo[active], hi[active], g_lo[active], g_hi[active]
+            x = b - gb * (b - a) / (gb - ga)
+            bisect = (iteration % 4 == 3) | ~((x > a) & (x < b))
+            x = np.where(bisect, 0.5 * (a + b), x)
+            g = excess(x, fixed[active])
+            ok = g <= 0
+            # Illinois: when the same end survives twice, halve its value to unstick the method.
+            same = last_side[active] == np.where(ok, 1, -1)
+            g_hi[active] = np.where(ok & same, 0.5 * gb, np.where(ok, gb, g))
+            g_lo[active] = np.where(~ok & same, 0.5 * ga, np.where(ok, g, ga))
+            lo[active] = np.where(ok, x, a)
+            hi[active] = np.where(ok, b, x)
+            last_side[active] = np.where(ok, -1, 1)
+            done = (hi[active] - lo[active] <= rtol * hi_rad) | (ok & (-g <= 1e-12 * accuracy_dph))
+            result[active] = lo[active]
+            active = active[~done]
+        return result
 
 
 @dataclass(frozen=True)
@@ -189,7 +216,7 @@ def largest_rectangle(
     for level in range(zooms + 1):
         start = lower + (upper - lower) / scan_points if level == 0 else lower
         us = np.linspace(start, upper, scan_points)
-        vs = function.largest(1, us, accuracy_dph, v_hi, iterations=32)
+        vs = function.largest(1, us, accuracy_dph, v_hi, rtol=1e-9)
         best = int(np.argmax(us * vs))
         best_a = float(us[best])
         lower = float(us[max(best - 1, 0)])
@@ -197,7 +224,8 @@ def largest_rectangle(
     b = float(function.largest(1, best_a, accuracy_dph, v_hi)[0])
     # Push to the contour along u as well so that neither side can grow, then b to the contour.
     a = float(function.largest(0, b * (1 - _MARGIN), accuracy_dph, u_hi)[0])
-    b = float(function.largest(1, a, accuracy_dph, v_hi)[0])
+    b = float(function.largest(1, a * (1 - _MARGIN), accuracy_dph, v_hi)[0])
+    a, b = _settle(function, a, b, accuracy_dph)
     return PlaneRectangle(
         plane=function.plane,
         axis=function.axis,
@@ -205,6 +233,16 @@ def largest_rectangle(
         axis_limits_rad=(u_limit, v_limit),
         capped=u_capped or v_capped,
     )
+
+
+def _settle(function: PlaneRateError, a: float, b: float, accuracy_dph: float):
+    """Shrink ``(a, b)`` by a few margins if the corner itself ends a hair outside the contour
+    (each side was pushed with the other one a margin inside)."""
+    for _ in range(8):
+        if float(function(a, b)) <= accuracy_dph:
+            break
+        a, b = a * (1 - 2 * _MARGIN), b * (1 - 2 * _MARGIN)
+    return a, b
 
 
 @dataclass(frozen=True)
@@ -318,6 +356,7 @@ def orientation_requirement(
                 1, theta * (1 - _MARGIN), accuracy_dph, rect_y.axis_limits_rad[1] * 1.000001
             )[0]
         )
+        theta, gamma = _settle(fy, theta, gamma, accuracy_dph)
     else:
         binding, theta = "theta_gamma", theta_y
         psi = float(
@@ -325,6 +364,7 @@ def orientation_requirement(
                 0, theta * (1 - _MARGIN), accuracy_dph, rect_x.axis_limits_rad[0] * 1.000001
             )[0]
         )
+        psi, theta = _settle(fx, psi, theta, accuracy_dph)
     signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
     corners = signs * np.array([psi, theta, gamma])
     box = rate_errors_dph(

@@ -73,8 +73,8 @@ def orientation_error_rotation(dpsi_rad, dtheta_rad, dgamma_rad, *, exact: bool 
 def _perturbed(vectors: np.ndarray, rotations: np.ndarray) -> np.ndarray:
     """Row vectors times dR: (N,3) with (K,3,3) or (K,N,3,3) -> (K,N,3)."""
     if rotations.ndim == 3:
-        return np.einsum("nj,kji->kni", vectors, rotations)
-    return np.einsum("nj,knji->kni", vectors, rotations)
+        return np.matmul(vectors[None], rotations)
+    return np.matmul(vectors[None, :, None, :], rotations)[:, :, 0, :]
 
 
 def _pinv_checked(matrix: np.ndarray, axis: str) -> np.ndarray:
@@ -88,23 +88,44 @@ def _pinv_checked(matrix: np.ndarray, axis: str) -> np.ndarray:
     return np.linalg.pinv(matrix)
 
 
-def _least_squares_batch(design: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """Minimum-norm least squares of K systems (K,N,7) x = (K,N).
+def _true_coefficient_fit(
+    design: np.ndarray, beta: np.ndarray, nominal_design: np.ndarray, perturbation: np.ndarray
+) -> np.ndarray:
+    """``beta2 = A'^+ (b1 - b2') = A'^+ A' beta`` (eq. 11) for K perturbed matrices (K,N,7).
 
-    Normal equations where ``A^T A`` is well conditioned (4x faster than an SVD per system, and
-    this is the inner loop of the requirement search); the pseudo-inverse where it is not (e.g.
-    a 90-degree grid whose ``ax ay`` column stays zero under some orientation errors).
+    Where ``A'`` has full column rank, ``A'^+ A' = I`` and eq. 11 returns ``beta`` exactly. That
+    is certain when ``perturbation``, an upper bound of ``||A' - A||_F`` per system, is below half
+    the smallest singular value of the nominal ``A`` (Weyl); this shortcut is the inner loop of
+    the requirement search. Elsewhere (e.g. a 90-degree grid, whose ``ax ay`` column is only as
+    large as the orientation error) eq. 11 is solved: normal equations with unit-norm columns
+    where their condition number is below 1e8, the pseudo-inverse otherwise.
     """
-    design_t = design.transpose(0, 2, 1)
-    gram = design_t @ design
-    projected = (design_t @ rhs[..., None])[..., 0]
-    solution = np.empty(projected.shape)
-    good = np.linalg.cond(gram) < 1e8
+    k = design.shape[0]
+    solution = np.broadcast_to(beta, (k, beta.size)).copy()
+    sigma_min = np.linalg.svd(nominal_design, compute_uv=False)[-1]
+    todo = perturbation >= 0.5 * sigma_min
+    if not np.any(todo):
+        return solution
+    sub = design[todo]
+    rhs = sub @ beta
+    sub_t = sub.transpose(0, 2, 1)
+    gram = sub_t @ sub
+    projected = (sub_t @ rhs[..., None])[..., 0]
+    norms = np.sqrt(np.einsum("kii->ki", gram))
+    good = np.all(norms > 1e-150, axis=1)
+    scale = 1.0 / np.where(norms > 1e-150, norms, 1.0)
+    scaled = gram * scale[:, :, None] * scale[:, None, :]
+    good[good] = np.linalg.cond(scaled[good]) < 1e8
+    fitted = np.empty(projected.shape)
     if np.any(good):
-        solution[good] = np.linalg.solve(gram[good], projected[good][..., None])[..., 0]
+        fitted[good] = (
+            np.linalg.solve(scaled[good], (projected[good] * scale[good])[..., None])[..., 0]
+            * scale[good]
+        )
     if not np.all(good):
         bad = ~good
-        solution[bad] = np.einsum("kpn,kn->kp", np.linalg.pinv(design[bad]), rhs[bad])
+        fitted[bad] = np.einsum("kpn,kn->kp", np.linalg.pinv(sub[bad]), rhs[bad])
+    solution[todo] = fitted
     return solution
 
 
@@ -137,6 +158,14 @@ def rate_errors_dph(
         raise InputError(f"rotations must have shape (K,3,3) or (K,N,3,3), got {rotations.shape}")
     a, w = inputs.specific_force_g, inputs.earth_rate_dph
     a_act, w_act = _perturbed(a, rotations), _perturbed(w, rotations)
+    # Bound of ||A' - A||_F from ||dR - I||_F = d and |a| <= r: |da| <= d r per row, the squares
+    # and the product change by at most 2 r^2 d + r^2 d^2 each.
+    deviation = np.sqrt(np.sum((rotations - np.eye(3)) ** 2, axis=(-2, -1)))
+    if deviation.ndim == 2:
+        deviation = deviation.max(axis=1)
+    radius = float(np.max(np.linalg.norm(a, axis=1)))
+    change = deviation * radius
+    perturbation = np.sqrt(len(a) * (change**2 + 3 * (2 * radius * change + change**2) ** 2))
     errors = []
     for index, axis in enumerate(AXES):
         beta = gyrowheel.axis(axis).as_array()
@@ -145,7 +174,7 @@ def rate_errors_dph(
         b2_act = w_act[..., index]
         b1 = b2_act + design_act @ beta
         if definition == "true_coefficients":
-            beta2 = _least_squares_batch(design_act, b1 - b2_act)
+            beta2 = _true_coefficient_fit(design_act, beta, design, perturbation)
             dw = b1 - beta2 @ design.T - b2_act
         else:
             beta1 = (b1 - w[:, index]) @ _pinv_checked(design, axis).T
