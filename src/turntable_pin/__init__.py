@@ -6,6 +6,7 @@ the package; names carry the unit where it is not radians.
 """
 
 from .batch_evaluation import OrientationErrorField, trig_basis
+from .calibration import AxisCalibration, CalibrationResult, calibrate, calibrate_run
 from .error_parameters import (
     ANGULAR_ERROR_NAMES,
     ERROR_DESCRIPTIONS,
@@ -19,26 +20,47 @@ from .exceptions import (
     ModelError,
     TurntablePinError,
 )
+from .gyrowheel_model import DriftCoefficients, GyroWheelModel, regressor_matrix
+from .orientation_requirement import OrientationRequirement, orientation_requirement
+from .rate_error import RateErrorResult, orientation_error_rotation, rate_error, rate_errors_dph
 from .small_angle import small_angle_matrix, small_angle_orientation_error, small_angle_rotation
+from .test_positions import EARTH_RATE_DPH, PositionInputs, PositionSet, position_inputs
 from .turntable_model import OrientationError, TurntableModel, default_urdf_path, error_placements
 from .urdf_io import YourdfpyTurntable, write_error_urdf
 
 __all__ = [
     "ANGULAR_ERROR_NAMES",
+    "AxisCalibration",
+    "CalibrationResult",
+    "DriftCoefficients",
+    "EARTH_RATE_DPH",
     "ERROR_DESCRIPTIONS",
     "ERROR_NAMES",
+    "GyroWheelModel",
     "IdentifiabilityError",
     "InfeasibleError",
     "InputError",
     "ModelError",
     "OrientationError",
     "OrientationErrorField",
+    "OrientationRequirement",
+    "PositionInputs",
+    "PositionSet",
+    "RateErrorResult",
     "TurntableErrors",
     "TurntableModel",
     "TurntablePinError",
     "YourdfpyTurntable",
+    "calibrate",
+    "calibrate_run",
     "default_urdf_path",
     "error_placements",
+    "orientation_error_rotation",
+    "orientation_requirement",
+    "position_inputs",
+    "rate_error",
+    "rate_errors_dph",
+    "regressor_matrix",
     "small_angle_matrix",
     "small_angle_orientation_error",
     "small_angle_rotation",
