@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .io_utils import write_atomic  # noqa: E402
-from .orientation_requirement import OrientationRequirement  # noqa: E402
+from .orientation_requirement import MAX_ANGLE_RAD, OrientationRequirement  # noqa: E402
 from .rate_error import orientation_error_rotation, rate_errors_dph  # noqa: E402
 from .units import deg_to_rad, rad_to_deg  # noqa: E402
 
@@ -26,9 +26,10 @@ _LABELS = {"psi": r"$\Delta\psi$ (deg)", "theta": r"$\Delta\theta$ (deg)",
 
 
 def plot_span_deg(result: OrientationRequirement) -> float:
-    """Half-width of the plotted angle range: 1.6 times the largest contour intercept, degrees."""
-    limits = [w for r in result.rectangles for w in r.axis_limits_rad]
-    return float(rad_to_deg(1.6 * max(limits)))
+    """Half-width of the plotted angle range: 1.6 times the largest contour intercept below the
+    search cap (intercepts at the cap would flatten the figure), degrees."""
+    limits = [w for r in result.rectangles for w in r.axis_limits_rad if w < MAX_ANGLE_RAD]
+    return float(rad_to_deg(1.6 * max(limits, default=MAX_ANGLE_RAD)))
 
 
 def _rate_errors(result: OrientationRequirement, angles_rad: np.ndarray) -> np.ndarray:

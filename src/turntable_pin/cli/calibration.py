@@ -143,6 +143,11 @@ def run_requirement(args: argparse.Namespace) -> int:
             f"({report[f'I_{name}_arcsec']:.2f} arcsec)"
         )
     print(f"I_theta set by the {report['binding_plane']} plane")
+    if any(r["capped"] for r in report["rectangles"]):
+        print(
+            "note: dw stays below w_m up to the 10-degree search limit along some angle; that "
+            "limit is a cap (the small-angle model), not a requirement"
+        )
     print(
         f"all three angles at their limits at once: dwx <= {report['box_dwx_dph']:.4g}, "
         f"dwy <= {report['box_dwy_dph']:.4g} deg/h"
