@@ -26,6 +26,8 @@ def test_noise_free_outputs_calibrate_back_to_table_1(scheme):
     np.testing.assert_allclose(result.y.coefficients_dph, gyro.y.as_array(), rtol=0, atol=1e-9)
     assert np.max(np.abs(result.x.residuals_dph)) < 1e-9
     assert 1 <= result.x.condition_number < 100
+    fitted = result.model()
+    np.testing.assert_allclose(fitted.y.as_array(), gyro.y.as_array(), atol=1e-9)
 
 
 @given(

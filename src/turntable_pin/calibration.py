@@ -20,7 +20,14 @@ import numpy as np
 
 from .csv_table import read_csv_table, write_csv_table
 from .exceptions import IdentifiabilityError, InputError
-from .gyrowheel_model import AXES, N_COEFFICIENTS, TERM_NAMES, GyroWheelModel, regressor_matrix
+from .gyrowheel_model import (
+    AXES,
+    N_COEFFICIENTS,
+    TERM_NAMES,
+    DriftCoefficients,
+    GyroWheelModel,
+    regressor_matrix,
+)
 from .test_positions import PositionInputs, PositionSet, position_inputs
 from .units import deg_to_rad, rad_to_deg
 
@@ -86,8 +93,6 @@ class CalibrationResult:
 
     def model(self, source: str = "calibration") -> GyroWheelModel:
         """The fitted coefficients as a :class:`GyroWheelModel`."""
-        from .gyrowheel_model import DriftCoefficients
-
         return GyroWheelModel(
             DriftCoefficients("x", tuple(self.x.coefficients_dph)),
             DriftCoefficients("y", tuple(self.y.coefficients_dph)),
