@@ -16,6 +16,9 @@ GYRO = GyroWheelModel.nominal()
 SCHEMES = ("grid:30", "grid:45", "grid:90", "grid:40")
 INPUTS = {s: position_inputs(PositionSet.parse(s), LAT_RAD) for s in SCHEMES}
 small = st.floats(-2e-3, 2e-3, allow_nan=False)
+# On a rank-deficient grid eq. 11 is ill-posed for an angle of 1e-13 rad (A' is singular to
+# rounding there), so the by-hand check takes zero or angles of at least 1e-9 rad.
+small_or_zero = st.one_of(st.just(0.0), st.floats(1e-9, 2e-3), st.floats(-2e-3, -1e-9))
 
 
 def dw(scheme, psi, theta, gamma, **kw):
@@ -176,7 +179,7 @@ def test_calibrated_definition_needs_an_identifying_position_set():
     assert result.beta1["x"] is None and result.dwx_dph > 0
 
 
-@given(psi=small, theta=small, gamma=small)
+@given(psi=small_or_zero, theta=small_or_zero, gamma=small_or_zero)
 @settings(max_examples=30, deadline=None)
 def test_eq13_on_a_rank_deficient_grid_by_hand(psi, theta, gamma):
     # grid:90: A has rank 6 and A' is (nearly) rank deficient, so eq. 11 is really solved.
