@@ -329,7 +329,7 @@ def solve_subproblem(
     def dual(t):
         return _fixed_angle_solution(basis(t), w, lower_z, 1.0)
 
-    grid = np.linspace(lo, hi, 721)
+    grid = np.linspace(lo, hi, 181)
     values = np.array([dual(t)[1] for t in grid])
     j = int(np.argmax(values))
     a, b = grid[max(j - 1, 0)], grid[min(j + 1, grid.size - 1)]
