@@ -488,7 +488,7 @@ class Allocation:
     def report(self) -> str:
         """The table of upper bounds with J, worst case and active constraints, as text."""
         lines = [f"Error allocation (weights: {self.weights_scheme})", ""]
-        lines.append(f"{'error':12s}{'upper bound':>14s}{'':>4s}{'lower bound':>14s}")
+        lines.append(f"{'error':12s}{'upper bound':>24s}{'lower bound':>14s}")
         for n, ub, lb in zip(
             ANGULAR_ERROR_NAMES,
             self.upper_bounds_rad,
@@ -496,8 +496,8 @@ class Allocation:
             strict=True,
         ):
             lines.append(
-                f"{n:12s}{ub * ARCMIN_PER_RAD:11.4f} '{ub * ARCMIN_PER_RAD * 60:9.2f} \""
-                f'{lb * ARCMIN_PER_RAD * 60:9.2f} "'
+                f"{n:12s}{ub * ARCMIN_PER_RAD:11.4f}' = {ub * ARCMIN_PER_RAD * 60:7.2f}\""
+                f'{lb * ARCMIN_PER_RAD * 60:12.2f}"'
             )
         lines.append("")
         limits = self.limits.to_dict()

@@ -18,6 +18,7 @@ import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -54,13 +55,18 @@ def phi1_dependence(field: OrientationErrorField) -> float:
     return float(max(np.abs(c[:, i, j, 1:, :]).max() for i, j in ANGLE_ENTRIES))
 
 
+@lru_cache(maxsize=4)
+def _nominal_model(urdf_path: str | None) -> TurntableModel:
+    """One nominal model per process and URDF (chunks only read its placements)."""
+    return TurntableModel(urdf_path=urdf_path)
+
+
 def _run_chunk(args) -> tuple[np.ndarray, float]:
     """Worker: sample one chunk and return each turntable's max |angle| (n, 3) and phi1 check."""
     seed_seq, n, upper, lower, phi2_grid_rad, phi1_grid_rad, urdf_path = args
     rng = np.random.default_rng(seed_seq)
     values = sample_errors(rng, n, upper, lower)
-    model = TurntableModel(urdf_path=urdf_path)
-    field = OrientationErrorField.from_error_values(values, model)
+    field = OrientationErrorField.from_error_values(values, _nominal_model(urdf_path))
     dependence = phi1_dependence(field)
     phi1_values = [0.0] if dependence <= PHI1_TOLERANCE else phi1_grid_rad
     worst = np.zeros((n, 3))

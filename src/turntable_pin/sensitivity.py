@@ -81,7 +81,9 @@ def sensitivity_matrix(model: TurntableModel, phi1_rad: float, phi2_rad: float) 
     Exact derivative of the exact chain at the model's error set (not the small-angle model).
     """
     pin_model, data = model.model, model.data
-    q = model._q(phi1_rad, phi2_rad)
+    q = np.zeros(pin_model.nq)
+    q[pin_model.joints[model.outer_joint_id].idx_q] = phi1_rad
+    q[pin_model.joints[model.inner_joint_id].idx_q] = phi2_rad
     pin.forwardKinematics(pin_model, data, q)
     pin.updateFramePlacements(pin_model, data)
     frame_id = pin_model.getFrameId(PAYLOAD_FRAME)

@@ -16,7 +16,7 @@ from ..allocation import (
 from ..exceptions import InputError
 from ..manufacturing_capability import ManufacturingCapability
 from ..monte_carlo import plot_monte_carlo, run_monte_carlo
-from ..sensitivity import average_sensitivities, plot_sensitivities
+from ..sensitivity import AverageSensitivities, average_sensitivities, plot_sensitivities
 from ..units import ARCMIN_PER_RAD
 from .common import finite_float, positive_int, print_json
 
@@ -122,7 +122,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     m.set_defaults(func=run_montecarlo)
 
 
-def _allocation_from_args(args: argparse.Namespace) -> Allocation:
+def _allocation_from_args(args: argparse.Namespace) -> tuple[Allocation, AverageSensitivities]:
+    """The allocation the options ask for and the sensitivities behind Figure 8."""
     if args.limits_arcmin is not None:
         limits = parse_limits(args.limits_arcmin, "arcmin")
     elif args.limits_deg is not None:
@@ -134,31 +135,34 @@ def _allocation_from_args(args: argparse.Namespace) -> Allocation:
         if args.lower_bounds
         else ManufacturingCapability.default()
     )
-    sensitivities = average_sensitivities(phi1_grid_deg=[0.0]) if args.weights == "model" else None
+    # phi1 drops out of dR (tested), so one phi1 value is enough for the averages.
+    sensitivities = average_sensitivities(phi1_grid_deg=[0.0])
     allocation = allocate_tolerances(limits, args.weights, capability, sensitivities)
-    if getattr(args, "plots", None) and args.func is run_allocate:
-        figure = (
-            average_sensitivities(phi1_grid_deg=[0.0]) if sensitivities is None else sensitivities
-        )
-        plot_sensitivities(figure, args.plots / "figure8_sensitivities.png")
-    return allocation
+    return allocation, sensitivities
 
 
 def run_allocate(args: argparse.Namespace) -> int:
-    allocation = _allocation_from_args(args)
+    allocation, sensitivities = _allocation_from_args(args)
+    figure = None
+    if args.plots:
+        figure = plot_sensitivities(sensitivities, args.plots / "figure8_sensitivities.png")
     if args.json:
-        print_json(allocation.to_dict())
+        report = allocation.to_dict()
+        report["sensitivities"] = sensitivities.to_dict()["sensitivities"]
+        if figure:
+            report["plot"] = str(figure)
+        print_json(report)
     else:
         print(allocation.report())
-        if args.plots:
-            print(f"\nwrote {args.plots / 'figure8_sensitivities.png'}")
+        if figure:
+            print(f"\nwrote {figure}")
     return 0
 
 
 def run_montecarlo(args: argparse.Namespace) -> int:
     if args.scale_bounds <= 0.0:
         raise InputError(f"--scale-bounds must be positive, got {args.scale_bounds}")
-    allocation = _allocation_from_args(args)
+    allocation, _ = _allocation_from_args(args)
     upper = allocation.upper_bounds_rad * args.scale_bounds
     lower = allocation.capability.lower_bounds_rad
     if args.scale_bounds < 1.0:
