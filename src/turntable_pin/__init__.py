@@ -5,6 +5,13 @@ orientation and the orientation error ``dR = Rd^T Rt``. Angles are radians and l
 the package; names carry the unit where it is not radians.
 """
 
+from .allocation import (
+    Allocation,
+    OrientationLimits,
+    allocate_tolerances,
+    default_orientation_limits,
+    worst_case_full_circle,
+)
 from .batch_evaluation import OrientationErrorField, trig_basis
 from .calibration import AxisCalibration, CalibrationResult, calibrate, calibrate_run
 from .error_parameters import (
@@ -21,14 +28,37 @@ from .exceptions import (
     TurntablePinError,
 )
 from .gyrowheel_model import DriftCoefficients, GyroWheelModel, regressor_matrix
+from .manufacturing_capability import ManufacturingCapability
+from .monte_carlo import MonteCarloResult, plot_monte_carlo, run_monte_carlo
 from .orientation_requirement import OrientationRequirement, orientation_requirement
 from .rate_error import RateErrorResult, orientation_error_rotation, rate_error, rate_errors_dph
+from .sensitivity import (
+    AverageSensitivities,
+    average_sensitivities,
+    plot_sensitivities,
+    sensitivity_matrix,
+    sensitivity_matrix_fd,
+)
 from .small_angle import small_angle_matrix, small_angle_orientation_error, small_angle_rotation
 from .test_positions import EARTH_RATE_DPH, PositionInputs, PositionSet, position_inputs
 from .turntable_model import OrientationError, TurntableModel, default_urdf_path, error_placements
 from .urdf_io import YourdfpyTurntable, write_error_urdf
 
 __all__ = [
+    "Allocation",
+    "AverageSensitivities",
+    "ManufacturingCapability",
+    "MonteCarloResult",
+    "OrientationLimits",
+    "allocate_tolerances",
+    "average_sensitivities",
+    "default_orientation_limits",
+    "plot_monte_carlo",
+    "plot_sensitivities",
+    "run_monte_carlo",
+    "sensitivity_matrix",
+    "sensitivity_matrix_fd",
+    "worst_case_full_circle",
     "ANGULAR_ERROR_NAMES",
     "AxisCalibration",
     "CalibrationResult",

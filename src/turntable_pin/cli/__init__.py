@@ -13,7 +13,7 @@ import sys
 
 from ..exceptions import TurntablePinError
 
-COMMAND_MODULES: tuple[str, ...] = ("orientation", "calibration")
+COMMAND_MODULES: tuple[str, ...] = ("orientation", "calibration", "allocation")
 
 
 def build_parser() -> argparse.ArgumentParser:

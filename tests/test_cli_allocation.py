@@ -1,0 +1,112 @@
+"""``turntable-pin allocate`` and ``montecarlo``: JSON keys, Table 4, units, clear errors."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from turntable_pin import ANGULAR_ERROR_NAMES
+from turntable_pin.cli import main
+from turntable_pin.cli.allocation import parse_limits
+from turntable_pin.exceptions import InputError
+
+PAPER = ["--limits-arcmin", "psi=1.4801,theta=1.56,gamma=1.4801", "--weights", "paper"]
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "turntable_pin", *args], capture_output=True, text=True, timeout=120
+    )
+
+
+def json_of(capsys, argv):
+    status = main(argv)
+    return status, json.loads(capsys.readouterr().out)
+
+
+def test_allocate_json_reproduces_table4(capsys):
+    status, out = json_of(capsys, ["allocate", *PAPER, "--json"])
+    assert status == 0
+    ub = out["upper_bounds_arcmin"]
+    assert set(ub) == set(ANGULAR_ERROR_NAMES)
+    assert round(ub["dphi_z2"], 4) == 0.78 and round(ub["dalpha_x2"], 4) == 0.2825
+    assert round(ub["deps_x"], 4) == 0.4234
+    assert set(out["J"]) == {"psi", "theta", "gamma", "total"}
+    for name, value in out["worst_case_arcmin"].items():
+        assert value <= out["limits_arcmin"][name] + 1e-12
+
+
+def test_limits_in_degrees_equal_limits_in_arcmin(capsys):
+    _, arcmin = json_of(capsys, ["allocate", "--limits-arcmin", "1.62", "--weights", "equal",
+                                 "--json"])  # fmt: skip
+    _, deg = json_of(capsys, ["allocate", "--limits-deg", "psi=0.027,theta=0.027,gamma=0.027",
+                              "--weights", "equal", "--json"])  # fmt: skip
+    for name in ANGULAR_ERROR_NAMES:
+        assert deg["upper_bounds_arcmin"][name] == pytest.approx(
+            arcmin["upper_bounds_arcmin"][name], rel=1e-12
+        )
+
+
+def test_default_limits_are_the_orientation_requirement(capsys):
+    _, out = json_of(capsys, ["allocate", "--json"])
+    assert out["limits_arcmin"] == pytest.approx({"psi": 1.62, "theta": 1.62, "gamma": 1.62})
+    assert out["weights"] == "model"
+
+
+def test_allocate_text_and_figure8(tmp_path, capsys):
+    assert main(["allocate", *PAPER, "--plots", str(tmp_path)]) == 0
+    text = capsys.readouterr().out
+    assert "dalpha_y2" in text and "worst case" in text
+    assert (tmp_path / "figure8_sensitivities.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_montecarlo_json(tmp_path, capsys):
+    status, out = json_of(
+        capsys,
+        ["montecarlo", *PAPER, "-n", "3000", "--seed", "4", "--plots", str(tmp_path), "--json"],
+    )
+    assert status == 0
+    assert out["all_within"] is True and out["seed"] == 4 and out["n"] == 3000
+    assert set(out["max_abs_arcmin"]) == set(out["limits_arcmin"]) == {"psi", "theta", "gamma"}
+    assert (tmp_path / "figure9_montecarlo.png").is_file()
+
+
+def test_montecarlo_beyond_the_bounds_fails_with_status_1(capsys):
+    status, out = json_of(
+        capsys, ["montecarlo", *PAPER, "-n", "3000", "--scale-bounds", "1.2", "--json"]
+    )
+    assert status == 1
+    assert out["all_within"] is False
+
+
+def test_infeasible_lower_bounds_exit_2_with_one_line(tmp_path):
+    lb = tmp_path / "lb.yaml"
+    lb.write_text("lower_bounds:\n  dalpha_x2_arcmin: 2.0\n")
+    proc = run_cli("allocate", *PAPER, "--lower-bounds", str(lb))
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+    assert "dgamma" in proc.stderr and "above the limit" in proc.stderr
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (["--limits-arcmin", "psi=1,theta=2"], "no limit for gamma"),
+        (["--limits-arcmin", "psi=1,theta=2,gamma=-1"], "positive"),
+        (["--limits-arcmin", "psi=1,theta=x,gamma=1"], "expected a number"),
+        (["--limits-arcmin", "psi=1,tau=2,gamma=1"], "expected psi=P"),
+        (["--lower-bounds", "/nonexistent/lb.yaml"], "cannot read"),
+    ],
+)
+def test_bad_input_exit_2(args, fragment, capsys):
+    assert main(["allocate", *args]) == 2
+    err = capsys.readouterr().err
+    assert fragment in err and err.count("\n") == 1
+
+
+def test_parse_limits_one_number_for_all():
+    limits = parse_limits("1.5", "arcmin").to_dict()
+    assert limits == pytest.approx({"psi": 1.5, "theta": 1.5, "gamma": 1.5})
+    with pytest.raises(InputError, match="twice"):
+        parse_limits("psi=1,psi=2,theta=1,gamma=1", "deg")
