@@ -92,7 +92,11 @@ class Exaggeration:
 
 @dataclass(frozen=True)
 class ScenePoses:
-    """Base-frame poses (4x4) of the scene's markers at one position of the magnified model."""
+    """Base-frame poses (4x4) of the scene's markers at one position of the magnified model.
+
+    The inner-axis poses are the inner joint's frame (after its rotation phi2): the rod is drawn
+    along its z axis, the inner rotation axis.
+    """
 
     actual_payload: np.ndarray
     ideal_payload: np.ndarray
