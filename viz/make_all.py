@@ -46,6 +46,7 @@ def discover(pattern: str = "fig_*.py") -> list[Path]:
 def _load(script: Path):
     spec = importlib.util.spec_from_file_location(f"viz_{script.stem}", script)
     module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses and pickling look a module up there
     spec.loader.exec_module(module)
     if not callable(getattr(module, "main", None)):
         raise TypeError(f"{script}: a figure script must define main(out_dir, fast=False)")
