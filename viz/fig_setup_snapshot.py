@@ -10,7 +10,7 @@ import numpy as np
 
 from turntable_pin import TurntableErrors
 from turntable_pin.scene import SetupScene
-from turntable_pin.snapshot import snapshot
+from turntable_pin.snapshot import render_snapshot
 from turntable_pin.turntable_model import models_dir
 
 POSITIONS_DEG = ((30.0, 45.0), (90.0, 0.0))
@@ -23,7 +23,7 @@ def main(out_dir: Path, fast: bool = False) -> list[Path]:
     written = []
     for phi1_deg, phi2_deg in POSITIONS_DEG[:1] if fast else POSITIONS_DEG:
         out = Path(out_dir) / f"setup_phi1_{phi1_deg:g}_phi2_{phi2_deg:g}.png"
-        result = snapshot(
+        result = render_snapshot(
             scene, np.radians(phi1_deg), np.radians(phi2_deg), out, width=width, height=height
         )
         print(f"wrote {out} ({result.scene_seconds + result.browser_seconds:.1f} s)")

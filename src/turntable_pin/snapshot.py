@@ -98,7 +98,7 @@ def _check_size(name: str, value: int) -> int:
     return int(value)
 
 
-def snapshot(
+def render_snapshot(
     scene: SetupScene,
     phi1_rad: float,
     phi2_rad: float,

@@ -145,10 +145,10 @@ def run_view(args: argparse.Namespace) -> int:
 
 
 def run_snapshot(args: argparse.Namespace) -> int:
-    from ..snapshot import snapshot
+    from ..snapshot import render_snapshot
 
     scene = scene_from_args(args)
-    result = snapshot(
+    result = render_snapshot(
         scene,
         deg_to_rad(args.phi1_deg),
         deg_to_rad(args.phi2_deg),
