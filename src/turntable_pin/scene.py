@@ -135,6 +135,8 @@ class SetupScene:
         errors: the true error set (default: none).
         urdf_path: the nominal URDF (default: the bundled one).
         exaggeration: the magnification (default: :meth:`Exaggeration.for_errors`).
+        camera_target_m, camera_offset_m: where the camera looks (base frame, metres) and its
+            eye's offset from there (default: the whole machine from north-east and above).
     """
 
     def __init__(
@@ -143,7 +145,11 @@ class SetupScene:
         *,
         urdf_path: str | Path | None = None,
         exaggeration: Exaggeration | None = None,
+        camera_target_m=CAMERA_TARGET_M,
+        camera_offset_m=CAMERA_OFFSET_M,
     ) -> None:
+        self.camera_target_m = tuple(float(v) for v in camera_target_m)
+        self.camera_offset_m = tuple(float(v) for v in camera_offset_m)
         self.errors = errors if errors is not None else TurntableErrors.zero()
         self.exaggeration = exaggeration or Exaggeration.for_errors(self.errors)
         self.display_errors = self.exaggeration.apply(self.errors)
@@ -240,14 +246,16 @@ class SetupScene:
         self._vis[f"{ROOT}/ideal_inner_axis"].set_transform(poses.ideal_inner_axis)
         return poses
 
-    def set_camera(self, target_m=CAMERA_TARGET_M, offset_m=CAMERA_OFFSET_M) -> None:
-        """Aim the camera at ``target_m`` from ``target_m + offset_m`` (base frame, metres).
+    def set_camera(self, target_m=None, offset_m=None) -> None:
+        """Aim the camera at ``target_m`` from ``target_m + offset_m`` (base frame, metres;
+        default: the scene's ``camera_target_m``, ``camera_offset_m``).
 
         pinocchio's ``setCameraPosition`` fails with meshcat 0.3.2; the camera is a node whose
         transform is the orbit target and whose child's ``position`` is the eye offset, in the
         viewer's y-up frame: ``[dx, dz, -dy]``.
         """
-        dx, dy, dz = offset_m
+        target_m = self.camera_target_m if target_m is None else target_m
+        dx, dy, dz = self.camera_offset_m if offset_m is None else offset_m
         self._vis["/Cameras/default"].set_transform(_translation(target_m))
         self._vis["/Cameras/default/rotated/<object>"].set_property("position", [dx, dz, -dy])
 
