@@ -23,10 +23,15 @@ from turntable_pin.browser import (
     screenshot_html,
 )
 
-needs_chromium = pytest.mark.skipif(
+_no_chromium = pytest.mark.skipif(
     not chromium_available(),
     reason="headless Chromium not found: install the Debian package 'chromium'",
 )
+
+
+def needs_chromium(test):
+    """Mark a test as a browser test that skips, saying why, without Chromium."""
+    return pytest.mark.browser(_no_chromium(test))
 
 
 def _png(path, size_in=(2.0, 1.5), dpi=50):

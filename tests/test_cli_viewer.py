@@ -15,10 +15,15 @@ from process_watch import ProcessWatch, alive
 from turntable_pin.browser import chromium_available
 
 pytest.importorskip("meshcat")
-needs_chromium = pytest.mark.skipif(
+_no_chromium = pytest.mark.skipif(
     not chromium_available(),
     reason="headless Chromium not found: install the Debian package 'chromium'",
 )
+
+
+def needs_chromium(test):
+    """Mark a test as a browser test that skips, saying why, without Chromium."""
+    return pytest.mark.browser(_no_chromium(test))
 
 
 def run_cli(*args: str, env: dict | None = None) -> subprocess.CompletedProcess:

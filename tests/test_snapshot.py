@@ -19,10 +19,16 @@ from turntable_pin.scene import SetupScene
 from turntable_pin.snapshot import decorate_static_page, render_snapshot
 
 pytest.importorskip("meshcat")
-needs_chromium = pytest.mark.skipif(
+_no_chromium = pytest.mark.skipif(
     not chromium_available(),
     reason="headless Chromium not found: install the Debian package 'chromium'",
 )
+
+
+def needs_chromium(test):
+    """Mark a test as a browser test that skips, saying why, without Chromium."""
+    return pytest.mark.browser(_no_chromium(test))
+
 
 EXAMPLE = TurntableErrors.from_arcsec(dalpha_x1=3.0, deps_x=4.0, deps_y=-3.0, deta_mm=0.2)
 # The URDF's material gyrowheel_orange, rgba 1.0 0.55 0.0: its hue, in degrees.
