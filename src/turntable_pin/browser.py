@@ -145,16 +145,17 @@ def _process_table() -> list[_ProcessInfo]:
     return table
 
 
-def related_processes(root_pid: int, marker: str) -> list[int]:
+def related_processes(marker: str) -> list[int]:
     """Live processes belonging to one browser run.
 
     Chromium calls ``setsid`` (so killing the launcher's process group is not enough) and its
-    crash handler detaches into a session of its own; but every one of them names the run's
-    temporary folder (``marker``) on its command line, or descends from or shares a session with
-    a process that does.
+    crash handler detaches into a session of its own; but every one of them, the launcher
+    included, names the run's temporary folder (``marker``) on its command line, or descends from
+    or shares a session or group with a process that does. Starting from the marker, not from a
+    pid, means a pid reused after the launcher was reaped is never mistaken for ours.
     """
     table = [p for p in _process_table() if p.alive]
-    members = {root_pid} | {p.pid for p in table if marker in p.cmdline}
+    members = {p.pid for p in table if marker in p.cmdline}
     grew = True
     while grew:
         before = len(members)
@@ -166,11 +167,11 @@ def related_processes(root_pid: int, marker: str) -> list[int]:
     return sorted(members & alive)
 
 
-def kill_related_processes(root_pid: int, marker: str, timeout_s: float = 5.0) -> None:
+def kill_related_processes(marker: str, timeout_s: float = 5.0) -> None:
     """SIGKILL every process of :func:`related_processes` and wait until none is alive."""
     deadline = time.monotonic() + timeout_s
     while True:
-        pids = related_processes(root_pid, marker)
+        pids = related_processes(marker)
         if not pids or time.monotonic() > deadline:
             return
         for pid in pids:
@@ -224,10 +225,10 @@ def run_chromium(
                 f"headless Chromium did not finish within {timeout_s:g} s and was stopped"
             ) from None
         finally:
+            kill_related_processes(str(tmp_path))
             if proc.poll() is None:
                 proc.kill()
             proc.wait()
-            kill_related_processes(proc.pid, str(tmp_path))
         seconds = time.perf_counter() - start
     return BrowserRun(
         pid=proc.pid,
