@@ -1,10 +1,11 @@
 """What each kind of turntable error does to the setup, one error at a time, magnified.
 
 Each panel is the 3-D scene (meshcat in headless Chromium) with a single error of the example's
-size magnified to 6 degrees (deta to 30 mm), at phi1 = 30 deg, phi2 = 45 deg. Wobble and
-orthogonality errors tilt the inner axis (magenta rod against the dark ideal one); the
-intersection error moves it sideways without turning it; the inner-axis wobble and position
-errors turn only the payload (the coloured triad parts from the dark ideal one).
+size magnified to 6 degrees (deta to 30 mm), at phi1 = 30 deg, phi2 = 45 deg. Orthogonality,
+outer-axis wobble and the outer position error tilt the inner axis (magenta rod against the dark
+ideal one) and the payload with it; the intersection error moves the axis sideways without
+turning anything; inner-axis wobble and the inner position error turn only the payload (the
+coloured triad parts from the dark ideal one while the axis stays put).
 """
 
 import math
