@@ -185,3 +185,26 @@ def test_meshcat_receives_the_poses_of_the_model():
     from process_watch import alive
 
     assert not alive(pid)
+
+
+@pytest.mark.parametrize(
+    "entries, axis_tilts, axis_moves, payload_turns",
+    [
+        ({"deps_x": 4.0}, True, False, True),
+        ({"dalpha_x1": 3.0}, True, False, True),
+        ({"dphi_y1": 2.0}, True, False, True),
+        ({"deta_mm": 0.2}, False, True, False),
+        ({"dalpha_y2": -2.2}, False, False, True),
+        ({"dphi_z2": -1.5}, False, False, True),
+    ],
+)
+def test_what_each_error_visibly_does(entries, axis_tilts, axis_moves, payload_turns):
+    """The statements of the error-effects figure's caption, marker by marker."""
+    scene = SetupScene(TurntableErrors.from_arcsec(**entries))
+    poses = scene.poses(math.radians(30.0), math.radians(45.0))
+    axis_turn = np.linalg.norm(poses.actual_inner_axis[:3, 2] - poses.ideal_inner_axis[:3, 2])
+    axis_shift = np.linalg.norm(poses.actual_inner_axis[:3, 3] - poses.ideal_inner_axis[:3, 3])
+    payload_turn = np.linalg.norm(poses.actual_payload[:3, :3] - poses.ideal_payload[:3, :3])
+    assert (axis_turn > 0.01) == axis_tilts
+    assert (axis_shift > 0.01) == axis_moves
+    assert (payload_turn > 0.01) == payload_turns
