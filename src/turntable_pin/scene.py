@@ -69,14 +69,19 @@ class Exaggeration:
         display_offset_m: float = DEFAULT_DISPLAY_OFFSET_M,
     ) -> Exaggeration:
         """The default magnification of ``errors`` (see the module docstring); either factor given
-        is used as is. A perfect table is shown at true size."""
+        is used as is. A perfect table is shown at true size; a table whose only error is deta
+        shows it as ``display_offset_m``."""
+        largest = float(np.max(np.abs(errors.angular_array_rad())))
+        angle_given = angle_factor is not None
         if angle_factor is None:
-            largest = float(np.max(np.abs(errors.angular_array_rad())))
             angle_factor = display_angle_rad / largest if largest > 0.0 else 1.0
         if length_factor is None:
             length_factor = angle_factor
             if errors.deta != 0.0:
-                length_factor = min(angle_factor, display_offset_m / abs(errors.deta))
+                to_display = display_offset_m / abs(errors.deta)
+                # With no angular error to take the factor from, deta alone sets it.
+                own = angle_given or largest > 0.0
+                length_factor = min(angle_factor, to_display) if own else to_display
         return cls(angle_factor, length_factor)
 
     def apply(self, errors: TurntableErrors) -> TurntableErrors:
