@@ -7,7 +7,12 @@ import builtins
 import pytest
 
 from process_watch import alive
-from turntable_pin.meshcat_server import MeshcatMissingError, MeshcatServer, import_meshcat
+from turntable_pin.meshcat_server import (
+    MeshcatMissingError,
+    MeshcatServer,
+    MeshcatServerError,
+    import_meshcat,
+)
 
 
 def test_server_runs_inside_and_is_gone_after_an_error():
@@ -33,3 +38,16 @@ def test_missing_meshcat_says_how_to_install_it(monkeypatch):
     monkeypatch.setattr(builtins, "__import__", no_meshcat)
     with pytest.raises(MeshcatMissingError, match=r"turntable-pin\[viz\]"):
         import_meshcat()
+
+
+def test_a_dead_server_is_an_error_not_a_hang(monkeypatch):
+    pytest.importorskip("meshcat")
+    import zmq
+
+    with pytest.raises(MeshcatServerError, match="did not answer"):
+        with MeshcatServer() as server:
+            server.visualizer.window.zmq_socket.setsockopt(zmq.RCVTIMEO, 300)
+            server.visualizer.window.server_proc.kill()
+            server.visualizer.window.server_proc.wait()
+            server.visualizer.static_html()
+    assert not alive(server.pid)

@@ -26,7 +26,7 @@ from .exceptions import (
     ModelError,
     TurntablePinError,
 )
-from .meshcat_server import MeshcatMissingError, MeshcatServer
+from .meshcat_server import MeshcatMissingError, MeshcatServer, MeshcatServerError
 from .scene import Exaggeration, SetupScene
 from .small_angle import small_angle_matrix, small_angle_orientation_error, small_angle_rotation
 from .snapshot import SnapshotResult, render_snapshot
@@ -46,6 +46,7 @@ __all__ = [
     "InputError",
     "MeshcatMissingError",
     "MeshcatServer",
+    "MeshcatServerError",
     "ModelError",
     "OrientationError",
     "OrientationErrorField",

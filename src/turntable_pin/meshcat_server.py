@@ -20,6 +20,14 @@ class MeshcatMissingError(TurntablePinError):
     """The optional dependency meshcat is not installed."""
 
 
+class MeshcatServerError(TurntablePinError):
+    """The meshcat server stopped answering."""
+
+
+REPLY_TIMEOUT_S = 60.0
+"""Longest wait for one reply of the meshcat server (a static page takes well under a second)."""
+
+
 def import_meshcat():
     """The ``meshcat`` module, or :class:`MeshcatMissingError` saying how to install it."""
     try:
@@ -53,10 +61,20 @@ class MeshcatServer:
         with contextlib.redirect_stdout(io.StringIO()):
             self.visualizer = meshcat.Visualizer()
         self.pid = self.visualizer.window.server_proc.pid
+        import zmq
+
+        # Without a timeout a dead server would block the client's recv() forever.
+        self.visualizer.window.zmq_socket.setsockopt(zmq.RCVTIMEO, int(REPLY_TIMEOUT_S * 1000))
         return self
 
-    def __exit__(self, *exc_info) -> None:
+    def __exit__(self, exc_type, exc, traceback) -> None:
         self.stop()
+        import zmq
+
+        if exc_type is not None and issubclass(exc_type, zmq.error.Again):
+            raise MeshcatServerError(
+                f"the meshcat server did not answer within {REPLY_TIMEOUT_S:g} s"
+            ) from None
 
     @property
     def url(self) -> str:
