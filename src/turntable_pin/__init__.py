@@ -13,6 +13,13 @@ from .allocation import (
     worst_case_full_circle,
 )
 from .batch_evaluation import OrientationErrorField, trig_basis
+from .browser import (
+    BrowserError,
+    BrowserNotFoundError,
+    ImageLoadReport,
+    check_page_images,
+    chromium_available,
+)
 from .calibration import AxisCalibration, CalibrationResult, calibrate, calibrate_run
 from .error_parameters import (
     ANGULAR_ERROR_NAMES,
@@ -29,9 +36,11 @@ from .exceptions import (
 )
 from .gyrowheel_model import DriftCoefficients, GyroWheelModel, regressor_matrix
 from .manufacturing_capability import ManufacturingCapability
+from .meshcat_server import MeshcatMissingError, MeshcatServer, MeshcatServerError
 from .monte_carlo import MonteCarloResult, plot_monte_carlo, run_monte_carlo
 from .orientation_requirement import OrientationRequirement, orientation_requirement
 from .rate_error import RateErrorResult, orientation_error_rotation, rate_error, rate_errors_dph
+from .scene import Exaggeration, SetupScene
 from .sensitivity import (
     AverageSensitivities,
     average_sensitivities,
@@ -40,61 +49,74 @@ from .sensitivity import (
     sensitivity_matrix_fd,
 )
 from .small_angle import small_angle_matrix, small_angle_orientation_error, small_angle_rotation
+from .snapshot import SnapshotResult, render_snapshot
 from .test_positions import EARTH_RATE_DPH, PositionInputs, PositionSet, position_inputs
 from .turntable_model import OrientationError, TurntableModel, default_urdf_path, error_placements
 from .urdf_io import YourdfpyTurntable, write_error_urdf
 
 __all__ = [
+    "ANGULAR_ERROR_NAMES",
     "Allocation",
     "AverageSensitivities",
-    "ManufacturingCapability",
-    "MonteCarloResult",
-    "OrientationLimits",
-    "allocate_tolerances",
-    "average_sensitivities",
-    "default_orientation_limits",
-    "plot_monte_carlo",
-    "plot_sensitivities",
-    "run_monte_carlo",
-    "sensitivity_matrix",
-    "sensitivity_matrix_fd",
-    "worst_case_full_circle",
-    "ANGULAR_ERROR_NAMES",
     "AxisCalibration",
+    "BrowserError",
+    "BrowserNotFoundError",
     "CalibrationResult",
     "DriftCoefficients",
     "EARTH_RATE_DPH",
     "ERROR_DESCRIPTIONS",
     "ERROR_NAMES",
+    "Exaggeration",
     "GyroWheelModel",
     "IdentifiabilityError",
+    "ImageLoadReport",
     "InfeasibleError",
     "InputError",
+    "ManufacturingCapability",
+    "MeshcatMissingError",
+    "MeshcatServer",
+    "MeshcatServerError",
     "ModelError",
+    "MonteCarloResult",
     "OrientationError",
     "OrientationErrorField",
+    "OrientationLimits",
     "OrientationRequirement",
     "PositionInputs",
     "PositionSet",
     "RateErrorResult",
+    "SetupScene",
+    "SnapshotResult",
     "TurntableErrors",
     "TurntableModel",
     "TurntablePinError",
     "YourdfpyTurntable",
+    "allocate_tolerances",
+    "average_sensitivities",
     "calibrate",
     "calibrate_run",
+    "check_page_images",
+    "chromium_available",
+    "default_orientation_limits",
     "default_urdf_path",
     "error_placements",
     "orientation_error_rotation",
     "orientation_requirement",
+    "plot_monte_carlo",
+    "plot_sensitivities",
     "position_inputs",
     "rate_error",
     "rate_errors_dph",
     "regressor_matrix",
+    "render_snapshot",
+    "run_monte_carlo",
+    "sensitivity_matrix",
+    "sensitivity_matrix_fd",
     "small_angle_matrix",
     "small_angle_orientation_error",
     "small_angle_rotation",
     "trig_basis",
+    "worst_case_full_circle",
     "write_error_urdf",
 ]
 

@@ -13,7 +13,7 @@ import sys
 
 from ..exceptions import TurntablePinError
 
-COMMAND_MODULES: tuple[str, ...] = ("orientation", "calibration", "allocation")
+COMMAND_MODULES: tuple[str, ...] = ("orientation", "calibration", "allocation", "viewer")
 
 
 def build_parser() -> argparse.ArgumentParser:

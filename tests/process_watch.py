@@ -1,0 +1,86 @@
+"""Test support: watch which helper processes a call starts, to check none outlives it (by pid).
+
+A thread samples /proc while the call runs and records (a) meshcat servers and (b) headless
+Chromium processes started on behalf of this test process: a Chromium launcher that is a child
+of this process names its throw-away folder on its command line, and every Chromium process of
+that run (renderers, GPU, crash handler) names the same folder.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import threading
+import time
+from pathlib import Path
+
+_RUN_DIR = re.compile(r"--user-data-dir=(/\S*turntable-pin-chromium-[^/\s]+)/profile")
+
+
+def _table() -> list[tuple[int, int, str, str]]:
+    """(pid, ppid, state, cmdline) of every process."""
+    rows = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+            cmdline = (
+                (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode("utf-8", "replace")
+            )
+        except OSError:
+            continue
+        fields = stat[stat.rfind(")") + 2 :].split()
+        rows.append((int(entry.name), int(fields[1]), fields[0], cmdline))
+    return rows
+
+
+def alive(pid: int) -> bool:
+    """Whether ``pid`` is a running (not zombie) process."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return stat[stat.rfind(")") + 2 :].split()[0] not in ("Z", "X")
+
+
+class ProcessWatch:
+    """Context manager collecting ``server_pids`` and ``browser_pids`` seen while it is open."""
+
+    def __init__(self, parent_pid: int | None = None, interval_s: float = 0.02) -> None:
+        self.parent_pid = parent_pid or os.getpid()
+        self.interval_s = interval_s
+        self.server_pids: set[int] = set()
+        self.browser_pids: set[int] = set()
+        self._run_dirs: set[str] = set()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._loop, daemon=True)
+
+    def _sample(self) -> None:
+        table = _table()
+        for pid, ppid, _, cmdline in table:
+            if ppid == self.parent_pid and "meshcat.servers.zmqserver" in cmdline:
+                self.server_pids.add(pid)
+            match = _RUN_DIR.search(cmdline)
+            if ppid == self.parent_pid and match:
+                self._run_dirs.add(match.group(1))
+        for pid, _, _, cmdline in table:
+            if any(run_dir in cmdline for run_dir in self._run_dirs):
+                self.browser_pids.add(pid)
+
+    def _loop(self) -> None:
+        while not self._stop.is_set():
+            self._sample()
+            time.sleep(self.interval_s)
+
+    def __enter__(self) -> ProcessWatch:
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self._stop.set()
+        self._thread.join()
+
+    def survivors(self) -> list[int]:
+        """Recorded pids still running."""
+        return sorted(pid for pid in self.server_pids | self.browser_pids if alive(pid))

@@ -1,0 +1,136 @@
+"""The ``view`` and ``snapshot`` commands: serving, clean shutdown by pid, and clear errors."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from process_watch import ProcessWatch, alive
+from turntable_pin.browser import chromium_available
+
+pytest.importorskip("meshcat")
+_no_chromium = pytest.mark.skipif(
+    not chromium_available(),
+    reason="headless Chromium not found: install the Debian package 'chromium'",
+)
+
+
+def needs_chromium(test):
+    """Mark a test as a browser test that skips, saying why, without Chromium."""
+    return pytest.mark.browser(_no_chromium(test))
+
+
+def run_cli(*args: str, env: dict | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "turntable_pin", *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+    )
+
+
+def _start_view(*args: str) -> tuple[subprocess.Popen, list[str]]:
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "turntable_pin", "view", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    lines = []
+    while not lines or not lines[-1].startswith("serving"):
+        line = proc.stdout.readline()
+        if not line:
+            raise AssertionError(f"view ended early: {proc.stderr.read()}")
+        lines.append(line.strip())
+    return proc, lines
+
+
+@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM])
+def test_view_serves_until_interrupted_then_stops_its_server(stop):
+    proc, lines = _start_view("--error", "deps_x=4", "--error", "deta=0.2")
+    with ProcessWatch(parent_pid=proc.pid) as watch:
+        time.sleep(0.3)
+    try:
+        assert lines[0].startswith("meshcat viewer: http://127.0.0.1:")
+        assert any("magnified x2700" in line for line in lines)
+        (server_pid,) = watch.server_pids
+        assert alive(server_pid)
+        os.kill(proc.pid, stop)
+        proc.wait(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0
+    assert "meshcat server stopped" in proc.stderr.read()
+    assert not alive(server_pid)
+
+
+def test_view_animates_a_positions_file_for_a_while(tmp_path):
+    positions = tmp_path / "positions.csv"
+    positions.write_text("phi1_deg,phi2_deg\n0,0\n90,0\n90,180\n")
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "turntable_pin", "view", "--animate", "--positions",
+         str(positions), "--frames-per-move", "3", "--frame-seconds", "0.01", "--duration", "1"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    with ProcessWatch(parent_pid=proc.pid) as watch:
+        out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    assert "serving for 1 s" in out
+    assert len(watch.server_pids) == 1 and watch.survivors() == []
+
+
+def test_view_names_the_bad_cell_of_a_positions_file(tmp_path):
+    positions = tmp_path / "positions.csv"
+    positions.write_text("phi1_deg,phi2_deg\n0,0\n90,abc\n")
+    proc = run_cli("view", "--animate", "--positions", str(positions), "--duration", "0")
+    assert proc.returncode == 2
+    assert str(positions) in proc.stderr and "row 3" in proc.stderr and "phi2_deg" in proc.stderr
+    assert "Traceback" not in proc.stderr
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--exaggerate", "0"], "angle_factor"),
+        (["--exaggerate-deta", "-1"], "length_factor"),
+        (["--error", "nonsense=1"], "unknown error name"),
+    ],
+)
+def test_snapshot_bad_options_exit_2(tmp_path, args, message):
+    proc = run_cli("snapshot", "-o", str(tmp_path / "x.png"), *args)
+    assert proc.returncode == 2
+    assert message in proc.stderr and "Traceback" not in proc.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_snapshot_without_chromium_names_the_package(tmp_path):
+    env = dict(os.environ)
+    env["PATH"] = os.path.dirname(sys.executable)  # python only, no browser
+    env.pop("TURNTABLE_PIN_CHROMIUM", None)
+    proc = run_cli("snapshot", "-o", str(tmp_path / "x.png"), env=env)
+    assert proc.returncode == 2
+    assert "Debian package 'chromium'" in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+
+
+@needs_chromium
+def test_snapshot_command_writes_the_png_and_reports_json(tmp_path):
+    out = tmp_path / "setup.png"
+    proc = run_cli(
+        "snapshot", "--error", "dalpha_x2=2", "--phi1-deg", "60", "--phi2-deg", "10",
+        "--width", "320", "--height", "240", "--exaggerate", "5000", "-o", str(out), "--json",
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    report = json.loads(proc.stdout)
+    assert report["width_px"] == 320 and report["height_px"] == 240
+    assert report["exaggeration"] == {"angle_factor": 5000.0, "length_factor": 5000.0}
+    assert report["phi1_deg"] == 60.0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
