@@ -19,6 +19,7 @@ from turntable_pin.allocation import (
     default_orientation_limits,
     interval_max,
     linear_angle_models,
+    paper_eq16_limits,
     solve_subproblem,
     worst_case_full_circle,
 )
@@ -258,12 +259,20 @@ def test_worst_case_equals_brute_force_over_angles_and_sign_corners(angle, rng):
 
 
 @pytest.mark.parametrize("weights", ["model", "paper", "equal"])
-def test_lemma1_worst_case_of_the_allocation_is_within_the_limits(weights):
-    allocation = allocate_tolerances(default_orientation_limits(), weights)
+@pytest.mark.parametrize("which", ["default", "paper"])
+def test_lemma1_worst_case_of_the_allocation_is_within_the_limits(weights, which):
+    chosen = default_orientation_limits() if which == "default" else PAPER_LIMITS
+    allocation = allocate_tolerances(chosen, weights)
     limits = allocation.limits.as_array()
-    assert np.all(allocation.worst_case_rad <= limits * (1 + 1e-12))
-    # each limit is used up: the allocation is not conservative
-    np.testing.assert_allclose(allocation.worst_case_rad, limits, rtol=1e-9)
+    used = allocation.worst_case_rad / limits
+    assert np.all(used <= 1 + 1e-12)
+    # Not conservative: theta's limit is used up, and so is the tighter of psi and gamma (eq. 34
+    # gives the errors shared by psi and gamma the smaller of the two solutions, so with unequal
+    # limits the looser one keeps some room).
+    assert used[1] == pytest.approx(1.0, rel=1e-9)
+    assert max(used[0], used[2]) == pytest.approx(1.0, rel=1e-9)
+    if limits[0] == limits[2]:
+        np.testing.assert_allclose(used, 1.0, rtol=1e-9)
 
 
 def test_equal_weights_give_the_traditional_allocation():
@@ -285,10 +294,22 @@ def test_model_weights_are_inverse_two_over_pi():
 
 
 # ---- limits and reporting --------------------------------------------------------------------
-def test_default_limits_are_eq16():
-    limits = default_orientation_limits().to_dict()
+def test_paper_limits_are_eq16():
+    limits = paper_eq16_limits().to_dict()
     for name in ORIENTATION_ANGLES:
         assert limits[name] == pytest.approx(0.027 * 60, rel=1e-12)
+
+
+def test_default_limits_are_the_calibration_layers_requirement():
+    from turntable_pin import PositionSet, orientation_requirement
+
+    requirement = orientation_requirement(0.01, PositionSet.parse("grid:30"), np.radians(45.75))
+    limits = default_orientation_limits()
+    assert limits.psi_rad == requirement.I_psi_rad
+    assert limits.theta_rad == requirement.I_theta_rad
+    assert limits.gamma_rad == requirement.I_gamma_rad
+    # a looser calibration accuracy allows a larger orientation error
+    assert np.all(default_orientation_limits(0.02).as_array() > limits.as_array())
 
 
 @pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), float("inf")])

@@ -4,12 +4,14 @@ import json
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from turntable_pin import ANGULAR_ERROR_NAMES
 from turntable_pin.cli import main
 from turntable_pin.cli.allocation import parse_limits
 from turntable_pin.exceptions import InputError
+from turntable_pin.units import ARCMIN_PER_RAD
 
 PAPER = ["--limits-arcmin", "psi=1.4801,theta=1.56,gamma=1.4801", "--weights", "paper"]
 
@@ -49,9 +51,17 @@ def test_limits_in_degrees_equal_limits_in_arcmin(capsys):
 
 
 def test_default_limits_are_the_orientation_requirement(capsys):
+    from turntable_pin import PositionSet, orientation_requirement
+
     _, out = json_of(capsys, ["allocate", "--json"])
-    assert out["limits_arcmin"] == pytest.approx({"psi": 1.62, "theta": 1.62, "gamma": 1.62})
+    req = orientation_requirement(0.01, PositionSet.parse("grid:30"), np.radians(45.75))
+    expected = {"psi": req.I_psi_rad, "theta": req.I_theta_rad, "gamma": req.I_gamma_rad}
+    assert out["limits_arcmin"] == pytest.approx(
+        {k: v * ARCMIN_PER_RAD for k, v in expected.items()}
+    )
     assert out["weights"] == "model"
+    _, looser = json_of(capsys, ["allocate", "--json", "--accuracy-dph", "0.02"])
+    assert all(looser["limits_arcmin"][k] > out["limits_arcmin"][k] for k in expected)
 
 
 def test_allocate_text_and_figure8(tmp_path, capsys):

@@ -10,6 +10,7 @@ from .allocation import (
     OrientationLimits,
     allocate_tolerances,
     default_orientation_limits,
+    paper_eq16_limits,
     worst_case_full_circle,
 )
 from .batch_evaluation import OrientationErrorField, trig_basis
@@ -98,6 +99,7 @@ __all__ = [
     "check_page_images",
     "chromium_available",
     "default_orientation_limits",
+    "paper_eq16_limits",
     "default_urdf_path",
     "error_placements",
     "orientation_error_rotation",

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 from scipy.optimize import minimize, minimize_scalar
@@ -85,13 +86,41 @@ class OrientationLimits:
         return {n: getattr(self, f"{n}_rad") * ARCMIN_PER_RAD for n in ORIENTATION_ANGLES}
 
 
-def default_orientation_limits() -> OrientationLimits:
-    """The orientation requirement used when the user gives none.
+DEFAULT_ACCURACY_DPH = 0.01
+"""Calibration accuracy behind the default limits: the paper's example, 0.01 deg/h."""
+DEFAULT_POSITIONS = "grid:30"
+"""Position scheme behind the default limits (the calibration layer's reference scheme)."""
+DEFAULT_LATITUDE_DEG = 45.75
+"""Latitude behind the default limits (Harbin; an assumption, the paper states none)."""
 
-    For now the paper's eq. 16 (0.027 deg on each angle, for a 0.01 deg/h calibration). This is the
-    one place to connect to the calibration layer's requirement once that layer exists.
-    """
+
+def paper_eq16_limits() -> OrientationLimits:
+    """The paper's eq. 16: 0.027 deg on each angle (for 0.01 deg/h, positions not stated)."""
     return OrientationLimits.from_deg(_EQ16_LIMIT_DEG, _EQ16_LIMIT_DEG, _EQ16_LIMIT_DEG)
+
+
+@lru_cache(maxsize=16)
+def default_orientation_limits(
+    accuracy_dph: float = DEFAULT_ACCURACY_DPH,
+    positions: str = DEFAULT_POSITIONS,
+    latitude_deg: float = DEFAULT_LATITUDE_DEG,
+) -> OrientationLimits:
+    """The orientation requirement used when the user gives no limits.
+
+    It is the calibration layer's requirement (eqs. 15-16, :func:`orientation_requirement`) for
+    calibration accuracy ``accuracy_dph`` (deg/h) on the position scheme ``positions`` at
+    ``latitude_deg`` (degrees), with the paper's Table 1 GyroWheel. The paper's own numbers are
+    :func:`paper_eq16_limits`.
+    """
+    from .orientation_requirement import orientation_requirement
+    from .test_positions import PositionSet
+
+    requirement = orientation_requirement(
+        accuracy_dph, PositionSet.parse(positions), math.radians(latitude_deg)
+    )
+    return OrientationLimits(
+        requirement.I_psi_rad, requirement.I_theta_rad, requirement.I_gamma_rad
+    )
 
 
 # ---- the linear model of each angle ----------------------------------------------------------

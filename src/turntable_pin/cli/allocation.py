@@ -6,6 +6,9 @@ import argparse
 from pathlib import Path
 
 from ..allocation import (
+    DEFAULT_ACCURACY_DPH,
+    DEFAULT_LATITUDE_DEG,
+    DEFAULT_POSITIONS,
     ORIENTATION_ANGLES,
     WEIGHT_SCHEMES,
     Allocation,
@@ -63,9 +66,27 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
         "--limits-arcmin",
         metavar="psi=P,theta=T,gamma=G",
         help="orientation limits in arc minutes (one number: the same for all three); "
-        "default: the orientation requirement (eq. 16, 0.027 deg each)",
+        "default: the calibration layer's orientation requirement for --accuracy-dph on "
+        "--positions at --latitude-deg",
     )
     limits.add_argument("--limits-deg", metavar="psi=P,theta=T,gamma=G", help="... in degrees")
+    p.add_argument(
+        "--accuracy-dph",
+        type=finite_float,
+        default=DEFAULT_ACCURACY_DPH,
+        help=f"calibration accuracy behind the default limits, deg/h ({DEFAULT_ACCURACY_DPH})",
+    )
+    p.add_argument(
+        "--positions",
+        default=DEFAULT_POSITIONS,
+        help=f"position scheme behind the default limits ({DEFAULT_POSITIONS})",
+    )
+    p.add_argument(
+        "--latitude-deg",
+        type=finite_float,
+        default=DEFAULT_LATITUDE_DEG,
+        help=f"latitude behind the default limits, degrees ({DEFAULT_LATITUDE_DEG})",
+    )
     p.add_argument(
         "--weights",
         choices=WEIGHT_SCHEMES,
@@ -129,7 +150,7 @@ def _allocation_from_args(args: argparse.Namespace) -> tuple[Allocation, Average
     elif args.limits_deg is not None:
         limits = parse_limits(args.limits_deg, "deg")
     else:
-        limits = default_orientation_limits()
+        limits = default_orientation_limits(args.accuracy_dph, args.positions, args.latitude_deg)
     capability = (
         ManufacturingCapability.from_yaml(args.lower_bounds)
         if args.lower_bounds
