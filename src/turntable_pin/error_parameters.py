@@ -16,6 +16,7 @@ import numpy as np
 import yaml
 
 from .exceptions import InputError
+from .io_utils import read_yaml, write_text_atomic
 from .units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, M_PER_MM
 
 ANGULAR_ERROR_NAMES: tuple[str, ...] = (
@@ -162,12 +163,7 @@ class TurntableErrors:
               deta_mm: 0.2
         """
         path = Path(path)
-        try:
-            data = yaml.safe_load(path.read_text(encoding="utf-8"))
-        except OSError as exc:
-            raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
-        except yaml.YAMLError as exc:
-            raise InputError(f"not valid YAML: {str(exc).splitlines()[0]}", path=path) from None
+        data = read_yaml(path)
         if isinstance(data, Mapping) and "errors" in data:
             data = data["errors"]
         if data is None:
@@ -204,6 +200,4 @@ class TurntableErrors:
 
     def to_yaml(self, path: str | Path) -> None:
         """Write the set in user units (arcsec, mm) as a YAML file that :meth:`from_yaml` reads."""
-        from .io_utils import write_text_atomic
-
         write_text_atomic(path, yaml.safe_dump({"errors": self.to_user_units()}, sort_keys=False))

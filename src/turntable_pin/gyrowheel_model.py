@@ -19,9 +19,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from .exceptions import InputError
+from .io_utils import read_yaml
 from .turntable_model import models_dir
 
 AXES: tuple[str, ...] = ("x", "y")
@@ -126,12 +126,7 @@ class GyroWheelModel:
     def from_yaml(cls, path: str | Path) -> GyroWheelModel:
         """Read ``{x: {DF: .., x: .., ...}, y: {...}}`` (names of :data:`TERM_NAMES`)."""
         path = Path(path)
-        try:
-            data = yaml.safe_load(path.read_text(encoding="utf-8"))
-        except OSError as exc:
-            raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
-        except yaml.YAMLError as exc:
-            raise InputError(f"not valid YAML: {str(exc).splitlines()[0]}", path=path) from None
+        data = read_yaml(path)
         if not isinstance(data, Mapping) or set(map(str, data)) != set(AXES):
             raise InputError("expected a mapping with exactly the keys 'x' and 'y'", path=path)
         return cls(

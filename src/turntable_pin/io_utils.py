@@ -35,3 +35,20 @@ def write_text_atomic(path: str | Path, text: str) -> Path:
 def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
     """Write ``data`` to ``path`` atomically."""
     return write_atomic(path, lambda tmp: tmp.write_bytes(data))
+
+
+def read_yaml(path: str | Path):
+    """Parse a YAML file; an unreadable file or invalid YAML raises :class:`InputError`."""
+    import yaml
+
+    from .exceptions import InputError
+
+    path = Path(path)
+    try:
+        return yaml.safe_load(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
+    except UnicodeDecodeError:
+        raise InputError("not a text (UTF-8) YAML file", path=path) from None
+    except yaml.YAMLError as exc:
+        raise InputError(f"not valid YAML: {str(exc).splitlines()[0]}", path=path) from None

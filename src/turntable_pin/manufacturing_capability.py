@@ -13,10 +13,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from .error_parameters import ANGULAR_ERROR_NAMES, parse_error_value
 from .exceptions import InputError
+from .io_utils import read_yaml
 from .turntable_model import models_dir
 from .units import ARCSEC_PER_RAD
 
@@ -69,12 +69,7 @@ class ManufacturingCapability:
             InputError: unreadable file, not YAML, unknown name, negative or non-numeric value.
         """
         path = Path(path)
-        try:
-            data = yaml.safe_load(path.read_text(encoding="utf-8"))
-        except OSError as exc:
-            raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
-        except yaml.YAMLError as exc:
-            raise InputError(f"not valid YAML: {str(exc).splitlines()[0]}", path=path) from None
+        data = read_yaml(path)
         if not isinstance(data, Mapping) or not isinstance(data.get("lower_bounds"), Mapping):
             raise InputError("expected a mapping 'lower_bounds: {name: value}'", path=path)
         values = np.zeros(len(ANGULAR_ERROR_NAMES))
