@@ -115,8 +115,9 @@ def analyse_identifiability(jacobian_weighted: np.ndarray, names) -> Identifiabi
     norms = np.linalg.norm(jacobian_weighted, axis=0)
     dead = norms <= 1e-300
     scale = np.where(dead, 1.0, norms)
-    _, s, vt = np.linalg.svd(jacobian_weighted / scale, full_matrices=True)
-    n = jacobian_weighted.shape[1]
+    m, n = jacobian_weighted.shape
+    # vt must be square (n x n) to hold the null space; U need not be (m can be large).
+    _, s, vt = np.linalg.svd(jacobian_weighted / scale, full_matrices=m < n)
     rank = int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
     v_r = vt[:rank].T
     v_null = vt[rank:].T
