@@ -89,8 +89,9 @@ class OrientationMeasurements:
     def columns(self) -> dict[str, np.ndarray]:
         """The spec's CSV columns in user units (degrees, arcsec, s)."""
         out = {
-            "phi1_deg": self.phi1_rad * DEG_PER_RAD,
-            "phi2_deg": self.phi2_rad * DEG_PER_RAD,
+            # Rounded to 1e-9 deg so that a 30-degree grid is written as 30.0, not 29.999999...
+            "phi1_deg": np.round(self.phi1_rad * DEG_PER_RAD, 9),
+            "phi2_deg": np.round(self.phi2_rad * DEG_PER_RAD, 9),
         }
         for i, name in enumerate(ANGLE_NAMES):
             out[f"{name}_arcsec"] = self.angles_rad[:, i] * ARCSEC_PER_RAD

@@ -13,7 +13,7 @@ import sys
 
 from ..exceptions import TurntablePinError
 
-COMMAND_MODULES: tuple[str, ...] = ("orientation",)
+COMMAND_MODULES: tuple[str, ...] = ("orientation", "measurement")
 
 
 def build_parser() -> argparse.ArgumentParser:
