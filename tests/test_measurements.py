@@ -68,7 +68,9 @@ def test_radians_in_a_degree_column_are_refused(tmp_path):
     for a in range(0, 360, 90):
         for b in range(0, 360, 30):
             lines.append(f"{float(np.radians(a))!r},{float(np.radians(b))!r},1,1,1")
-    with pytest.raises(InputError, match="row 2, column 'phi1_deg': these angles look like radians"):
+    with pytest.raises(
+        InputError, match="row 2, column 'phi1_deg': these angles look like radians"
+    ):
         read_measurements(write(tmp_path, "\n".join(lines) + "\n"))
     # Irregular values spread over a radian-sized range.
     rng = np.random.default_rng(3)

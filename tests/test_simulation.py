@@ -23,7 +23,9 @@ def test_grid_schedule_and_reproducible_seed():
 
 def test_random_order_with_repeats_is_a_permutation_of_the_grid():
     sim = simulate_measurements(schedule=Schedule(90, 45, order="random", repeats=3), seed=1)
-    pairs = sorted(zip(np.degrees(sim.data.phi1_rad).round(6), np.degrees(sim.data.phi2_rad).round(6)))
+    pairs = sorted(
+        zip(np.degrees(sim.data.phi1_rad).round(6), np.degrees(sim.data.phi2_rad).round(6))
+    )
     expected = sorted((a, b) for a in (0, 90, 180, 270) for b in range(0, 360, 45)) * 1
     assert pairs == sorted(expected * 3)
 
@@ -47,8 +49,12 @@ def test_noise_and_truth(tmp_path):
     sag = sim.truth_rad - expected_base
     phi1, phi2 = sim.data.phi1_rad, sim.data.phi2_rad
     # to first order the sag adds k ax to dpsi and -k ay to dgamma (k = 2 arcsec per g)
-    np.testing.assert_allclose(sag[:, 0] * ARCSEC_PER_RAD, -2 * np.sin(phi1) * np.cos(phi2), atol=1e-3)
-    np.testing.assert_allclose(sag[:, 2] * ARCSEC_PER_RAD, -2 * np.sin(phi1) * np.sin(phi2), atol=1e-3)
+    np.testing.assert_allclose(
+        sag[:, 0] * ARCSEC_PER_RAD, -2 * np.sin(phi1) * np.cos(phi2), atol=1e-3
+    )
+    np.testing.assert_allclose(
+        sag[:, 2] * ARCSEC_PER_RAD, -2 * np.sin(phi1) * np.sin(phi2), atol=1e-3
+    )
 
 
 def test_csv_round_trip_records_seed_and_truth(tmp_path):

@@ -130,7 +130,7 @@ class OrientationFamily:
         return probes
 
     def _dense_variables(self) -> PositionVariables:
-        g = np.radians(np.arange(0.0, 360.0, 10.0))
+        g = np.radians(np.arange(0.0, 360.0, 15.0))
         g1, g2 = np.meshgrid(g, g, indexing="ij")
         n = g1.size
         rng = np.random.default_rng(0)
@@ -158,13 +158,13 @@ class OrientationFamily:
         chi2 = misfit.result.rss
         if chi2 > SEPARATION_CHI2:
             return (
-                f"{effect_b.name} mimics {a.name} on these positions only: on a 10-degree grid "
+                f"{effect_b.name} mimics {a.name} on these positions only: on a 15-degree grid "
                 f"({variables.n} positions, random time order) it would leave chi2 = {chi2:.0f} "
                 f"of misfit at the same noise, so measuring more angles separates them"
             )
         return (
             f"{effect_b.name} reproduces the fitted {a.name} at every turntable position "
-            f"(noise-free misfit chi2 = {chi2:.2g} on a 10-degree grid), so no set of positions "
+            f"(noise-free misfit chi2 = {chi2:.2g} on a 15-degree grid), so no set of positions "
             f"separates them; an independent measurement does. For {a.name}: {a.confirm} "
             f"For {effect_b.name}: {effect_b.confirm}"
         )
