@@ -1,4 +1,4 @@
-"""The exact chain model: equal to the foundation's batch path, Jacobian equal to finite differences."""
+"""The exact chain model: equal to the foundation's batch path; Jacobian = finite differences."""
 
 import numpy as np
 from hypothesis import given, settings

@@ -24,7 +24,11 @@ def test_grid_schedule_and_reproducible_seed():
 def test_random_order_with_repeats_is_a_permutation_of_the_grid():
     sim = simulate_measurements(schedule=Schedule(90, 45, order="random", repeats=3), seed=1)
     pairs = sorted(
-        zip(np.degrees(sim.data.phi1_rad).round(6), np.degrees(sim.data.phi2_rad).round(6))
+        zip(
+            np.degrees(sim.data.phi1_rad).round(6),
+            np.degrees(sim.data.phi2_rad).round(6),
+            strict=True,
+        )
     )
     expected = sorted((a, b) for a in (0, 90, 180, 270) for b in range(0, 360, 45)) * 1
     assert pairs == sorted(expected * 3)
