@@ -85,3 +85,10 @@ def test_bad_simulation_requests():
         simulate_measurements(noise_arcsec=0)
     with pytest.raises(InputError, match="order"):
         Schedule(order="spiral")
+
+
+def test_cli_choices_match_the_library():
+    from turntable_pin.cli import measurement
+    from turntable_pin.simulation import APPROACHES, ORDERS
+
+    assert measurement.ORDERS == ORDERS and measurement.APPROACHES == APPROACHES

@@ -8,12 +8,12 @@ from pathlib import Path
 from ..effects import EFFECT_NAMES, get_effect, parse_effect_list
 from ..exceptions import InputError
 from ..measurements import read_measurements
-from ..orientation_diagnosis import diagnose_measurements
-from ..orientation_fit import fit_orientation
-from ..report_html import write_report
-from ..residual_analysis import analyse_residuals, orientation_residuals, write_residual_plots
-from ..simulation import APPROACHES, ORDERS, Schedule, simulate_measurements
 from .common import add_error_options, errors_from_args, finite_float, positive_int, print_json
+
+# The fitting, plotting and report modules (scipy, matplotlib) are imported inside the commands
+# that need them, so that every other subcommand starts fast.
+ORDERS = ("grid", "random")
+APPROACHES = ("random", "motion", "positive")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -121,6 +121,8 @@ def _parse_effect_option(text: str) -> tuple[str, dict[str, float]]:
 
 
 def run_simulate(args: argparse.Namespace) -> int:
+    from ..simulation import Schedule, simulate_measurements
+
     _not_an_input(args.output, args.errors, args.urdf)
     effects = dict(_parse_effect_option(t) for t in args.effect)
     schedule = Schedule(
@@ -156,6 +158,9 @@ def _fit_line(label: str, summary: dict) -> str:
 
 
 def run_fit(args: argparse.Namespace) -> int:
+    from ..orientation_fit import fit_orientation
+    from ..residual_analysis import analyse_residuals, orientation_residuals, write_residual_plots
+
     data = _read(args)
     effects = parse_effect_list(args.effects)
     after = fit_orientation(data, effects)
@@ -198,6 +203,9 @@ def run_fit(args: argparse.Namespace) -> int:
 
 
 def run_diagnose(args: argparse.Namespace) -> int:
+    from ..orientation_diagnosis import diagnose_measurements
+    from ..residual_analysis import orientation_residuals, write_residual_plots
+
     data = _read(args)
     diagnosis = diagnose_measurements(data, until_explained=args.until_explained)
     out = diagnosis.to_dict()
@@ -217,6 +225,9 @@ def run_diagnose(args: argparse.Namespace) -> int:
 
 
 def run_report(args: argparse.Namespace) -> int:
+    from ..orientation_diagnosis import diagnose_measurements
+    from ..report_html import write_report
+
     _not_an_input(args.output, args.data)
     data = read_measurements(args.data)
     if args.ignore_sigma:
