@@ -148,3 +148,14 @@ def test_spec_json_keys():
     testable = [c["delta_bic"] for c in d["candidates"] if c["delta_bic"] is not None]
     assert testable == sorted(testable)
     assert set(d["verdict"]) >= {"missing_effect", "alternatives", "unexplained"}
+
+
+def test_few_positions_leave_large_effects_untestable_instead_of_failing():
+    from turntable_pin.simulation import Schedule
+
+    sim = simulate_measurements(schedule=Schedule(360, 180), seed=1)  # 2 positions, 6 angles
+    d = diagnose_measurements(sim.data).to_dict()
+    assert d["n_positions"] == 2 and d["verdict"]["missing_effect"] is None
+    reasons = {c["effect"]: c.get("reason", "") for c in d["candidates"]}
+    assert "cannot be fitted on these data: 6 observations" in reasons["inner_encoder_harmonics"]
+    assert reasons["outer_encoder_harmonics"].startswith("indistinguishable")  # phi1 never moves

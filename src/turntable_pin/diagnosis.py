@@ -34,6 +34,7 @@ from typing import Any, Protocol
 
 from scipy import stats
 
+from .exceptions import IdentifiabilityError
 from .least_squares_fit import FitResult
 from .structure_search import BIC_THRESHOLD, FoundTerm, Probe, delta_bic, search_structure
 
@@ -104,7 +105,11 @@ def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, ca
         if reason:
             out.append(Candidate(effect.name, False, reason))
             continue
-        fit = family.fit([*current, effect])
+        try:
+            fit = family.fit([*current, effect])
+        except IdentifiabilityError as exc:
+            out.append(Candidate(effect.name, False, f"cannot be fitted on these data: {exc}"))
+            continue
         added = fit.result.rank - base.rank
         if added <= 0:
             names = [c for c in fit.result.undetermined_combinations() if effect.name in c]
