@@ -32,8 +32,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
-from scipy import stats
-
 from .exceptions import IdentifiabilityError
 from .least_squares_fit import FitResult
 from .structure_search import BIC_THRESHOLD, FoundTerm, Probe, delta_bic, search_structure
@@ -84,6 +82,8 @@ def _chi2(result: FitResult, noise_variance: float) -> float:
 
 
 def _summary(result: FitResult, noise_variance: float) -> dict:
+    from scipy import stats  # imported on use: keeps `import turntable_pin` light
+
     chi2 = _chi2(result, noise_variance)
     return {
         "rms_arcsec": result.rms_user,
@@ -135,6 +135,8 @@ def _noise_variance(best: FitResult) -> float:
 
 
 def _mark_alternatives(candidates: list[Candidate], noise_variance: float) -> None:
+    from scipy import stats
+
     accepted = [c for c in candidates if c.significant]
     for a in accepted:
         limit = stats.chi2.ppf(ALTERNATIVE_LEVEL, max(a.added_rank, 1))

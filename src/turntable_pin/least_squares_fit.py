@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
-from scipy import optimize, stats
 
 from .exceptions import IdentifiabilityError
 
@@ -192,6 +191,8 @@ class FitResult:
         """Probability of a chi2 at least this large if the model were right (sigma known)."""
         if not self.sigma_known or self.dof <= 0:
             return None
+        from scipy import stats  # imported on use: keeps `import turntable_pin` light
+
         return float(stats.chi2.sf(self.chi2, self.dof))
 
     @property
@@ -327,6 +328,8 @@ def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = Non
     Raises:
         IdentifiabilityError: no parameter is determined, or no degree of freedom is left.
     """
+    from scipy import optimize  # imported on use: keeps `import turntable_pin` light
+
     sigma_known = problem.sigma is not None
     weights = 1.0 / problem.sigma if sigma_known else np.ones_like(problem.observed)
     n = len(problem.parameter_names)
