@@ -22,7 +22,8 @@ family then says whether more positions could separate them or only an independe
 Unexplained: the best model still fails the fit test, i.e. its chi2 p-value is below
 ``FIT_TEST_ALPHA`` (sigma given), or the structure search finds a term it lacks (any sigma; the
 only test possible when sigma is estimated, because chi2 with an estimated sigma is 1 by
-construction).
+construction). The structure search pays a look-elsewhere penalty of ``2 ln G`` for its G probes
+(:mod:`structure_search`).
 """
 
 from __future__ import annotations
