@@ -159,3 +159,20 @@ def test_few_positions_leave_large_effects_untestable_instead_of_failing():
     reasons = {c["effect"]: c.get("reason", "") for c in d["candidates"]}
     assert "cannot be fitted on these data: 6 observations" in reasons["inner_encoder_harmonics"]
     assert reasons["outer_encoder_harmonics"].startswith("indistinguishable")  # phi1 never moves
+
+
+def test_a_partial_explanation_is_not_an_alternative():
+    rng = np.random.default_rng(3)
+    sim = simulate_measurements(random_errors(rng), {"base_tilt": {"tx": 3.0, "tz": -2.0}}, seed=3)
+    d = diagnose_measurements(sim.data.without_sigma()).to_dict()
+    for c in d["candidates"]:
+        for other in c["alternatives"]:
+            mate = next(x for x in d["candidates"] if x["effect"] == other)
+            assert c["effect"] in mate["alternatives"]  # the relation is symmetric
+    # thermal drift in grid order explains part of a tilt (significant, chi2_reduced ~5): it is
+    # not an alternative, in either direction
+    partial = [c for c in d["candidates"] if c["significant"] and c["chi2_reduced"] > 1.5]
+    assert [c["effect"] for c in partial] == ["thermal_drift"]
+    assert partial[0]["alternatives"] == []
+    best = d["candidates"][0]
+    assert best["effect"] == "base_tilt" and best["alternatives"] == ["outer_wobble_harmonics"]

@@ -15,8 +15,8 @@ catalogue well under 1 %, while an effect of a few arcsec on 1-arcsec noise lowe
 hundreds. A plain likelihood-ratio test at a fixed level would not penalise the 8-parameter
 wobble series more than a 1-parameter sag, and BIC does.
 
-Alternatives: effects that are themselves accepted and whose fit is not significantly worse than
-the best one's (``chi2_B - chi2_A <= chi2_0.99(added_rank_A)``) explain the data as well; the
+Alternatives: effects that are themselves accepted and whose fit is as good as the best one's
+(``|chi2_B - chi2_A| <= chi2_0.99(max(added_rank_A, added_rank_B))``) explain the data as well; the
 family then says whether more positions could separate them or only an independent measurement.
 
 Unexplained: the best model still fails the fit test, i.e. its chi2 p-value is below
@@ -140,12 +140,13 @@ def _mark_alternatives(candidates: list[Candidate], noise_variance: float) -> No
 
     accepted = [c for c in candidates if c.significant]
     for a in accepted:
-        limit = stats.chi2.ppf(ALTERNATIVE_LEVEL, max(a.added_rank, 1))
         chi2_a = _chi2(a.fit.result, noise_variance)
         a.alternatives = [
             b.effect
             for b in accepted
-            if b is not a and _chi2(b.fit.result, noise_variance) - chi2_a <= limit
+            if b is not a
+            and abs(_chi2(b.fit.result, noise_variance) - chi2_a)
+            <= stats.chi2.ppf(ALTERNATIVE_LEVEL, max(a.added_rank, b.added_rank, 1))
         ]
 
 
@@ -273,8 +274,8 @@ class Diagnosis:
             "verdict": verdict,
             "decision_rule": {
                 "accept_effect": f"delta_bic <= {BIC_THRESHOLD:g}",
-                "alternative": f"chi2 within the {ALTERNATIVE_LEVEL:g} quantile of "
-                "chi2(added_rank) of the best effect's",
+                "alternative": f"|chi2 difference| within the {ALTERNATIVE_LEVEL:g} quantile "
+                "of chi2(larger added_rank)",
                 "fit_test_alpha": FIT_TEST_ALPHA if self.sigma_known else None,
             },
         }

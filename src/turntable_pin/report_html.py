@@ -175,7 +175,9 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
             ],
         )  # fmt: skip
     )
-    words = "<br>".join(html.escape(line) for line in diagnosis.report_lines()[-8:])
+    lines = diagnosis.report_lines()
+    start = next((i for i, ln in enumerate(lines) if ln.startswith(("step ", "missing effect"))), 0)
+    words = "<br>".join(html.escape(line) for line in lines[start:])
     parts.append(f'<div class="{cls}">{words}</div>')
     if verdict["missing_effect"]:
         story = verdict["effect_story"]
