@@ -167,13 +167,16 @@ class Diagnosis:
     Attributes:
         base_fit: the base model's fit.
         candidates: every catalogued effect tested against the base, best first.
-        steps: accepted effects in order (one at most unless ``until_explained``).
-        best_fit: the fit of base + accepted effects.
+        steps: accepted effects in order (forward selection while delta_bic <= -6; always run,
+            because whether structure remains "that no catalogued effect removes" can only be
+            judged on the model with every significant effect).
+        best_fit: the fit of base + all accepted effects.
         noise_variance: unit-weight variance chi2 is reported with (1 when sigma is given).
         structure: terms the structure search finds in the best model's residuals.
         fails_fit_test: the best model's chi2 p-value is below ``FIT_TEST_ALPHA``.
         separations: advice per alternative of the accepted first effect.
-        until_explained: whether forward selection was run.
+        until_explained: whether the verdict names every accepted effect (``missing_effects``)
+            or the first one, with the others as ``also_significant``.
     """
 
     family: Any = field(repr=False)
@@ -193,7 +196,13 @@ class Diagnosis:
 
     @property
     def missing_effects(self) -> list[str]:
-        return [s.added for s in self.steps]
+        names = [s.added for s in self.steps]
+        return names if self.until_explained else names[:1]
+
+    @property
+    def also_significant(self) -> list[str]:
+        """Effects still significant on top of the first one (plain diagnosis only)."""
+        return [] if self.until_explained else [s.added for s in self.steps[1:]]
 
     @property
     def alternatives(self) -> list[str]:
@@ -247,6 +256,7 @@ class Diagnosis:
             "alternatives": self.alternatives,
             "unexplained": self.unexplained,
             "missing_effects": self.missing_effects,
+            "also_significant": self.also_significant,
             "fails_fit_test": self.fails_fit_test,
             "remaining_structure": [t.to_dict() for t in self.structure],
             "separations": dict(self.separations),
@@ -270,7 +280,7 @@ class Diagnosis:
                 }
                 for s in self.steps
             ],
-            "best": {"effects": list(self.missing_effects), **_summary(best.result, nv)},
+            "best": {"effects": [s.added for s in self.steps], **_summary(best.result, nv)},
             "verdict": verdict,
             "decision_rule": {
                 "accept_effect": f"delta_bic <= {BIC_THRESHOLD:g}",
@@ -319,6 +329,12 @@ class Diagnosis:
             lines.append(f"  confirm on the machine: {story['confirm']}")
         else:
             lines.append("missing effect: none (no catalogued effect improves the base fit)")
+        if self.also_significant:
+            lines.append(
+                "also significant on top of it: "
+                + ", ".join(self.also_significant)
+                + " (--until-explained names every step)"
+            )
         for name, text in self.separations.items():
             lines.append(f"  alternative {name}: {text}")
         for name in self.indistinguishable_from_base:
@@ -365,8 +381,6 @@ def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis
         current.append(next(e for e in family.catalogue if e.name == chosen.effect))
         current_fit = chosen.fit
         steps.append(Step(chosen.effect, float(chosen.delta_bic), chosen.fit, round_candidates))
-        if not until_explained:
-            break
         rest = [e for e in family.catalogue if e not in current]
         if not rest:
             break

@@ -6,6 +6,7 @@ Probes of the structure search (what "shape" the missing part has):
   of the eight turntable errors times ``cos(k phi)``, ``sin(k phi)`` -- a harmonic of order k of
   that error in either axis angle (k = 1 .. 5, fewer when the data have fewer distinct angles);
 - ``<angle> k/rev in <phi>``: a harmonic added directly to ``dpsi``, ``dtheta`` or ``dgamma``;
+- ``<angle> k/rev in phi1+phi2`` / ``phi1-phi2`` (k = 1, 2): shapes that couple the two angles;
 - ``<angle> drift in time`` (with ``time_s``): a quadratic in time;
 - ``<angle> with dir1`` / ``dir2``: a step with the approach direction.
 """
@@ -99,6 +100,24 @@ class OrientationFamily:
                         Probe(
                             f"{angle} {k}/rev in {var}",
                             f"a {k}/rev term in {var} of {angle} itself",
+                            (cols * w[:, :, None]).reshape(-1, 2),
+                            ARCSEC_PER_RAD,
+                            "arcsec",
+                        )
+                    )
+        # Terms coupling the two angles (k/rev in phi1 + phi2 or phi1 - phi2) on each angle: the
+        # shapes above are separable in phi1 and phi2 and would miss them.
+        for label, combined in (("phi1+phi2", data.phi1_rad + data.phi2_rad),
+                                ("phi1-phi2", data.phi1_rad - data.phi2_rad)):  # fmt: skip
+            for k in range(1, min(2, _max_order(combined)) + 1):
+                trig = np.stack([np.cos(k * combined), np.sin(k * combined)], axis=-1)
+                for a, angle in enumerate(ANGLE_NAMES):
+                    cols = np.zeros((data.n_positions, 3, 2))
+                    cols[:, a, :] = trig
+                    probes.append(
+                        Probe(
+                            f"{angle} {k}/rev in {label}",
+                            f"a {k}/rev term in {label} of {angle} itself",
                             (cols * w[:, :, None]).reshape(-1, 2),
                             ARCSEC_PER_RAD,
                             "arcsec",
