@@ -218,6 +218,10 @@ def harmonics_figure(analyses: Sequence[ResidualAnalysis]) -> bytes:
             if row == 0:
                 ax.set_title(an.residual_set.label, fontsize=10)
                 ax.legend(fontsize=7)
+    for row in range(axes.shape[0]):  # one scale per row, so the fall from left to right shows
+        top = max(ax.get_ylim()[1] for ax in axes[row])
+        for ax in axes[row]:
+            ax.set_ylim(0, top)
     fig.tight_layout()
     return _png(fig)
 
