@@ -48,6 +48,8 @@ def test_fit_json_keys_and_before_after(sim_file, capsys, tmp_path):
     assert out["params"]["gravity_sag.k"]["value"] == pytest.approx(3, abs=0.5)
     assert out["before"]["chi2_reduced"] > 1.5 > out["chi2_reduced"]
     assert out["identifiable"]["rank"] == 6
+    table = out["where_it_fails"]["per_position"]
+    assert len(table) == 144 and {"row", "phi1_deg", "dtheta_arcsec", "max_sigmas"} <= set(table[0])
     assert (tmp_path / "plots" / "residuals.png").read_bytes()[:4] == b"\x89PNG"
 
 

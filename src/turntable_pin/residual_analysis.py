@@ -113,9 +113,24 @@ class ResidualAnalysis:
     rms_by_angle: dict[str, dict[str, list]]
     harmonics: dict[str, dict[str, list[float]]]
 
-    def to_dict(self) -> dict:
+    def per_position(self) -> list[dict]:
+        """Every position's residuals (user units) and its largest normalised residual."""
         rs = self.residual_set
+        out = []
+        for i in range(rs.residuals.shape[0]):
+            entry = {"row": int(rs.rows[i])}
+            entry.update({k: float(v[i]) for k, v in rs.angles_deg.items()})
+            entry.update({f"{c}_{rs.unit}": float(rs.residuals[i, j])
+                          for j, c in enumerate(rs.components)})  # fmt: skip
+            entry["max_sigmas"] = float(np.abs(rs.normalised[i]).max())
+            out.append(entry)
+        return out
+
+    def to_dict(self, *, per_position: bool = False) -> dict:
+        rs = self.residual_set
+        extra = {"per_position": self.per_position()} if per_position else {}
         return {
+            **extra,
             "label": rs.label,
             "unit": rs.unit,
             "k_sigma": self.k_sigma,

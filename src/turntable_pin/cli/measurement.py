@@ -175,7 +175,7 @@ def run_fit(args: argparse.Namespace) -> int:
     out = after.to_dict()
     out["before"] = {k: before.to_dict()[k] for k in ("rms_arcsec", "chi2_reduced", "p_value",
                                                      "rank", "n_params")}  # fmt: skip
-    out["where_it_fails"] = analysis.to_dict()
+    out["where_it_fails"] = analysis.to_dict(per_position=True)
     out["plots"] = plots
     if args.json:
         print_json(out)
