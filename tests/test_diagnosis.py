@@ -180,3 +180,17 @@ def test_a_partial_explanation_is_not_an_alternative():
     assert partial[0]["alternatives"] == []
     best = d["candidates"][0]
     assert best["effect"] == "base_tilt" and best["alternatives"] == ["outer_wobble_harmonics"]
+
+
+def test_a_spurious_first_round_candidate_is_shown_not_significant_on_top_of_the_real_one():
+    from pathlib import Path
+
+    from turntable_pin.measurements import read_measurements
+
+    example = Path(__file__).resolve().parents[1] / "models/examples/measurements_example.csv"
+    d = diagnose_measurements(read_measurements(example)).to_dict()
+    first = d["verdict"]["missing_effect"]
+    spurious = [c for c in d["candidates"] if c["significant"] and c["effect"] != first]
+    for c in spurious:  # soaked up part of the real effect against the bare base model
+        assert c["delta_bic_after_first"] > -6
+    assert d["verdict"]["also_significant"] == []

@@ -177,6 +177,9 @@ class Diagnosis:
         separations: advice per alternative of the accepted first effect.
         until_explained: whether the verdict names every accepted effect (``missing_effects``)
             or the first one, with the others as ``also_significant``.
+        after_first: delta_bic of each other effect on top of the first accepted one: an effect
+            that only looked significant against a base that lacked the real effect (because
+            it soaked up part of that effect's signal) is no longer significant there.
     """
 
     family: Any = field(repr=False)
@@ -189,6 +192,7 @@ class Diagnosis:
     fails_fit_test: bool
     separations: dict[str, str]
     until_explained: bool
+    after_first: dict[str, float | None] = field(default_factory=dict)
 
     @property
     def missing_effect(self) -> str | None:
@@ -247,6 +251,8 @@ class Diagnosis:
                 "significant": c.significant,
                 "alternatives": list(c.alternatives),
             }
+            if self.steps and c.effect != self.steps[0].added:
+                entry["delta_bic_after_first"] = self.after_first.get(c.effect)
             if c.reason:
                 entry["reason"] = c.reason
             candidates.append(entry)
@@ -312,6 +318,9 @@ class Diagnosis:
                 lines.append(f"  {c['effect']:26s} not testable: {c['reason']}")
                 continue
             alt = f"  same as: {', '.join(c['alternatives'])}" if c["alternatives"] else ""
+            later = c.get("delta_bic_after_first")
+            if c["significant"] and later is not None:
+                alt += f"  (on top of {self.steps[0].added}: {later:+.1f})"
             lines.append(
                 f"  {c['effect']:26s} delta_bic {c['delta_bic']:10.1f}  rms "
                 f"{c['rms_arcsec']:.3f}  chi2_red {c['chi2_reduced']:.3f}"
@@ -373,6 +382,7 @@ def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis
     current: list[Any] = []
     current_fit = base_fit
     round_candidates = candidates
+    after_first: dict[str, float | None] = {}
     while True:
         accepted = [c for c in round_candidates if c.significant]
         if not accepted:
@@ -385,6 +395,8 @@ def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis
         if not rest:
             break
         round_candidates = compare_effects(family, current, current_fit, rest)
+        if len(steps) == 1:
+            after_first = {c.effect: c.delta_bic for c in round_candidates}
     best = current_fit.result
     noise_variance = _noise_variance(best)
     _mark_alternatives(candidates, noise_variance)
@@ -413,4 +425,5 @@ def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis
         fails_fit_test=fails,
         separations=separations,
         until_explained=until_explained,
+        after_first=after_first,
     )

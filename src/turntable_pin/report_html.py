@@ -159,22 +159,38 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
     parts.append(_img(harmonics_figure([base_an]), "base harmonics"))
     cls = "verdict" if not verdict["unexplained"] else "verdict warn"
     parts.append("<h2>4. Diagnosis: which physical effect is missing?</h2>")
+    first = verdict["missing_effect"]
     parts.append(
         _table(
-            ["effect", "delta BIC", "rms (arcsec)", "chi2_reduced", "new rank", "same as"],
+            [
+                "effect",
+                "delta BIC",
+                f"on top of {first}" if first else "-",
+                "rms (arcsec)",
+                "chi2_reduced",
+                "new rank",
+                "same as",
+            ],
             [
                 [
                     c["effect"],
                     "-" if c["delta_bic"] is None else f"{c['delta_bic']:.1f}",
+                    "-"
+                    if c.get("delta_bic_after_first") is None
+                    else f"{c['delta_bic_after_first']:.1f}",
                     "-" if c["rms_arcsec"] is None else c["rms_arcsec"],
                     "-" if c["chi2_reduced"] is None else c["chi2_reduced"],
-                    c["added_rank"] if c["testable"] else c.get("reason", ""),
+                    c["added_rank"] if c["testable"] else "-",
                     ", ".join(c["alternatives"]),
                 ]
                 for c in d["candidates"]
             ],
         )  # fmt: skip
     )
+    notes = [f"<li><b>{html.escape(c['effect'])}</b>: {html.escape(c['reason'])}</li>"
+             for c in d["candidates"] if c.get("reason")]  # fmt: skip
+    if notes:
+        parts.append("<p>Not testable here:</p><ul>" + "".join(notes) + "</ul>")
     lines = diagnosis.report_lines()
     start = next((i for i, ln in enumerate(lines) if ln.startswith(("step ", "missing effect"))), 0)
     words = "<br>".join(html.escape(line) for line in lines[start:])
