@@ -22,6 +22,8 @@ from .browser import (
     chromium_available,
 )
 from .calibration import AxisCalibration, CalibrationResult, calibrate, calibrate_run
+from .diagnosis import Diagnosis, diagnose
+from .effects import EFFECT_NAMES, EFFECTS, Effect, get_effect
 from .error_parameters import (
     ANGULAR_ERROR_NAMES,
     ERROR_DESCRIPTIONS,
@@ -36,11 +38,18 @@ from .exceptions import (
     TurntablePinError,
 )
 from .gyrowheel_model import DriftCoefficients, GyroWheelModel, regressor_matrix
+from .least_squares_fit import FitResult, fit_least_squares
 from .manufacturing_capability import ManufacturingCapability
+from .measurements import OrientationMeasurements, read_measurements
 from .meshcat_server import MeshcatMissingError, MeshcatServer, MeshcatServerError
 from .monte_carlo import MonteCarloResult, plot_monte_carlo, run_monte_carlo
+from .orientation_diagnosis import OrientationFamily, diagnose_measurements
+from .orientation_fit import OrientationFit, fit_orientation
+from .orientation_model import OrientationModel
 from .orientation_requirement import OrientationRequirement, orientation_requirement
 from .rate_error import RateErrorResult, orientation_error_rotation, rate_error, rate_errors_dph
+from .report_html import write_report
+from .residual_analysis import analyse_residuals, orientation_residuals
 from .scene import Exaggeration, SetupScene
 from .sensitivity import (
     AverageSensitivities,
@@ -49,6 +58,7 @@ from .sensitivity import (
     sensitivity_matrix,
     sensitivity_matrix_fd,
 )
+from .simulation import Schedule, SimulatedMeasurements, simulate_measurements
 from .small_angle import small_angle_matrix, small_angle_orientation_error, small_angle_rotation
 from .snapshot import SnapshotResult, render_snapshot
 from .test_positions import EARTH_RATE_DPH, PositionInputs, PositionSet, position_inputs
@@ -63,11 +73,16 @@ __all__ = [
     "BrowserError",
     "BrowserNotFoundError",
     "CalibrationResult",
+    "Diagnosis",
     "DriftCoefficients",
     "EARTH_RATE_DPH",
+    "EFFECTS",
+    "EFFECT_NAMES",
     "ERROR_DESCRIPTIONS",
     "ERROR_NAMES",
+    "Effect",
     "Exaggeration",
+    "FitResult",
     "GyroWheelModel",
     "IdentifiabilityError",
     "ImageLoadReport",
@@ -81,45 +96,61 @@ __all__ = [
     "MonteCarloResult",
     "OrientationError",
     "OrientationErrorField",
+    "OrientationFamily",
+    "OrientationFit",
     "OrientationLimits",
+    "OrientationMeasurements",
+    "OrientationModel",
     "OrientationRequirement",
     "PositionInputs",
     "PositionSet",
     "RateErrorResult",
+    "Schedule",
     "SetupScene",
+    "SimulatedMeasurements",
     "SnapshotResult",
     "TurntableErrors",
     "TurntableModel",
     "TurntablePinError",
     "YourdfpyTurntable",
     "allocate_tolerances",
+    "analyse_residuals",
     "average_sensitivities",
     "calibrate",
     "calibrate_run",
     "check_page_images",
     "chromium_available",
     "default_orientation_limits",
-    "paper_eq16_limits",
     "default_urdf_path",
+    "diagnose",
+    "diagnose_measurements",
     "error_placements",
+    "fit_least_squares",
+    "fit_orientation",
+    "get_effect",
     "orientation_error_rotation",
     "orientation_requirement",
+    "orientation_residuals",
+    "paper_eq16_limits",
     "plot_monte_carlo",
     "plot_sensitivities",
     "position_inputs",
     "rate_error",
     "rate_errors_dph",
+    "read_measurements",
     "regressor_matrix",
     "render_snapshot",
     "run_monte_carlo",
     "sensitivity_matrix",
     "sensitivity_matrix_fd",
+    "simulate_measurements",
     "small_angle_matrix",
     "small_angle_orientation_error",
     "small_angle_rotation",
     "trig_basis",
     "worst_case_full_circle",
     "write_error_urdf",
+    "write_report",
 ]
 
 __version__ = "0.1.0"

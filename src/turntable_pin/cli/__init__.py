@@ -13,7 +13,13 @@ import sys
 
 from ..exceptions import TurntablePinError
 
-COMMAND_MODULES: tuple[str, ...] = ("orientation", "calibration", "allocation", "viewer")
+COMMAND_MODULES: tuple[str, ...] = (
+    "orientation",
+    "calibration",
+    "allocation",
+    "measurement",
+    "viewer",
+)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,238 @@
+"""``simulate``, ``fit``, ``diagnose`` and ``report``: measurements against the error model."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..effects import EFFECT_NAMES, get_effect, parse_effect_list
+from ..exceptions import InputError
+from ..measurements import read_measurements
+from .common import add_error_options, errors_from_args, finite_float, positive_int, print_json
+
+# The fitting, plotting and report modules (scipy, matplotlib) are imported inside the commands
+# that need them, so that every other subcommand starts fast.
+ORDERS = ("grid", "random")
+APPROACHES = ("random", "motion", "positive")
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    s = subparsers.add_parser(
+        "simulate",
+        help="simulate orientation measurements with hidden effects",
+        description="Simulate a measurement run (the CSV of spec/measurements.md): turntable "
+        "errors, catalogued effects with their parameters, a position schedule, noise, time "
+        "stamps and approach directions; the seed and the truth go into comment lines. "
+        f"Effects: {', '.join(EFFECT_NAMES)}.",
+    )
+    add_error_options(s)
+    s.add_argument(
+        "--effect",
+        action="append",
+        default=[],
+        metavar="NAME[:P=V,...]",
+        help="a hidden effect and its parameters in user units (arcsec, arcsec/g, arcsec/h), "
+        "e.g. inner_encoder_harmonics:c1=3,s2=-2; repeatable",
+    )
+    s.add_argument("--noise-arcsec", type=finite_float, default=1.0, help="1-sigma noise")
+    s.add_argument("--seed", type=int, default=0, help="random seed (recorded in the file)")
+    s.add_argument("--phi1-step-deg", type=finite_float, default=30.0)
+    s.add_argument("--phi2-step-deg", type=finite_float, default=30.0)
+    s.add_argument("--order", choices=ORDERS, default="grid")
+    s.add_argument("--repeats", type=positive_int, default=1)
+    s.add_argument("--dwell-s", type=finite_float, default=60.0, help="time per position")
+    s.add_argument("--approach", choices=APPROACHES, default="random")
+    s.add_argument("--no-sigma", action="store_true", help="leave out the sigma_arcsec column")
+    s.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.csv")
+    s.set_defaults(func=run_simulate)
+
+    f = subparsers.add_parser(
+        "fit",
+        help="fit the error model (plus effects) to measurements",
+        description="Weighted least squares of the base error model plus the chosen effects; "
+        "rank, determined combinations with standard errors, rms, chi2_reduced, p-value; "
+        "before (base) and after (with the effects), and where the fit fails.",
+    )
+    _add_data_options(f)
+    f.add_argument("--effects", default="", metavar="A,B", help="effects to add to the base")
+    f.add_argument("--plots", type=Path, metavar="DIR", help="write residual plots (PNG) here")
+    f.add_argument("--k-sigma", type=finite_float, default=3.0, help="failing threshold")
+    f.set_defaults(func=run_fit)
+
+    d = subparsers.add_parser(
+        "diagnose",
+        help="which catalogued physical effect is missing",
+        description="Test every catalogued effect against the base fit (BIC, delta <= -6), "
+        "rank them, name the missing effect, its equivalent alternatives, and whether "
+        "structure remains that nothing in the catalogue explains.",
+    )
+    _add_data_options(d)
+    d.add_argument("--until-explained", action="store_true", help="add effects while significant")
+    d.add_argument("--plots", type=Path, metavar="DIR", help="write residual plots (PNG) here")
+    d.set_defaults(func=run_diagnose)
+
+    r = subparsers.add_parser(
+        "report",
+        help="one self-contained HTML page with the whole story",
+        description="Data, base fit, where it fails, diagnosis, fit with the missing effect, "
+        "parameters; plots embedded.",
+    )
+    r.add_argument("data", type=Path, metavar="DATA.csv")
+    r.add_argument("--ignore-sigma", action="store_true")
+    r.add_argument("--until-explained", action="store_true")
+    r.add_argument("-o", "--output", type=Path, required=True, metavar="report.html")
+    r.set_defaults(func=run_report)
+
+
+def _add_data_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("data", type=Path, metavar="DATA.csv")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument(
+        "--ignore-sigma",
+        action="store_true",
+        help="estimate the noise from the fit even if the file has sigma_arcsec",
+    )
+
+
+def _read(args: argparse.Namespace):
+    data = read_measurements(args.data)
+    return data.without_sigma() if args.ignore_sigma else data
+
+
+def _not_an_input(output: Path, *inputs: Path | None) -> None:
+    for item in inputs:
+        if item is not None and Path(output).resolve() == Path(item).resolve():
+            raise InputError(f"the output {output} is an input file; choose another name")
+
+
+def _parse_effect_option(text: str) -> tuple[str, dict[str, float]]:
+    name, _, rest = text.partition(":")
+    effect = get_effect(name)
+    params: dict[str, float] = {}
+    for item in filter(None, (x.strip() for x in rest.split(","))):
+        key, eq, value = item.partition("=")
+        if not eq:
+            raise InputError(f"--effect '{text}': expected NAME:P=V,... , got '{item}'")
+        try:
+            params[key.strip()] = finite_float(value)
+        except argparse.ArgumentTypeError as exc:
+            raise InputError(f"--effect '{text}', parameter '{key}': {exc}") from None
+    return effect.name, params
+
+
+def run_simulate(args: argparse.Namespace) -> int:
+    from ..simulation import Schedule, simulate_measurements
+
+    _not_an_input(args.output, args.errors, args.urdf)
+    effects = dict(_parse_effect_option(t) for t in args.effect)
+    schedule = Schedule(
+        phi1_step_deg=args.phi1_step_deg,
+        phi2_step_deg=args.phi2_step_deg,
+        order=args.order,
+        repeats=args.repeats,
+        dwell_s=args.dwell_s,
+        approach=args.approach,
+    )
+    from ..turntable_model import TurntableModel
+
+    sim = simulate_measurements(
+        errors_from_args(args),
+        effects,
+        schedule=schedule,
+        noise_arcsec=args.noise_arcsec,
+        seed=args.seed,
+        turntable=TurntableModel(urdf_path=args.urdf) if args.urdf else None,
+    )
+    path = sim.write_csv(args.output, with_sigma=not args.no_sigma)
+    print(f"wrote {path}: {sim.data.n_positions} positions, seed {sim.seed}")
+    return 0
+
+
+def _fit_line(label: str, summary: dict) -> str:
+    p = summary["p_value"]
+    return (
+        f"  {label:40s} rms {summary['rms_arcsec']:8.3f} arcsec   chi2_reduced "
+        f"{summary['chi2_reduced']:8.3f}   rank {summary['rank']}/{summary['n_params']}"
+        + (f"   p {p:.3g}" if p is not None else "")
+    )
+
+
+def run_fit(args: argparse.Namespace) -> int:
+    from ..orientation_fit import fit_orientation
+    from ..residual_analysis import analyse_residuals, orientation_residuals, write_residual_plots
+
+    data = _read(args)
+    effects = parse_effect_list(args.effects)
+    after = fit_orientation(data, effects)
+    before = fit_orientation(data) if effects else after
+    # With sigma estimated, both fits are judged with the noise of the fuller model.
+    before = before.with_noise_variance(after.result.noise_variance)
+    analysis = analyse_residuals(orientation_residuals(after), args.k_sigma)
+    plots = []
+    if args.plots:
+        sets = [orientation_residuals(before)] + ([orientation_residuals(after)] if effects else [])
+        plots = [str(p) for p in write_residual_plots(sets, args.plots, args.k_sigma)]
+    out = after.to_dict()
+    out["before"] = {k: before.to_dict()[k] for k in ("rms_arcsec", "chi2_reduced", "p_value",
+                                                     "rank", "n_params")}  # fmt: skip
+    out["where_it_fails"] = analysis.to_dict(per_position=True)
+    out["plots"] = plots
+    if args.json:
+        print_json(out)
+        return 0
+    print(f"{args.data}: {data.n_positions} positions, sigma {out['sigma_source']} "
+          f"({out['sigma_arcsec']:.3g} arcsec)")  # fmt: skip
+    if effects:
+        print(_fit_line("before: base", out["before"]))
+    print(_fit_line("fit: " + " + ".join(("base", *after.effect_names)), out))
+    print("determined combinations (value +- std):")
+    for c in after.result.combinations():
+        print(f"  {c['name']:55s} {c['value']:10.3f} +- {c['std']:.3f} {c['unit']}")
+    und = after.result.undetermined_combinations()
+    if und:
+        print("not determined by these data: " + "; ".join(und))
+    print(f"positions beyond {args.k_sigma:g} sigma: {len(analysis.failing)}")
+    for f in analysis.failing[:10]:
+        print(
+            f"  row {f['row']}: phi1 {f['phi1_deg']:g} phi2 {f['phi2_deg']:g} deg, "
+            f"{f['component']} {f['residual_arcsec']:+.2f} arcsec ({f['sigmas']:+.1f} sigma)"
+        )
+    for p in plots:
+        print(f"wrote {p}")
+    return 0
+
+
+def run_diagnose(args: argparse.Namespace) -> int:
+    from ..orientation_diagnosis import diagnose_measurements
+    from ..residual_analysis import orientation_residuals, write_residual_plots
+
+    data = _read(args)
+    diagnosis = diagnose_measurements(data, until_explained=args.until_explained)
+    out = diagnosis.to_dict()
+    if args.plots:
+        base = diagnosis.base_fit.with_noise_variance(diagnosis.noise_variance)
+        sets = [orientation_residuals(base)]
+        if diagnosis.steps:
+            sets.append(orientation_residuals(diagnosis.best_fit))
+        out["plots"] = [str(p) for p in write_residual_plots(sets, args.plots)]
+    if args.json:
+        print_json(out)
+        return 0
+    print("\n".join(diagnosis.report_lines()))
+    for p in out.get("plots", []):
+        print(f"wrote {p}")
+    return 0
+
+
+def run_report(args: argparse.Namespace) -> int:
+    from ..orientation_diagnosis import diagnose_measurements
+    from ..report_html import write_report
+
+    _not_an_input(args.output, args.data)
+    data = read_measurements(args.data)
+    if args.ignore_sigma:
+        data = data.without_sigma()
+    diagnosis = diagnose_measurements(data, until_explained=args.until_explained)
+    path = write_report(diagnosis, args.output, title=f"Diagnosis of {args.data.name}")
+    print(f"wrote {path}")
+    return 0

@@ -1,0 +1,129 @@
+"""The measurement commands: simulate -> fit / diagnose / report, JSON keys, bad files exit 2."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from turntable_pin.cli import main
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "models" / "examples" / "measurements_example.csv"
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "turntable_pin", *args], capture_output=True, text=True, timeout=120
+    )
+
+
+@pytest.fixture(scope="module")
+def sim_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("sim") / "gravity.csv"
+    code = main([
+        "simulate", "--error", "dphi_y1=4", "--error", "deps_x=-3", "--effect", "gravity_sag:k=3",
+        "--seed", "21", "--order", "random", "-o", str(path),
+    ])  # fmt: skip
+    assert code == 0
+    return path
+
+
+def test_bundled_example_diagnosis_names_its_hidden_effect_and_the_error_falls():
+    proc = run_cli("diagnose", str(EXAMPLE), "--json")
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    hidden = [ln for ln in EXAMPLE.read_text().splitlines() if ln.startswith("# hidden effects")]
+    assert out["verdict"]["missing_effect"] in hidden[0]
+    assert out["steps"][0]["rms_arcsec"] < 0.6 * out["base"]["rms_arcsec"]
+    assert 0.8 < out["steps"][0]["chi2_reduced"] < 1.25 < out["base"]["chi2_reduced"]
+
+
+def test_fit_json_keys_and_before_after(sim_file, capsys, tmp_path):
+    assert main(["fit", str(sim_file), "--effects", "gravity_sag", "--json",
+                 "--plots", str(tmp_path / "plots")]) == 0  # fmt: skip
+    out = json.loads(capsys.readouterr().out)
+    for key in ("rms_arcsec", "chi2_reduced", "params", "identifiable", "p_value", "before"):
+        assert key in out
+    assert out["params"]["gravity_sag.k"]["value"] == pytest.approx(3, abs=0.5)
+    assert out["before"]["chi2_reduced"] > 1.5 > out["chi2_reduced"]
+    assert out["identifiable"]["rank"] == 6
+    table = out["where_it_fails"]["per_position"]
+    assert len(table) == 144 and {"row", "phi1_deg", "dtheta_arcsec", "max_sigmas"} <= set(table[0])
+    assert (tmp_path / "plots" / "residuals.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_diagnose_until_explained_text_and_report(sim_file, capsys, tmp_path):
+    assert main(["diagnose", str(sim_file), "--until-explained"]) == 0
+    text = capsys.readouterr().out
+    assert "missing effect: gravity_sag" in text and "step 1: add gravity_sag" in text
+    report = tmp_path / "r.html"
+    assert main(["report", str(sim_file), "-o", str(report)]) == 0
+    html = report.read_text()
+    assert "data:image/png;base64," in html and "gravity_sag" in html
+    assert 'src="http' not in html and "<script" not in html  # self-contained
+
+
+def test_fit_with_estimated_sigma(sim_file, capsys):
+    assert main(["fit", str(sim_file), "--effects", "gravity_sag", "--ignore-sigma", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["sigma_source"] == "estimated" and out["p_value"] is None
+    assert out["chi2_reduced"] == pytest.approx(1.0)
+    assert out["before"]["chi2_reduced"] > 1.5
+
+
+BAD = {
+    "missing": ("phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec\n0,0,1,1\n", "row 1"),
+    "text": (
+        "phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec\n0,0,1,1,1\n0,30,1,oops,1\n",
+        "row 3, column 'dtheta_arcsec'",
+    ),
+    "sigma": (
+        "phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec,sigma_arcsec\n0,0,1,1,1,0\n",
+        "row 2, column 'sigma_arcsec'",
+    ),
+}
+
+
+@pytest.mark.parametrize("kind", list(BAD))
+def test_bad_files_exit_2_naming_row_and_column(kind, tmp_path, capsys):
+    text, fragment = BAD[kind]
+    path = tmp_path / "bad.csv"
+    path.write_text(text)
+    proc = run_cli("diagnose", str(path), "--json")
+    assert proc.returncode == 2
+    assert fragment in proc.stderr and "bad.csv" in proc.stderr
+    assert "Traceback" not in proc.stderr and proc.stdout == ""
+    assert main(["fit", str(path)]) == 2
+    err = capsys.readouterr()
+    assert fragment in err.err and err.out == ""
+    out = tmp_path / "r.html"
+    assert main(["report", str(path), "-o", str(out)]) == 2 and not out.exists()
+
+
+def test_report_never_overwrites_its_input(sim_file, capsys):
+    before = sim_file.read_bytes()
+    assert main(["report", str(sim_file), "-o", str(sim_file)]) == 2
+    assert "is an input file" in capsys.readouterr().err
+    assert sim_file.read_bytes() == before
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (["simulate", "--effect", "gravity:k=1", "-o", "x.csv"], "unknown effect 'gravity'"),
+        (["simulate", "--effect", "gravity_sag:k", "-o", "x.csv"], "expected NAME:P=V"),
+        (["simulate", "--effect", "gravity_sag:k=nan", "-o", "x.csv"], "finite"),
+        (["fit", "nofile.csv"], "cannot read the file"),
+    ],
+)
+def test_bad_arguments(args, fragment, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(args) == 2
+    assert fragment in capsys.readouterr().err
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_unknown_effect_in_fit(sim_file, capsys):
+    assert main(["fit", str(sim_file), "--effects", "gravity_sag,wobble"]) == 2
+    assert "unknown effect 'wobble'" in capsys.readouterr().err

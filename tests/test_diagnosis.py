@@ -1,0 +1,196 @@
+"""The diagnosis names hidden effects, stays quiet on clean data, and flags what it cannot explain.
+
+Data: the 30-degree grid (144 positions), random turntable errors of +-10 arcsec, 1 arcsec noise,
+effects of a few arcsec, random approach directions and a time stamp per position.
+"""
+
+import numpy as np
+import pytest
+
+from conftest import random_errors
+from turntable_pin.effects import EFFECTS
+from turntable_pin.measurements import OrientationMeasurements
+from turntable_pin.orientation_diagnosis import diagnose_measurements
+from turntable_pin.orientation_fit import fit_orientation
+from turntable_pin.simulation import simulate_measurements
+from turntable_pin.units import ARCSEC_PER_RAD
+
+
+def effect_parameters(name: str, rng: np.random.Generator) -> dict[str, float]:
+    """A few arcsec (arcsec/g, arcsec/h for a 2.4 h run) with random signs."""
+    specs = EFFECTS[name].parameters(simulate_measurements(seed=0).data.variables())
+    return {s.name: rng.choice([-1, 1]) * rng.uniform(1.5, 3.0) for s in specs}
+
+
+DETECTABLE = [n for n in EFFECTS if n != "payload_mount"]
+SEEDS = (1, 2, 3)
+
+
+@pytest.mark.parametrize("name", DETECTABLE)
+def test_every_detectable_effect_is_named_and_its_fit_reaches_the_noise(name):
+    for seed in SEEDS:
+        rng = np.random.default_rng(1000 * seed + len(name))
+        sim = simulate_measurements(
+            random_errors(rng), {name: effect_parameters(name, rng)}, seed=seed
+        )
+        for data in (sim.data, sim.data.without_sigma()):
+            verdict = diagnose_measurements(data).to_dict()["verdict"]
+            assert name == verdict["missing_effect"] or name in verdict["alternatives"], (
+                seed, data.has_sigma, verdict,
+            )  # fmt: skip
+            assert not verdict["unexplained"], (seed, verdict)
+        fit = fit_orientation(sim.data, [EFFECTS[name]])
+        assert 0.8 < fit.result.chi2_reduced < 1.25
+        assert fit.result.p_value > 1e-3
+
+
+@pytest.mark.parametrize(
+    "hidden, named",
+    [("gravity_sag", "outer_encoder_harmonics"), ("base_tilt", "outer_wobble_harmonics")],
+)
+def test_nested_effects_are_reported_as_alternatives_with_separation_advice(hidden, named):
+    rng = np.random.default_rng(7)
+    sim = simulate_measurements(random_errors(rng), {hidden: effect_parameters(hidden, rng)})
+    d = diagnose_measurements(sim.data).to_dict()
+    assert d["verdict"]["missing_effect"] == hidden
+    assert named in d["verdict"]["alternatives"]
+    assert "no set of positions separates them" in d["verdict"]["separations"][named]
+
+
+def test_payload_mount_is_absorbed_by_the_base_and_said_so():
+    rng = np.random.default_rng(9)
+    sim = simulate_measurements(
+        random_errors(rng), {"payload_mount": {"mx": 40.0, "my": -30.0, "mz": 25.0}}, seed=4
+    )
+    d = diagnose_measurements(sim.data).to_dict()
+    assert d["verdict"]["missing_effect"] is None and not d["verdict"]["unexplained"]
+    assert d["verdict"]["indistinguishable_from_base"] == ["payload_mount"]
+    entry = next(c for c in d["candidates"] if c["effect"] == "payload_mount")
+    assert not entry["testable"] and "dalpha_y2 - payload_mount.my" in entry["reason"]
+    # ... and the base fit already reaches the noise, even for large mount angles (exactly).
+    assert 0.8 < d["base"]["chi2_reduced"] < 1.25
+
+
+def test_clean_data_false_alarm_rate(capsys):
+    alarms = {"column": 0, "estimated": 0}
+    n_seeds = 20
+    for seed in range(n_seeds):
+        rng = np.random.default_rng(500 + seed)
+        sim = simulate_measurements(random_errors(rng), seed=100 + seed)
+        for key, data in (("column", sim.data), ("estimated", sim.data.without_sigma())):
+            v = diagnose_measurements(data).to_dict()["verdict"]
+            alarms[key] += bool(v["missing_effect"] or v["unexplained"])
+    rates = {k: v / n_seeds for k, v in alarms.items()}
+    with capsys.disabled():
+        print(f"\nclean-data false-alarm rate over {n_seeds} seeds: {rates}")
+    assert rates["column"] <= 0.10 and rates["estimated"] <= 0.10
+
+
+def _with_extra(data: OrientationMeasurements, extra_rad: np.ndarray) -> OrientationMeasurements:
+    return OrientationMeasurements(
+        data.phi1_rad, data.phi2_rad, data.angles_rad + extra_rad, data.sigma_rad, data.time_s,
+        data.dir1, data.dir2,
+    )  # fmt: skip
+
+
+def test_an_effect_outside_the_catalogue_is_unexplained():
+    for seed in (1, 2):
+        rng = np.random.default_rng(seed)
+        sim = simulate_measurements(random_errors(rng), seed=seed)
+        extra = np.zeros_like(sim.data.angles_rad)
+        extra[:, 1] = 3.0 / ARCSEC_PER_RAD * np.cos(3 * sim.data.phi2_rad + 0.4)  # 3/rev
+        data = _with_extra(sim.data, extra)
+        for variant in (data, data.without_sigma()):
+            d = diagnose_measurements(variant)
+            v = d.to_dict()["verdict"]
+            assert v["unexplained"], v
+            top = v["remaining_structure"][0]
+            assert "3/rev in phi2" in top["term"] and top["amplitude"] == pytest.approx(3, rel=0.2)
+        assert d.fails_fit_test is False  # sigma estimated: only the structure search can tell
+
+
+def test_until_explained_finds_two_effects():
+    for seed in (1, 2):
+        rng = np.random.default_rng(seed + 50)
+        effects = {
+            "inner_encoder_harmonics": effect_parameters("inner_encoder_harmonics", rng),
+            "thermal_drift": effect_parameters("thermal_drift", rng),
+        }
+        sim = simulate_measurements(random_errors(rng), effects, seed=seed)
+        single = diagnose_measurements(sim.data).to_dict()["verdict"]
+        # the plain diagnosis names the stronger effect and the other as also significant; what
+        # remains is removable by the catalogue, so it is not "unexplained"
+        assert sorted([single["missing_effect"], *single["also_significant"]]) == sorted(effects)
+        assert single["missing_effects"] == [single["missing_effect"]]
+        assert not single["unexplained"]
+        d = diagnose_measurements(sim.data, until_explained=True).to_dict()
+        assert sorted(d["verdict"]["missing_effects"]) == sorted(effects)
+        assert not d["verdict"]["unexplained"]
+        rms = [d["base"]["rms_arcsec"]] + [s["rms_arcsec"] for s in d["steps"]]
+        assert rms == sorted(rms, reverse=True)  # the error falls at each step
+        assert 0.8 < d["steps"][-1]["chi2_reduced"] < 1.25
+
+
+def test_untestable_effects_are_reported():
+    sim = simulate_measurements(seed=1)
+    data = OrientationMeasurements(sim.data.phi1_rad, sim.data.phi2_rad, sim.data.angles_rad,
+                                   sim.data.sigma_rad)  # fmt: skip
+    d = diagnose_measurements(data).to_dict()
+    assert sorted(d["verdict"]["untestable"]) == ["backlash", "thermal_drift"]
+    entry = next(c for c in d["candidates"] if c["effect"] == "thermal_drift")
+    assert "time_s" in entry["reason"] and entry["delta_bic"] is None
+
+
+def test_spec_json_keys():
+    d = diagnose_measurements(simulate_measurements(seed=3).data).to_dict()
+    assert d["n_positions"] == 144
+    assert set(d["base"]) >= {"rms_arcsec", "chi2_reduced", "n_params", "rank"}
+    assert d["base"]["n_params"] == 8 and d["base"]["rank"] == 5
+    assert [c["effect"] for c in d["candidates"]].__len__() == len(EFFECTS)
+    for c in d["candidates"]:
+        assert set(c) >= {"effect", "delta_bic", "rms_arcsec", "chi2_reduced", "alternatives"}
+    testable = [c["delta_bic"] for c in d["candidates"] if c["delta_bic"] is not None]
+    assert testable == sorted(testable)
+    assert set(d["verdict"]) >= {"missing_effect", "alternatives", "unexplained"}
+
+
+def test_few_positions_leave_large_effects_untestable_instead_of_failing():
+    from turntable_pin.simulation import Schedule
+
+    sim = simulate_measurements(schedule=Schedule(360, 180), seed=1)  # 2 positions, 6 angles
+    d = diagnose_measurements(sim.data).to_dict()
+    assert d["n_positions"] == 2 and d["verdict"]["missing_effect"] is None
+    reasons = {c["effect"]: c.get("reason", "") for c in d["candidates"]}
+    assert "cannot be fitted on these data: 6 observations" in reasons["inner_encoder_harmonics"]
+    assert reasons["outer_encoder_harmonics"].startswith("indistinguishable")  # phi1 never moves
+
+
+def test_a_partial_explanation_is_not_an_alternative():
+    rng = np.random.default_rng(3)
+    sim = simulate_measurements(random_errors(rng), {"base_tilt": {"tx": 3.0, "tz": -2.0}}, seed=3)
+    d = diagnose_measurements(sim.data.without_sigma()).to_dict()
+    for c in d["candidates"]:
+        for other in c["alternatives"]:
+            mate = next(x for x in d["candidates"] if x["effect"] == other)
+            assert c["effect"] in mate["alternatives"]  # the relation is symmetric
+    # thermal drift in grid order explains part of a tilt (significant, chi2_reduced ~5): it is
+    # not an alternative, in either direction
+    partial = [c for c in d["candidates"] if c["significant"] and c["chi2_reduced"] > 1.5]
+    assert [c["effect"] for c in partial] == ["thermal_drift"]
+    assert partial[0]["alternatives"] == []
+    best = d["candidates"][0]
+    assert best["effect"] == "base_tilt" and best["alternatives"] == ["outer_wobble_harmonics"]
+
+
+def test_a_spurious_first_round_candidate_is_shown_not_significant_on_top_of_the_real_one():
+    from pathlib import Path
+
+    from turntable_pin.measurements import read_measurements
+
+    example = Path(__file__).resolve().parents[1] / "models/examples/measurements_example.csv"
+    d = diagnose_measurements(read_measurements(example)).to_dict()
+    first = d["verdict"]["missing_effect"]
+    spurious = [c for c in d["candidates"] if c["significant"] and c["effect"] != first]
+    for c in spurious:  # soaked up part of the real effect against the bare base model
+        assert c["delta_bic_after_first"] > -6
+    assert d["verdict"]["also_significant"] == []

@@ -1,0 +1,91 @@
+"""Reading orientation measurements: what is accepted, and what is refused with row and column."""
+
+import numpy as np
+import pytest
+
+from turntable_pin import InputError
+from turntable_pin.measurements import read_measurements
+
+HEAD = "phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec"
+
+
+def write(tmp_path, text, name="m.csv"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def grid_rows(extra=lambda i: ""):
+    rows = []
+    for i, (a, b) in enumerate((a, b) for a in (0, 90, 180) for b in (0, 120, 240)):
+        rows.append(f"{a},{b},1.5,-0.5,2.0{extra(i)}")
+    return "\n".join(rows) + "\n"
+
+
+def test_reads_columns_in_any_order_with_extras(tmp_path):
+    text = "# comment\nnote,dgamma_arcsec,phi2_deg,phi1_deg,dtheta_arcsec,dpsi_arcsec,"
+    text += "sigma_arcsec,time_s,dir1\n"
+    text += "x,3,45,30,2,1,0.5,10,-1\ny,6,90,30,5,4,0.5,20,1\n"
+    data = read_measurements(write(tmp_path, text))
+    assert data.n_positions == 2
+    np.testing.assert_allclose(np.degrees(data.phi1_rad), [30, 30])
+    np.testing.assert_allclose(data.angles_rad[0] * 206264.80624709636, [1, 2, 3])
+    np.testing.assert_allclose(data.sigma_rad * 206264.80624709636, [0.5, 0.5])
+    assert data.dir2 is None and data.dir1.tolist() == [-1, 1] and data.rows.tolist() == [3, 4]
+
+
+@pytest.mark.parametrize(
+    "text, fragment",
+    [
+        ("phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec\n0,0,1,1\n", "missing required column(s)"),
+        ("phi1_deg,phi_2_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec\n0,0,1,1,1\n", "'phi2_deg'"),
+        (HEAD + "\n0,0,1,1,1\n0,30,1,x,1\n", "row 3, column 'dtheta_arcsec': expected a number"),
+        (HEAD + "\n0,0,1,1,NaN\n", "row 2, column 'dgamma_arcsec': expected a finite"),
+        (HEAD + ",sigma_arcsec\n0,0,1,1,1,1\n0,30,1,1,1,0\n", "row 3, column 'sigma_arcsec': "),
+        (HEAD + ",sigma_arcsec\n0,0,1,1,1,-2\n", "row 2, column 'sigma_arcsec'"),
+        (HEAD + ",dir1\n0,0,1,1,1,1\n0,30,1,1,1,0\n", "row 3, column 'dir1': an approach"),
+        (HEAD + ",time_s\n0,0,1,1,1,-5\n", "row 2, column 'time_s'"),
+        (HEAD + "\n0,0,1,1,1\n0,30,1,1,1\n0,0,2,2,2\n", "row 4, column 'phi1_deg': the same"),
+        (HEAD + ",time_s\n0,0,1,1,1,10\n0,0,1,1,1,10\n", "row 3, column 'phi1_deg'"),
+    ],
+)  # fmt: skip
+def test_bad_files_name_row_and_column(tmp_path, text, fragment):
+    with pytest.raises(InputError) as info:
+        read_measurements(write(tmp_path, text))
+    assert fragment in str(info.value)
+    assert "m.csv" in str(info.value)
+
+
+def test_repeats_at_different_times_or_directions_are_fine(tmp_path):
+    text = HEAD + ",time_s\n0,0,1,1,1,10\n0,0,1.2,1,1,20\n"
+    assert read_measurements(write(tmp_path, text)).n_positions == 2
+    text = HEAD + ",dir1\n0,0,1,1,1,1\n0,0,1.2,1,1,-1\n"
+    assert read_measurements(write(tmp_path, text)).n_positions == 2
+
+
+def test_radians_in_a_degree_column_are_refused(tmp_path):
+    # A 30-degree schedule written in radians: every value is a whole degree when read as rad.
+    lines = [HEAD]
+    for a in range(0, 360, 90):
+        for b in range(0, 360, 30):
+            lines.append(f"{float(np.radians(a))!r},{float(np.radians(b))!r},1,1,1")
+    with pytest.raises(
+        InputError, match="row 2, column 'phi1_deg': these angles look like radians"
+    ):
+        read_measurements(write(tmp_path, "\n".join(lines) + "\n"))
+    # Irregular values spread over a radian-sized range.
+    rng = np.random.default_rng(3)
+    lines = [HEAD] + [f"{a},{b},1,1,1" for a, b in rng.uniform(0, 2 * np.pi, (20, 2))]
+    with pytest.raises(InputError, match="look like radians"):
+        read_measurements(write(tmp_path, "\n".join(lines) + "\n"))
+
+
+def test_small_angle_degree_data_are_not_mistaken_for_radians(tmp_path):
+    lines = [HEAD]
+    for a in (-3, -1.5, 0, 1.5, 3):
+        for b in (-2.25, 0, 2.25, 4.5):
+            lines.append(f"{a},{b},1,1,1")
+    data = read_measurements(write(tmp_path, "\n".join(lines) + "\n"))
+    assert data.n_positions == 20
+    # A whole-degree grid is never flagged.
+    assert read_measurements(write(tmp_path, HEAD + "\n" + grid_rows())).n_positions == 9

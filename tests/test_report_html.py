@@ -1,0 +1,32 @@
+"""The HTML report: one self-contained page with every section and decodable embedded images."""
+
+import base64
+import re
+
+from turntable_pin import TurntableErrors
+from turntable_pin.orientation_diagnosis import diagnose_measurements
+from turntable_pin.report_html import diagnosis_html, write_report
+from turntable_pin.simulation import simulate_measurements
+
+
+def test_report_tells_the_whole_story(tmp_path):
+    sim = simulate_measurements(
+        TurntableErrors.from_arcsec(deps_y=4), {"backlash": {"b1": 3.0, "b2": -2.0}}, seed=5
+    )
+    diagnosis = diagnose_measurements(sim.data)
+    page = diagnosis_html(diagnosis, title="t")
+    headings = ("1. The data", "2. The base model", "3. Where the base model fails",
+                "4. Diagnosis", "5. Add it and watch the error fall", "6. Parameters")  # fmt: skip
+    assert all(h in page for h in headings)
+    assert "backlash" in page and "dphi_y1 + deps_y" in page
+    images = re.findall(r'src="data:image/png;base64,([^"]+)"', page)
+    assert len(images) == 5  # data; base residuals, harmonics; the same before/after
+    assert all(base64.b64decode(i)[:4] == b"\x89PNG" for i in images)
+    assert "http://" not in page and "https://" not in page
+    path = write_report(diagnosis, tmp_path / "r.html")
+    assert path.read_text() == diagnosis_html(diagnosis)
+
+
+def test_clean_data_report_has_no_after_section():
+    page = diagnosis_html(diagnose_measurements(simulate_measurements(seed=2).data))
+    assert "5. Add it" not in page and "missing effect: none" in page

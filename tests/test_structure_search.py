@@ -1,0 +1,47 @@
+"""The structure search: finds a planted shape and its size, ignores what the model absorbs."""
+
+import numpy as np
+import pytest
+
+from turntable_pin.structure_search import Probe, delta_bic, search_structure
+
+
+def _probes(x):
+    return [
+        Probe(f"{k}/rev", f"harmonic {k}", np.stack([np.cos(k * x), np.sin(k * x)], axis=1))
+        for k in range(1, 6)
+    ]
+
+
+def test_planted_harmonic_is_found_with_its_amplitude():
+    rng = np.random.default_rng(0)
+    x = np.linspace(0, 2 * np.pi, 240, endpoint=False)
+    r = 0.8 * np.cos(3 * x + 0.5) + rng.normal(0, 0.3, x.size)
+    model = np.ones((x.size, 1))  # the model absorbs a constant
+    for variance in (0.09, None):
+        found = search_structure(r, model, _probes(x), noise_variance=variance)
+        assert [t.name for t in found] == ["3/rev"]
+        assert found[0].amplitude == pytest.approx(0.8, abs=0.1)
+
+
+def test_what_the_model_absorbs_is_not_structure_and_noise_is_quiet():
+    rng = np.random.default_rng(1)
+    x = np.linspace(0, 2 * np.pi, 240, endpoint=False)
+    r = 2.0 * np.sin(x) + rng.normal(0, 0.3, x.size)
+    model = np.stack([np.cos(x), np.sin(x)], axis=1)
+    # the residual of a real fit is orthogonal to the model; project to make it so
+    q, _ = np.linalg.qr(model)
+    r = r - q @ (q.T @ r)
+    assert search_structure(r, model, _probes(x), noise_variance=0.09) == []
+    hits = 0
+    for seed in range(200):
+        noise = np.random.default_rng(seed).normal(0, 1, x.size)
+        hits += bool(search_structure(noise, np.zeros((x.size, 0)), _probes(x), noise_variance=1))
+    assert hits <= 2  # P(chi2_2 > 2 ln 240 + 6 + 2 ln 5) ~ 1e-4 per probe
+
+
+def test_delta_bic_forms():
+    assert delta_bic(90.0, 100.0, 2, 100, 1.0) == pytest.approx(-10 + 2 * np.log(100))
+    assert delta_bic(90.0, 100.0, 2, 100, None) == pytest.approx(
+        100 * np.log(0.9) + 2 * np.log(100)
+    )
