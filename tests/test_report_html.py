@@ -3,7 +3,10 @@
 import base64
 import re
 
+import pytest
+
 from turntable_pin import TurntableErrors
+from turntable_pin.browser import check_page_images, chromium_available
 from turntable_pin.orientation_diagnosis import diagnose_measurements
 from turntable_pin.report_html import diagnosis_html, write_report
 from turntable_pin.simulation import simulate_measurements
@@ -30,3 +33,18 @@ def test_report_tells_the_whole_story(tmp_path):
 def test_clean_data_report_has_no_after_section():
     page = diagnosis_html(diagnose_measurements(simulate_measurements(seed=2).data))
     assert "5. Add it" not in page and "missing effect: none" in page
+
+
+@pytest.mark.browser
+@pytest.mark.skipif(
+    not chromium_available(),
+    reason="headless Chromium not found: install the Debian package 'chromium'",
+)
+def test_report_opens_in_the_browser_and_every_image_loads(tmp_path):
+    sim = simulate_measurements(
+        TurntableErrors.from_arcsec(dalpha_x1=3), {"gravity_sag": {"k": 4.0}}, seed=11
+    )
+    path = write_report(diagnose_measurements(sim.data), tmp_path / "report.html")
+    report = check_page_images(path)
+    assert report.n_images == len(re.findall(r"<img ", path.read_text())) == 5
+    assert report.all_loaded, report.failed
