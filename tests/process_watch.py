@@ -14,25 +14,9 @@ import threading
 import time
 from pathlib import Path
 
+from turntable_pin.browser import process_table
+
 _RUN_DIR = re.compile(r"--user-data-dir=(/\S*turntable-pin-chromium-[^/\s]+)/profile")
-
-
-def _table() -> list[tuple[int, int, str, str]]:
-    """(pid, ppid, state, cmdline) of every process."""
-    rows = []
-    for entry in Path("/proc").iterdir():
-        if not entry.name.isdigit():
-            continue
-        try:
-            stat = (entry / "stat").read_text()
-            cmdline = (
-                (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode("utf-8", "replace")
-            )
-        except OSError:
-            continue
-        fields = stat[stat.rfind(")") + 2 :].split()
-        rows.append((int(entry.name), int(fields[1]), fields[0], cmdline))
-    return rows
 
 
 def alive(pid: int) -> bool:
@@ -57,16 +41,16 @@ class ProcessWatch:
         self._thread = threading.Thread(target=self._loop, daemon=True)
 
     def _sample(self) -> None:
-        table = _table()
-        for pid, ppid, _, cmdline in table:
-            if ppid == self.parent_pid and "meshcat.servers.zmqserver" in cmdline:
-                self.server_pids.add(pid)
-            match = _RUN_DIR.search(cmdline)
-            if ppid == self.parent_pid and match:
+        table = process_table()
+        for p in table:
+            if p.ppid == self.parent_pid and "meshcat.servers.zmqserver" in p.cmdline:
+                self.server_pids.add(p.pid)
+            match = _RUN_DIR.search(p.cmdline)
+            if p.ppid == self.parent_pid and match:
                 self._run_dirs.add(match.group(1))
-        for pid, _, _, cmdline in table:
-            if any(run_dir in cmdline for run_dir in self._run_dirs):
-                self.browser_pids.add(pid)
+        for p in table:
+            if any(run_dir in p.cmdline for run_dir in self._run_dirs):
+                self.browser_pids.add(p.pid)
 
     def _loop(self) -> None:
         while not self._stop.is_set():

@@ -105,7 +105,7 @@ class BrowserRun:
 
 
 @dataclass(frozen=True)
-class _ProcessInfo:
+class ProcessInfo:
     pid: int
     ppid: int
     pgid: int
@@ -114,7 +114,7 @@ class _ProcessInfo:
     cmdline: str
 
 
-def _process_table() -> list[_ProcessInfo]:
+def process_table() -> list[ProcessInfo]:
     """Every process of the machine, read from /proc (empty where /proc does not exist)."""
     table = []
     proc = Path("/proc")
@@ -133,7 +133,7 @@ def _process_table() -> list[_ProcessInfo]:
         # Fields after the parenthesised command name: state ppid pgrp session ...
         fields = stat[stat.rfind(")") + 2 :].split()
         table.append(
-            _ProcessInfo(
+            ProcessInfo(
                 pid=int(entry.name),
                 ppid=int(fields[1]),
                 pgid=int(fields[2]),
@@ -154,7 +154,7 @@ def related_processes(marker: str) -> list[int]:
     or shares a session or group with a process that does. Starting from the marker, not from a
     pid, means a pid reused after the launcher was reaped is never mistaken for ours.
     """
-    table = [p for p in _process_table() if p.alive]
+    table = [p for p in process_table() if p.alive]
     members = {p.pid for p in table if marker in p.cmdline}
     grew = True
     while grew:
