@@ -11,7 +11,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from turntable_pin import SetupScene, TurntableErrors, check_page_images, render_snapshot
+from turntable_pin import SetupScene, TurntableErrors, render_snapshot
+from turntable_pin.browser import check_page_images
 from turntable_pin.turntable_model import models_dir
 
 
