@@ -40,3 +40,13 @@ def test_read_yaml_names_the_file(tmp_path):
         read_yaml(bad)
     with pytest.raises(InputError, match="cannot read the file"):
         read_yaml(tmp_path / "missing.yaml")
+
+
+def test_unwritable_outputs_are_input_errors(tmp_path):
+    blocker = tmp_path / "data.csv"
+    blocker.write_text("precious")
+    with pytest.raises(InputError, match="data.csv"):
+        write_text_atomic(blocker / "residuals.png", "x")  # a 'folder' that is a file
+    with pytest.raises(InputError, match="it is a folder"):
+        write_text_atomic(tmp_path, "x")
+    assert blocker.read_text() == "precious"

@@ -12,10 +12,22 @@ def write_atomic(path: str | Path, write: Callable[[Path], None]) -> Path:
     """Call ``write(tmp_path)`` on a temporary file beside ``path``, then rename it into place.
 
     If ``write`` raises, the temporary file is removed and any existing ``path`` is untouched.
+    An operating-system error (a folder that is a file, no permission, a full disk) becomes an
+    :class:`InputError` naming the output path.
     """
+    from .exceptions import InputError
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    if path.is_dir():
+        raise InputError("cannot write the file: it is a folder", path=path)
+    blocking = next((p for p in path.parents if p.exists() and not p.is_dir()), None)
+    if blocking is not None:
+        raise InputError(f"cannot write the file: {blocking} is a file, not a folder", path=path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as exc:
+        raise InputError(f"cannot write the file: {exc.strerror or exc}", path=path) from None
     os.close(fd)
     tmp = Path(tmp_name)
     try:
@@ -25,6 +37,9 @@ def write_atomic(path: str | Path, write: Callable[[Path], None]) -> Path:
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, path)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise InputError(f"cannot write the file: {exc.strerror or exc}", path=path) from None
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
