@@ -45,3 +45,18 @@ def test_delta_bic_forms():
     assert delta_bic(90.0, 100.0, 2, 100, None) == pytest.approx(
         100 * np.log(0.9) + 2 * np.log(100)
     )
+
+
+def test_a_shape_the_model_spans_to_first_order_is_not_new_structure():
+    # A probe equal to a model column up to a second-order remainder (1e-5 of it) used to be
+    # accepted, its tiny remainder fitted to the residuals with an amplitude of ~1e5 (found on
+    # orientation data: "dgamma 1/rev in phi1" next to the wobble terms, 2.6e5 arcsec).
+    rng = np.random.default_rng(2)
+    x = np.linspace(0, 2 * np.pi, 240, endpoint=False)
+    model = np.stack([np.cos(x), np.sin(x)], axis=1)
+    wiggle = np.stack([np.cos(7 * x), np.sin(7 * x)], axis=1)
+    near_model = Probe("near", "the model's shape plus 1e-5 of a 7/rev", model + 1e-5 * wiggle)
+    r = 3.0 * np.cos(7 * x) + rng.normal(0, 0.3, x.size)  # real structure the probe barely has
+    found = search_structure(r, model, [near_model, *_probes(x)], noise_variance=0.09)
+    assert "near" not in [t.name for t in found]
+    assert all(t.amplitude < 10 for t in found)

@@ -24,6 +24,12 @@ BIC_THRESHOLD = -6.0
 """A term is accepted when it lowers BIC by at least 6 (strong evidence on the Kass-Raftery
 scale; the acceptance rule of telescope-pointing practice)."""
 
+NEW_FRACTION = 1e-2
+"""A probe direction counts as new only if more than this fraction of it (relative to the probe's
+own largest singular value) survives projecting out the model and the terms already found. Shapes
+the model spans to first order leave only second-order remainders (about the size of the errors,
+1e-5..1e-3 rad); fitting one of those to the residuals gave absurd amplitudes (1e5 arcsec)."""
+
 
 @dataclass(frozen=True)
 class Probe:
@@ -114,20 +120,23 @@ def search_structure(
         rss = float(r @ r)
         best = None
         for probe in remaining:
+            scale = np.linalg.norm(probe.columns, 2) if probe.columns.size else 0.0
             t = probe.columns - q @ (q.T @ probe.columns)
-            basis = _orthonormal_columns(t)
-            if basis.shape[1] == 0:
+            u, s, vt = np.linalg.svd(t, full_matrices=False)
+            keep = s > NEW_FRACTION * scale
+            if not keep.any():
                 continue
+            basis = u[:, keep]
             reduction = float(np.sum((basis.T @ r) ** 2))
             if best is None or reduction > best[0]:
-                best = (reduction, probe, basis, t)
+                best = (reduction, probe, basis, vt[keep].T / s[keep])
         if best is None:
             break
-        reduction, probe, basis, t = best
+        reduction, probe, basis, pseudo_inverse = best
         dbic = delta_bic(rss - reduction, rss, basis.shape[1], m, noise_variance)
         if dbic > threshold:
             break
-        coef = np.linalg.lstsq(t, r, rcond=None)[0] * probe.unit_scale
+        coef = pseudo_inverse @ (basis.T @ r) * probe.unit_scale
         found.append(
             FoundTerm(
                 name=probe.name,
