@@ -73,6 +73,23 @@ class OrientationFamily:
     def describe(self, effect: Effect | str) -> dict:
         return (get_effect(effect) if isinstance(effect, str) else effect).describe()
 
+    def _measured_angle_probes(self, trig: np.ndarray, shape: str, w: np.ndarray) -> list[Probe]:
+        """One probe per measured angle: the harmonic pair ``trig`` (N, 2) added to that angle."""
+        probes = []
+        for a, angle in enumerate(ANGLE_NAMES):
+            cols = np.zeros((self.data.n_positions, 3, 2))
+            cols[:, a, :] = trig
+            probes.append(
+                Probe(
+                    f"{angle} {shape}",
+                    f"a {shape.replace('/rev', '/rev term', 1)} of {angle} itself",
+                    (cols * w[:, :, None]).reshape(-1, 2),
+                    ARCSEC_PER_RAD,
+                    "arcsec",
+                )
+            )
+        return probes
+
     def probes(self, fit: OrientationFit) -> list[Probe]:
         data = self.data
         w = fit.result.weights.reshape(-1, 3)
@@ -93,36 +110,14 @@ class OrientationFamily:
                             "arcsec",
                         )
                     )
-                for a, angle in enumerate(ANGLE_NAMES):
-                    cols = np.zeros((data.n_positions, 3, 2))
-                    cols[:, a, :] = trig
-                    probes.append(
-                        Probe(
-                            f"{angle} {k}/rev in {var}",
-                            f"a {k}/rev term in {var} of {angle} itself",
-                            (cols * w[:, :, None]).reshape(-1, 2),
-                            ARCSEC_PER_RAD,
-                            "arcsec",
-                        )
-                    )
+                probes += self._measured_angle_probes(trig, f"{k}/rev in {var}", w)
         # Terms coupling the two angles (k/rev in phi1 + phi2 or phi1 - phi2) on each angle: the
         # shapes above are separable in phi1 and phi2 and would miss them.
         for label, combined in (("phi1+phi2", data.phi1_rad + data.phi2_rad),
                                 ("phi1-phi2", data.phi1_rad - data.phi2_rad)):  # fmt: skip
             for k in range(1, min(2, _max_order(combined)) + 1):
                 trig = np.stack([np.cos(k * combined), np.sin(k * combined)], axis=-1)
-                for a, angle in enumerate(ANGLE_NAMES):
-                    cols = np.zeros((data.n_positions, 3, 2))
-                    cols[:, a, :] = trig
-                    probes.append(
-                        Probe(
-                            f"{angle} {k}/rev in {label}",
-                            f"a {k}/rev term in {label} of {angle} itself",
-                            (cols * w[:, :, None]).reshape(-1, 2),
-                            ARCSEC_PER_RAD,
-                            "arcsec",
-                        )
-                    )
+                probes += self._measured_angle_probes(trig, f"{k}/rev in {label}", w)
         extra = []
         if data.time_s is not None and np.ptp(data.time_s) > 0:
             t = (data.time_s - data.time_s.min()) / np.ptp(data.time_s)
