@@ -52,14 +52,21 @@ def _title(result: OrientationRequirement) -> str:
     )
 
 
-def plot_figure4(result: OrientationRequirement, path: str | Path, *, points: int = 41) -> Path:
-    """Write Figure 4 (surfaces Gamma1, Gamma2 and one-angle slices) to ``path`` (PNG)."""
+def _surfaces(result: OrientationRequirement, points: int):
+    """Grids u, v (deg) and the surfaces Gamma1 = dwx(dpsi=u, dtheta=v), Gamma2 = dwy(dtheta=u,
+    dgamma=v) on them (deg/h, flat)."""
     span = plot_span_deg(result)
     grid_deg = np.linspace(-span, span, points)
     u, v = np.meshgrid(grid_deg, grid_deg, indexing="ij")
     zeros = np.zeros(u.size)
     gamma1 = _rate_errors(result, deg_to_rad(np.stack([u.ravel(), v.ravel(), zeros], 1)))[:, 0]
     gamma2 = _rate_errors(result, deg_to_rad(np.stack([zeros, u.ravel(), v.ravel()], 1)))[:, 1]
+    return u, v, gamma1, gamma2
+
+
+def plot_figure4(result: OrientationRequirement, path: str | Path, *, points: int = 41) -> Path:
+    """Write Figure 4 (surfaces Gamma1, Gamma2 and one-angle slices) to ``path`` (PNG)."""
+    u, v, gamma1, gamma2 = _surfaces(result, points)
 
     fig = plt.figure(figsize=(15, 9))
     fig.suptitle("Figure 4: rate-sensing errors against the orientation error\n" + _title(result))
@@ -84,6 +91,7 @@ def plot_figure4(result: OrientationRequirement, path: str | Path, *, points: in
         ("e", 1, 2, 0, "gamma", "psi"),
         ("f", 1, 1, 0, "theta", "psi"),
     )
+    span = plot_span_deg(result)
     line = np.linspace(-span, span, 161)
     for n, (letter, column, along, other, along_name, other_name) in enumerate(slices):
         ax = fig.add_subplot(2, 3, (2, 3, 5, 6)[n])
@@ -105,12 +113,7 @@ def plot_figure4(result: OrientationRequirement, path: str | Path, *, points: in
 
 def plot_figure5(result: OrientationRequirement, path: str | Path, *, points: int = 121) -> Path:
     """Write Figure 5 (contours ``dw = w_m`` and the requirement rectangles) to ``path``."""
-    span = plot_span_deg(result)
-    grid_deg = np.linspace(-span, span, points)
-    u, v = np.meshgrid(grid_deg, grid_deg, indexing="ij")
-    zeros = np.zeros(u.size)
-    gamma1 = _rate_errors(result, deg_to_rad(np.stack([u.ravel(), v.ravel(), zeros], 1)))[:, 0]
-    gamma2 = _rate_errors(result, deg_to_rad(np.stack([zeros, u.ravel(), v.ravel()], 1)))[:, 1]
+    u, v, gamma1, gamma2 = _surfaces(result, points)
     limits_deg = rad_to_deg(result.limits_rad)
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.5))
     fig.suptitle("Figure 5: requirement of the orientation error\n" + _title(result))
