@@ -154,3 +154,11 @@ def test_central_differences_of_the_exact_chain_give_eq26(rng):
                  for a in ("dpsi_rad", "dtheta_rad", "dgamma_rad")]
             )  # fmt: skip
         np.testing.assert_allclose(np.array(columns).T, small_angle_matrix(phi2), atol=1e-9)
+
+
+def test_models_dir_prefers_the_environment_then_the_checkout(tmp_path, monkeypatch):
+    from turntable_pin.turntable_model import default_urdf_path, models_dir
+
+    assert (models_dir() / "turntable.urdf").is_file()  # the repository's models/
+    monkeypatch.setenv("TURNTABLE_PIN_MODELS", str(tmp_path))
+    assert models_dir() == tmp_path and default_urdf_path() == tmp_path / "turntable.urdf"

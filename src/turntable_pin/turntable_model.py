@@ -26,6 +26,7 @@ mechanism (placements) carry every error, for the URDF writer and for Jacobians 
 from __future__ import annotations
 
 import os
+import sys
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -62,11 +63,18 @@ PLACEMENT_ORDER: tuple[str, ...] = (OUTER_JOINT, INNER_JOINT, PAYLOAD_MOUNT)
 
 
 def models_dir() -> Path:
-    """The folder of bundled models: ``$TURNTABLE_PIN_MODELS`` or the repository's ``models/``."""
+    """The folder of bundled models.
+
+    ``$TURNTABLE_PIN_MODELS`` if set; else the repository's ``models/`` (a source checkout or an
+    editable install); else the copy a wheel installs under ``<prefix>/share/turntable-pin``.
+    """
     env = os.environ.get("TURNTABLE_PIN_MODELS")
     if env:
         return Path(env)
-    return Path(__file__).resolve().parents[2] / "models"
+    checkout = Path(__file__).resolve().parents[2] / "models"
+    if checkout.is_dir():
+        return checkout
+    return Path(sys.prefix) / "share" / "turntable-pin" / "models"
 
 
 def default_urdf_path() -> Path:
