@@ -74,6 +74,11 @@ def test_csv_round_trip_records_seed_and_truth(tmp_path):
     assert "30.0," in text.splitlines()[-1] or "330.0," in text.splitlines()[-1]
     no_sigma = read_measurements(sim.write_csv(tmp_path / "ns.csv", with_sigma=False))
     assert no_sigma.sigma_rad is None
+    blind = sim.write_csv(tmp_path / "blind.csv", hide_truth=True)
+    blind_text = blind.read_text()
+    assert "# seed=11" in blind_text and "not recorded" in blind_text
+    assert "backlash" not in blind_text and "dalpha_x2" not in blind_text
+    np.testing.assert_array_equal(read_measurements(blind).angles_rad, back.angles_rad)
 
 
 def test_bad_simulation_requests():

@@ -111,8 +111,12 @@ class SimulatedMeasurements:
     schedule: Schedule
     truth_rad: np.ndarray = field(repr=False)
 
-    def comment(self) -> str:
-        """The comment lines written above the CSV header."""
+    def comment(self, *, hide_truth: bool = False) -> str:
+        """The comment lines written above the CSV header.
+
+        With ``hide_truth`` only the seed, noise and schedule are written, not the errors and the
+        hidden effects, so that the file can be used to rehearse a blind diagnosis.
+        """
         errors = ", ".join(
             f"{k}={v:.6g}" for k, v in self.errors.to_user_units().items() if k != "deta_mm"
         )
@@ -121,25 +125,28 @@ class SimulatedMeasurements:
             for name, params in self.effects.items()
         )
         s = self.schedule
+        lines = [
+            "simulated by turntable-pin simulate",
+            f"seed={self.seed}",
+            f"noise_arcsec={self.noise_arcsec:g}",
+            f"schedule: phi1_step_deg={s.phi1_step_deg:g} phi2_step_deg={s.phi2_step_deg:g} "
+            f"order={s.order} repeats={s.repeats} dwell_s={s.dwell_s:g} "
+            f"approach={s.approach}",
+        ]
+        if hide_truth:
+            return "\n".join([*lines, "errors and hidden effects: not recorded (--hide-truth)"])
         return "\n".join(
-            [
-                "simulated by turntable-pin simulate",
-                f"seed={self.seed}",
-                f"noise_arcsec={self.noise_arcsec:g}",
-                f"schedule: phi1_step_deg={s.phi1_step_deg:g} phi2_step_deg={s.phi2_step_deg:g} "
-                f"order={s.order} repeats={s.repeats} dwell_s={s.dwell_s:g} "
-                f"approach={s.approach}",
-                f"errors (arcsec): {errors}",
-                f"hidden effects: {effects or 'none'}",
-            ]
+            [*lines, f"errors (arcsec): {errors}", f"hidden effects: {effects or 'none'}"]
         )
 
-    def write_csv(self, path: str | Path, *, with_sigma: bool = True) -> Path:
-        """Write the spec's CSV (atomically) with the seed and truth as comments."""
+    def write_csv(
+        self, path: str | Path, *, with_sigma: bool = True, hide_truth: bool = False
+    ) -> Path:
+        """Write the spec's CSV (atomically) with the seed (and the truth) as comments."""
         columns = self.data.columns()
         if not with_sigma:
             columns.pop("sigma_arcsec", None)
-        return write_csv_table(path, columns, comment=self.comment())
+        return write_csv_table(path, columns, comment=self.comment(hide_truth=hide_truth))
 
 
 def simulate_measurements(

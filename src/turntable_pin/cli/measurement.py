@@ -43,6 +43,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     s.add_argument("--dwell-s", type=finite_float, default=60.0, help="time per position")
     s.add_argument("--approach", choices=APPROACHES, default="random")
     s.add_argument("--no-sigma", action="store_true", help="leave out the sigma_arcsec column")
+    s.add_argument(
+        "--hide-truth",
+        action="store_true",
+        help="record only seed, noise and schedule, not the errors and effects (blind rehearsal)",
+    )
     s.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.csv")
     s.set_defaults(func=run_simulate)
 
@@ -143,7 +148,7 @@ def run_simulate(args: argparse.Namespace) -> int:
         seed=args.seed,
         turntable=TurntableModel(urdf_path=args.urdf) if args.urdf else None,
     )
-    path = sim.write_csv(args.output, with_sigma=not args.no_sigma)
+    path = sim.write_csv(args.output, with_sigma=not args.no_sigma, hide_truth=args.hide_truth)
     print(f"wrote {path}: {sim.data.n_positions} positions, seed {sim.seed}")
     return 0
 
