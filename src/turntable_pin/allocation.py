@@ -38,7 +38,7 @@ from .exceptions import InfeasibleError, InputError
 from .manufacturing_capability import ManufacturingCapability
 from .sensitivity import PAPER_FIGURE8_TRIG, AverageSensitivities, average_sensitivities
 from .small_angle import small_angle_matrix
-from .units import ARCMIN_PER_RAD, DEG_PER_RAD
+from .units import ARCMIN_PER_RAD, DEG_PER_RAD, arcmin_by_name
 
 ORIENTATION_ANGLES: tuple[str, ...] = ("psi", "theta", "gamma")
 """Names of the three orientation angles dpsi, dtheta, dgamma as used in keys and options."""
@@ -273,10 +273,7 @@ class SubproblemResult:
     def to_dict(self) -> dict:
         return {
             "angle": self.angle,
-            "solution_arcmin": {
-                n: float(v * ARCMIN_PER_RAD)
-                for n, v in zip(self.error_names, self.solution_rad, strict=True)
-            },
+            "solution_arcmin": arcmin_by_name(self.error_names, self.solution_rad),
             "weights": dict(zip(self.error_names, map(float, self.weights), strict=True)),
             "J": self.J,
             "limit_arcmin": self.limit_rad * ARCMIN_PER_RAD,
@@ -494,19 +491,10 @@ class Allocation:
 
     def to_dict(self) -> dict:
         return {
-            "upper_bounds_arcmin": {
-                n: float(v * ARCMIN_PER_RAD)
-                for n, v in zip(ANGULAR_ERROR_NAMES, self.upper_bounds_rad, strict=True)
-            },
+            "upper_bounds_arcmin": arcmin_by_name(ANGULAR_ERROR_NAMES, self.upper_bounds_rad),
             "J": self.J,
             "J_unit": "1/arcmin^2 (errors in arc minutes)",
-            "worst_case_arcmin": dict(
-                zip(
-                    ORIENTATION_ANGLES,
-                    map(float, self.worst_case_rad * ARCMIN_PER_RAD),
-                    strict=True,
-                )
-            ),
+            "worst_case_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.worst_case_rad),
             "limits_arcmin": self.limits.to_dict(),
             "weights": self.weights_scheme,
             "lower_bounds": self.capability.to_dict(),

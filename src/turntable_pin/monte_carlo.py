@@ -28,7 +28,7 @@ from .error_parameters import ANGULAR_ERROR_NAMES, ERROR_NAMES
 from .exceptions import InputError
 from .progress import Progress
 from .turntable_model import TurntableModel
-from .units import ARCMIN_PER_RAD, DEG_PER_RAD
+from .units import ARCMIN_PER_RAD, DEG_PER_RAD, arcmin_by_name
 
 CHUNK_SIZE = 2000  # turntables per block: the (chunk, 3, 360) intermediates stay small
 # Relative size of phi1 harmonics in dR below which phi1 is taken to drop out (rounding of the
@@ -119,9 +119,7 @@ class MonteCarloResult:
     def to_dict(self) -> dict:
         limits = self.limits.as_array()
         return {
-            "max_abs_arcmin": dict(
-                zip(ORIENTATION_ANGLES, map(float, self.max_abs_rad * ARCMIN_PER_RAD), strict=True)
-            ),
+            "max_abs_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.max_abs_rad),
             "limits_arcmin": self.limits.to_dict(),
             "all_within": self.all_within,
             "n_exceeding": dict(
@@ -134,20 +132,8 @@ class MonteCarloResult:
             "n": self.n,
             "seed": self.seed,
             "sampling": "magnitude uniform in [lower, upper] bound, random sign; deta = 0",
-            "upper_bounds_arcmin": dict(
-                zip(
-                    ANGULAR_ERROR_NAMES,
-                    map(float, self.upper_bounds_rad * ARCMIN_PER_RAD),
-                    strict=True,
-                )
-            ),
-            "lower_bounds_arcmin": dict(
-                zip(
-                    ANGULAR_ERROR_NAMES,
-                    map(float, self.lower_bounds_rad * ARCMIN_PER_RAD),
-                    strict=True,
-                )
-            ),
+            "upper_bounds_arcmin": arcmin_by_name(ANGULAR_ERROR_NAMES, self.upper_bounds_rad),
+            "lower_bounds_arcmin": arcmin_by_name(ANGULAR_ERROR_NAMES, self.lower_bounds_rad),
             "phi2_step_deg": self.phi2_step_deg,
             "phi1_evaluated_deg": list(self.phi1_evaluated_deg),
             "max_phi1_dependence": self.max_phi1_dependence,

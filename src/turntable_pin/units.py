@@ -47,3 +47,11 @@ def deg_to_rad(value_deg):
 def rad_to_deg(value_rad):
     """Radians to degrees (scalars or arrays)."""
     return _scaled(value_rad, DEG_PER_RAD)
+
+
+def arcmin_by_name(names, values_rad) -> dict[str, float]:
+    """``{name: value in arc minutes}`` for parallel sequences of names and radian values."""
+    return {
+        str(n): float(v) * ARCMIN_PER_RAD
+        for n, v in zip(names, np.asarray(values_rad, dtype=float).ravel(), strict=True)
+    }
