@@ -23,9 +23,9 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 from turntable_pin import TurntableErrors  # noqa: E402
-from turntable_pin.measurements import read_measurements  # noqa: E402
-from turntable_pin.orientation_diagnosis import diagnose_measurements  # noqa: E402
-from turntable_pin.simulation import simulate_measurements  # noqa: E402
+from turntable_pin.measurement.data import read_measurements  # noqa: E402
+from turntable_pin.measurement.diagnosis import diagnose_measurements  # noqa: E402
+from turntable_pin.measurement.simulation import simulate_measurements  # noqa: E402
 
 HIDDEN = {
     "none": {},

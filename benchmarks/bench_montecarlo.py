@@ -16,9 +16,9 @@ import time
 
 import numpy as np
 
-from turntable_pin.allocation import OrientationLimits, allocate_tolerances
-from turntable_pin.monte_carlo import run_monte_carlo
-from turntable_pin.units import ARCMIN_PER_RAD
+from turntable_pin.allocation.monte_carlo import run_monte_carlo
+from turntable_pin.allocation.solver import OrientationLimits, allocate_tolerances
+from turntable_pin.core.units import ARCMIN_PER_RAD
 
 
 def main() -> None:

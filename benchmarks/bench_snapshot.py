@@ -12,8 +12,8 @@ import time
 from pathlib import Path
 
 from turntable_pin import SetupScene, TurntableErrors, render_snapshot
-from turntable_pin.browser import check_page_images
-from turntable_pin.turntable_model import models_dir
+from turntable_pin.core.resources import models_dir
+from turntable_pin.viewer.browser import check_page_images
 
 
 def main() -> None:

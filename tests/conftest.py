@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from turntable_pin import TurntableErrors
-from turntable_pin.units import arcsec_to_rad
+from turntable_pin.core.units import arcsec_to_rad
 
 
 def random_errors(rng: np.random.Generator, scale_arcsec: float = 10.0) -> TurntableErrors:

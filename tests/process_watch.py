@@ -14,7 +14,7 @@ import threading
 import time
 from pathlib import Path
 
-from turntable_pin.browser import process_table
+from turntable_pin.viewer.browser import process_table
 
 _RUN_DIR = re.compile(r"--user-data-dir=(/\S*turntable-pin-chromium-[^/\s]+)/profile")
 

@@ -9,7 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from turntable_pin import ANGULAR_ERROR_NAMES, InfeasibleError, InputError
-from turntable_pin.allocation import (
+from turntable_pin.allocation.capability import ManufacturingCapability
+from turntable_pin.allocation.solver import (
     ORIENTATION_ANGLES,
     PHI2_INTERVALS_RAD,
     OrientationLimits,
@@ -23,8 +24,7 @@ from turntable_pin.allocation import (
     solve_subproblem,
     worst_case_full_circle,
 )
-from turntable_pin.manufacturing_capability import ManufacturingCapability
-from turntable_pin.units import ARCMIN_PER_RAD, arcmin_to_rad, arcsec_to_rad
+from turntable_pin.core.units import ARCMIN_PER_RAD, arcmin_to_rad, arcsec_to_rad
 
 TABLE4_ARCMIN = {
     "dphi_y1": 0.4235, "dphi_z2": 0.7800, "dalpha_x1": 0.4234, "dalpha_z1": 0.7800,

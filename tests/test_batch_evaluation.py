@@ -5,7 +5,7 @@ import pytest
 
 from conftest import random_errors
 from turntable_pin import OrientationErrorField, TurntableModel
-from turntable_pin.batch_evaluation import trig_basis
+from turntable_pin.model.batch_field import trig_basis
 
 
 def test_batch_equals_per_call_pinocchio(rng):

@@ -11,7 +11,7 @@ import matplotlib.pyplot as plt
 import pytest
 
 from process_watch import ProcessWatch
-from turntable_pin.browser import (
+from turntable_pin.viewer.browser import (
     CHROMIUM_ENV,
     BrowserError,
     BrowserNotFoundError,

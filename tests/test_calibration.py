@@ -8,9 +8,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from turntable_pin import IdentifiabilityError, InputError
-from turntable_pin.calibration import calibrate, calibrate_run, simulate_run, write_simulated_run
-from turntable_pin.gyrowheel_model import GyroWheelModel
-from turntable_pin.test_positions import PositionSet, position_inputs
+from turntable_pin.calibration.drift_fit import (
+    calibrate,
+    calibrate_run,
+    simulate_run,
+    write_simulated_run,
+)
+from turntable_pin.calibration.gyrowheel import GyroWheelModel
+from turntable_pin.calibration.positions import PositionSet, position_inputs
 
 LAT_RAD = np.radians(45.75)
 EXAMPLE = Path(__file__).resolve().parents[1] / "models" / "examples" / "gyrowheel_run_example.csv"
@@ -39,7 +44,7 @@ def test_noise_free_outputs_calibrate_back_to_table_1(scheme):
 @settings(max_examples=25, deadline=None)
 def test_any_identifying_position_set_recovers_random_coefficients(phi, lat):
     rng = np.random.default_rng(len(phi))
-    from turntable_pin.gyrowheel_model import DriftCoefficients
+    from turntable_pin.calibration.gyrowheel import DriftCoefficients
 
     gyro = GyroWheelModel(
         DriftCoefficients("x", tuple(rng.uniform(-100, 100, 7))),

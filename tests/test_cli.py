@@ -10,7 +10,7 @@ import pytest
 
 from turntable_pin import TurntableErrors, TurntableModel
 from turntable_pin.cli import main
-from turntable_pin.units import ARCSEC_PER_RAD
+from turntable_pin.core.units import ARCSEC_PER_RAD
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess:

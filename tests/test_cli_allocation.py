@@ -10,8 +10,8 @@ import pytest
 from turntable_pin import ANGULAR_ERROR_NAMES
 from turntable_pin.cli import main
 from turntable_pin.cli.allocation import parse_limits
-from turntable_pin.exceptions import InputError
-from turntable_pin.units import ARCMIN_PER_RAD
+from turntable_pin.core.exceptions import InputError
+from turntable_pin.core.units import ARCMIN_PER_RAD
 
 PAPER = ["--limits-arcmin", "psi=1.4801,theta=1.56,gamma=1.4801", "--weights", "paper"]
 

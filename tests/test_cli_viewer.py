@@ -12,7 +12,7 @@ import time
 import pytest
 
 from process_watch import ProcessWatch, alive
-from turntable_pin.browser import chromium_available
+from turntable_pin.viewer.browser import chromium_available
 
 pytest.importorskip("meshcat")
 _no_chromium = pytest.mark.skipif(

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from turntable_pin import InputError
-from turntable_pin.csv_table import read_csv_table, write_csv_table
+from turntable_pin.core.csv_table import read_csv_table, write_csv_table
 
 REQ = ("phi1_deg", "phi2_deg", "dpsi_arcsec")
 HEAD = "phi1_deg,phi2_deg,dpsi_arcsec\n"

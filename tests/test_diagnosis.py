@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 from conftest import random_errors
-from turntable_pin.effects import EFFECTS
-from turntable_pin.measurements import OrientationMeasurements
-from turntable_pin.orientation_diagnosis import diagnose_measurements
-from turntable_pin.orientation_fit import fit_orientation
-from turntable_pin.simulation import simulate_measurements
-from turntable_pin.units import ARCSEC_PER_RAD
+from turntable_pin.core.units import ARCSEC_PER_RAD
+from turntable_pin.measurement.data import OrientationMeasurements
+from turntable_pin.measurement.diagnosis import diagnose_measurements
+from turntable_pin.measurement.effects import EFFECTS
+from turntable_pin.measurement.fit import fit_orientation
+from turntable_pin.measurement.simulation import simulate_measurements
 
 
 def effect_parameters(name: str, rng: np.random.Generator) -> dict[str, float]:
@@ -155,7 +155,7 @@ def test_spec_json_keys():
 
 
 def test_few_positions_leave_large_effects_untestable_instead_of_failing():
-    from turntable_pin.simulation import Schedule
+    from turntable_pin.measurement.simulation import Schedule
 
     sim = simulate_measurements(schedule=Schedule(360, 180), seed=1)  # 2 positions, 6 angles
     d = diagnose_measurements(sim.data).to_dict()
@@ -185,7 +185,7 @@ def test_a_partial_explanation_is_not_an_alternative():
 def test_a_spurious_first_round_candidate_is_shown_not_significant_on_top_of_the_real_one():
     from pathlib import Path
 
-    from turntable_pin.measurements import read_measurements
+    from turntable_pin.measurement.data import read_measurements
 
     example = Path(__file__).resolve().parents[1] / "models/examples/measurements_example.csv"
     d = diagnose_measurements(read_measurements(example)).to_dict()

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from turntable_pin import TurntableErrors, TurntableModel
-from turntable_pin.effects import EFFECT_NAMES, EFFECTS, PositionVariables, get_effect
-from turntable_pin.error_parameters import ANGULAR_ERROR_NAMES
-from turntable_pin.exceptions import InputError
-from turntable_pin.orientation_model import OrientationModel
-from turntable_pin.rotations import rot_x, rot_y, rot_z
+from turntable_pin.core.exceptions import InputError
+from turntable_pin.core.rotations import rot_x, rot_y, rot_z
+from turntable_pin.measurement.effect_model import OrientationModel
+from turntable_pin.measurement.effects import EFFECT_NAMES, EFFECTS, PositionVariables, get_effect
+from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
 
 SPEC_NAMES = (
     "outer_encoder_harmonics", "inner_encoder_harmonics", "outer_wobble_harmonics",

@@ -6,7 +6,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from turntable_pin import ERROR_NAMES, InputError, TurntableErrors
-from turntable_pin.units import ARCSEC_PER_RAD
+from turntable_pin.core.units import ARCSEC_PER_RAD
 
 
 def test_user_units_are_arcsec_and_mm():

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from turntable_pin import InputError
-from turntable_pin.gyrowheel_model import DriftCoefficients, GyroWheelModel, regressor_matrix
+from turntable_pin.calibration.gyrowheel import DriftCoefficients, GyroWheelModel, regressor_matrix
 
 # Paper Table 1, typed from the paper independently of models/gyrowheel_nominal.yaml.
 TABLE1_X = {"DF": -93.3, "x": -43.2, "y": 3.5, "z": -1.2, "xx": 2.1, "zz": -0.089, "xy": 17.4}

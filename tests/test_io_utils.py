@@ -3,7 +3,7 @@ import os
 import pytest
 
 from turntable_pin import InputError
-from turntable_pin.io_utils import read_yaml, write_text_atomic
+from turntable_pin.core.files import read_yaml, write_text_atomic
 
 
 def test_atomic_write_replaces_and_leaves_no_temporary(tmp_path):
@@ -18,7 +18,7 @@ def test_atomic_write_replaces_and_leaves_no_temporary(tmp_path):
 
 
 def test_failed_write_keeps_the_old_file(tmp_path):
-    from turntable_pin.io_utils import write_atomic
+    from turntable_pin.core.files import write_atomic
 
     target = tmp_path / "out.txt"
     target.write_text("precious")

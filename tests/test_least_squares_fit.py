@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from turntable_pin import IdentifiabilityError, TurntableErrors
-from turntable_pin.effects import EFFECTS
-from turntable_pin.least_squares_fit import combination_name, fit_least_squares
-from turntable_pin.orientation_fit import fit_orientation
-from turntable_pin.simulation import simulate_measurements
+from turntable_pin.measurement.effects import EFFECTS
+from turntable_pin.measurement.fit import fit_orientation
+from turntable_pin.measurement.simulation import simulate_measurements
+from turntable_pin.stats.least_squares import combination_name, fit_least_squares
 
 
 class LinearToy:

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from turntable_pin import ANGULAR_ERROR_NAMES, InputError
-from turntable_pin.manufacturing_capability import ManufacturingCapability
-from turntable_pin.units import arcmin_to_rad, arcsec_to_rad
+from turntable_pin.allocation.capability import ManufacturingCapability
+from turntable_pin.core.units import arcmin_to_rad, arcsec_to_rad
 
 
 def test_defaults_have_a_reason_for_every_error():

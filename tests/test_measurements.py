@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from turntable_pin import InputError
-from turntable_pin.measurements import read_measurements
+from turntable_pin.measurement.data import read_measurements
 
 HEAD = "phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec"
 

@@ -7,7 +7,7 @@ import builtins
 import pytest
 
 from process_watch import alive
-from turntable_pin.meshcat_server import (
+from turntable_pin.viewer.meshcat_server import (
     MeshcatMissingError,
     MeshcatServer,
     MeshcatServerError,

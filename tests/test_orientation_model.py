@@ -5,8 +5,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from turntable_pin import OrientationErrorField, small_angle_orientation_error
-from turntable_pin.effects import EFFECTS, PositionVariables
-from turntable_pin.orientation_model import OrientationModel
+from turntable_pin.measurement.effect_model import OrientationModel
+from turntable_pin.measurement.effects import EFFECTS, PositionVariables
 
 
 def _grid_variables(seed=0, n=60):

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from turntable_pin import InputError
-from turntable_pin.orientation_requirement import orientation_requirement
-from turntable_pin.rate_error import orientation_error_rotation, rate_errors_dph
-from turntable_pin.test_positions import PositionSet
+from turntable_pin.calibration.positions import PositionSet
+from turntable_pin.calibration.rate_error import orientation_error_rotation, rate_errors_dph
+from turntable_pin.calibration.requirement import orientation_requirement
 
 LAT_RAD = np.radians(45.75)
 W_M = 0.01

@@ -1,6 +1,6 @@
 import io
 
-from turntable_pin.progress import Progress
+from turntable_pin.core.progress import Progress
 
 
 def test_non_tty_prints_every_ten_percent():

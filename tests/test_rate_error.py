@@ -7,9 +7,13 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from turntable_pin import IdentifiabilityError, OrientationErrorField, TurntableErrors
-from turntable_pin.gyrowheel_model import GyroWheelModel, regressor_matrix
-from turntable_pin.rate_error import orientation_error_rotation, rate_error, rate_errors_dph
-from turntable_pin.test_positions import PositionSet, position_inputs
+from turntable_pin.calibration.gyrowheel import GyroWheelModel, regressor_matrix
+from turntable_pin.calibration.positions import PositionSet, position_inputs
+from turntable_pin.calibration.rate_error import (
+    orientation_error_rotation,
+    rate_error,
+    rate_errors_dph,
+)
 
 LAT_RAD = np.radians(45.75)
 GYRO = GyroWheelModel.nominal()

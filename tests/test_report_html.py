@@ -6,10 +6,10 @@ import re
 import pytest
 
 from turntable_pin import TurntableErrors
-from turntable_pin.browser import check_page_images, chromium_available
-from turntable_pin.orientation_diagnosis import diagnose_measurements
-from turntable_pin.report_html import diagnosis_html, write_report
-from turntable_pin.simulation import simulate_measurements
+from turntable_pin.measurement.diagnosis import diagnose_measurements
+from turntable_pin.measurement.simulation import simulate_measurements
+from turntable_pin.report.html_report import diagnosis_html, write_report
+from turntable_pin.viewer.browser import check_page_images, chromium_available
 
 
 def test_report_tells_the_whole_story(tmp_path):

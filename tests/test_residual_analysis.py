@@ -3,16 +3,16 @@
 import numpy as np
 import pytest
 
-from turntable_pin.measurements import OrientationMeasurements
-from turntable_pin.orientation_fit import fit_orientation
-from turntable_pin.residual_analysis import (
+from turntable_pin.core.units import ARCSEC_PER_RAD
+from turntable_pin.measurement.data import OrientationMeasurements
+from turntable_pin.measurement.fit import fit_orientation
+from turntable_pin.measurement.residuals import (
     analyse_residuals,
     harmonic_amplitudes,
     orientation_residuals,
     write_residual_plots,
 )
-from turntable_pin.simulation import simulate_measurements
-from turntable_pin.units import ARCSEC_PER_RAD
+from turntable_pin.measurement.simulation import simulate_measurements
 
 
 def test_harmonic_amplitudes_of_a_pure_harmonic():

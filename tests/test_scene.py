@@ -14,9 +14,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from turntable_pin import InputError, TurntableErrors
-from turntable_pin.error_parameters import ANGULAR_ERROR_NAMES
-from turntable_pin.rotations import rot_x, rot_y, rot_z
-from turntable_pin.scene import (
+from turntable_pin.core.rotations import rot_x, rot_y, rot_z
+from turntable_pin.core.units import arcsec_to_rad
+from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
+from turntable_pin.viewer.scene import (
     DEFAULT_DISPLAY_ANGLE_RAD,
     DEFAULT_DISPLAY_OFFSET_M,
     ROOT,
@@ -25,7 +26,6 @@ from turntable_pin.scene import (
     animation_frames_rad,
     default_positions_deg,
 )
-from turntable_pin.units import arcsec_to_rad
 
 EXAMPLE = TurntableErrors.from_arcsec(
     dphi_y1=2.0,
@@ -157,7 +157,7 @@ def _decoded_commands(page: str) -> list[dict]:
 
 def test_meshcat_receives_the_poses_of_the_model():
     pytest.importorskip("meshcat")
-    from turntable_pin.meshcat_server import MeshcatServer
+    from turntable_pin.viewer.meshcat_server import MeshcatServer
 
     scene = SetupScene(EXAMPLE)
     phi1, phi2 = 0.7, 2.1

@@ -5,7 +5,7 @@ import pytest
 
 from conftest import random_errors
 from turntable_pin import TurntableErrors, TurntableModel, small_angle_matrix
-from turntable_pin.sensitivity import (
+from turntable_pin.allocation.sensitivity import (
     average_sensitivities,
     paper_style_grid_deg,
     plot_sensitivities,

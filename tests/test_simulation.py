@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from turntable_pin import InputError, TurntableErrors
-from turntable_pin.measurements import read_measurements
-from turntable_pin.orientation_model import OrientationModel
-from turntable_pin.simulation import Schedule, simulate_measurements
-from turntable_pin.units import ARCSEC_PER_RAD
+from turntable_pin.core.units import ARCSEC_PER_RAD
+from turntable_pin.measurement.data import read_measurements
+from turntable_pin.measurement.effect_model import OrientationModel
+from turntable_pin.measurement.simulation import Schedule, simulate_measurements
 
 
 def test_grid_schedule_and_reproducible_seed():
@@ -94,6 +94,6 @@ def test_bad_simulation_requests():
 
 def test_cli_choices_match_the_library():
     from turntable_pin.cli import measurement
-    from turntable_pin.simulation import APPROACHES, ORDERS
+    from turntable_pin.measurement.simulation import APPROACHES, ORDERS
 
     assert measurement.ORDERS == ORDERS and measurement.APPROACHES == APPROACHES

@@ -14,9 +14,9 @@ import pytest
 
 from process_watch import ProcessWatch, alive
 from turntable_pin import InputError, TurntableErrors
-from turntable_pin.browser import CHROMIUM_ENV, BrowserError, chromium_available
-from turntable_pin.scene import SetupScene
-from turntable_pin.snapshot import decorate_static_page, render_snapshot
+from turntable_pin.viewer.browser import CHROMIUM_ENV, BrowserError, chromium_available
+from turntable_pin.viewer.scene import SetupScene
+from turntable_pin.viewer.snapshot import decorate_static_page, render_snapshot
 
 pytest.importorskip("meshcat")
 _no_chromium = pytest.mark.skipif(

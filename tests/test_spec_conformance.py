@@ -23,14 +23,14 @@ import pytest
 
 import spec_reference as ref
 from turntable_pin import TurntableErrors
-from turntable_pin.batch_evaluation import OrientationErrorField
-from turntable_pin.effects import EFFECT_NAMES, get_effect
-from turntable_pin.effects.base import PositionVariables
-from turntable_pin.measurements import read_measurements
-from turntable_pin.orientation_fit import fit_orientation
-from turntable_pin.orientation_model import OrientationModel
-from turntable_pin.simulation import Schedule, simulate_measurements
-from turntable_pin.turntable_model import TurntableModel
+from turntable_pin.measurement.data import read_measurements
+from turntable_pin.measurement.effect_model import OrientationModel
+from turntable_pin.measurement.effects import EFFECT_NAMES, get_effect
+from turntable_pin.measurement.effects.base import PositionVariables
+from turntable_pin.measurement.fit import fit_orientation
+from turntable_pin.measurement.simulation import Schedule, simulate_measurements
+from turntable_pin.model.batch_field import OrientationErrorField
+from turntable_pin.model.turntable import TurntableModel
 
 SEEDS = (3, 11)  # the CLI part takes ~20 s on 2 cores; more seeds were tried by hand
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from turntable_pin.structure_search import Probe, delta_bic, search_structure
+from turntable_pin.stats.structure_search import Probe, delta_bic, search_structure
 
 
 def _probes(x):

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from turntable_pin import InputError
-from turntable_pin.test_positions import EARTH_RATE_DPH, PositionSet, position_inputs
+from turntable_pin.calibration.positions import EARTH_RATE_DPH, PositionSet, position_inputs
 
 
 def eq3(phi1, phi2, lat):

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 from conftest import random_errors
 from turntable_pin import ANGULAR_ERROR_NAMES, TurntableErrors, TurntableModel, YourdfpyTurntable
-from turntable_pin.small_angle import small_angle_matrix, small_angle_orientation_error
+from turntable_pin.model.small_angle import small_angle_matrix, small_angle_orientation_error
 
 
 def _rx(a):
@@ -157,7 +157,7 @@ def test_central_differences_of_the_exact_chain_give_eq26(rng):
 
 
 def test_models_dir_prefers_the_environment_then_the_checkout(tmp_path, monkeypatch):
-    from turntable_pin.turntable_model import default_urdf_path, models_dir
+    from turntable_pin.core.resources import default_urdf_path, models_dir
 
     assert (models_dir() / "turntable.urdf").is_file()  # the repository's models/
     monkeypatch.setenv("TURNTABLE_PIN_MODELS", str(tmp_path))

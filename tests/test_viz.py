@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from turntable_pin.browser import check_page_images, chromium_available
+from turntable_pin.viewer.browser import check_page_images, chromium_available
 
 VIZ = Path(__file__).resolve().parents[1] / "viz"
 SCRIPTS = sorted(VIZ.glob("fig_*.py"))

@@ -15,8 +15,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from turntable_pin import OrientationErrorField, TurntableErrors, small_angle_orientation_error
-from turntable_pin.turntable_model import models_dir
-from turntable_pin.units import ARCSEC_PER_RAD
+from turntable_pin.core.resources import models_dir
+from turntable_pin.core.units import ARCSEC_PER_RAD
 
 PHI1_DEG = 30.0
 

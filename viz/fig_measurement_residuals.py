@@ -9,11 +9,11 @@ The HTML report of the same diagnosis is written beside them.
 import sys
 from pathlib import Path
 
-from turntable_pin.measurements import read_measurements
-from turntable_pin.orientation_diagnosis import diagnose_measurements
-from turntable_pin.report_html import write_report
-from turntable_pin.residual_analysis import orientation_residuals, write_residual_plots
-from turntable_pin.turntable_model import models_dir
+from turntable_pin.core.resources import models_dir
+from turntable_pin.measurement.data import read_measurements
+from turntable_pin.measurement.diagnosis import diagnose_measurements
+from turntable_pin.measurement.residuals import orientation_residuals, write_residual_plots
+from turntable_pin.report.html_report import write_report
 
 
 def main(out_dir: Path, fast: bool = False) -> list[Path]:

@@ -22,8 +22,8 @@ from turntable_pin import (
     TurntableModel,
     small_angle_orientation_error,
 )
-from turntable_pin.turntable_model import models_dir
-from turntable_pin.units import ARCSEC_PER_RAD
+from turntable_pin.core.resources import models_dir
+from turntable_pin.core.units import ARCSEC_PER_RAD
 
 PHI1_DEG = (0.0, 45.0, 90.0)
 

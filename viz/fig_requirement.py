@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 from turntable_pin import PositionSet, orientation_requirement
-from turntable_pin.requirement_plots import write_requirement_figures
+from turntable_pin.report.requirement_figures import write_requirement_figures
 
 
 def main(out_dir: Path, fast: bool = False) -> list[Path]:

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 
 from turntable_pin import TurntableErrors
-from turntable_pin.scene import SetupScene
-from turntable_pin.snapshot import render_snapshot
-from turntable_pin.turntable_model import models_dir
+from turntable_pin.core.resources import models_dir
+from turntable_pin.viewer.scene import SetupScene
+from turntable_pin.viewer.snapshot import render_snapshot
 
 POSITIONS_DEG = ((30.0, 45.0), (90.0, 0.0))
 

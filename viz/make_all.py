@@ -20,8 +20,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from turntable_pin.exceptions import TurntablePinError
-from turntable_pin.io_utils import write_text_atomic
+from turntable_pin.core.exceptions import TurntablePinError
+from turntable_pin.core.files import write_text_atomic
 
 VIZ_DIR = Path(__file__).resolve().parent
 

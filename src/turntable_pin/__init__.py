@@ -13,106 +13,114 @@ calibration layer (``GyroWheelModel``, ``PositionSet``, ``calibrate_run``, ``rat
 viewer (``SetupScene``, ``render_snapshot``). Everything else lives in its module.
 """
 
-from .allocation import (
-    Allocation,
-    OrientationLimits,
-    allocate_tolerances,
-    default_orientation_limits,
-    paper_eq16_limits,
-)
-from .batch_evaluation import OrientationErrorField
-from .calibration import CalibrationResult, calibrate, calibrate_run
-from .diagnosis import Diagnosis
-from .effects import EFFECT_NAMES, EFFECTS, Effect
-from .error_parameters import ANGULAR_ERROR_NAMES, ERROR_NAMES, TurntableErrors
-from .exceptions import (
-    IdentifiabilityError,
-    InfeasibleError,
-    InputError,
-    ModelError,
-    TurntablePinError,
-)
-from .gyrowheel_model import GyroWheelModel
-from .least_squares_fit import FitResult
-from .manufacturing_capability import ManufacturingCapability
-from .measurements import OrientationMeasurements, read_measurements
-from .monte_carlo import MonteCarloResult, plot_monte_carlo, run_monte_carlo
-from .orientation_diagnosis import diagnose_measurements
-from .orientation_fit import OrientationFit, fit_orientation
-from .orientation_model import OrientationModel
-from .orientation_requirement import OrientationRequirement, orientation_requirement
-from .rate_error import RateErrorResult, rate_error
-from .report_html import write_report
-from .scene import Exaggeration, SetupScene
-from .sensitivity import (
-    AverageSensitivities,
-    average_sensitivities,
-    plot_sensitivities,
-    sensitivity_matrix,
-)
-from .simulation import SimulatedMeasurements, simulate_measurements
-from .small_angle import small_angle_matrix, small_angle_orientation_error
-from .snapshot import render_snapshot
-from .test_positions import PositionSet, position_inputs
-from .turntable_model import OrientationError, TurntableModel, default_urdf_path
-from .urdf_io import YourdfpyTurntable
+from typing import TYPE_CHECKING
 
-__all__ = [
-    "ANGULAR_ERROR_NAMES",
-    "Allocation",
-    "AverageSensitivities",
-    "CalibrationResult",
-    "Diagnosis",
-    "EFFECTS",
-    "EFFECT_NAMES",
-    "ERROR_NAMES",
-    "Effect",
-    "Exaggeration",
-    "FitResult",
-    "GyroWheelModel",
-    "IdentifiabilityError",
-    "InfeasibleError",
-    "InputError",
-    "ManufacturingCapability",
-    "ModelError",
-    "MonteCarloResult",
-    "OrientationError",
-    "OrientationErrorField",
-    "OrientationFit",
-    "OrientationLimits",
-    "OrientationMeasurements",
-    "OrientationModel",
-    "OrientationRequirement",
-    "PositionSet",
-    "RateErrorResult",
-    "SetupScene",
-    "SimulatedMeasurements",
-    "TurntableErrors",
-    "TurntableModel",
-    "TurntablePinError",
-    "YourdfpyTurntable",
-    "allocate_tolerances",
-    "average_sensitivities",
-    "calibrate",
-    "calibrate_run",
-    "default_orientation_limits",
-    "default_urdf_path",
-    "diagnose_measurements",
-    "fit_orientation",
-    "orientation_requirement",
-    "paper_eq16_limits",
-    "plot_monte_carlo",
-    "plot_sensitivities",
-    "position_inputs",
-    "rate_error",
-    "read_measurements",
-    "render_snapshot",
-    "run_monte_carlo",
-    "sensitivity_matrix",
-    "simulate_measurements",
-    "small_angle_matrix",
-    "small_angle_orientation_error",
-    "write_report",
-]
+from .core.lazy import lazy_exports
 
+_EXPORTS = {
+    "ANGULAR_ERROR_NAMES": "model.errors",
+    "Allocation": "allocation.solver",
+    "AverageSensitivities": "allocation.sensitivity",
+    "CalibrationResult": "calibration.drift_fit",
+    "Diagnosis": "stats.model_selection",
+    "EFFECTS": "measurement.effects",
+    "EFFECT_NAMES": "measurement.effects",
+    "ERROR_NAMES": "model.errors",
+    "Effect": "measurement.effects",
+    "Exaggeration": "viewer.scene",
+    "FitResult": "stats.least_squares",
+    "GyroWheelModel": "calibration.gyrowheel",
+    "IdentifiabilityError": "core.exceptions",
+    "InfeasibleError": "core.exceptions",
+    "InputError": "core.exceptions",
+    "ManufacturingCapability": "allocation.capability",
+    "ModelError": "core.exceptions",
+    "MonteCarloResult": "allocation.monte_carlo",
+    "OrientationError": "model.turntable",
+    "OrientationErrorField": "model.batch_field",
+    "OrientationFit": "measurement.fit",
+    "OrientationLimits": "allocation.solver",
+    "OrientationMeasurements": "measurement.data",
+    "OrientationModel": "measurement.effect_model",
+    "OrientationRequirement": "calibration.requirement",
+    "PositionSet": "calibration.positions",
+    "RateErrorResult": "calibration.rate_error",
+    "SetupScene": "viewer.scene",
+    "SimulatedMeasurements": "measurement.simulation",
+    "TurntableErrors": "model.errors",
+    "TurntableModel": "model.turntable",
+    "TurntablePinError": "core.exceptions",
+    "YourdfpyTurntable": "model.urdf_io",
+    "allocate_tolerances": "allocation.solver",
+    "average_sensitivities": "allocation.sensitivity",
+    "calibrate": "calibration.drift_fit",
+    "calibrate_run": "calibration.drift_fit",
+    "default_orientation_limits": "allocation.solver",
+    "default_urdf_path": "core.resources",
+    "diagnose_measurements": "measurement.diagnosis",
+    "fit_orientation": "measurement.fit",
+    "orientation_requirement": "calibration.requirement",
+    "paper_eq16_limits": "allocation.solver",
+    "plot_monte_carlo": "allocation.monte_carlo",
+    "plot_sensitivities": "allocation.sensitivity",
+    "position_inputs": "calibration.positions",
+    "rate_error": "calibration.rate_error",
+    "read_measurements": "measurement.data",
+    "render_snapshot": "viewer.snapshot",
+    "run_monte_carlo": "allocation.monte_carlo",
+    "sensitivity_matrix": "allocation.sensitivity",
+    "simulate_measurements": "measurement.simulation",
+    "small_angle_matrix": "model.small_angle",
+    "small_angle_orientation_error": "model.small_angle",
+    "write_report": "report.html_report",
+}
+
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 __version__ = "0.1.0"
+
+if TYPE_CHECKING:  # names for static checkers; nothing is imported at run time
+    from .allocation.capability import ManufacturingCapability  # noqa: F401
+    from .allocation.monte_carlo import MonteCarloResult, plot_monte_carlo, run_monte_carlo  # noqa: F401
+    from .allocation.sensitivity import (  # noqa: F401
+        AverageSensitivities,
+        average_sensitivities,
+        plot_sensitivities,
+        sensitivity_matrix,
+    )
+    from .allocation.solver import (  # noqa: F401
+        Allocation,
+        OrientationLimits,
+        allocate_tolerances,
+        default_orientation_limits,
+        paper_eq16_limits,
+    )
+    from .calibration.drift_fit import CalibrationResult, calibrate, calibrate_run  # noqa: F401
+    from .calibration.gyrowheel import GyroWheelModel  # noqa: F401
+    from .calibration.positions import PositionSet, position_inputs  # noqa: F401
+    from .calibration.rate_error import RateErrorResult, rate_error  # noqa: F401
+    from .calibration.requirement import OrientationRequirement, orientation_requirement  # noqa: F401
+    from .core.exceptions import (  # noqa: F401
+        IdentifiabilityError,
+        InfeasibleError,
+        InputError,
+        ModelError,
+        TurntablePinError,
+    )
+    from .core.resources import default_urdf_path  # noqa: F401
+    from .measurement.data import OrientationMeasurements, read_measurements  # noqa: F401
+    from .measurement.diagnosis import diagnose_measurements  # noqa: F401
+    from .measurement.effect_model import OrientationModel  # noqa: F401
+    from .measurement.effects import EFFECT_NAMES, EFFECTS, Effect  # noqa: F401
+    from .measurement.fit import OrientationFit, fit_orientation  # noqa: F401
+    from .measurement.simulation import SimulatedMeasurements, simulate_measurements  # noqa: F401
+    from .model.batch_field import OrientationErrorField  # noqa: F401
+    from .model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES, TurntableErrors  # noqa: F401
+    from .model.small_angle import small_angle_matrix, small_angle_orientation_error  # noqa: F401
+    from .model.turntable import OrientationError, TurntableModel  # noqa: F401
+    from .model.urdf_io import YourdfpyTurntable  # noqa: F401
+    from .report.html_report import write_report  # noqa: F401
+    from .stats.least_squares import FitResult  # noqa: F401
+    from .stats.model_selection import Diagnosis  # noqa: F401
+    from .viewer.scene import Exaggeration, SetupScene  # noqa: F401
+    from .viewer.snapshot import render_snapshot  # noqa: F401

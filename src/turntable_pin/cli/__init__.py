@@ -11,7 +11,7 @@ import argparse
 import importlib
 import sys
 
-from ..exceptions import TurntablePinError
+from ..core.exceptions import TurntablePinError
 
 COMMAND_MODULES: tuple[str, ...] = (
     "orientation",

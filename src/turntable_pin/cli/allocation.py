@@ -5,7 +5,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..allocation import (
+from ..allocation.capability import ManufacturingCapability
+from ..allocation.monte_carlo import plot_monte_carlo, run_monte_carlo
+from ..allocation.sensitivity import AverageSensitivities, average_sensitivities, plot_sensitivities
+from ..allocation.solver import (
     DEFAULT_ACCURACY_DPH,
     DEFAULT_LATITUDE_DEG,
     DEFAULT_POSITIONS,
@@ -16,11 +19,8 @@ from ..allocation import (
     allocate_tolerances,
     default_orientation_limits,
 )
-from ..exceptions import InputError
-from ..manufacturing_capability import ManufacturingCapability
-from ..monte_carlo import plot_monte_carlo, run_monte_carlo
-from ..sensitivity import AverageSensitivities, average_sensitivities, plot_sensitivities
-from ..units import ARCMIN_PER_RAD
+from ..core.exceptions import InputError
+from ..core.units import ARCMIN_PER_RAD
 from .common import finite_float, positive_int, print_json
 
 

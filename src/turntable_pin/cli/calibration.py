@@ -5,12 +5,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..calibration import calibrate_run
-from ..gyrowheel_model import GyroWheelModel
-from ..orientation_requirement import orientation_requirement
-from ..rate_error import DEFINITIONS, rate_error
-from ..test_positions import PositionSet, position_inputs
-from ..units import deg_to_rad
+from ..calibration.drift_fit import calibrate_run
+from ..calibration.gyrowheel import GyroWheelModel
+from ..calibration.positions import PositionSet, position_inputs
+from ..calibration.rate_error import DEFINITIONS, rate_error
+from ..calibration.requirement import orientation_requirement
+from ..core.units import deg_to_rad
 from .common import finite_float, print_json
 
 DEFAULT_LATITUDE_DEG = 45.75
@@ -126,7 +126,7 @@ def run_requirement(args: argparse.Namespace) -> int:
     )  # fmt: skip
     report = result.to_dict()
     if args.plots:
-        from ..requirement_plots import write_requirement_figures
+        from ..report.requirement_figures import write_requirement_figures
 
         report["plots"] = [str(p) for p in write_requirement_figures(result, args.plots)]
     if args.json:

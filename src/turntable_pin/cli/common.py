@@ -10,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..error_parameters import TurntableErrors, parse_error_value
-from ..exceptions import InputError
-from ..turntable_model import TurntableModel
+from ..core.exceptions import InputError
+from ..model.errors import TurntableErrors, parse_error_value
+from ..model.turntable import TurntableModel
 
 
 def finite_float(text: str) -> float:

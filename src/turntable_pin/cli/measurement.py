@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..effects import EFFECT_NAMES, get_effect, parse_effect_list
-from ..exceptions import InputError
-from ..measurements import read_measurements
+from ..core.exceptions import InputError
+from ..measurement.data import read_measurements
+from ..measurement.effects import EFFECT_NAMES, get_effect, parse_effect_list
 from .common import add_error_options, errors_from_args, finite_float, positive_int, print_json
 
 # The fitting, plotting and report modules (scipy, matplotlib) are imported inside the commands
@@ -126,7 +126,7 @@ def _parse_effect_option(text: str) -> tuple[str, dict[str, float]]:
 
 
 def run_simulate(args: argparse.Namespace) -> int:
-    from ..simulation import Schedule, simulate_measurements
+    from ..measurement.simulation import Schedule, simulate_measurements
 
     _not_an_input(args.output, args.errors, args.urdf)
     effects = dict(_parse_effect_option(t) for t in args.effect)
@@ -138,7 +138,7 @@ def run_simulate(args: argparse.Namespace) -> int:
         dwell_s=args.dwell_s,
         approach=args.approach,
     )
-    from ..turntable_model import TurntableModel
+    from ..model.turntable import TurntableModel
 
     sim = simulate_measurements(
         errors_from_args(args),
@@ -163,8 +163,12 @@ def _fit_line(label: str, summary: dict) -> str:
 
 
 def run_fit(args: argparse.Namespace) -> int:
-    from ..orientation_fit import fit_orientation
-    from ..residual_analysis import analyse_residuals, orientation_residuals, write_residual_plots
+    from ..measurement.fit import fit_orientation
+    from ..measurement.residuals import (
+        analyse_residuals,
+        orientation_residuals,
+        write_residual_plots,
+    )
 
     data = _read(args)
     effects = parse_effect_list(args.effects)
@@ -208,8 +212,8 @@ def run_fit(args: argparse.Namespace) -> int:
 
 
 def run_diagnose(args: argparse.Namespace) -> int:
-    from ..orientation_diagnosis import diagnose_measurements
-    from ..residual_analysis import orientation_residuals, write_residual_plots
+    from ..measurement.diagnosis import diagnose_measurements
+    from ..measurement.residuals import orientation_residuals, write_residual_plots
 
     data = _read(args)
     diagnosis = diagnose_measurements(data, until_explained=args.until_explained)
@@ -230,8 +234,8 @@ def run_diagnose(args: argparse.Namespace) -> int:
 
 
 def run_report(args: argparse.Namespace) -> int:
-    from ..orientation_diagnosis import diagnose_measurements
-    from ..report_html import write_report
+    from ..measurement.diagnosis import diagnose_measurements
+    from ..report.html_report import write_report
 
     _not_an_input(args.output, args.data)
     data = read_measurements(args.data)

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..small_angle import small_angle_orientation_error
-from ..units import M_PER_MM, deg_to_rad, rad_to_arcsec
+from ..core.units import M_PER_MM, deg_to_rad, rad_to_arcsec
+from ..model.small_angle import small_angle_orientation_error
 from .common import add_error_options, finite_float, model_from_args, print_json
 
 

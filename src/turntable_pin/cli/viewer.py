@@ -10,10 +10,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..csv_table import read_csv_table
-from ..exceptions import InputError
-from ..scene import Exaggeration, SetupScene, animation_frames_rad, default_positions_deg
-from ..units import deg_to_rad
+from ..core.csv_table import read_csv_table
+from ..core.exceptions import InputError
+from ..core.units import deg_to_rad
+from ..viewer.scene import Exaggeration, SetupScene, animation_frames_rad, default_positions_deg
 from .common import add_error_options, errors_from_args, finite_float, positive_int, print_json
 
 
@@ -106,7 +106,7 @@ def _raise_interrupt(signum, frame):
 
 
 def run_view(args: argparse.Namespace) -> int:
-    from ..meshcat_server import MeshcatServer
+    from ..viewer.meshcat_server import MeshcatServer
 
     scene = scene_from_args(args)
     phi1_rad, phi2_rad = deg_to_rad(args.phi1_deg), deg_to_rad(args.phi2_deg)
@@ -145,7 +145,7 @@ def run_view(args: argparse.Namespace) -> int:
 
 
 def run_snapshot(args: argparse.Namespace) -> int:
-    from ..snapshot import render_snapshot
+    from ..viewer.snapshot import render_snapshot
 
     scene = scene_from_args(args)
     result = render_snapshot(

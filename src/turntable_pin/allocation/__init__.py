@@ -1,0 +1,25 @@
+"""The sensitivity and error-allocation layer (paper section 4): sensitivities (eq. 28),
+manufacturing capability, the allocation optimisation (eqs. 31-34, Lemma 1) and the Monte Carlo
+check.
+"""
+
+from ..core.lazy import lazy_exports
+
+_EXPORTS = {
+    "Allocation": "solver",
+    "AverageSensitivities": "sensitivity",
+    "ManufacturingCapability": "capability",
+    "MonteCarloResult": "monte_carlo",
+    "OrientationLimits": "solver",
+    "allocate_tolerances": "solver",
+    "average_sensitivities": "sensitivity",
+    "default_orientation_limits": "solver",
+    "paper_eq16_limits": "solver",
+    "plot_monte_carlo": "monte_carlo",
+    "plot_sensitivities": "sensitivity",
+    "run_monte_carlo": "monte_carlo",
+    "sensitivity_matrix": "sensitivity",
+}
+
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -1,0 +1,94 @@
+"""Manufacturing capability: the lower bounds ``LB_i`` of the eight angular errors (paper eq. 29).
+
+A turntable cannot be made arbitrarily accurate; the allocation must not ask for an error component
+smaller than what manufacturing reaches. The bundled defaults live in
+``models/manufacturing_lower_bounds.yaml`` with the reasoning behind each value; users pass their
+own YAML file of the same form.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..core.exceptions import InputError
+from ..core.files import read_yaml
+from ..core.resources import default_lower_bounds_path
+from ..core.units import ARCSEC_PER_RAD
+from ..model.errors import ANGULAR_ERROR_NAMES, parse_error_value
+
+
+@dataclass(frozen=True)
+class ManufacturingCapability:
+    """Lower bounds of the eight angular errors and why they are what they are.
+
+    Attributes:
+        lower_bounds_rad: (8,) in :data:`ANGULAR_ERROR_NAMES` order, radians, each >= 0.
+        reasoning: ``{error name: text}`` saying where each bound comes from.
+        source: the file the bounds were read from (or a description).
+    """
+
+    lower_bounds_rad: np.ndarray
+    reasoning: dict[str, str] = field(default_factory=dict)
+    source: str = "none"
+
+    def __post_init__(self) -> None:
+        values = np.array(self.lower_bounds_rad, dtype=float).reshape(-1)
+        if values.size != len(ANGULAR_ERROR_NAMES):
+            raise InputError(f"expected {len(ANGULAR_ERROR_NAMES)} lower bounds, got {values.size}")
+        if not np.all(np.isfinite(values)) or np.any(values < 0.0):
+            raise InputError("lower bounds must be finite and not negative")
+        values.setflags(write=False)
+        object.__setattr__(self, "lower_bounds_rad", values)
+
+    @classmethod
+    def none(cls) -> ManufacturingCapability:
+        """No manufacturing limit (every lower bound 0)."""
+        return cls(np.zeros(len(ANGULAR_ERROR_NAMES)), source="none (all lower bounds 0)")
+
+    @classmethod
+    def default(cls) -> ManufacturingCapability:
+        """The bundled defaults (:func:`default_lower_bounds_path`)."""
+        return cls.from_yaml(default_lower_bounds_path())
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> ManufacturingCapability:
+        """Read ``lower_bounds: {name[_unit]: value}`` and optional ``reasoning: {name: text}``.
+
+        Names without a unit suffix are arc seconds; missing names get no lower bound (0).
+
+        Raises:
+            InputError: unreadable file, not YAML, unknown name, negative or non-numeric value.
+        """
+        path = Path(path)
+        data = read_yaml(path)
+        if not isinstance(data, Mapping) or not isinstance(data.get("lower_bounds"), Mapping):
+            raise InputError("expected a mapping 'lower_bounds: {name: value}'", path=path)
+        values = np.zeros(len(ANGULAR_ERROR_NAMES))
+        for key, raw in data["lower_bounds"].items():
+            try:
+                name, value = parse_error_value(str(key), raw)
+            except InputError as exc:
+                raise InputError(f"lower_bounds: {exc.detail}", path=path) from None
+            if name not in ANGULAR_ERROR_NAMES:
+                raise InputError(f"lower_bounds: '{key}' is not an angular error", path=path)
+            if value < 0.0:
+                raise InputError(f"lower_bounds: '{key}' is negative ({raw})", path=path)
+            values[ANGULAR_ERROR_NAMES.index(name)] = value
+        reasoning = data.get("reasoning") or {}
+        if not isinstance(reasoning, Mapping):
+            raise InputError("'reasoning' must map error names to text", path=path)
+        return cls(values, {str(k): str(v) for k, v in reasoning.items()}, str(path))
+
+    def to_dict(self) -> dict:
+        return {
+            "source": self.source,
+            "lower_bounds_arcsec": {
+                n: float(v * ARCSEC_PER_RAD)
+                for n, v in zip(ANGULAR_ERROR_NAMES, self.lower_bounds_rad, strict=True)
+            },
+            "reasoning": dict(self.reasoning),
+        }

@@ -1,0 +1,254 @@
+"""Monte Carlo check of an allocation with the exact Pinocchio chain (paper Figure 9).
+
+N random turntables are drawn inside the allocated box: each angular error gets a magnitude uniform
+in ``[LB_i, UB_i]`` and a random sign (the intersection error is left at 0: it moves the payload
+origin, never its orientation). Each turntable's exact ``dR`` is evaluated on a dense grid of phi2
+through :class:`OrientationErrorField` (coefficients read off the Pinocchio placements). With the
+errors of Table 2 ``dR`` does not depend on phi1 at all; the run checks that on every chunk (the
+phi1 harmonics of the coefficients) and, should some effect make it depend on phi1, evaluates a phi1
+grid as well. The result keeps each turntable's largest ``|dpsi|, |dtheta|, |dgamma|``.
+
+Chunks draw their samples from ``SeedSequence(seed).spawn(...)``, so the result depends on the seed
+only, not on the number of worker processes.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from ..core.exceptions import InputError
+from ..core.progress import Progress
+from ..core.units import ARCMIN_PER_RAD, DEG_PER_RAD, arcmin_by_name
+from ..model.batch_field import ANGLE_ENTRIES, OrientationErrorField
+from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES
+from ..model.turntable import TurntableModel
+from .solver import ORIENTATION_ANGLES, OrientationLimits
+
+CHUNK_SIZE = 2000  # turntables per block: the (chunk, 3, 360) intermediates stay small
+# Relative size of phi1 harmonics in dR below which phi1 is taken to drop out (rounding of the
+# 5x5 trigonometric fit is ~1e-16 of the largest coefficient, which is ~1).
+PHI1_TOLERANCE = 1e-12
+
+
+def sample_errors(
+    rng: np.random.Generator, n: int, upper_bounds_rad, lower_bounds_rad
+) -> np.ndarray:
+    """(n, 9) error sets: magnitudes uniform in [LB, UB], random signs, deta = 0."""
+    upper = np.asarray(upper_bounds_rad, dtype=float)
+    lower = np.asarray(lower_bounds_rad, dtype=float)
+    values = np.zeros((n, len(ERROR_NAMES)))
+    magnitudes = rng.uniform(lower, upper, size=(n, upper.size))
+    signs = rng.choice(np.array([-1.0, 1.0]), size=(n, upper.size))
+    values[:, : upper.size] = magnitudes * signs
+    return values
+
+
+def phi1_dependence(field: OrientationErrorField) -> float:
+    """Largest coefficient of a phi1 harmonic in dpsi, dtheta, dgamma (0 when phi1 drops out)."""
+    c = field.coefficients
+    return float(max(np.abs(c[:, i, j, 1:, :]).max() for i, j in ANGLE_ENTRIES))
+
+
+@lru_cache(maxsize=4)
+def _nominal_model(urdf_path: str | None) -> TurntableModel:
+    """One nominal model per process and URDF (chunks only read its placements)."""
+    return TurntableModel(urdf_path=urdf_path)
+
+
+def _run_chunk(args) -> tuple[np.ndarray, float]:
+    """Worker: sample one chunk and return each turntable's max |angle| (n, 3) and phi1 check."""
+    seed_seq, n, upper, lower, phi2_grid_rad, phi1_grid_rad, urdf_path = args
+    rng = np.random.default_rng(seed_seq)
+    values = sample_errors(rng, n, upper, lower)
+    field = OrientationErrorField.from_error_values(values, _nominal_model(urdf_path))
+    dependence = phi1_dependence(field)
+    phi1_values = [0.0] if dependence <= PHI1_TOLERANCE else phi1_grid_rad
+    worst = np.zeros((n, 3))
+    for phi1 in phi1_values:
+        angles = field.angles_on_phi2_grid(phi1, phi2_grid_rad)  # (n, 3, M)
+        np.maximum(worst, np.maximum(angles.max(axis=2), -angles.min(axis=2)), out=worst)
+    return worst, dependence
+
+
+@dataclass(frozen=True)
+class MonteCarloResult:
+    """The outcome of :func:`run_monte_carlo`.
+
+    Attributes:
+        worst_rad: (N, 3) each turntable's largest |dpsi|, |dtheta|, |dgamma| over the grid, rad.
+        upper_bounds_rad, lower_bounds_rad: (8,) the box sampled.
+        limits: the orientation limits checked against.
+        n, seed: sample size and the seed that reproduces it.
+        phi2_step_deg: grid step of phi2.  phi1_evaluated_deg: the phi1 values evaluated.
+        max_phi1_dependence: largest phi1 harmonic found in any turntable's dR.
+        elapsed_s: wall time.  workers: processes used.
+    """
+
+    worst_rad: np.ndarray
+    upper_bounds_rad: np.ndarray
+    lower_bounds_rad: np.ndarray
+    limits: OrientationLimits
+    n: int
+    seed: int
+    phi2_step_deg: float
+    phi1_evaluated_deg: tuple[float, ...]
+    max_phi1_dependence: float
+    elapsed_s: float
+    workers: int
+
+    @property
+    def max_abs_rad(self) -> np.ndarray:
+        """(3,) largest |dpsi|, |dtheta|, |dgamma| over all turntables and angles."""
+        return self.worst_rad.max(axis=0)
+
+    @property
+    def all_within(self) -> bool:
+        return bool(np.all(self.max_abs_rad <= self.limits.as_array()))
+
+    @property
+    def evaluations(self) -> int:
+        """Turntable x angle-pair evaluations done."""
+        return self.n * int(round(360.0 / self.phi2_step_deg)) * len(self.phi1_evaluated_deg)
+
+    def to_dict(self) -> dict:
+        limits = self.limits.as_array()
+        return {
+            "max_abs_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.max_abs_rad),
+            "limits_arcmin": self.limits.to_dict(),
+            "all_within": self.all_within,
+            "n_exceeding": dict(
+                zip(
+                    ORIENTATION_ANGLES,
+                    map(int, np.sum(self.worst_rad > limits, axis=0)),
+                    strict=True,
+                )
+            ),
+            "n": self.n,
+            "seed": self.seed,
+            "sampling": "magnitude uniform in [lower, upper] bound, random sign; deta = 0",
+            "upper_bounds_arcmin": arcmin_by_name(ANGULAR_ERROR_NAMES, self.upper_bounds_rad),
+            "lower_bounds_arcmin": arcmin_by_name(ANGULAR_ERROR_NAMES, self.lower_bounds_rad),
+            "phi2_step_deg": self.phi2_step_deg,
+            "phi1_evaluated_deg": list(self.phi1_evaluated_deg),
+            "max_phi1_dependence": self.max_phi1_dependence,
+            "elapsed_s": self.elapsed_s,
+            "evaluations_per_s": self.evaluations / max(self.elapsed_s, 1e-12),
+            "workers": self.workers,
+        }
+
+
+def run_monte_carlo(
+    upper_bounds_rad,
+    limits: OrientationLimits,
+    n: int,
+    seed: int,
+    *,
+    lower_bounds_rad=None,
+    phi2_step_deg: float = 1.0,
+    phi1_step_deg: float = 10.0,
+    workers: int = 1,
+    progress: bool = True,
+    urdf_path=None,
+) -> MonteCarloResult:
+    """Evaluate ``n`` random turntables inside the box and compare with ``limits``.
+
+    Args:
+        upper_bounds_rad, lower_bounds_rad: (8,) bounds of the magnitudes (lower default 0).
+        limits: orientation limits.  n: number of turntables.  seed: random seed (recorded).
+        phi2_step_deg: phi2 grid step over the whole turn.
+        phi1_step_deg: phi1 grid step, used only if dR turns out to depend on phi1.
+        workers: processes (the result does not depend on it).  progress: report on stderr.
+        urdf_path: nominal URDF (default bundled).
+    """
+    upper = np.asarray(upper_bounds_rad, dtype=float).reshape(-1)
+    lower = (
+        np.zeros_like(upper) if lower_bounds_rad is None else np.asarray(lower_bounds_rad, float)
+    )
+    if upper.size != len(ANGULAR_ERROR_NAMES) or lower.shape != upper.shape:
+        raise InputError(f"expected {len(ANGULAR_ERROR_NAMES)} upper and lower bounds")
+    if np.any(lower > upper) or np.any(lower < 0.0):
+        raise InputError("every lower bound must be between 0 and its upper bound")
+    if n < 1:
+        raise InputError(f"the number of turntables must be at least 1, got {n}")
+    for name, step in (("phi2", phi2_step_deg), ("phi1", phi1_step_deg)):
+        if not 0.0 < step <= 90.0:
+            raise InputError(f"{name} grid step must be in (0, 90] degrees, got {step}")
+    phi2_grid = np.arange(0.0, 360.0, phi2_step_deg) / DEG_PER_RAD
+    phi1_grid = np.arange(0.0, 360.0, phi1_step_deg) / DEG_PER_RAD
+    urdf = None if urdf_path is None else str(urdf_path)
+    sizes = [CHUNK_SIZE] * (n // CHUNK_SIZE) + ([n % CHUNK_SIZE] if n % CHUNK_SIZE else [])
+    seeds = np.random.SeedSequence(seed).spawn(len(sizes))
+    tasks = [
+        (s, size, upper, lower, phi2_grid, phi1_grid, urdf)
+        for s, size in zip(seeds, sizes, strict=True)
+    ]
+    workers = max(1, min(int(workers), os.cpu_count() or 1, len(tasks)))
+    start = time.perf_counter()
+    worst = np.empty((n, 3))
+    dependence = 0.0
+    with Progress(n, "Monte Carlo", enabled=progress) as bar:
+        if workers == 1:
+            results = map(_run_chunk, tasks)
+        else:
+            pool = ProcessPoolExecutor(max_workers=workers)
+            results = pool.map(_run_chunk, tasks)
+        offset = 0
+        try:
+            for (chunk_worst, chunk_dependence), size in zip(results, sizes, strict=True):
+                worst[offset : offset + size] = chunk_worst
+                dependence = max(dependence, chunk_dependence)
+                offset += size
+                bar.update(size)
+        finally:
+            if workers > 1:
+                pool.shutdown(cancel_futures=True)
+    elapsed = time.perf_counter() - start
+    phi1_used = (0.0,) if dependence <= PHI1_TOLERANCE else tuple(phi1_grid * DEG_PER_RAD)
+    return MonteCarloResult(
+        worst_rad=worst,
+        upper_bounds_rad=upper,
+        lower_bounds_rad=lower,
+        limits=limits,
+        n=n,
+        seed=seed,
+        phi2_step_deg=phi2_step_deg,
+        phi1_evaluated_deg=phi1_used,
+        max_phi1_dependence=dependence,
+        elapsed_s=elapsed,
+        workers=workers,
+    )
+
+
+def plot_monte_carlo(result: MonteCarloResult, path):
+    """Figure 9: histograms of each turntable's largest |dpsi|, |dtheta|, |dgamma| (PNG)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ..core.files import write_atomic
+
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.8))
+    limits = result.limits.as_array() * ARCMIN_PER_RAD
+    for k, (ax, name) in enumerate(zip(axes, ORIENTATION_ANGLES, strict=True)):
+        values = result.worst_rad[:, k] * ARCMIN_PER_RAD
+        ax.hist(values, bins=60, color="tab:blue", alpha=0.85)
+        ax.axvline(limits[k], color="tab:red", linestyle="--", label=f"limit {limits[k]:.4f}'")
+        ax.set_xlabel(f"max |d{name}| over phi2 (arcmin)")
+        ax.set_title(f"d{name}: max {values.max():.4f}'")
+        ax.legend(fontsize=8)
+    axes[0].set_ylabel("turntables")
+    fig.suptitle(
+        f"Monte Carlo: {result.n} turntables inside the allocated bounds (seed {result.seed}), "
+        f"exact chain, phi2 step {result.phi2_step_deg:g} deg"
+    )
+    fig.tight_layout()
+    write_atomic(path, lambda tmp: fig.savefig(tmp, format="png", dpi=120))
+    plt.close(fig)
+    return path

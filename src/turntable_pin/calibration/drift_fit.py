@@ -1,0 +1,314 @@
+"""Multi-position calibration of the GyroWheel drift coefficients by least squares (eqs. 2-6).
+
+For each sensing axis, ``b1 - b2 = A beta`` (eq. 5) over the test positions, with ``b1`` the
+measured outputs, ``b2`` the earth-rate components and ``A`` the regressor rows of eq. 2. The fit
+reports the coefficients, their standard errors, the residual per position and the condition
+number of ``A``; a position set that cannot determine all seven coefficients raises
+:class:`IdentifiabilityError` naming why.
+
+Calibration run files (CSV, one row per position): ``phi1_deg, phi2_deg, out_x_dph, out_y_dph``
+and optionally ``sigma_dph`` (1-sigma output noise of the row) and ``time_s``; the latitude is a
+parameter of the run.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..core.csv_table import read_csv_table, write_csv_table
+from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.units import deg_to_rad, rad_to_deg
+from .gyrowheel import (
+    AXES,
+    N_COEFFICIENTS,
+    TERM_NAMES,
+    DriftCoefficients,
+    GyroWheelModel,
+    regressor_matrix,
+)
+from .positions import PositionInputs, PositionSet, position_inputs
+
+RUN_REQUIRED_COLUMNS: tuple[str, ...] = ("phi1_deg", "phi2_deg", "out_x_dph", "out_y_dph")
+RUN_OPTIONAL_COLUMNS: tuple[str, ...] = ("sigma_dph", "time_s")
+
+
+@dataclass(frozen=True)
+class AxisCalibration:
+    """The least-squares fit of one axis.
+
+    Attributes:
+        axis: ``"x"`` or ``"y"``.
+        coefficients_dph: (7,) fitted coefficients in :data:`TERM_NAMES` order.
+        standard_errors_dph: (7,) 1-sigma standard errors; NaN when there are no degrees of
+            freedom and no ``sigma_dph`` to scale by.
+        residuals_dph: (N,) measured minus fitted output per position, deg/h.
+        condition_number: 2-norm condition number of ``A``.
+        rank: numerical rank of ``A`` (7 here; lower ranks raise).
+        dof: degrees of freedom ``N - 7``.
+        sigma_source: ``"sigma_dph"`` (weights from the file) or ``"residuals"``.
+    """
+
+    axis: str
+    coefficients_dph: np.ndarray
+    standard_errors_dph: np.ndarray
+    residuals_dph: np.ndarray
+    condition_number: float
+    rank: int
+    dof: int
+    sigma_source: str
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return TERM_NAMES[self.axis]
+
+    @property
+    def rms_dph(self) -> float:
+        return float(np.sqrt(np.mean(self.residuals_dph**2)))
+
+    def to_dict(self) -> dict:
+        return {
+            "coefficients_dph": dict(zip(self.names, self.coefficients_dph, strict=True)),
+            "standard_errors_dph": dict(zip(self.names, self.standard_errors_dph, strict=True)),
+            "condition_number": self.condition_number,
+            "rank": self.rank,
+            "dof": self.dof,
+            "rms_residual_dph": self.rms_dph,
+            "sigma_source": self.sigma_source,
+        }
+
+
+@dataclass(frozen=True)
+class CalibrationResult:
+    """Both axes' fits and the set-up they came from."""
+
+    x: AxisCalibration
+    y: AxisCalibration
+    inputs: PositionInputs
+
+    def axis(self, name: str) -> AxisCalibration:
+        return getattr(self, name)
+
+    def model(self, source: str = "calibration") -> GyroWheelModel:
+        """The fitted coefficients as a :class:`GyroWheelModel`."""
+        return GyroWheelModel(
+            DriftCoefficients("x", tuple(self.x.coefficients_dph)),
+            DriftCoefficients("y", tuple(self.y.coefficients_dph)),
+            source=source,
+        )
+
+    def to_dict(self) -> dict:
+        positions = self.inputs.positions
+        return {
+            "positions": positions.name,
+            "n_positions": len(positions),
+            "latitude_deg": float(rad_to_deg(self.inputs.latitude_rad)),
+            "x": self.x.to_dict(),
+            "y": self.y.to_dict(),
+            "residuals": [
+                {
+                    "phi1_deg": float(p1),
+                    "phi2_deg": float(p2),
+                    "residual_x_dph": float(rx),
+                    "residual_y_dph": float(ry),
+                }
+                for p1, p2, rx, ry in zip(
+                    rad_to_deg(positions.phi1_rad),
+                    rad_to_deg(positions.phi2_rad),
+                    self.x.residuals_dph,
+                    self.y.residuals_dph,
+                    strict=True,
+                )
+            ],
+        }
+
+    def report(self) -> str:
+        """A human-readable summary: coefficients with standard errors, residuals per position."""
+        d = self.to_dict()
+        lines = [
+            f"positions: {d['positions']} ({d['n_positions']}), latitude {d['latitude_deg']:g} deg"
+        ]
+        for axis in AXES:
+            fit = self.axis(axis)
+            lines.append(
+                f"axis {axis}: cond(A) = {fit.condition_number:.4g}, rms residual "
+                f"{fit.rms_dph:.4g} deg/h, sigma from {fit.sigma_source}"
+            )
+            for name, value, error in zip(
+                fit.names, fit.coefficients_dph, fit.standard_errors_dph, strict=True
+            ):
+                lines.append(f"  D{axis}{name:3s} = {value:12.6f} +- {error:.3g}")
+        lines.append(f"{'phi1_deg':>9s} {'phi2_deg':>9s} {'res_x_dph':>12s} {'res_y_dph':>12s}")
+        for row in d["residuals"]:
+            lines.append(
+                f"{row['phi1_deg']:9.3f} {row['phi2_deg']:9.3f} "
+                f"{row['residual_x_dph']:12.3e} {row['residual_y_dph']:12.3e}"
+            )
+        return "\n".join(lines)
+
+
+def check_identifiable(design: np.ndarray, axis: str, positions: PositionSet) -> int:
+    """Raise :class:`IdentifiabilityError` unless ``A`` determines all seven coefficients.
+
+    Returns the rank (7). The message says whether there are too few distinct positions or which
+    combination of regressor columns the positions cannot tell apart.
+    """
+    distinct = positions.distinct_count()
+    if distinct < N_COEFFICIENTS:
+        raise IdentifiabilityError(
+            f"too few distinct positions: {distinct} distinct position(s) cannot determine the "
+            f"{N_COEFFICIENTS} drift coefficients of axis {axis} (at least 7 are needed)"
+        )
+    distinct_rows = np.unique(np.round(design, 12), axis=0).shape[0]
+    if distinct_rows < N_COEFFICIENTS:
+        raise IdentifiabilityError(
+            f"too few distinct gravity directions: the {distinct} positions give only "
+            f"{distinct_rows} distinct regressor rows for axis {axis}; 7 coefficients need 7"
+        )
+    _, singular, vt = np.linalg.svd(design, full_matrices=False)
+    tol = singular[0] * max(design.shape) * np.finfo(float).eps
+    rank = int(np.sum(singular > tol))
+    if rank < N_COEFFICIENTS:
+        names = TERM_NAMES[axis]
+        combos = []
+        for null in vt[rank:]:
+            null = null / np.max(np.abs(null))
+            combos.append(
+                " + ".join(
+                    f"{v:.3g}*D{axis}{n}" for v, n in zip(null, names, strict=True) if abs(v) > 1e-6
+                )
+            )
+        raise IdentifiabilityError(
+            f"axis {axis}: the positions give A of rank {rank} < 7; they cannot determine "
+            f"{'; '.join(combos)} (choose positions where those regressors vary independently)"
+        )
+    return rank
+
+
+def fit_axis(
+    axis: str,
+    inputs: PositionInputs,
+    outputs_dph: np.ndarray,
+    sigma_dph: np.ndarray | None = None,
+) -> AxisCalibration:
+    """Least squares of eq. 6 for one axis (weighted by ``1/sigma^2`` when given)."""
+    outputs = np.asarray(outputs_dph, dtype=float)
+    if outputs.shape != (len(inputs),):
+        raise InputError(f"axis {axis}: expected {len(inputs)} outputs, got shape {outputs.shape}")
+    if not np.all(np.isfinite(outputs)):
+        raise InputError(f"axis {axis}: outputs must be finite numbers (found NaN or inf)")
+    design = regressor_matrix(axis, inputs.specific_force_g)
+    rank = check_identifiable(design, axis, inputs.positions)
+    rhs = outputs - inputs.earth_rate_dph[:, AXES.index(axis)]
+    if sigma_dph is not None:
+        sigma = np.asarray(sigma_dph, dtype=float)
+        if np.any(~np.isfinite(sigma)) or np.any(sigma <= 0):
+            raise InputError("sigma_dph must be finite and positive")
+        weights = 1.0 / sigma
+    else:
+        weights = np.ones_like(rhs)
+    weighted = design * weights[:, None]
+    coefficients, *_ = np.linalg.lstsq(weighted, rhs * weights, rcond=None)
+    residuals = rhs - design @ coefficients
+    dof = len(inputs) - N_COEFFICIENTS
+    cov_unit = np.linalg.inv(weighted.T @ weighted)
+    if sigma_dph is not None:
+        covariance = cov_unit
+        source = "sigma_dph"
+    elif dof > 0:
+        covariance = cov_unit * float(np.sum(residuals**2)) / dof
+        source = "residuals"
+    else:
+        covariance = np.full_like(cov_unit, np.nan)
+        source = "none (no degrees of freedom)"
+    return AxisCalibration(
+        axis=axis,
+        coefficients_dph=coefficients,
+        standard_errors_dph=np.sqrt(np.diag(covariance)),
+        residuals_dph=residuals,
+        condition_number=float(np.linalg.cond(design)),
+        rank=rank,
+        dof=dof,
+        sigma_source=source,
+    )
+
+
+def calibrate(
+    inputs: PositionInputs,
+    out_x_dph: np.ndarray,
+    out_y_dph: np.ndarray,
+    sigma_dph: np.ndarray | None = None,
+) -> CalibrationResult:
+    """Fit the seven coefficients of both axes to measured outputs (eqs. 5-6)."""
+    return CalibrationResult(
+        x=fit_axis("x", inputs, out_x_dph, sigma_dph),
+        y=fit_axis("y", inputs, out_y_dph, sigma_dph),
+        inputs=inputs,
+    )
+
+
+def calibrate_run(path: str | Path, latitude_rad: float) -> CalibrationResult:
+    """Read a calibration run CSV and fit it (see the module docstring for the format)."""
+    table = read_csv_table(path, RUN_REQUIRED_COLUMNS, RUN_OPTIONAL_COLUMNS)
+    if table.has("sigma_dph"):
+        bad = np.flatnonzero(table["sigma_dph"] <= 0)
+        if bad.size:
+            raise InputError(
+                "sigma_dph must be positive", path=path, row=int(table.rows[bad[0]]),
+                column="sigma_dph",
+            )  # fmt: skip
+    positions = PositionSet(
+        deg_to_rad(table["phi1_deg"]), deg_to_rad(table["phi2_deg"]), name=str(path)
+    )
+    inputs = position_inputs(positions, latitude_rad)
+    try:
+        return calibrate(
+            inputs,
+            table["out_x_dph"],
+            table["out_y_dph"],
+            table["sigma_dph"] if table.has("sigma_dph") else None,
+        )
+    except IdentifiabilityError as exc:
+        raise IdentifiabilityError(f"{path}: {exc}") from None
+
+
+def simulate_run(
+    gyrowheel: GyroWheelModel,
+    inputs: PositionInputs,
+    *,
+    noise_dph: float,
+    seed: int,
+) -> dict[str, np.ndarray]:
+    """Outputs of eq. 1 at the ideal orientation plus seeded Gaussian noise, as run columns."""
+    rng = np.random.default_rng(seed)
+    outputs = gyrowheel.outputs_dph(inputs.specific_force_g, inputs.earth_rate_dph)
+    outputs = outputs + rng.normal(0.0, noise_dph, size=outputs.shape)
+    columns = {
+        "phi1_deg": rad_to_deg(inputs.positions.phi1_rad),
+        "phi2_deg": rad_to_deg(inputs.positions.phi2_rad),
+        "out_x_dph": outputs[:, 0],
+        "out_y_dph": outputs[:, 1],
+    }
+    if noise_dph > 0:
+        columns["sigma_dph"] = np.full(len(inputs), float(noise_dph))
+    return columns
+
+
+def write_simulated_run(
+    path: str | Path,
+    gyrowheel: GyroWheelModel,
+    inputs: PositionInputs,
+    *,
+    noise_dph: float,
+    seed: int,
+) -> Path:
+    """Write :func:`simulate_run` as a calibration run CSV whose comment records the seed."""
+    columns = simulate_run(gyrowheel, inputs, noise_dph=noise_dph, seed=seed)
+    comment = (
+        f"simulated GyroWheel calibration run: coefficients {gyrowheel.source or 'given'}, "
+        f"positions {inputs.positions.name}, latitude {rad_to_deg(inputs.latitude_rad):g} deg, "
+        f"noise {noise_dph:g} deg/h, seed {seed}"
+    )
+    return write_csv_table(path, columns, comment=comment)

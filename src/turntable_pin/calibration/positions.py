@@ -1,0 +1,186 @@
+"""Test positions of a multi-position calibration and the inputs the GyroWheel senses at each.
+
+A position is a pair of commanded turntable angles (phi1 about the outer axis y, phi2 about the
+inner axis z). A position set comes from a scheme name or a CSV file:
+
+- ``grid:STEP``: phi1 and phi2 each in {0, STEP, ..., < 360} degrees, all pairs;
+- ``grid:STEP1xSTEP2``: the same with separate steps for phi1 and phi2;
+- a CSV file with columns ``phi1_deg, phi2_deg``.
+
+The specific force and the earth rate along the payload axes come from the payload orientation
+``Rd`` of the Pinocchio model (:class:`TurntableModel`): in the base frame F0 (x north, y west,
+z up) the specific force of a resting body is ``+e_z`` (1 g up) and the earth rate is
+``we (cos lat, 0, sin lat)``; along the payload axes they are ``Rd^T`` times these, which is the
+closed form of paper eq. 3.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..core.csv_table import read_csv_table
+from ..core.exceptions import InputError
+from ..core.units import deg_to_rad, rad_to_deg
+from ..model.turntable import TurntableModel
+
+EARTH_RATE_DPH = 15.041067
+"""Earth rotation rate used by the paper (eq. 3), deg/h."""
+
+_GRID = re.compile(r"^grid:\s*([0-9.eE+-]+)(?:\s*x\s*([0-9.eE+-]+))?$")
+
+
+@dataclass(frozen=True)
+class PositionSet:
+    """Commanded turntable positions.
+
+    Attributes:
+        phi1_rad, phi2_rad: outer- and inner-axis angles, radians, shape (N,).
+        name: the scheme name or file the positions came from.
+    """
+
+    phi1_rad: np.ndarray
+    phi2_rad: np.ndarray
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        phi1 = np.array(self.phi1_rad, dtype=float).reshape(-1)
+        phi2 = np.array(self.phi2_rad, dtype=float).reshape(-1)
+        if phi1.shape != phi2.shape:
+            raise InputError(f"positions: {phi1.size} phi1 values but {phi2.size} phi2 values")
+        if phi1.size == 0:
+            raise InputError("positions: the set is empty")
+        if not (np.all(np.isfinite(phi1)) and np.all(np.isfinite(phi2))):
+            raise InputError("positions: angles must be finite numbers")
+        phi1.setflags(write=False)
+        phi2.setflags(write=False)
+        object.__setattr__(self, "phi1_rad", phi1)
+        object.__setattr__(self, "phi2_rad", phi2)
+
+    def __len__(self) -> int:
+        return int(self.phi1_rad.size)
+
+    @classmethod
+    def grid(cls, step1_deg: float, step2_deg: float | None = None) -> PositionSet:
+        """phi1 in {0, step1, ... < 360} and phi2 in {0, step2, ... < 360} degrees, all pairs."""
+        step2_deg = step1_deg if step2_deg is None else step2_deg
+        for step in (step1_deg, step2_deg):
+            if not (np.isfinite(step) and 0 < step <= 360):
+                raise InputError(f"grid step must be in (0, 360] degrees, got {step!r}")
+        phi1 = np.arange(0.0, 360.0 - 1e-9, step1_deg)
+        phi2 = np.arange(0.0, 360.0 - 1e-9, step2_deg)
+        p1, p2 = np.meshgrid(phi1, phi2, indexing="ij")
+        name = (
+            f"grid:{step1_deg:g}" if step2_deg == step1_deg else f"grid:{step1_deg:g}x{step2_deg:g}"
+        )
+        return cls(deg_to_rad(p1.ravel()), deg_to_rad(p2.ravel()), name)
+
+    @classmethod
+    def from_csv(cls, path: str | Path) -> PositionSet:
+        """Read columns ``phi1_deg, phi2_deg`` (other columns are ignored)."""
+        table = read_csv_table(path, ("phi1_deg", "phi2_deg"))
+        return cls(deg_to_rad(table["phi1_deg"]), deg_to_rad(table["phi2_deg"]), str(path))
+
+    @classmethod
+    def parse(cls, spec: str) -> PositionSet:
+        """A scheme name (``grid:STEP``, ``grid:STEP1xSTEP2``) or the path of a CSV file."""
+        text = str(spec).strip()
+        match = _GRID.match(text)
+        if match:
+            try:
+                step1 = float(match.group(1))
+                step2 = float(match.group(2)) if match.group(2) else None
+            except ValueError:
+                raise InputError(f"positions '{text}': bad grid step") from None
+            return cls.grid(step1, step2)
+        if text.startswith("grid"):
+            raise InputError(
+                f"positions '{text}': expected grid:STEP or grid:STEP1xSTEP2 (degrees)"
+            )
+        path = Path(text)
+        if not path.exists():
+            raise InputError(
+                f"positions '{text}': neither a scheme (grid:STEP) nor an existing CSV file"
+            )
+        return cls.from_csv(path)
+
+    def distinct_count(self, decimals: int = 9) -> int:
+        """Number of distinct payload orientations (angles taken modulo 360 degrees)."""
+        wrapped = (
+            np.round(
+                np.mod(rad_to_deg(np.stack([self.phi1_rad, self.phi2_rad], 1)), 360.0), decimals
+            )
+            % 360.0
+        )
+        return int(np.unique(wrapped, axis=0).shape[0])
+
+    def to_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "n_positions": len(self),
+            "phi1_deg": rad_to_deg(self.phi1_rad),
+            "phi2_deg": rad_to_deg(self.phi2_rad),
+        }
+
+
+@dataclass(frozen=True)
+class PositionInputs:
+    """What the GyroWheel senses at each position of a set, at the ideal orientation.
+
+    Attributes:
+        positions: the :class:`PositionSet`.
+        latitude_rad: latitude of the test site, radians.
+        specific_force_g: (N, 3) specific force along the payload axes, g (eq. 3 ``a``).
+        earth_rate_dph: (N, 3) earth rate along the payload axes, deg/h (eq. 3 ``w``).
+        payload_rotation: (N, 3, 3) ideal payload orientation ``Rd`` (base <- payload).
+    """
+
+    positions: PositionSet
+    latitude_rad: float
+    specific_force_g: np.ndarray
+    earth_rate_dph: np.ndarray
+    payload_rotation: np.ndarray = field(repr=False)
+
+    def __len__(self) -> int:
+        return len(self.positions)
+
+
+def base_frame_inputs(latitude_rad: float) -> tuple[np.ndarray, np.ndarray]:
+    """Specific force (g) and earth rate (deg/h) in the base frame F0 (x north, y west, z up)."""
+    force = np.array([0.0, 0.0, 1.0])
+    rate = EARTH_RATE_DPH * np.array([np.cos(latitude_rad), 0.0, np.sin(latitude_rad)])
+    return force, rate
+
+
+def position_inputs(
+    positions: PositionSet, latitude_rad: float, model: TurntableModel | None = None
+) -> PositionInputs:
+    """Specific force and earth rate along the payload axes at each position (eq. 3).
+
+    Args:
+        positions: the commanded angles.
+        latitude_rad: latitude of the test site, radians (|lat| <= pi/2).
+        model: the turntable whose *ideal* (nominal) payload orientation is used; default the
+            bundled URDF. Orientation errors enter later (eq. 8), not here.
+    """
+    if not (np.isfinite(latitude_rad) and abs(latitude_rad) <= np.pi / 2 + 1e-12):
+        raise InputError(f"latitude must be within +-90 degrees, got {rad_to_deg(latitude_rad)!r}")
+    model = model if model is not None else TurntableModel()
+    rotations = np.array(
+        [
+            model.ideal_pose(p1, p2).rotation
+            for p1, p2 in zip(positions.phi1_rad, positions.phi2_rad, strict=True)
+        ]
+    )
+    force, rate = base_frame_inputs(latitude_rad)
+    # Rd maps payload to base coordinates, so payload components are Rd^T v (row vector v Rd).
+    return PositionInputs(
+        positions=positions,
+        latitude_rad=float(latitude_rad),
+        specific_force_g=force @ rotations,
+        earth_rate_dph=rate @ rotations,
+        payload_rotation=rotations,
+    )

@@ -1,0 +1,390 @@
+"""The orientation requirement of a calibration (paper eqs. 15-16, Figures 4-5).
+
+Given a required calibration accuracy ``w_m`` (deg/h), find limits ``I_psi, I_theta, I_gamma`` such
+that ``dwx <= w_m`` and ``dwy <= w_m`` whenever ``|dpsi| <= I_psi``, ``|dtheta| <= I_theta``,
+``|dgamma| <= I_gamma``. As in the paper, ``dwx`` is studied over the plane (dpsi, dtheta) with
+``dgamma = 0`` (surface Gamma1) and ``dwy`` over (dtheta, dgamma) with ``dpsi = 0`` (Gamma2).
+
+The largest rectangle, precisely: in each plane (u, v) the rectangle is ``[-a, a] x [-b, b]``
+centred at the origin that maximises the area ``4ab`` subject to ``dw <= w_m`` at its four
+corners. Because ``dw`` is even in each angle and grows with each ``|angle|`` (tested), the corners
+bound ``dw`` on the whole rectangle. For each ``a`` the largest admissible ``b(a)`` comes from a
+bisection on the contour ``dw = w_m``; ``a b(a)`` is maximised by a dense scan refined by a bounded
+scalar search; the rectangle is then pushed to the contour along ``a`` too, so neither side can
+grow. ``dtheta`` appears in both planes: ``I_theta`` is the smaller of the two rectangles'
+theta half-widths (the binding plane), and the other plane's free side is re-extended to the
+contour at that ``I_theta`` (it can only grow). The result is therefore maximal: growing any one
+of ``I_psi, I_theta, I_gamma`` makes ``dwx`` or ``dwy`` exceed ``w_m``.
+
+The result also reports ``dwx`` and ``dwy`` at the corners of the three-dimensional box (all three
+angles at their limits), which the paper's planar analysis does not look at.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.exceptions import InputError
+from ..core.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
+from .gyrowheel import GyroWheelModel
+from .positions import PositionInputs, PositionSet, position_inputs
+from .rate_error import DEFINITIONS, orientation_error_rotation, rate_errors_dph
+
+MAX_ANGLE_RAD = np.radians(10.0)
+"""Search limit: beyond ten degrees the small-angle model of eq. 7 is meaningless."""
+
+ANGLE_NAMES: tuple[str, ...] = ("psi", "theta", "gamma")
+PLANES: dict[str, tuple[str, tuple[int, int]]] = {
+    "psi_theta": ("x", (0, 1)),
+    "theta_gamma": ("y", (1, 2)),
+}
+"""Each plane of Figure 4: the axis whose error is studied and the two angle indices (u, v)."""
+
+_SIGNS = np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]], dtype=float)
+_MARGIN = 1e-9
+
+
+class PlaneRateError:
+    """``dw`` of one axis over one plane of orientation-error angles (the third angle zero).
+
+    Calling it with half-widths ``(u, v)`` (radians, arrays) gives the largest ``dw`` (deg/h) over
+    the four corners ``(+-u, +-v)``; :meth:`surface` gives ``dw`` itself at signed points.
+    """
+
+    def __init__(
+        self,
+        plane: str,
+        gyrowheel: GyroWheelModel,
+        inputs: PositionInputs,
+        *,
+        exact: bool = False,
+        definition: str = "true_coefficients",
+    ) -> None:
+        if plane not in PLANES:
+            raise InputError(f"unknown plane '{plane}'; expected one of {tuple(PLANES)}")
+        self.plane = plane
+        self.axis, self.indices = PLANES[plane]
+        self.gyrowheel, self.inputs = gyrowheel, inputs
+        self.exact, self.definition = exact, definition
+
+    def surface(self, u_rad, v_rad) -> np.ndarray:
+        """``dw`` (deg/h) of this plane's axis at the signed points ``(u, v)`` (broadcast)."""
+        u, v = np.broadcast_arrays(np.asarray(u_rad, float), np.asarray(v_rad, float))
+        angles = np.zeros(u.shape + (3,))
+        angles[..., self.indices[0]] = u
+        angles[..., self.indices[1]] = v
+        flat = angles.reshape(-1, 3)
+        out = np.empty(flat.shape[0])
+        column = 0 if self.axis == "x" else 1
+        for start in range(0, flat.shape[0], 4096):  # bounded memory for large surfaces
+            chunk = flat[start : start + 4096]
+            rotations = orientation_error_rotation(*chunk.T, exact=self.exact)
+            out[start : start + 4096] = rate_errors_dph(
+                self.gyrowheel, self.inputs, rotations, definition=self.definition
+            )[:, column]
+        return out.reshape(u.shape)
+
+    def __call__(self, u_rad, v_rad) -> np.ndarray:
+        u, v = np.broadcast_arrays(np.asarray(u_rad, float), np.asarray(v_rad, float))
+        corners = self.surface(u[..., None] * _SIGNS[:, 0], v[..., None] * _SIGNS[:, 1])  # (..., 4)
+        return corners.max(axis=-1)
+
+    # ---- contour ----------------------------------------------------------------------------
+    def axis_limit(self, along: int, accuracy_dph: float) -> tuple[float, bool]:
+        """Largest half-width along u (``along=0``) or v (1) with the other at zero.
+
+        Returns ``(limit_rad, capped)``; ``capped`` when ``dw`` stays below ``w_m`` up to
+        :data:`MAX_ANGLE_RAD`.
+        """
+        hi = 1e-5
+        while True:
+            point = (hi, 0.0) if along == 0 else (0.0, hi)
+            if float(self(*point)) > accuracy_dph:
+                break
+            if hi >= MAX_ANGLE_RAD:
+                return MAX_ANGLE_RAD, True
+            hi = min(2.0 * hi, MAX_ANGLE_RAD)
+        fixed = np.zeros(1)
+        return float(self.largest(along, fixed, accuracy_dph, hi)[0]), False
+
+    def largest(
+        self,
+        along: int,
+        fixed_rad,
+        accuracy_dph: float,
+        hi_rad: float,
+        *,
+        rtol: float = 1e-13,
+    ) -> np.ndarray:
+        """For each fixed value of the other half-width, the largest half-width along ``along``
+        in ``[0, hi_rad]`` with ``dw <= w_m`` at the corners.
+
+        A vectorised Illinois (modified regula falsi) search on ``dw - w_m``, which is nearly
+        piecewise linear here, with a bisection step every fourth iteration so that the bracket
+        always shrinks. It stops where the bracket is narrower than ``rtol * hi_rad`` or where an
+        admissible point is within ``1e-12 w_m`` of the contour; the admissible end is returned.
+        """
+        fixed = np.atleast_1d(np.asarray(fixed_rad, float)).copy()
+
+        def excess(x, f):
+            return (self(x, f) if along == 0 else self(f, x)) - accuracy_dph
+
+        lo = np.zeros_like(fixed)
+        hi = np.full_like(fixed, hi_rad)
+        g_lo = excess(lo, fixed)
+        g_hi = excess(hi, fixed)
+        result = np.where(g_hi <= 0, hi, lo)
+        active = np.flatnonzero((g_hi > 0) & (g_lo <= 0))
+        last_side = np.zeros(fixed.size, dtype=int)
+        for iteration in range(200):
+            if active.size == 0:
+                break
+            a, b, ga, gb = lo[active], hi[active], g_lo[active], g_hi[active]
+            x = b - gb * (b - a) / (gb - ga)
+            bisect = (iteration % 4 == 3) | ~((x > a) & (x < b))
+            x = np.where(bisect, 0.5 * (a + b), x)
+            g = excess(x, fixed[active])
+            ok = g <= 0
+            # Illinois: when the same end survives twice, halve its value to unstick the method.
+            same = last_side[active] == np.where(ok, 1, -1)
+            g_hi[active] = np.where(ok & same, 0.5 * gb, np.where(ok, gb, g))
+            g_lo[active] = np.where(~ok & same, 0.5 * ga, np.where(ok, g, ga))
+            lo[active] = np.where(ok, x, a)
+            hi[active] = np.where(ok, b, x)
+            last_side[active] = np.where(ok, -1, 1)
+            done = (hi[active] - lo[active] <= rtol * hi_rad) | (ok & (-g <= 1e-12 * accuracy_dph))
+            result[active] = lo[active]
+            active = active[~done]
+        return result
+
+
+@dataclass(frozen=True)
+class PlaneRectangle:
+    """The largest-area centred rectangle of one plane.
+
+    Attributes:
+        plane: ``"psi_theta"`` or ``"theta_gamma"``.
+        axis: the GyroWheel axis whose error bounds it.
+        half_widths_rad: ``(a, b)`` along the plane's two angles.
+        axis_limits_rad: the contour's intercepts on the two angle axes.
+        capped: whether an intercept hit :data:`MAX_ANGLE_RAD`.
+    """
+
+    plane: str
+    axis: str
+    half_widths_rad: tuple[float, float]
+    axis_limits_rad: tuple[float, float]
+    capped: bool
+
+    def to_dict(self) -> dict:
+        names = self.plane.split("_")
+        return {
+            "plane": self.plane,
+            "axis": self.axis,
+            **{
+                f"{n}_half_width_deg": rad_to_deg(w)
+                for n, w in zip(names, self.half_widths_rad, strict=True)
+            },
+            **{
+                f"{n}_axis_limit_deg": rad_to_deg(w)
+                for n, w in zip(names, self.axis_limits_rad, strict=True)
+            },
+            "capped": self.capped,
+        }
+
+
+def largest_rectangle(
+    function: PlaneRateError, accuracy_dph: float, *, scan_points: int = 48, zooms: int = 3
+) -> PlaneRectangle:
+    """The centred rectangle of largest area with ``dw <= w_m`` at its corners (see module).
+
+    ``a b(a)`` is scanned on ``scan_points`` values of ``a``, then ``zooms`` times on as many
+    points between the best one's neighbours (the relative resolution of ``a`` ends near
+    ``(2 / scan_points)^zooms``; the area is flat at its maximum, so it is far finer).
+    """
+    u_limit, u_capped = function.axis_limit(0, accuracy_dph)
+    v_limit, v_capped = function.axis_limit(1, accuracy_dph)
+    u_hi = u_limit * (1 + 1e-9) + 1e-15
+    v_hi = v_limit * (1 + 1e-9) + 1e-15
+    # Scanning and pushing a hair inside the contour keeps the bisections well defined where the
+    # contour has a flat edge (dw constant along one angle, e.g. on a 90-degree grid): there the
+    # test dw <= w_m on the edge itself would be decided by rounding.
+    lower, upper = 0.0, u_limit * (1 - _MARGIN)
+    best_a = u_limit
+    for level in range(zooms + 1):
+        start = lower + (upper - lower) / scan_points if level == 0 else lower
+        us = np.linspace(start, upper, scan_points)
+        vs = function.largest(1, us, accuracy_dph, v_hi, rtol=1e-9)
+        best = int(np.argmax(us * vs))
+        best_a = float(us[best])
+        lower = float(us[max(best - 1, 0)])
+        upper = float(us[min(best + 1, scan_points - 1)])
+    b = float(function.largest(1, best_a, accuracy_dph, v_hi)[0])
+    # Push to the contour along u as well so that neither side can grow, then b to the contour.
+    a = float(function.largest(0, b * (1 - _MARGIN), accuracy_dph, u_hi)[0])
+    b = float(function.largest(1, a * (1 - _MARGIN), accuracy_dph, v_hi)[0])
+    a, b = _settle(function, a, b, accuracy_dph)
+    return PlaneRectangle(
+        plane=function.plane,
+        axis=function.axis,
+        half_widths_rad=(a, b),
+        axis_limits_rad=(u_limit, v_limit),
+        capped=u_capped or v_capped,
+    )
+
+
+def _settle(function: PlaneRateError, a: float, b: float, accuracy_dph: float):
+    """Shrink ``(a, b)`` by a few margins if the corner itself ends a hair outside the contour
+    (each side was pushed with the other one a margin inside)."""
+    for _ in range(8):
+        if float(function(a, b)) <= accuracy_dph:
+            break
+        a, b = a * (1 - 2 * _MARGIN), b * (1 - 2 * _MARGIN)
+    return a, b
+
+
+@dataclass(frozen=True)
+class OrientationRequirement:
+    """The requirement ``|dpsi| <= I_psi, |dtheta| <= I_theta, |dgamma| <= I_gamma`` (eq. 15).
+
+    Attributes:
+        accuracy_dph: the required accuracy ``w_m``, deg/h.
+        I_psi_rad, I_theta_rad, I_gamma_rad: the limits, radians.
+        binding_plane: the plane whose rectangle set ``I_theta``.
+        rectangles: the largest-area rectangle of each plane before ``I_theta`` was shared.
+        box_dwx_dph, box_dwy_dph: largest ``dwx``, ``dwy`` over the eight corners of the box
+            with all three angles at their limits (the paper's planes leave the third angle out).
+        latitude_rad, positions_name, n_positions, definition, exact: the set-up.
+    """
+
+    accuracy_dph: float
+    I_psi_rad: float
+    I_theta_rad: float
+    I_gamma_rad: float
+    binding_plane: str
+    rectangles: tuple[PlaneRectangle, PlaneRectangle]
+    box_dwx_dph: float
+    box_dwy_dph: float
+    latitude_rad: float
+    positions_name: str
+    n_positions: int
+    definition: str
+    exact: bool
+    gyrowheel: GyroWheelModel = field(repr=False)
+    inputs: PositionInputs = field(repr=False)
+
+    def plane_function(self, plane: str) -> PlaneRateError:
+        """The :class:`PlaneRateError` this requirement was computed with."""
+        return PlaneRateError(
+            plane, self.gyrowheel, self.inputs, exact=self.exact, definition=self.definition
+        )
+
+    @property
+    def limits_rad(self) -> np.ndarray:
+        return np.array([self.I_psi_rad, self.I_theta_rad, self.I_gamma_rad])
+
+    def to_dict(self) -> dict:
+        out = {
+            f"I_{n}_deg": rad_to_deg(v) for n, v in zip(ANGLE_NAMES, self.limits_rad, strict=True)
+        }
+        out.update(
+            {
+                f"I_{n}_arcmin": rad_to_arcmin(v)
+                for n, v in zip(ANGLE_NAMES, self.limits_rad, strict=True)
+            }
+        )
+        out.update(
+            {
+                f"I_{n}_arcsec": rad_to_arcsec(v)
+                for n, v in zip(ANGLE_NAMES, self.limits_rad, strict=True)
+            }
+        )
+        out.update(
+            {
+                "accuracy_dph": self.accuracy_dph,
+                "positions": self.positions_name,
+                "n_positions": self.n_positions,
+                "latitude_deg": rad_to_deg(self.latitude_rad),
+                "definition": self.definition,
+                "exact_rotation": self.exact,
+                "binding_plane": self.binding_plane,
+                "rectangles": [r.to_dict() for r in self.rectangles],
+                "box_dwx_dph": self.box_dwx_dph,
+                "box_dwy_dph": self.box_dwy_dph,
+            }
+        )
+        return out
+
+
+def orientation_requirement(
+    accuracy_dph: float,
+    positions: PositionSet,
+    latitude_rad: float,
+    *,
+    gyrowheel: GyroWheelModel | None = None,
+    exact: bool = False,
+    definition: str = "true_coefficients",
+) -> OrientationRequirement:
+    """The orientation requirement (eqs. 15-16) for accuracy ``w_m`` on a position set.
+
+    Args:
+        accuracy_dph: required calibration accuracy ``w_m``, deg/h (> 0).
+        positions: the test positions.
+        latitude_rad: latitude of the test site, radians.
+        gyrowheel: the drift coefficients (default: paper Table 1).
+        exact: exact rotation for ``dR`` instead of eq. 7.
+        definition: the rate-error definition (see :mod:`turntable_pin.calibration.rate_error`).
+    """
+    if not (np.isfinite(accuracy_dph) and accuracy_dph > 0):
+        raise InputError(f"the required accuracy must be a positive number, got {accuracy_dph!r}")
+    if definition not in DEFINITIONS:
+        raise InputError(f"unknown rate-error definition '{definition}'; expected {DEFINITIONS}")
+    gyrowheel = gyrowheel if gyrowheel is not None else GyroWheelModel.nominal()
+    inputs = position_inputs(positions, latitude_rad)
+    fx = PlaneRateError("psi_theta", gyrowheel, inputs, exact=exact, definition=definition)
+    fy = PlaneRateError("theta_gamma", gyrowheel, inputs, exact=exact, definition=definition)
+    rect_x = largest_rectangle(fx, accuracy_dph)
+    rect_y = largest_rectangle(fy, accuracy_dph)
+    psi, theta_x = rect_x.half_widths_rad
+    theta_y, gamma = rect_y.half_widths_rad
+    if theta_x <= theta_y:
+        binding, theta = "psi_theta", theta_x
+        gamma = float(
+            fy.largest(
+                1, theta * (1 - _MARGIN), accuracy_dph, rect_y.axis_limits_rad[1] * 1.000001
+            )[0]
+        )
+        theta, gamma = _settle(fy, theta, gamma, accuracy_dph)
+    else:
+        binding, theta = "theta_gamma", theta_y
+        psi = float(
+            fx.largest(
+                0, theta * (1 - _MARGIN), accuracy_dph, rect_x.axis_limits_rad[0] * 1.000001
+            )[0]
+        )
+        psi, theta = _settle(fx, psi, theta, accuracy_dph)
+    signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
+    corners = signs * np.array([psi, theta, gamma])
+    box = rate_errors_dph(
+        gyrowheel, inputs, orientation_error_rotation(*corners.T, exact=exact),
+        definition=definition,
+    ).max(axis=0)  # fmt: skip
+    return OrientationRequirement(
+        accuracy_dph=float(accuracy_dph),
+        I_psi_rad=float(psi),
+        I_theta_rad=float(theta),
+        I_gamma_rad=float(gamma),
+        binding_plane=binding,
+        rectangles=(rect_x, rect_y),
+        box_dwx_dph=float(box[0]),
+        box_dwy_dph=float(box[1]),
+        latitude_rad=float(latitude_rad),
+        positions_name=positions.name,
+        n_positions=len(positions),
+        definition=definition,
+        exact=exact,
+        gyrowheel=gyrowheel,
+        inputs=inputs,
+    )

@@ -1,0 +1,159 @@
+"""Reading numeric CSV tables with checks that name the file, row and column of every problem.
+
+Rows are counted as a spreadsheet shows them: the header is row 1, the first data row is row 2.
+Nothing is written; a file that fails a check raises :class:`InputError`.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .exceptions import InputError
+
+
+@dataclass(frozen=True)
+class CsvTable:
+    """The numeric columns of a CSV file.
+
+    Attributes:
+        path: the file read.
+        columns: ``{name: float array}`` of the required and the present optional columns.
+        header: every column name of the file, in file order (unknown ones are kept, unused).
+        rows: the spreadsheet row number of each data row (2 for the first).
+    """
+
+    path: Path
+    columns: dict[str, np.ndarray]
+    header: tuple[str, ...]
+    rows: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.rows.size)
+
+    def has(self, name: str) -> bool:
+        """Whether the optional column ``name`` is present."""
+        return name in self.columns
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.columns[name]
+
+
+def read_csv_table(
+    path: str | Path,
+    required: Sequence[str],
+    optional: Sequence[str] = (),
+    *,
+    min_rows: int = 1,
+) -> CsvTable:
+    """Read ``path`` and check that every required column exists and every value is finite.
+
+    Args:
+        path: the CSV file (comma-separated, one header line; ``#`` lines before it are skipped).
+        required: column names that must be present, exactly spelled.
+        optional: column names that are read (and checked) when present.
+        min_rows: fewest data rows accepted.
+
+    Raises:
+        InputError: unreadable file, missing header, a missing column (with close matches named),
+            a duplicated column, a cell that is empty, not a number, NaN or infinite.
+    """
+    path = Path(path)
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as handle:
+            lines = [(i, line) for i, line in enumerate(handle, start=1)]
+    except OSError as exc:
+        raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
+    except UnicodeDecodeError:
+        raise InputError("not a text (UTF-8) CSV file", path=path) from None
+    lines = [(i, line) for i, line in lines if line.strip() and not line.lstrip().startswith("#")]
+    if not lines:
+        raise InputError("the file is empty (expected a header line)", path=path)
+    reader = csv.reader([line for _, line in lines])
+    parsed = list(reader)
+    header = tuple(name.strip() for name in parsed[0])
+    header_line = lines[0][0]
+    seen = set()
+    for name in header:
+        if name in seen:
+            raise InputError(
+                f"column '{name}' appears twice in the header", path=path, row=header_line
+            )
+        seen.add(name)
+    missing = [name for name in required if name not in header]
+    if missing:
+        hints = []
+        for name in missing:
+            close = [h for h in header if h.lower().replace(" ", "") == name.lower()]
+            close += [h for h in header if h not in close and name.split("_")[0] == h.split("_")[0]]
+            if close:
+                hints.append(f"'{name}' (found {', '.join(repr(c) for c in close)})")
+            else:
+                hints.append(f"'{name}'")
+        raise InputError(
+            f"missing required column(s) {', '.join(hints)}; the header has {', '.join(header)}",
+            path=path,
+            row=header_line,
+        )
+    wanted = [name for name in (*required, *optional) if name in header]
+    index = {name: header.index(name) for name in wanted}
+    values = {name: [] for name in wanted}
+    row_numbers = []
+    for (line_no, _), cells in zip(lines[1:], parsed[1:], strict=True):
+        if len(cells) != len(header):
+            raise InputError(
+                f"expected {len(header)} cells as in the header, found {len(cells)}",
+                path=path,
+                row=line_no,
+            )
+        for name in wanted:
+            text = cells[index[name]].strip()
+            try:
+                number = float(text)
+            except ValueError:
+                what = "an empty cell" if not text else f"'{text}'"
+                raise InputError(
+                    f"expected a number, found {what}", path=path, row=line_no, column=name
+                ) from None
+            if not math.isfinite(number):
+                raise InputError(
+                    f"expected a finite number, found '{text}'", path=path, row=line_no, column=name
+                )
+            values[name].append(number)
+        row_numbers.append(line_no)
+    if len(row_numbers) < min_rows:
+        raise InputError(
+            f"expected at least {min_rows} data row(s), found {len(row_numbers)}", path=path
+        )
+    return CsvTable(
+        path=path,
+        columns={name: np.asarray(v, dtype=float) for name, v in values.items()},
+        header=header,
+        rows=np.asarray(row_numbers, dtype=int),
+    )
+
+
+def write_csv_table(
+    path: str | Path, columns: dict[str, Sequence[float]], *, comment: str = ""
+) -> Path:
+    """Write equal-length columns as a CSV file, atomically; ``comment`` lines get a ``#``."""
+    from .files import write_text_atomic
+
+    names = list(columns)
+    n = len(next(iter(columns.values()))) if columns else 0
+    lines = [f"# {line}" for line in comment.splitlines()] if comment else []
+    lines.append(",".join(names))
+    for i in range(n):
+        lines.append(",".join(_format_cell(columns[name][i]) for name in names))
+    return write_text_atomic(path, "\n".join(lines) + "\n")
+
+
+def _format_cell(value) -> str:
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    return repr(float(value))

@@ -1,0 +1,50 @@
+"""Where the bundled files are: the models folder and the files in it.
+
+``$TURNTABLE_PIN_MODELS`` if set; else the repository's ``models/`` (a source checkout or an
+editable install); else the copy a wheel installs under ``<prefix>/share/turntable-pin/models``.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+__all__ = [
+    "default_gyrowheel_path",
+    "default_lower_bounds_path",
+    "default_urdf_path",
+    "examples_dir",
+    "models_dir",
+]
+
+
+def models_dir() -> Path:
+    """The folder of bundled models (see the module docstring for the search order)."""
+    env = os.environ.get("TURNTABLE_PIN_MODELS")
+    if env:
+        return Path(env)
+    checkout = Path(__file__).resolve().parents[3] / "models"
+    if checkout.is_dir():
+        return checkout
+    return Path(sys.prefix) / "share" / "turntable-pin" / "models"
+
+
+def examples_dir() -> Path:
+    """The bundled example inputs, ``models/examples``."""
+    return models_dir() / "examples"
+
+
+def default_urdf_path() -> Path:
+    """The bundled nominal turntable of the paper, ``models/turntable.urdf``."""
+    return models_dir() / "turntable.urdf"
+
+
+def default_gyrowheel_path() -> Path:
+    """Paper Table 1 drift coefficients, ``models/gyrowheel_nominal.yaml``."""
+    return models_dir() / "gyrowheel_nominal.yaml"
+
+
+def default_lower_bounds_path() -> Path:
+    """Manufacturing lower bounds of the allocation, ``models/manufacturing_lower_bounds.yaml``."""
+    return models_dir() / "manufacturing_lower_bounds.yaml"

@@ -1,0 +1,217 @@
+"""The orientation error predicted by the turntable's exact chain plus catalogued effects.
+
+The chain is read off the Pinocchio model (its nominal joint placements, joint axes and payload
+mount, :meth:`TurntableModel.placement_chain`) and the error factors of each placement
+(:data:`PLACEMENT_ERROR_FACTORS`), the same data :class:`OrientationErrorField` composes. Effects
+(:mod:`turntable_pin.measurement.effects`) add to the error angles per position or insert
+rotations before or
+after ``Rt``. Every parametrised factor is a rotation about a coordinate axis by an angle *linear*
+in the parameters, so the Jacobian is exact and cheap: for ``Rt = A R_a(theta) B``,
+``dRt/dtheta = A R_a(theta) [e_a]x B``, composed from prefix and suffix products.
+
+Parameters (internal units): the eight angular errors (rad) in :data:`ANGULAR_ERROR_NAMES` order,
+then each effect's parameters as ``"<effect>.<name>"``. ``deta`` is left out: it moves the payload
+origin, never its orientation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.exceptions import InputError
+from ..core.rotations import AXIS_INDEX, axis_rotation
+from ..core.units import ARCSEC_PER_RAD
+from ..model.batch_field import ANGLE_ENTRIES
+from ..model.errors import ANGULAR_ERROR_NAMES
+from ..model.turntable import (
+    INNER_JOINT,
+    OUTER_JOINT,
+    PAYLOAD_FRAME,
+    PAYLOAD_MOUNT,
+    PLACEMENT_ERROR_FACTORS,
+    TurntableModel,
+    joint_axis,
+)
+from .effects.base import POST, PRE, Effect, ParameterSpec, PositionVariables
+
+BASE_PARAMETERS: tuple[ParameterSpec, ...] = tuple(
+    ParameterSpec(name, "arcsec", 1.0 / ARCSEC_PER_RAD, name) for name in ANGULAR_ERROR_NAMES
+)
+
+_GENERATORS = {
+    axis: np.array(m, dtype=float)
+    for axis, m in {
+        "x": [[0, 0, 0], [0, 0, -1], [0, 1, 0]],
+        "y": [[0, 0, 1], [0, 0, 0], [-1, 0, 0]],
+        "z": [[0, -1, 0], [1, 0, 0], [0, 0, 0]],
+    }.items()
+}
+
+
+@dataclass(frozen=True)
+class _Factor:
+    """One rotation of the chain: fixed matrices (N or 1, 3, 3) or ``R_axis(G @ p)``."""
+
+    fixed: np.ndarray | None = None
+    axis: str | None = None
+    gain: np.ndarray | None = None  # (N, n_params): angle = gain @ p
+
+
+class OrientationModel:
+    """``dpsi, dtheta, dgamma`` at N positions from the base errors and a set of effects.
+
+    Args:
+        variables: the commanded angles (and time, directions) of the positions.
+        effects: catalogued effects to include (their required columns must be present).
+        turntable: the Pinocchio model whose nominal chain is used (default: bundled URDF).
+    """
+
+    def __init__(
+        self,
+        variables: PositionVariables,
+        effects: Sequence[Effect] = (),
+        turntable: TurntableModel | None = None,
+    ) -> None:
+        self.variables = variables
+        self.effects = tuple(effects)
+        turntable = turntable or TurntableModel()
+        specs: list[ParameterSpec] = list(BASE_PARAMETERS)
+        names = list(ANGULAR_ERROR_NAMES)
+        terms_by_effect = []
+        for effect in self.effects:
+            missing = effect.missing_columns(variables)
+            if missing:
+                raise InputError(
+                    f"effect '{effect.name}' needs the column(s) {', '.join(missing)}, "
+                    "which the data do not have"
+                )
+            for spec in effect.parameters(variables):
+                specs.append(spec)
+                names.append(f"{effect.name}.{spec.name}")
+            terms_by_effect.append((effect, effect.chain_terms(variables)))
+        self.parameter_specs = tuple(specs)
+        self.parameter_names = tuple(names)
+        self.parameter_units = tuple(s.unit for s in specs)
+        self.per_user_unit = np.array([s.per_user_unit for s in specs])
+        self._index = {name: i for i, name in enumerate(names)}
+        self._factors, self._rd = self._build_chain(turntable, terms_by_effect)
+
+    @property
+    def n_params(self) -> int:
+        return len(self.parameter_names)
+
+    def _gain(self, weights: dict[str, np.ndarray], prefix: str) -> np.ndarray:
+        gain = np.zeros((self.variables.n, self.n_params))
+        for name, w in weights.items():
+            gain[:, self._index[f"{prefix}{name}"]] += np.asarray(w, dtype=float)
+        return gain
+
+    def _build_chain(self, turntable: TurntableModel, terms_by_effect):
+        n = self.variables.n
+        nominal = turntable.nominal_model
+        pre, post = [], []
+        error_gain = {}
+        for name in ANGULAR_ERROR_NAMES:
+            gain = np.zeros((n, self.n_params))
+            gain[:, self._index[name]] = 1.0
+            error_gain[name] = gain
+        for effect, terms in terms_by_effect:
+            for term in terms:
+                gain = self._gain(term.weights, f"{effect.name}.")
+                if term.site == PRE:
+                    pre.append(_Factor(axis=term.axis, gain=gain))
+                elif term.site == POST:
+                    post.append(_Factor(axis=term.axis, gain=gain))
+                else:
+                    error_gain[term.site] = error_gain[term.site] + gain
+
+        def error_factors(placement: str) -> list[_Factor]:
+            return [
+                _Factor(axis=axis, gain=error_gain[name])
+                for kind, axis, name in PLACEMENT_ERROR_FACTORS[placement]
+                if kind == "rot"
+            ]
+
+        angles = {OUTER_JOINT: self.variables.phi1_rad, INNER_JOINT: self.variables.phi2_rad}
+        chain: list[_Factor] = list(pre)
+        ideal = np.broadcast_to(np.eye(3), (n, 3, 3))
+        for joint in (OUTER_JOINT, INNER_JOINT):
+            jid = nominal.getJointId(joint)
+            placement = nominal.jointPlacements[jid].rotation[None]
+            rotation = axis_rotation(joint_axis(nominal, jid), np.asarray(angles[joint], float))
+            chain.append(_Factor(fixed=placement))
+            chain.extend(error_factors(joint))
+            chain.append(_Factor(fixed=rotation))
+            ideal = ideal @ placement @ rotation
+        mount_id = nominal.getFrameId(PAYLOAD_MOUNT)
+        mount = nominal.frames[mount_id].placement
+        relative = mount.actInv(nominal.frames[nominal.getFrameId(PAYLOAD_FRAME)].placement)
+        chain.append(_Factor(fixed=mount.rotation[None]))
+        chain.extend(error_factors(PAYLOAD_MOUNT))
+        chain.append(_Factor(fixed=relative.rotation[None]))
+        chain.extend(post)
+        ideal = ideal @ mount.rotation @ relative.rotation
+        return chain, np.swapaxes(ideal, -1, -2).copy()
+
+    def _matrices(self, params: np.ndarray) -> list[np.ndarray]:
+        n = self.variables.n
+        out = []
+        for f in self._factors:
+            if f.fixed is not None:
+                out.append(np.broadcast_to(f.fixed, (n, 3, 3)))
+            else:
+                out.append(axis_rotation(f.axis, f.gain @ params))
+        return out
+
+    def _check(self, params) -> np.ndarray:
+        params = np.asarray(params, dtype=float).reshape(-1)
+        if params.size != self.n_params:
+            raise InputError(f"expected {self.n_params} parameters, got {params.size}")
+        return params
+
+    def rotation_error(self, params) -> np.ndarray:
+        """``dR = Rd^T Rt`` at each position, (N, 3, 3)."""
+        total = None
+        for m in self._matrices(self._check(params)):
+            total = m if total is None else total @ m
+        return self._rd @ total
+
+    def predict(self, params) -> np.ndarray:
+        """``[dpsi, dtheta, dgamma]`` (rad) at each position, (N, 3)."""
+        dR = self.rotation_error(params)
+        return np.stack([dR[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)
+
+    def jacobian(self, params) -> np.ndarray:
+        """Exact derivative of :meth:`predict` with respect to the parameters, (N, 3, n)."""
+        mats = self._matrices(self._check(params))
+        n = self.variables.n
+        prefix = [self._rd]
+        for m in mats:
+            prefix.append(prefix[-1] @ m)
+        suffix = [np.broadcast_to(np.eye(3), (n, 3, 3))]
+        for m in reversed(mats):
+            suffix.append(m @ suffix[-1])
+        suffix = suffix[::-1]  # suffix[f] = product of factors f..end
+        jac = np.zeros((n, 3, self.n_params))
+        for f, factor in enumerate(self._factors):
+            if factor.fixed is not None:
+                continue
+            d = prefix[f + 1] @ _GENERATORS[factor.axis] @ suffix[f + 1]
+            entries = np.stack([d[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)  # (N, 3)
+            jac += entries[:, :, None] * factor.gain[:, None, :]
+        return jac
+
+    def parameter_vector(self, values: dict[str, float] | None = None) -> np.ndarray:
+        """A parameter vector (internal units) from ``{name: value in internal units}``."""
+        p = np.zeros(self.n_params)
+        for name, value in (values or {}).items():
+            if name not in self._index:
+                raise InputError(f"unknown parameter '{name}'; parameters: {self.parameter_names}")
+            p[self._index[name]] = value
+        return p
+
+
+__all__ = ["AXIS_INDEX", "BASE_PARAMETERS", "OrientationModel"]

@@ -1,0 +1,153 @@
+"""What a candidate physical effect is: parameters, how it changes the kinematic chain, its story.
+
+An effect changes the exact rotation chain of ``model.md`` in one of three ways, each *linear in
+its parameters* (the angles it adds are ``sum_k weight_k(position) * p_k``):
+
+- ``ChainTerm(site=<error name>, ...)``: adds to one of the eight turntable error angles, per
+  position (encoder harmonics, wobble harmonics, backlash);
+- ``ChainTerm(site="pre", axis=...)``: an extra rotation multiplied *before* ``Rt`` (in the base
+  frame: base tilt);
+- ``ChainTerm(site="post", axis=...)``: an extra rotation multiplied *after* ``Rt`` (in the payload
+  frame: gravity sag, thermal drift, payload mount).
+
+Terms of one site are applied in the order listed. :class:`OrientationModel` turns these terms into
+factors of the chain and differentiates them analytically.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...core.units import ARCSEC_PER_RAD
+
+PRE = "pre"
+POST = "post"
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    """One parameter of an effect.
+
+    Attributes:
+        name: short name, unique within the effect (``c1``, ``k``, ``rz``).
+        unit: the user unit it is reported in (``arcsec``, ``arcsec/g``, ``arcsec/h``).
+        per_user_unit: internal value (rad, rad/g, rad/s) of one user unit.
+        description: what it is.
+    """
+
+    name: str
+    unit: str
+    per_user_unit: float
+    description: str
+
+
+ARCSEC = 1.0 / ARCSEC_PER_RAD
+
+
+@dataclass(frozen=True)
+class ChainTerm:
+    """An angle added to the chain: ``sum_k weights[k] * p_k`` (radians) at each position.
+
+    Attributes:
+        site: an error name of :data:`ANGULAR_ERROR_NAMES`, or ``"pre"`` / ``"post"``.
+        axis: ``"x"``, ``"y"`` or ``"z"`` for ``pre`` / ``post`` terms (unused otherwise).
+        weights: ``{parameter name: array (N,)}`` multiplying that parameter per position.
+    """
+
+    site: str
+    axis: str | None
+    weights: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class PositionVariables:
+    """What an effect may depend on at each of N positions (commanded values).
+
+    ``time_s``, ``dir1``, ``dir2`` are ``None`` when the data set has no such column.
+    """
+
+    phi1_rad: np.ndarray
+    phi2_rad: np.ndarray
+    time_s: np.ndarray | None = None
+    dir1: np.ndarray | None = None
+    dir2: np.ndarray | None = None
+
+    @property
+    def n(self) -> int:
+        return int(np.asarray(self.phi1_rad).size)
+
+    def has(self, column: str) -> bool:
+        return getattr(self, column) is not None
+
+
+def harmonic_weights(angle_rad: np.ndarray, prefix: str = "") -> dict[str, np.ndarray]:
+    """Weights of ``h(a) = c1 cos a + s1 sin a + c2 cos 2a + s2 sin 2a`` (``prefix + c1``...)."""
+    a = np.asarray(angle_rad, dtype=float)
+    return {
+        f"{prefix}c1": np.cos(a),
+        f"{prefix}s1": np.sin(a),
+        f"{prefix}c2": np.cos(2 * a),
+        f"{prefix}s2": np.sin(2 * a),
+    }
+
+
+def harmonic_parameters(prefix: str, what: str, angle: str) -> tuple[ParameterSpec, ...]:
+    """The four :class:`ParameterSpec` of a harmonic series of ``what`` in ``angle`` (arcsec)."""
+    return (
+        ParameterSpec(f"{prefix}c1", "arcsec", ARCSEC, f"{what}: cos({angle}) coefficient"),
+        ParameterSpec(f"{prefix}s1", "arcsec", ARCSEC, f"{what}: sin({angle}) coefficient"),
+        ParameterSpec(f"{prefix}c2", "arcsec", ARCSEC, f"{what}: cos(2 {angle}) coefficient"),
+        ParameterSpec(f"{prefix}s2", "arcsec", ARCSEC, f"{what}: sin(2 {angle}) coefficient"),
+    )
+
+
+class Effect:
+    """Base class of a candidate physical effect (a plug-in of
+    :mod:`turntable_pin.measurement.effects`).
+
+    Subclasses set the class attributes and implement :meth:`parameters` and :meth:`chain_terms`.
+
+    Attributes:
+        name: the catalogue name of the spec (``inner_encoder_harmonics``).
+        title: a few words for people.
+        definition: the spec's definition (how it changes the chain).
+        explanation: one paragraph of physics.
+        confirm: how to confirm it on the machine.
+        required_columns: data columns it needs; with ``any_column=True`` one of them suffices.
+    """
+
+    name: str = ""
+    title: str = ""
+    definition: str = ""
+    explanation: str = ""
+    confirm: str = ""
+    required_columns: tuple[str, ...] = ()
+    any_column: bool = False
+
+    def missing_columns(self, variables: PositionVariables) -> tuple[str, ...]:
+        """The required data columns ``variables`` lacks (empty when the effect can be tested)."""
+        missing = tuple(c for c in self.required_columns if not variables.has(c))
+        if self.any_column and len(missing) < len(self.required_columns):
+            return ()
+        return missing
+
+    def parameters(self, variables: PositionVariables) -> tuple[ParameterSpec, ...]:
+        """The parameters this effect has on a data set with these variables."""
+        raise NotImplementedError
+
+    def chain_terms(self, variables: PositionVariables) -> tuple[ChainTerm, ...]:
+        """How it changes the chain at each position (see the module docstring)."""
+        raise NotImplementedError
+
+    def describe(self) -> dict:
+        """The effect's story, as the reports show it."""
+        return {
+            "effect": self.name,
+            "title": self.title,
+            "definition": self.definition,
+            "explanation": self.explanation,
+            "confirm": self.confirm,
+            "required_columns": list(self.required_columns),
+        }

@@ -1,0 +1,118 @@
+"""Fitting orientation measurements with the base error model plus chosen effects.
+
+:class:`OrientationFitProblem` adapts :class:`OrientationModel` and :class:`OrientationMeasurements`
+to the generic :class:`FitProblem` of :mod:`least_squares_fit` (observations flattened position by
+position as ``dpsi, dtheta, dgamma``); :func:`fit_orientation` fits and returns an
+:class:`OrientationFit` that knows its data, model, residuals and parameters.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.units import ARCSEC_PER_RAD
+from ..model.turntable import TurntableModel
+from ..stats.least_squares import FitResult, fit_least_squares
+from .data import OrientationMeasurements
+from .effect_model import OrientationModel
+from .effects.base import Effect
+
+
+class OrientationFitProblem:
+    """A :class:`FitProblem`: orientation data and a base + effects model."""
+
+    user_unit_scale = ARCSEC_PER_RAD
+
+    def __init__(self, data: OrientationMeasurements, model: OrientationModel) -> None:
+        self.data = data
+        self.model = model
+        self.parameter_names = model.parameter_names
+        self.parameter_units = model.parameter_units
+        self.per_user_unit = model.per_user_unit
+        self.observed = data.angles_rad.reshape(-1)
+        self.sigma = None if data.sigma_rad is None else np.repeat(data.sigma_rad, 3)
+
+    def predict(self, params: np.ndarray) -> np.ndarray:
+        return self.model.predict(params).reshape(-1)
+
+    def jacobian(self, params: np.ndarray) -> np.ndarray:
+        return self.model.jacobian(params).reshape(-1, self.model.n_params)
+
+
+@dataclass(frozen=True)
+class OrientationFit:
+    """A fit of orientation data: the generic result plus the data, model and effects."""
+
+    data: OrientationMeasurements
+    model: OrientationModel
+    result: FitResult
+
+    @property
+    def effects(self) -> tuple[Effect, ...]:
+        return self.model.effects
+
+    @property
+    def effect_names(self) -> tuple[str, ...]:
+        return tuple(e.name for e in self.model.effects)
+
+    @property
+    def residuals_rad(self) -> np.ndarray:
+        """Measured minus fitted ``dpsi, dtheta, dgamma`` per position, (N, 3)."""
+        return self.result.residuals.reshape(-1, 3)
+
+    @property
+    def normalised_residuals(self) -> np.ndarray:
+        """Residuals in units of the noise sigma (given or estimated), (N, 3)."""
+        w = self.result.weights.reshape(-1, 3)
+        return self.residuals_rad * w / np.sqrt(self.result.noise_variance)
+
+    @property
+    def sigma_rad(self) -> np.ndarray:
+        """The noise sigma of each position used to judge the fit (given or estimated), (N,)."""
+        w = self.result.weights.reshape(-1, 3)[:, 0]
+        return np.sqrt(self.result.noise_variance) / w
+
+    def fitted_rad(self) -> np.ndarray:
+        """The model's ``dpsi, dtheta, dgamma`` at the measured positions, (N, 3)."""
+        return self.model.predict(self.result.params)
+
+    def with_noise_variance(self, noise_variance: float) -> OrientationFit:
+        """The same fit judged with another noise variance (sigma-unknown data only)."""
+        if self.result.sigma_known:
+            return self
+        return OrientationFit(
+            self.data, self.model, self.result.with_noise_variance(noise_variance)
+        )
+
+    def to_dict(self) -> dict:
+        out = {
+            "n_positions": self.data.n_positions,
+            "effects": list(self.effect_names),
+            "sigma_arcsec": float(np.median(self.sigma_rad) * ARCSEC_PER_RAD),
+        }
+        out.update(self.result.to_dict())
+        return out
+
+
+def fit_orientation(
+    data: OrientationMeasurements,
+    effects: Sequence[Effect] = (),
+    *,
+    noise_variance: float | None = None,
+    turntable: TurntableModel | None = None,
+) -> OrientationFit:
+    """Fit the base error model plus ``effects`` to ``data``.
+
+    Args:
+        data: the measurements.
+        effects: catalogued effects to include.
+        noise_variance: for data without sigmas, the unit-weight variance (rad^2) to judge the fit
+            with (default: estimated from this fit).
+        turntable: the Pinocchio model whose chain is used (default: bundled URDF).
+    """
+    model = OrientationModel(data.variables(), effects, turntable)
+    result = fit_least_squares(OrientationFitProblem(data, model), noise_variance=noise_variance)
+    return OrientationFit(data, model, result)

@@ -1,0 +1,220 @@
+"""Simulated orientation measurements: turntable errors, hidden effects, a schedule, noise, a seed.
+
+Users rehearse a measurement campaign with it and the tests make data with known, hidden effects.
+The truth goes through the same exact chain the fit uses (:class:`OrientationModel`), with the
+chosen effect parameters; noise is Gaussian with the stated sigma on each of the three angles.
+The output is the CSV of ``spec/measurements.md`` with the seed and the truth in comment lines.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..core.csv_table import write_csv_table
+from ..core.exceptions import InputError
+from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
+from ..model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
+from ..model.turntable import TurntableModel
+from .data import OrientationMeasurements
+from .effect_model import OrientationModel
+from .effects import get_effect
+from .effects.base import PositionVariables
+
+ORDERS = ("grid", "random")
+APPROACHES = ("random", "motion", "positive")
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """Which positions are measured, in which order, when, and from which side.
+
+    Attributes:
+        phi1_step_deg, phi2_step_deg: grid steps; the grid covers [start, start + 360).
+        phi1_start_deg, phi2_start_deg: first grid angles.
+        order: ``grid`` (phi1 outer loop, phi2 inner loop) or ``random`` (shuffled).
+        repeats: how many times each position is measured.
+        dwell_s: time between consecutive measurements.
+        approach: ``random`` (each axis from a random side), ``motion`` (the side the move from the
+            previous position came from; unchanged when the axis did not move) or ``positive``.
+    """
+
+    phi1_step_deg: float = 30.0
+    phi2_step_deg: float = 30.0
+    phi1_start_deg: float = 0.0
+    phi2_start_deg: float = 0.0
+    order: str = "grid"
+    repeats: int = 1
+    dwell_s: float = 60.0
+    approach: str = "random"
+
+    def __post_init__(self) -> None:
+        for name in ("phi1_step_deg", "phi2_step_deg"):
+            step = getattr(self, name)
+            if not 0 < step <= 360:
+                raise InputError(f"{name} must be in (0, 360], got {step:g}")
+        if self.order not in ORDERS:
+            raise InputError(f"order must be one of {', '.join(ORDERS)}, got '{self.order}'")
+        if self.approach not in APPROACHES:
+            raise InputError(f"approach must be one of {', '.join(APPROACHES)}")
+        if self.repeats < 1:
+            raise InputError(f"repeats must be >= 1, got {self.repeats}")
+        if self.dwell_s <= 0:
+            raise InputError(f"dwell_s must be > 0, got {self.dwell_s:g}")
+
+    def positions_deg(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """Commanded (phi1, phi2) in degrees, in measurement order."""
+        a1 = self.phi1_start_deg + np.arange(0.0, 360.0 - 1e-9, self.phi1_step_deg)
+        a2 = self.phi2_start_deg + np.arange(0.0, 360.0 - 1e-9, self.phi2_step_deg)
+        g1, g2 = np.meshgrid(a1, a2, indexing="ij")
+        phi1 = np.tile(g1.ravel(), self.repeats)
+        phi2 = np.tile(g2.ravel(), self.repeats)
+        if self.order == "random":
+            perm = rng.permutation(phi1.size)
+            phi1, phi2 = phi1[perm], phi2[perm]
+        return phi1, phi2
+
+    def directions(self, phi_deg: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """Approach direction (+1 / -1) of one axis at each measurement."""
+        if self.approach == "positive":
+            return np.ones(phi_deg.size)
+        if self.approach == "random":
+            return rng.choice([-1.0, 1.0], size=phi_deg.size)
+        out = np.ones(phi_deg.size)
+        for i in range(1, phi_deg.size):
+            move = phi_deg[i] - phi_deg[i - 1]
+            out[i] = out[i - 1] if move == 0 else np.sign(move)
+        return out
+
+
+@dataclass(frozen=True)
+class SimulatedMeasurements:
+    """Simulated data and the truth behind it.
+
+    Attributes:
+        data: the measurements (with sigma, time and directions).
+        errors: the turntable errors used.
+        effects: ``{effect: {parameter: value in user units}}`` hidden in the data.
+        noise_arcsec: the noise sigma.
+        seed: the random seed.
+        truth_rad: noise-free ``dpsi, dtheta, dgamma`` (N, 3).
+    """
+
+    data: OrientationMeasurements
+    errors: TurntableErrors
+    effects: dict[str, dict[str, float]]
+    noise_arcsec: float
+    seed: int
+    schedule: Schedule
+    truth_rad: np.ndarray = field(repr=False)
+
+    def comment(self, *, hide_truth: bool = False) -> str:
+        """The comment lines written above the CSV header.
+
+        With ``hide_truth`` only the seed, noise and schedule are written, not the errors and the
+        hidden effects, so that the file can be used to rehearse a blind diagnosis.
+        """
+        errors = ", ".join(
+            f"{k}={v:.6g}" for k, v in self.errors.to_user_units().items() if k != "deta_mm"
+        )
+        effects = "; ".join(
+            f"{name}: " + ", ".join(f"{p}={v:.6g}" for p, v in params.items())
+            for name, params in self.effects.items()
+        )
+        s = self.schedule
+        lines = [
+            "simulated by turntable-pin simulate",
+            f"seed={self.seed}",
+            f"noise_arcsec={self.noise_arcsec:g}",
+            f"schedule: phi1_step_deg={s.phi1_step_deg:g} phi2_step_deg={s.phi2_step_deg:g} "
+            f"order={s.order} repeats={s.repeats} dwell_s={s.dwell_s:g} "
+            f"approach={s.approach}",
+        ]
+        if hide_truth:
+            return "\n".join([*lines, "errors and hidden effects: not recorded (--hide-truth)"])
+        return "\n".join(
+            [*lines, f"errors (arcsec): {errors}", f"hidden effects: {effects or 'none'}"]
+        )
+
+    def write_csv(
+        self, path: str | Path, *, with_sigma: bool = True, hide_truth: bool = False
+    ) -> Path:
+        """Write the spec's CSV (atomically) with the seed (and the truth) as comments."""
+        columns = self.data.columns()
+        if not with_sigma:
+            columns.pop("sigma_arcsec", None)
+        return write_csv_table(path, columns, comment=self.comment(hide_truth=hide_truth))
+
+
+def simulate_measurements(
+    errors: TurntableErrors | None = None,
+    effects: Mapping[str, Mapping[str, float]] | None = None,
+    *,
+    schedule: Schedule | None = None,
+    noise_arcsec: float = 1.0,
+    seed: int = 0,
+    turntable: TurntableModel | None = None,
+) -> SimulatedMeasurements:
+    """Simulate a measurement run.
+
+    Args:
+        errors: turntable errors (default none).
+        effects: ``{effect name: {parameter name: value in user units}}`` (parameters not given
+            are zero; units are the effect's, e.g. arcsec, arcsec/g, arcsec/h).
+        schedule: positions, order, time and approach directions (default: 30-degree grid).
+        noise_arcsec: 1-sigma Gaussian noise on each angle (> 0).
+        seed: seed of every random choice (order, directions, noise).
+        turntable: the Pinocchio model (default: bundled URDF).
+    """
+    if not noise_arcsec > 0:
+        raise InputError(f"noise_arcsec must be > 0, got {noise_arcsec:g}")
+    errors = errors or TurntableErrors.zero()
+    schedule = schedule or Schedule()
+    effects = {name: dict(params) for name, params in (effects or {}).items()}
+    rng = np.random.default_rng(seed)
+    phi1_deg, phi2_deg = schedule.positions_deg(rng)
+    n = phi1_deg.size
+    variables = PositionVariables(
+        phi1_rad=phi1_deg / DEG_PER_RAD,
+        phi2_rad=phi2_deg / DEG_PER_RAD,
+        time_s=np.arange(n) * schedule.dwell_s,
+        dir1=schedule.directions(phi1_deg, rng),
+        dir2=schedule.directions(phi2_deg, rng),
+    )
+    effect_objects = [get_effect(name) for name in effects]
+    model = OrientationModel(variables, effect_objects, turntable)
+    values = dict(zip(ANGULAR_ERROR_NAMES, errors.angular_array_rad(), strict=True))
+    for effect in effect_objects:
+        specs = {s.name: s for s in effect.parameters(variables)}
+        for pname, value in effects[effect.name].items():
+            if pname not in specs:
+                raise InputError(
+                    f"effect '{effect.name}' has no parameter '{pname}'; "
+                    f"its parameters: {', '.join(specs)}"
+                )
+            values[f"{effect.name}.{pname}"] = float(value) * specs[pname].per_user_unit
+    truth = model.predict(model.parameter_vector(values))
+    sigma_rad = noise_arcsec / ARCSEC_PER_RAD
+    measured = truth + rng.normal(0.0, sigma_rad, truth.shape)
+    data = OrientationMeasurements(
+        phi1_rad=variables.phi1_rad,
+        phi2_rad=variables.phi2_rad,
+        angles_rad=measured,
+        sigma_rad=np.full(n, sigma_rad),
+        time_s=variables.time_s,
+        dir1=variables.dir1,
+        dir2=variables.dir2,
+        source=f"simulated (seed {seed})",
+    )
+    return SimulatedMeasurements(
+        data=data,
+        errors=errors,
+        effects=effects,
+        noise_arcsec=float(noise_arcsec),
+        seed=int(seed),
+        schedule=schedule,
+        truth_rad=truth,
+    )

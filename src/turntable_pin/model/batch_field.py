@@ -1,0 +1,206 @@
+"""Fast orientation error over many angle pairs and many error sets, from the model's placements.
+
+Every entry of ``dR(phi1, phi2) = Rd^T Rt`` is a trigonometric polynomial of degree two in each
+angle: ``phi1`` enters only through the outer joint's rotation in ``Rt`` and in ``Rd^T`` (twice),
+``phi2`` likewise through the inner joint. So, exactly,
+
+    dR_ij(phi1, phi2) = u(phi1)^T C_ij u(phi2),   u(a) = [1, cos a, sin a, cos 2a, sin 2a],
+
+with a 5x5 coefficient matrix ``C_ij`` per entry. The coefficients are obtained by composing the
+Pinocchio model's own placement chain (joint placements, joint axes, payload frame placement; see
+:meth:`TurntableModel.placement_chain`) on a 5x5 grid of equally spaced angles and inverting the
+(orthogonal) trigonometric basis there. Evaluating ``dR`` at N angle pairs then costs two small
+matrix products, which is what makes allocation, Monte Carlo and fitting fast.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..core.rotations import axis_rotation
+from .errors import ERROR_NAMES
+from .turntable import (
+    INNER_JOINT,
+    OUTER_JOINT,
+    PAYLOAD_FRAME,
+    PAYLOAD_MOUNT,
+    TurntableModel,
+    error_placements,
+    joint_axis,
+)
+
+N_BASIS = 5
+_GRID_RAD = 2.0 * np.pi * np.arange(N_BASIS) / N_BASIS
+ANGLE_ENTRIES: tuple[tuple[int, int], ...] = ((0, 2), (1, 0), (2, 1))
+"""(row, column) of dpsi, dtheta, dgamma in dR (eq. 24)."""
+
+
+_CHUNK = 8192  # angle pairs per block: keeps the intermediates in cache
+
+
+def _basis_rows(angle_rad: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """Fill ``out`` (5, ...) with ``1, cos a, sin a, cos 2a, sin 2a``.
+
+    cos and sin come from one ``tan(a/2)`` through the rational half-angle formulas (a few ulp
+    of error): one transcendental call instead of two, which is most of the cost of a batch.
+    """
+    t = np.tan(0.5 * angle_rad)
+    t2 = t * t
+    inv = 1.0 / (1.0 + t2)
+    c = np.multiply(1.0 - t2, inv, out=out[1])
+    s = np.multiply(2.0 * t, inv, out=out[2])
+    out[0] = 1.0
+    np.subtract(c * c, s * s, out=out[3])
+    np.multiply(2.0 * s, c, out=out[4])
+    return out
+
+
+def trig_basis(angle_rad) -> np.ndarray:
+    """``[1, cos a, sin a, cos 2a, sin 2a]`` stacked on a new last axis."""
+    a = np.asarray(angle_rad, dtype=float)
+    flat = a.reshape(-1)
+    rows = _basis_rows(flat, np.empty((N_BASIS, flat.size)))
+    return rows.T.reshape(a.shape + (N_BASIS,))
+
+
+def _outer_basis_blocks(phi1_rad: np.ndarray, phi2_rad: np.ndarray):
+    """Yield ``(slice, B)`` with ``B[5*m + n, p] = u_m(phi1[p]) u_n(phi2[p])`` per block."""
+    u1 = np.empty((N_BASIS, _CHUNK))
+    u2 = np.empty((N_BASIS, _CHUNK))
+    for start in range(0, phi1_rad.size, _CHUNK):
+        block = slice(start, min(start + _CHUNK, phi1_rad.size))
+        size = block.stop - block.start
+        a = _basis_rows(phi1_rad[block], u1[:, :size])
+        b = _basis_rows(phi2_rad[block], u2[:, :size])
+        yield block, (a[:, None, :] * b[None, :, :]).reshape(N_BASIS * N_BASIS, size)
+
+
+_BASIS_INV = np.linalg.inv(trig_basis(_GRID_RAD))  # rows: grid points, cols: basis functions
+
+
+def _compose(chain: Sequence[tuple[np.ndarray, np.ndarray | None]], q_rad: Sequence) -> np.ndarray:
+    """Rotation of a placement chain at joint values ``q_rad`` (broadcast over leading dims)."""
+    result = None
+    qi = 0
+    for placement, axis in chain:
+        rot = np.asarray(placement)[..., :3, :3]
+        result = rot if result is None else result @ rot
+        if axis is not None:
+            result = result @ axis_rotation(axis, q_rad[qi])
+            qi += 1
+    return result
+
+
+def _coefficients(actual_chain, ideal_chain) -> np.ndarray:
+    """Coefficients C (K, 3, 3, 5, 5) of dR for chains whose placements have a leading dim K."""
+    g1, g2 = np.meshgrid(_GRID_RAD, _GRID_RAD, indexing="ij")  # (5, 5)
+    # Placements (K, 4, 4) broadcast against the (5, 5) grid of joint values.
+    rt = _compose([(p[:, None, None], a) for p, a in actual_chain], (g1, g2))
+    rd = _compose([(p[:, None, None], a) for p, a in ideal_chain], (g1, g2))
+    dR = np.swapaxes(rd, -1, -2) @ rt  # (K, 5, 5, 3, 3)
+    # dR[k, a, b] = sum_mn B[a, m] C[m, n] B[b, n]  ->  C = Binv dR Binv^T on the grid axes.
+    return np.einsum("ma,kabij,nb->kijmn", _BASIS_INV, dR, _BASIS_INV)
+
+
+class OrientationErrorField:
+    """``dR`` of one or many turntables as a function of (phi1, phi2), evaluated in batches.
+
+    Build it with :meth:`from_model` (one Pinocchio model) or :meth:`from_error_values` (many
+    error sets on the same URDF). ``coefficients`` has shape (K, 3, 3, 5, 5).
+    """
+
+    def __init__(self, coefficients: np.ndarray) -> None:
+        coefficients = np.asarray(coefficients, dtype=float)
+        if coefficients.ndim == 4:
+            coefficients = coefficients[None]
+        self.coefficients = coefficients
+        self.coefficients.setflags(write=False)
+        # dpsi, dtheta, dgamma coefficient blocks, (K, 3, 5, 5).
+        self._angle_coefficients = np.stack(
+            [coefficients[:, i, j] for i, j in ANGLE_ENTRIES], axis=1
+        )
+
+    @property
+    def n_sets(self) -> int:
+        """Number of error sets K."""
+        return self.coefficients.shape[0]
+
+    @classmethod
+    def from_model(cls, model: TurntableModel) -> OrientationErrorField:
+        """The field of one :class:`TurntableModel`, read off its Pinocchio placements."""
+        actual = [(p[None], a) for p, a in model.placement_chain(model.model)]
+        ideal = [(p[None], a) for p, a in model.placement_chain(model.nominal_model)]
+        return cls(_coefficients(actual, ideal))
+
+    @classmethod
+    def from_error_values(
+        cls, error_values: np.ndarray, model: TurntableModel | None = None
+    ) -> OrientationErrorField:
+        """The fields of K error sets, ``error_values`` of shape (K, 9) (rad, deta in m).
+
+        The placements are the nominal model's with :func:`error_placements` applied, the same
+        construction :class:`TurntableModel` writes into Pinocchio.
+        """
+        model = model or TurntableModel()
+        values = np.atleast_2d(np.asarray(error_values, dtype=float))
+        if values.shape[-1] == len(ERROR_NAMES) - 1:
+            values = np.concatenate([values, np.zeros((values.shape[0], 1))], axis=1)
+        transforms = error_placements(values)
+        nominal = model.nominal_model
+        mount_id = nominal.getFrameId(PAYLOAD_MOUNT)
+        payload = nominal.frames[nominal.getFrameId(PAYLOAD_FRAME)]
+        relative = nominal.frames[mount_id].placement.actInv(payload.placement).homogeneous
+        actual = []
+        for name in (OUTER_JOINT, INNER_JOINT):
+            jid = nominal.getJointId(name)
+            actual.append(
+                (
+                    nominal.jointPlacements[jid].homogeneous @ transforms[name],
+                    joint_axis(nominal, jid),
+                )
+            )
+        mount = nominal.frames[mount_id].placement.homogeneous
+        actual.append((mount @ transforms[PAYLOAD_MOUNT] @ relative, None))
+        ideal = [(np.broadcast_to(p, (1, 4, 4)), a) for p, a in model.placement_chain(nominal)]
+        return cls(_coefficients(actual, ideal))
+
+    # ---- evaluation --------------------------------------------------------------------------
+    def _evaluate(self, coefficients: np.ndarray, phi1_rad, phi2_rad) -> np.ndarray:
+        """Contract (K, E, 5, 5) coefficients with the basis at N pairs: (K, E, N)."""
+        phi1, phi2 = np.broadcast_arrays(
+            np.asarray(phi1_rad, dtype=float).ravel(), np.asarray(phi2_rad, dtype=float).ravel()
+        )
+        k, e = coefficients.shape[:2]
+        flat = coefficients.reshape(k * e, N_BASIS * N_BASIS)
+        out = np.empty((k * e, phi1.size))
+        for block, basis in _outer_basis_blocks(phi1, phi2):
+            out[:, block] = flat @ basis
+        return out.reshape(k, e, phi1.size)
+
+    def rotation(self, phi1_rad, phi2_rad) -> np.ndarray:
+        """Full ``dR`` at N angle pairs (broadcast, flattened): shape (K, N, 3, 3)."""
+        k = self.n_sets
+        values = self._evaluate(
+            self.coefficients.reshape(k, 9, N_BASIS, N_BASIS), phi1_rad, phi2_rad
+        )
+        return values.transpose(0, 2, 1).reshape(k, -1, 3, 3)
+
+    def angles(self, phi1_rad, phi2_rad) -> np.ndarray:
+        """``(dpsi, dtheta, dgamma)`` in radians at N angle pairs, shape (K, N, 3).
+
+        One (3K, 25) x (25, P) product per block of P pairs; see the module docstring.
+        """
+        return self._evaluate(self._angle_coefficients, phi1_rad, phi2_rad).transpose(0, 2, 1)
+
+    def angles_on_phi2_grid(self, phi1_rad: float, phi2_grid_rad) -> np.ndarray:
+        """``(dpsi, dtheta, dgamma)`` of every error set on a grid of phi2 at one phi1.
+
+        Returns shape (K, 3, M) for M grid values: one (K*3, 5) x (5, M) product, the fast path
+        of Monte Carlo runs over many turntables.
+        """
+        u1 = trig_basis(float(phi1_rad))
+        u2 = trig_basis(np.asarray(phi2_grid_rad, dtype=float).ravel())
+        per_phi2 = np.einsum("m,kemn->ken", u1, self._angle_coefficients)  # (K, 3, 5)
+        return per_phi2 @ u2.T

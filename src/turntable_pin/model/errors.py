@@ -1,0 +1,203 @@
+"""The nine error components of a two-axis turntable (paper Table 2) as one frozen parameter set.
+
+Inside the set, the eight angular errors are radians and the intersection error ``deta`` is
+metres. Readers take user units: arc seconds (or ``_arcmin``, ``_deg``, ``_rad`` suffixes) for
+angles, millimetres (or ``_m``) for ``deta``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from ..core.exceptions import InputError
+from ..core.files import read_yaml, write_text_atomic
+from ..core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, M_PER_MM
+
+ANGULAR_ERROR_NAMES: tuple[str, ...] = (
+    "dphi_y1",
+    "dphi_z2",
+    "dalpha_x1",
+    "dalpha_z1",
+    "dalpha_x2",
+    "dalpha_y2",
+    "deps_x",
+    "deps_y",
+)
+"""The eight angular errors in the order of the paper's vector chi (eq. 25)."""
+
+ERROR_NAMES: tuple[str, ...] = (*ANGULAR_ERROR_NAMES, "deta")
+"""All nine components of Table 2; ``deta`` (a length) last."""
+
+ERROR_DESCRIPTIONS: dict[str, str] = {
+    "dphi_y1": "position error of the outer axis",
+    "dphi_z2": "position error of the inner axis",
+    "dalpha_x1": "wobble of the outer axis about x",
+    "dalpha_z1": "wobble of the outer axis about z",
+    "dalpha_x2": "wobble of the inner axis about x",
+    "dalpha_y2": "wobble of the inner axis about y",
+    "deps_x": "orthogonality error between the axes about x",
+    "deps_y": "orthogonality error between the axes about y",
+    "deta": "intersection error: offset of the inner axis along x",
+}
+
+# Factor that turns a value in the named unit into radians / metres.
+_ANGLE_UNITS = {
+    "arcsec": 1.0 / ARCSEC_PER_RAD,
+    "arcmin": 1.0 / ARCMIN_PER_RAD,
+    "deg": 1.0 / DEG_PER_RAD,
+    "rad": 1.0,
+}
+_LENGTH_UNITS = {"mm": M_PER_MM, "um": 1e-6, "m": 1.0}
+DEFAULT_ANGLE_UNIT = "arcsec"
+DEFAULT_LENGTH_UNIT = "mm"
+
+
+def _to_float(value: object, what: str) -> float:
+    if isinstance(value, bool):
+        raise InputError(f"{what}: expected a number, got {value!r}")
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise InputError(f"{what}: expected a number, got {value!r}") from None
+    if not math.isfinite(number):
+        raise InputError(f"{what}: expected a finite number, got {value!r}")
+    return number
+
+
+def parse_error_value(key: str, value: object) -> tuple[str, float]:
+    """Turn one user entry into ``(name, value in rad or m)``.
+
+    ``key`` is an error name, optionally with a unit suffix (``dphi_y1_arcmin``, ``deta_m``).
+    Without a suffix angles are arc seconds and ``deta`` is millimetres.
+
+    Raises:
+        InputError: unknown name or unit, or a value that is not a finite number.
+    """
+    key = key.strip()
+    name, unit = key, None
+    if key not in ERROR_NAMES:
+        base, _, suffix = key.rpartition("_")
+        if base in ERROR_NAMES:
+            name, unit = base, suffix
+        else:
+            raise InputError(
+                f"unknown error name '{key}'; known names: {', '.join(ERROR_NAMES)} "
+                "(optionally with a unit suffix such as _arcsec, _arcmin, _deg, _rad, _mm, _m)"
+            )
+    units = _LENGTH_UNITS if name == "deta" else _ANGLE_UNITS
+    unit = unit or (DEFAULT_LENGTH_UNIT if name == "deta" else DEFAULT_ANGLE_UNIT)
+    if unit not in units:
+        raise InputError(f"'{key}': unit '{unit}' is not one of {', '.join(units)}")
+    return name, _to_float(value, f"error '{key}'") * units[unit]
+
+
+@dataclass(frozen=True)
+class TurntableErrors:
+    """The nine turntable error components of paper Table 2.
+
+    Attributes (radians, except ``deta`` in metres): see :data:`ERROR_DESCRIPTIONS`.
+    """
+
+    dphi_y1: float = 0.0
+    dphi_z2: float = 0.0
+    dalpha_x1: float = 0.0
+    dalpha_z1: float = 0.0
+    dalpha_x2: float = 0.0
+    dalpha_y2: float = 0.0
+    deps_x: float = 0.0
+    deps_y: float = 0.0
+    deta: float = 0.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            object.__setattr__(self, f.name, _to_float(value, f.name))
+
+    # ---- constructors -------------------------------------------------------------------
+    @classmethod
+    def zero(cls) -> TurntableErrors:
+        """The perfect turntable."""
+        return cls()
+
+    @classmethod
+    def from_array(cls, values: Iterable[float]) -> TurntableErrors:
+        """From the nine values in :data:`ERROR_NAMES` order (rad, ``deta`` in m)."""
+        values = np.asarray(list(values), dtype=float).ravel()
+        if values.size == len(ANGULAR_ERROR_NAMES):
+            values = np.append(values, 0.0)
+        if values.size != len(ERROR_NAMES):
+            raise InputError(f"expected 8 or 9 error values, got {values.size}")
+        return cls(*values.tolist())
+
+    @classmethod
+    def from_user_units(cls, entries: Mapping[str, object]) -> TurntableErrors:
+        """From a mapping ``name[_unit] -> value`` in user units (see :func:`parse_error_value`)."""
+        values: dict[str, float] = {}
+        for key, value in entries.items():
+            name, si_value = parse_error_value(str(key), value)
+            if name in values:
+                raise InputError(f"error '{name}' is given twice")
+            values[name] = si_value
+        return cls(**values)
+
+    @classmethod
+    def from_arcsec(cls, deta_mm: float = 0.0, **angles_arcsec: float) -> TurntableErrors:
+        """From angular errors in arc seconds and ``deta`` in millimetres."""
+        return cls.from_user_units({**angles_arcsec, "deta_mm": deta_mm})
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> TurntableErrors:
+        """Read a YAML file: a mapping ``name[_unit]: value``, optionally under a key ``errors``.
+
+        Example::
+
+            errors:
+              dphi_y1_arcsec: 3.0
+              deps_x_arcsec: -2.0
+              deta_mm: 0.2
+        """
+        path = Path(path)
+        data = read_yaml(path)
+        if isinstance(data, Mapping) and "errors" in data:
+            data = data["errors"]
+        if data is None:
+            data = {}
+        if not isinstance(data, Mapping):
+            raise InputError("expected a mapping of error names to values", path=path)
+        try:
+            return cls.from_user_units(data)
+        except InputError as exc:
+            raise InputError(exc.detail, path=path) from None
+
+    # ---- views ---------------------------------------------------------------------------
+    def as_array(self) -> np.ndarray:
+        """The nine values in :data:`ERROR_NAMES` order (rad, ``deta`` in m)."""
+        return np.array([getattr(self, n) for n in ERROR_NAMES], dtype=float)
+
+    def angular_array_rad(self) -> np.ndarray:
+        """The eight angular errors in :data:`ANGULAR_ERROR_NAMES` order, radians."""
+        return self.as_array()[: len(ANGULAR_ERROR_NAMES)]
+
+    def to_user_units(self) -> dict[str, float]:
+        """``{name_arcsec: value, ..., deta_mm: value}``, the form :meth:`from_user_units` reads."""
+        out = {f"{n}_arcsec": getattr(self, n) * ARCSEC_PER_RAD for n in ANGULAR_ERROR_NAMES}
+        out["deta_mm"] = self.deta / M_PER_MM
+        return out
+
+    def as_dict(self) -> dict[str, float]:
+        """``{name: value}`` in internal units (rad, m)."""
+        return asdict(self)
+
+    def scaled(self, factor: float) -> TurntableErrors:
+        """Every component multiplied by ``factor``."""
+        return TurntableErrors.from_array(self.as_array() * factor)
+
+    def to_yaml(self, path: str | Path) -> None:
+        """Write the set in user units (arcsec, mm) as a YAML file that :meth:`from_yaml` reads."""
+        write_text_atomic(path, yaml.safe_dump({"errors": self.to_user_units()}, sort_keys=False))

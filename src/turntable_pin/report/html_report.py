@@ -1,0 +1,264 @@
+"""One self-contained HTML page telling the whole story of a measurement file.
+
+Data, base fit, where it fails, the diagnosis, the fit with the missing effect(s) and the
+parameters, with every plot embedded as a base64 PNG (the page needs no other file).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+from pathlib import Path
+
+from ..core.files import write_text_atomic
+from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
+from ..measurement.data import ANGLE_NAMES
+from ..measurement.residuals import (
+    COLOURS,
+    analyse_residuals,
+    harmonics_figure,
+    orientation_residuals,
+    residual_figure,
+)
+from ..stats.model_selection import Diagnosis
+
+_STYLE = """
+body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
+h1{font-size:1.5em}h2{font-size:1.2em;border-bottom:1px solid #ccc;margin-top:2em}
+table{border-collapse:collapse;font-size:.9em;margin:.5em 0}
+td,th{border:1px solid #ddd;padding:.25em .6em;text-align:right}th{background:#f4f4f4}
+td.l,th.l{text-align:left}.verdict{background:#eef6ee;padding:.8em;border-left:4px solid #3a3}
+.warn{background:#fbf1e6;border-left-color:#d80}img{max-width:100%}code{background:#f4f4f4}
+"""
+
+
+def _img(png: bytes, alt: str) -> str:
+    data = base64.b64encode(png).decode("ascii")
+    return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{data}">'
+
+
+def _table(header: list[str], rows: list[list], left: int = 1) -> str:
+    def cell(v, i, tag):
+        cls = ' class="l"' if i < left else ""
+        if isinstance(v, float):
+            v = f"{v:.4g}"
+        return f"<{tag}{cls}>{html.escape(str(v))}</{tag}>"
+
+    out = ["<table><tr>" + "".join(cell(h, i, "th") for i, h in enumerate(header)) + "</tr>"]
+    for row in rows:
+        out.append("<tr>" + "".join(cell(v, i, "td") for i, v in enumerate(row)) + "</tr>")
+    return "".join(out) + "</table>"
+
+
+def data_figure(data) -> bytes:
+    """PNG: the measured angles against phi2, one panel per angle, coloured by phi1."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(14, 3.4))
+    phi1 = data.phi1_rad * DEG_PER_RAD
+    phi2 = data.phi2_rad * DEG_PER_RAD
+    for i, (ax, name) in enumerate(zip(axes, ANGLE_NAMES, strict=True)):
+        sc = ax.scatter(phi2, data.angles_rad[:, i] * ARCSEC_PER_RAD, c=phi1, s=10, cmap="viridis")
+        ax.set_xlabel("phi2 (deg)")
+        ax.set_ylabel(f"{name} (arcsec)")
+        ax.set_title(f"measured {name}", fontsize=10, color=COLOURS[i])
+    fig.colorbar(sc, ax=axes, label="phi1 (deg)")
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=90, bbox_inches="tight")
+    plt.close(fig)
+    return buffer.getvalue()
+
+
+def _fit_rows(diagnosis: Diagnosis, fits) -> list[list]:
+    rows = []
+    for label, fit in fits:
+        s = diagnosis.summary(fit)
+        rows.append(
+            [label, s["rms_arcsec"], s["chi2_reduced"], s["rank"], s["n_params"],
+             "-" if s["p_value"] is None else f"{s['p_value']:.3g}"]
+        )  # fmt: skip
+    return rows
+
+
+def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
+    """The HTML page of a diagnosis (self-contained)."""
+    data = diagnosis.family.data
+    d = diagnosis.to_dict()
+    verdict = d["verdict"]
+    base_fit = diagnosis.base_fit.with_noise_variance(diagnosis.noise_variance)
+    best_fit = diagnosis.best_fit.with_noise_variance(diagnosis.noise_variance)
+    base_rs = orientation_residuals(base_fit)
+    best_rs = orientation_residuals(best_fit)
+    base_an = analyse_residuals(base_rs)
+    parts = [f"<h1>{html.escape(title or 'Turntable measurement diagnosis')}</h1>"]
+    parts.append(
+        f"<p>Source: <code>{html.escape(data.source)}</code> &mdash; {data.n_positions} "
+        f"positions, {3 * data.n_positions} measured angles; noise sigma "
+        + (
+            f"from the file's <code>sigma_arcsec</code> column (median {d['sigma_arcsec']:.3g} "
+            "arcsec)."
+            if diagnosis.sigma_known
+            else f"not given: estimated from the best fit, {d['sigma_arcsec']:.3g} arcsec."
+        )
+        + "</p>"
+    )
+    parts.append("<h2>1. The data</h2>" + _img(data_figure(data), "measured angles"))
+    b = d["base"]
+    parts.append(
+        "<h2>2. The base model</h2><p>The nine turntable errors of the paper (the intersection "
+        "error never changes the orientation, so eight angles are fitted). The data determine "
+        f"{b['rank']} combinations of them:</p>"
+    )
+    combos = base_fit.result.combinations()
+    parts.append(
+        _table(
+            ["combination", "value", "std", "unit"],
+            [[c["name"], c["value"], c["std"], c["unit"]] for c in combos],
+        )
+    )
+    und = base_fit.result.undetermined_combinations()
+    if und:
+        parts.append(
+            "<p>Not determined by orientation data (flat directions): "
+            + ", ".join(f"<code>{html.escape(u)}</code>" for u in und)
+            + ".</p>"
+        )
+    parts.append(
+        _table(
+            ["model", "rms (arcsec)", "chi2_reduced", "rank", "params", "p-value"],
+            _fit_rows(diagnosis, [("base", base_fit)]),
+        )
+    )
+    failing = base_an.failing
+    parts.append(
+        f"<h2>3. Where the base model fails</h2><p>{len(failing)} of {data.n_positions} "
+        f"positions have a residual beyond {base_an.k_sigma:g} sigma.</p>"
+    )
+    if failing:
+        parts.append(
+            _table(
+                ["row", "phi1 (deg)", "phi2 (deg)", "angle", "residual (arcsec)", "sigmas"],
+                [
+                    [
+                        f["row"],
+                        f["phi1_deg"],
+                        f["phi2_deg"],
+                        f["component"],
+                        f["residual_arcsec"],
+                        f["sigmas"],
+                    ]
+                    for f in failing[:15]
+                ],
+            )  # fmt: skip
+        )
+    parts.append(_img(residual_figure([base_rs]), "base residuals"))
+    parts.append(_img(harmonics_figure([base_an]), "base harmonics"))
+    cls = "verdict" if not verdict["unexplained"] else "verdict warn"
+    parts.append("<h2>4. Diagnosis: which physical effect is missing?</h2>")
+    first = verdict["missing_effect"]
+    parts.append(
+        _table(
+            [
+                "effect",
+                "delta BIC",
+                f"on top of {first}" if first else "-",
+                "rms (arcsec)",
+                "chi2_reduced",
+                "new rank",
+                "same as",
+            ],
+            [
+                [
+                    c["effect"],
+                    "-" if c["delta_bic"] is None else f"{c['delta_bic']:.1f}",
+                    "-"
+                    if c.get("delta_bic_after_first") is None
+                    else f"{c['delta_bic_after_first']:.1f}",
+                    "-" if c["rms_arcsec"] is None else c["rms_arcsec"],
+                    "-" if c["chi2_reduced"] is None else c["chi2_reduced"],
+                    c["added_rank"] if c["testable"] else "-",
+                    ", ".join(c["alternatives"]),
+                ]
+                for c in d["candidates"]
+            ],
+        )  # fmt: skip
+    )
+    notes = [f"<li><b>{html.escape(c['effect'])}</b>: {html.escape(c['reason'])}</li>"
+             for c in d["candidates"] if c.get("reason")]  # fmt: skip
+    if notes:
+        parts.append("<p>Not testable here:</p><ul>" + "".join(notes) + "</ul>")
+    lines = diagnosis.report_lines()
+    start = next((i for i, ln in enumerate(lines) if ln.startswith(("step ", "missing effect"))), 0)
+    words = "<br>".join(html.escape(line) for line in lines[start:])
+    parts.append(f'<div class="{cls}">{words}</div>')
+    if verdict["missing_effect"]:
+        story = verdict["effect_story"]
+        parts.append(
+            f"<p><b>{html.escape(story['effect'])}</b> &mdash; {html.escape(story['title'])}. "
+            f"Definition: <code>{html.escape(story['definition'])}</code>.</p>"
+            f"<p>{html.escape(story['explanation'])}</p>"
+            f"<p><i>How to confirm it on the machine:</i> {html.escape(story['confirm'])}</p>"
+        )
+        best_an = analyse_residuals(best_rs)
+        parts.append(
+            "<h2>5. Add it and watch the error fall</h2>"
+            + _table(
+                ["model", "rms (arcsec)", "chi2_reduced", "rank", "params", "p-value"],
+                _fit_rows(diagnosis, [("base", base_fit)])
+                + [
+                    [
+                        f"+ {s['added']}",
+                        s["rms_arcsec"],
+                        s["chi2_reduced"],
+                        s["rank"],
+                        s["n_params"],
+                        "-" if s["p_value"] is None else f"{s['p_value']:.3g}",
+                    ]
+                    for s in d["steps"]
+                ],
+            )  # fmt: skip
+            + _img(residual_figure([base_rs, best_rs]), "residuals before and after")
+            + _img(harmonics_figure([base_an, best_an]), "harmonics before and after")
+        )
+    res = best_fit.result
+    parts.append(
+        "<h2>6. Parameters of the final model</h2><p>Determined combinations (value &plusmn; "
+        f"standard error; rank {res.rank} of {res.n_params} parameters):</p>"
+    )
+    parts.append(
+        _table(
+            ["combination", "value", "std", "unit"],
+            [[c["name"], c["value"], c["std"], c["unit"]] for c in res.combinations()],
+        )
+    )
+    und = res.undetermined_combinations()
+    if und:
+        parts.append(
+            "<p>Flat directions: "
+            + ", ".join(f"<code>{html.escape(u)}</code>" for u in und)
+            + ".</p>"
+        )
+    parts.append(
+        "<p style='color:#777;font-size:.85em'>Decision rule: an effect is accepted when it "
+        "lowers BIC by 6 or more; effects whose fit is as good are listed as alternatives; the "
+        "final model is 'unexplained' when it fails the chi2 test (sigma given) or a harmonic "
+        "structure search still finds a term.</p>"
+    )
+    body = "\n".join(parts)
+    return (
+        "<!DOCTYPE html><html><head><meta charset='utf-8'>"
+        f"<title>{html.escape(title or 'turntable-pin report')}</title><style>{_STYLE}</style>"
+        f"</head><body>{body}</body></html>\n"
+    )
+
+
+def write_report(diagnosis: Diagnosis, path: str | Path, *, title: str = "") -> Path:
+    """Write :func:`diagnosis_html` to ``path`` atomically."""
+    return write_text_atomic(path, diagnosis_html(diagnosis, title=title))
+
+
+__all__ = ["data_figure", "diagnosis_html", "write_report"]

@@ -1,0 +1,159 @@
+"""Figures 4 and 5 of the paper for an :class:`OrientationRequirement`, as PNG files.
+
+Figure 4: the rate-sensing errors over the orientation-error angles: the surfaces Gamma1
+(``dwx`` over dpsi, dtheta) and Gamma2 (``dwy`` over dtheta, dgamma) with the plane ``w_m``, and
+slices showing that ``dwx`` hardly depends on dgamma and ``dwy`` hardly on dpsi.
+Figure 5: the contour lines ``dwx = w_m`` and ``dwy = w_m`` with the requirement rectangles.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ..calibration.rate_error import orientation_error_rotation, rate_errors_dph  # noqa: E402
+from ..calibration.requirement import MAX_ANGLE_RAD, OrientationRequirement  # noqa: E402
+from ..core.files import write_atomic  # noqa: E402
+from ..core.units import deg_to_rad, rad_to_deg  # noqa: E402
+
+_LABELS = {"psi": r"$\Delta\psi$ (deg)", "theta": r"$\Delta\theta$ (deg)",
+           "gamma": r"$\Delta\gamma$ (deg)"}  # fmt: skip
+
+
+def plot_span_deg(result: OrientationRequirement) -> float:
+    """Half-width of the plotted angle range: 1.6 times the largest contour intercept below the
+    search cap (intercepts at the cap would flatten the figure), degrees."""
+    limits = [w for r in result.rectangles for w in r.axis_limits_rad if w < MAX_ANGLE_RAD]
+    return float(rad_to_deg(1.6 * max(limits, default=MAX_ANGLE_RAD)))
+
+
+def _rate_errors(result: OrientationRequirement, angles_rad: np.ndarray) -> np.ndarray:
+    """``[dwx, dwy]`` (deg/h) at (M, 3) angle triples."""
+    out = np.empty((angles_rad.shape[0], 2))
+    for start in range(0, angles_rad.shape[0], 4096):
+        chunk = angles_rad[start : start + 4096]
+        rotations = orientation_error_rotation(*chunk.T, exact=result.exact)
+        out[start : start + 4096] = rate_errors_dph(
+            result.gyrowheel, result.inputs, rotations, definition=result.definition
+        )
+    return out
+
+
+def _title(result: OrientationRequirement) -> str:
+    return (
+        f"positions {result.positions_name} ({result.n_positions}), latitude "
+        f"{rad_to_deg(result.latitude_rad):g} deg, w_m = {result.accuracy_dph:g} deg/h, "
+        f"{result.definition.replace('_', ' ')}"
+    )
+
+
+def _surfaces(result: OrientationRequirement, points: int):
+    """Grids u, v (deg) and the surfaces Gamma1 = dwx(dpsi=u, dtheta=v), Gamma2 = dwy(dtheta=u,
+    dgamma=v) on them (deg/h, flat)."""
+    span = plot_span_deg(result)
+    grid_deg = np.linspace(-span, span, points)
+    u, v = np.meshgrid(grid_deg, grid_deg, indexing="ij")
+    zeros = np.zeros(u.size)
+    gamma1 = _rate_errors(result, deg_to_rad(np.stack([u.ravel(), v.ravel(), zeros], 1)))[:, 0]
+    gamma2 = _rate_errors(result, deg_to_rad(np.stack([zeros, u.ravel(), v.ravel()], 1)))[:, 1]
+    return u, v, gamma1, gamma2
+
+
+def plot_figure4(result: OrientationRequirement, path: str | Path, *, points: int = 41) -> Path:
+    """Write Figure 4 (surfaces Gamma1, Gamma2 and one-angle slices) to ``path`` (PNG)."""
+    u, v, gamma1, gamma2 = _surfaces(result, points)
+
+    fig = plt.figure(figsize=(15, 9))
+    fig.suptitle("Figure 4: rate-sensing errors against the orientation error\n" + _title(result))
+    for index, (values, names, axis) in enumerate(
+        ((gamma1, ("psi", "theta"), "x"), (gamma2, ("theta", "gamma"), "y"))
+    ):
+        ax = fig.add_subplot(2, 3, 1 + 3 * index, projection="3d")
+        ax.plot_surface(u, v, values.reshape(u.shape), cmap="viridis", linewidth=0, alpha=0.9)
+        ax.plot_surface(
+            u, v, np.full(u.shape, result.accuracy_dph), color="red", alpha=0.25, linewidth=0
+        )
+        ax.set_xlabel(_LABELS[names[0]])
+        ax.set_ylabel(_LABELS[names[1]])
+        ax.set_zlabel(rf"$\Delta\omega_{axis}$ (deg/h)")
+        ax.set_title(
+            f"({'ab'[index]}) $\\Gamma_{index + 1}$: $\\Delta\\omega_{axis}$, plane $\\omega_m$"
+        )
+    # Slices: each error against each angle, the third angle (the "other" one) at three values.
+    slices = (
+        ("c", 0, 0, 2, "psi", "gamma"),
+        ("d", 0, 1, 2, "theta", "gamma"),
+        ("e", 1, 2, 0, "gamma", "psi"),
+        ("f", 1, 1, 0, "theta", "psi"),
+    )
+    span = plot_span_deg(result)
+    line = np.linspace(-span, span, 161)
+    for n, (letter, column, along, other, along_name, other_name) in enumerate(slices):
+        ax = fig.add_subplot(2, 3, (2, 3, 5, 6)[n])
+        for fraction in (0.0, 0.5, 1.0):
+            angles = np.zeros((line.size, 3))
+            angles[:, along] = line
+            angles[:, other] = fraction * span
+            values = _rate_errors(result, deg_to_rad(angles))[:, column]
+            ax.plot(line, values, label=f"$\\Delta\\{other_name}$ = {fraction * span:.3g} deg")
+        ax.axhline(result.accuracy_dph, color="red", lw=0.8, ls="--", label=r"$\omega_m$")
+        ax.set_xlabel(_LABELS[along_name])
+        ax.set_ylabel(rf"$\Delta\omega_{'xy'[column]}$ (deg/h)")
+        ax.set_title(f"({letter}) $\\Delta\\omega_{'xy'[column]}$ against $\\Delta\\{along_name}$")
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def plot_figure5(result: OrientationRequirement, path: str | Path, *, points: int = 121) -> Path:
+    """Write Figure 5 (contours ``dw = w_m`` and the requirement rectangles) to ``path``."""
+    u, v, gamma1, gamma2 = _surfaces(result, points)
+    limits_deg = rad_to_deg(result.limits_rad)
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.5))
+    fig.suptitle("Figure 5: requirement of the orientation error\n" + _title(result))
+    panels = (
+        (axes[0], gamma1, ("psi", "theta"), (limits_deg[0], limits_deg[1]), "x", 0),
+        (axes[1], gamma2, ("theta", "gamma"), (limits_deg[1], limits_deg[2]), "y", 1),
+    )
+    for ax, values, names, (a, b), axis, index in panels:
+        ax.contour(u, v, values.reshape(u.shape), levels=[result.accuracy_dph], colors="C0")
+        ax.fill(
+            [-a, a, a, -a], [-b, -b, b, b], color="black", alpha=0.85,
+            label=f"|$\\Delta\\{names[0]}$| <= {a:.4g}, |$\\Delta\\{names[1]}$| <= {b:.4g} deg",
+        )  # fmt: skip
+        rect = result.rectangles[index]
+        ra, rb = rad_to_deg(np.asarray(rect.half_widths_rad))
+        ax.plot(
+            [-ra, ra, ra, -ra, -ra], [-rb, -rb, rb, rb, -rb], color="C1", ls="--",
+            label="largest rectangle of this plane alone",
+        )  # fmt: skip
+        ax.plot([], [], color="C0", label=f"$\\Delta\\omega_{axis} = \\omega_m$")
+        ax.set_xlabel(_LABELS[names[0]])
+        ax.set_ylabel(_LABELS[names[1]])
+        ax.set_aspect("equal")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="upper right")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def write_requirement_figures(result: OrientationRequirement, directory: str | Path) -> list[Path]:
+    """Write ``figure4_rate_errors.png`` and ``figure5_requirement.png`` into ``directory``."""
+    directory = Path(directory)
+    return [
+        plot_figure4(result, directory / "figure4_rate_errors.png"),
+        plot_figure5(result, directory / "figure5_requirement.png"),
+    ]
+
+
+def _save(fig, path: str | Path) -> Path:
+    try:
+        return write_atomic(path, lambda tmp: fig.savefig(tmp, format="png", dpi=110))
+    finally:
+        plt.close(fig)

@@ -1,0 +1,390 @@
+"""Weighted nonlinear least squares with identifiability analysis, for any model of the protocol.
+
+The machinery is not tied to orientation data: any :class:`FitProblem` (observations, their
+sigmas, parameter names and units, ``predict`` and ``jacobian``) can be fitted, and the result
+knows its rank, the parameter combinations the data determine and those they cannot, their
+standard errors, and its goodness of fit.
+
+Identifiability is read from the SVD of the column-normalised weighted Jacobian at zero
+parameters (the models here are first-order exact there; second-order terms of size |error|^2,
+~1e-10 rad, cannot be resolved by data): singular values below ``RANK_RTOL`` times the largest
+are flat directions. The fit then runs in the coordinates of the determined subspace, which gives
+the minimum-norm (in normalised units) representative of the family of equivalent solutions; the
+determined combinations are the reduced row-echelon form of the row space, so they read
+like ``dphi_y1 + deps_y``.
+
+Noise: with sigmas given, ``chi2 = sum((r / sigma)^2)`` and its p-value test the fit. Without
+them the observations get unit weights and the noise variance is estimated (``rss / dof`` of this
+fit, or a value supplied by the caller, e.g. the best model of a diagnosis): a chi2 computed with
+an estimated sigma is 1 per degree of freedom by construction, so no p-value is reported then.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from ..core.exceptions import IdentifiabilityError
+
+RANK_RTOL = 1e-6
+"""Singular values of the normalised Jacobian below this fraction of the largest are flat."""
+
+
+class FitProblem(Protocol):
+    """What :func:`fit_least_squares` needs from a model and its data."""
+
+    parameter_names: tuple[str, ...]
+    parameter_units: tuple[str, ...]
+    per_user_unit: np.ndarray  # internal value of one user unit, per parameter
+    observed: np.ndarray  # (m,)
+    sigma: np.ndarray | None  # (m,) or None (unknown: unit weights, variance estimated)
+    user_unit_scale: float  # user units (e.g. arcsec) per internal unit of an observation
+
+    def predict(self, params: np.ndarray) -> np.ndarray: ...  # (m,)
+
+    def jacobian(self, params: np.ndarray) -> np.ndarray: ...  # (m, n)
+
+
+def _rref(matrix: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+    """Reduced row-echelon form (rows normalised so each pivot is 1; tiny entries zeroed)."""
+    a = np.array(matrix, dtype=float)
+    rows, cols = a.shape
+    r = 0
+    for c in range(cols):
+        if r >= rows:
+            break
+        pivot = r + int(np.argmax(np.abs(a[r:, c])))
+        if abs(a[pivot, c]) <= tol * max(1.0, np.abs(a).max()):
+            continue
+        a[[r, pivot]] = a[[pivot, r]]
+        a[r] /= a[r, c]
+        for k in range(rows):
+            if k != r:
+                a[k] -= a[k, c] * a[r]
+        r += 1
+    a = a[:r]
+    a[np.abs(a) < 1e-9] = 0.0
+    return a
+
+
+def combination_name(coefficients: np.ndarray, names: tuple[str, ...]) -> str:
+    """``"dphi_y1 + deps_y"``, ``"dphi_y1 - 0.5 backlash.b1"``, from coefficients per name."""
+    parts = []
+    for c, name in zip(coefficients, names, strict=True):
+        if c == 0:
+            continue
+        sign = "-" if c < 0 else "+"
+        mag = abs(c)
+        text = name if abs(mag - 1.0) < 1e-6 else f"{mag:.4g} {name}"
+        parts.append((sign, text))
+    if not parts:
+        return "0"
+    first_sign, first = parts[0]
+    out = ("-" if first_sign == "-" else "") + first
+    for sign, text in parts[1:]:
+        out += f" {sign} {text}"
+    return out
+
+
+@dataclass(frozen=True)
+class Identifiability:
+    """What the data determine (linearised at zero parameters).
+
+    Attributes:
+        rank: number of independent combinations determined.
+        singular_values: of the column-normalised weighted Jacobian, largest first.
+        basis: (n, rank) map from reduced coordinates to parameters (internal units).
+        determined: (rank, n) coefficients of the determined combinations (RREF of the row space).
+        undetermined: (n - rank, n) coefficients of the flat directions (RREF of the null space).
+        unresponsive: parameters no observation responds to.
+    """
+
+    rank: int
+    singular_values: np.ndarray
+    basis: np.ndarray
+    determined: np.ndarray
+    undetermined: np.ndarray
+    unresponsive: tuple[str, ...]
+
+
+def analyse_identifiability(jacobian_weighted: np.ndarray, names) -> Identifiability:
+    """Rank, determined combinations and flat directions of a weighted Jacobian (m, n)."""
+    norms = np.linalg.norm(jacobian_weighted, axis=0)
+    dead = norms <= 1e-300
+    scale = np.where(dead, 1.0, norms)
+    m, n = jacobian_weighted.shape
+    # vt must be square (n x n) to hold the null space; U need not be (m can be large).
+    _, s, vt = np.linalg.svd(jacobian_weighted / scale, full_matrices=m < n)
+    rank = int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
+    v_r = vt[:rank].T
+    v_null = vt[rank:].T
+    basis = v_r / scale[:, None]
+    determined = _rref((v_r * scale[:, None]).T) if rank else np.zeros((0, n))
+    undetermined = _rref((v_null / scale[:, None]).T) if rank < n else np.zeros((0, n))
+    full_s = np.zeros(n)
+    full_s[: s.size] = s
+    return Identifiability(
+        rank=rank,
+        singular_values=full_s,
+        basis=basis,
+        determined=determined,
+        undetermined=undetermined,
+        unresponsive=tuple(name for name, d in zip(names, dead, strict=True) if d),
+    )
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """The outcome of one weighted least-squares fit.
+
+    Attributes:
+        parameter_names, parameter_units, per_user_unit: of the model.
+        params: the minimum-norm representative of the best-fitting parameters (internal units).
+        covariance: of ``params`` (internal units), on the determined subspace (pseudo-inverse).
+        residuals: observed - predicted (internal units), (m,).
+        weights: 1/sigma per observation (unit weights when sigma is unknown).
+        rss: sum of squared weighted residuals.
+        rank, dof: determined combinations and ``m - rank``.
+        noise_variance: variance of a unit-weight residual used for chi2 and covariances (1 when
+            sigmas are given).
+        sigma_known: whether sigmas were given (then chi2 has a p-value).
+        identifiability: see :class:`Identifiability`.
+    """
+
+    parameter_names: tuple[str, ...]
+    parameter_units: tuple[str, ...]
+    per_user_unit: np.ndarray
+    params: np.ndarray
+    covariance: np.ndarray
+    residuals: np.ndarray
+    weights: np.ndarray
+    rss: float
+    rank: int
+    dof: int
+    noise_variance: float
+    sigma_known: bool
+    identifiability: Identifiability
+    user_unit_scale: float
+    jacobian_weighted: np.ndarray = field(repr=False)
+    n_function_evaluations: int = 0
+
+    @property
+    def n_obs(self) -> int:
+        return int(self.residuals.size)
+
+    @property
+    def n_params(self) -> int:
+        return len(self.parameter_names)
+
+    @property
+    def chi2(self) -> float:
+        return self.rss / self.noise_variance
+
+    @property
+    def chi2_reduced(self) -> float:
+        return self.chi2 / self.dof if self.dof > 0 else float("nan")
+
+    @property
+    def p_value(self) -> float | None:
+        """Probability of a chi2 at least this large if the model were right (sigma known)."""
+        if not self.sigma_known or self.dof <= 0:
+            return None
+        from scipy import stats  # imported on use: keeps `import turntable_pin` light
+
+        return float(stats.chi2.sf(self.chi2, self.dof))
+
+    @property
+    def rms_user(self) -> float:
+        """Root mean square of the (unweighted) residuals, in user units (arcsec)."""
+        return float(np.sqrt(np.mean(self.residuals**2)) * self.user_unit_scale)
+
+    def with_noise_variance(self, noise_variance: float) -> FitResult:
+        """The same fit judged with another unit-weight noise variance (sigma unknown case)."""
+        ratio = noise_variance / self.noise_variance
+        return _replace(
+            self, noise_variance=float(noise_variance), covariance=self.covariance * ratio
+        )
+
+    def combinations(self) -> list[dict]:
+        """The determined combinations: name, value and standard error in user units."""
+        out = []
+        names = self.parameter_names
+        for row in self.identifiability.determined:
+            pivot = int(np.flatnonzero(row)[0])
+            unit_scale = self.per_user_unit[pivot]
+            coeffs_user = row * self.per_user_unit / unit_scale
+            value = float(row @ self.params) / unit_scale
+            std = float(np.sqrt(max(row @ self.covariance @ row, 0.0))) / unit_scale
+            out.append(
+                {
+                    "name": combination_name(coeffs_user, names),
+                    "coefficients": {
+                        n: float(c) for n, c in zip(names, coeffs_user, strict=True) if c != 0
+                    },
+                    "value": value,
+                    "std": std,
+                    "unit": self.parameter_units[pivot],
+                }
+            )
+        return out
+
+    def undetermined_combinations(self) -> list[str]:
+        """Names of the flat directions (combinations the data cannot determine)."""
+        out = []
+        for row in self.identifiability.undetermined:
+            pivot = int(np.flatnonzero(row)[0])
+            out.append(
+                combination_name(
+                    row * self.per_user_unit / self.per_user_unit[pivot], self.parameter_names
+                )
+            )
+        return out
+
+    def individually_determined(self) -> np.ndarray:
+        """Boolean mask of the parameters the data determine on their own."""
+        basis = self.identifiability.basis
+        if basis.size == 0:
+            return np.zeros(self.n_params, dtype=bool)
+        # e_i is determined iff it lies in the row space: its null-space component vanishes.
+        und = self.identifiability.undetermined
+        return np.all(np.abs(und) < 1e-9, axis=0) if und.size else np.ones(self.n_params, bool)
+
+    def parameter_table(self) -> dict[str, dict]:
+        """``{name: {value, std (None when not determined alone), unit}}`` in user units."""
+        mask = self.individually_determined()
+        std = np.sqrt(np.clip(np.diag(self.covariance), 0, None))
+        out = {}
+        for i, name in enumerate(self.parameter_names):
+            out[name] = {
+                "value": float(self.params[i] / self.per_user_unit[i]),
+                "std": float(std[i] / self.per_user_unit[i]) if mask[i] else None,
+                "unit": self.parameter_units[i],
+                "determined_alone": bool(mask[i]),
+            }
+        return out
+
+    def high_correlations(self, threshold: float = 0.95) -> list[dict]:
+        """Pairs of individually determined parameters correlated above ``threshold``."""
+        mask = self.individually_determined()
+        idx = np.flatnonzero(mask)
+        cov = self.covariance[np.ix_(idx, idx)]
+        d = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
+        corr = cov / np.outer(d, d)
+        out = []
+        for a in range(idx.size):
+            for b in range(a + 1, idx.size):
+                if abs(corr[a, b]) > threshold:
+                    out.append(
+                        {
+                            "a": self.parameter_names[idx[a]],
+                            "b": self.parameter_names[idx[b]],
+                            "correlation": float(corr[a, b]),
+                        }
+                    )
+        return out
+
+    def to_dict(self) -> dict:
+        """The fit as a JSON-ready dictionary (user units; keys of the spec)."""
+        return {
+            "n_observations": self.n_obs,
+            "rms_arcsec": self.rms_user,
+            "chi2": self.chi2,
+            "chi2_reduced": self.chi2_reduced,
+            "dof": self.dof,
+            "p_value": self.p_value,
+            "sigma_source": "column" if self.sigma_known else "estimated",
+            "noise_variance": self.noise_variance,
+            "n_params": self.n_params,
+            "rank": self.rank,
+            "params": self.parameter_table(),
+            "identifiable": {
+                "rank": self.rank,
+                "n_params": self.n_params,
+                "combinations": self.combinations(),
+                "undetermined": self.undetermined_combinations(),
+                "unresponsive": list(self.identifiability.unresponsive),
+                "singular_values": self.identifiability.singular_values.tolist(),
+                "high_correlations": self.high_correlations(),
+            },
+        }
+
+
+def _replace(result: FitResult, **changes) -> FitResult:
+    from dataclasses import replace
+
+    return replace(result, **changes)
+
+
+def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = None) -> FitResult:
+    """Fit ``problem`` by weighted nonlinear least squares (scipy ``least_squares``).
+
+    Args:
+        problem: the model and data.
+        noise_variance: unit-weight noise variance to judge the fit with when sigmas are unknown
+            (default: estimated from this fit, ``rss / dof``). Ignored when sigmas are given.
+
+    Raises:
+        IdentifiabilityError: no parameter is determined, or no degree of freedom is left.
+    """
+    from scipy import optimize  # imported on use: keeps `import turntable_pin` light
+
+    sigma_known = problem.sigma is not None
+    weights = 1.0 / problem.sigma if sigma_known else np.ones_like(problem.observed)
+    n = len(problem.parameter_names)
+    j0 = problem.jacobian(np.zeros(n)) * weights[:, None]
+    ident = analyse_identifiability(j0, problem.parameter_names)
+    m = problem.observed.size
+    if ident.rank == 0:
+        raise IdentifiabilityError("the data determine no parameter of the model")
+    if m - ident.rank <= 0:
+        raise IdentifiabilityError(
+            f"{m} observations cannot fit {ident.rank} independent parameter combinations with a "
+            "degree of freedom left; measure more positions"
+        )
+    basis = ident.basis
+
+    def fun(z):
+        return (problem.observed - problem.predict(basis @ z)) * weights
+
+    def jac(z):
+        return -(problem.jacobian(basis @ z) * weights[:, None]) @ basis
+
+    # The models are nearly linear: one Gauss-Newton step from zero lands close to the optimum.
+    z0 = np.linalg.lstsq(-jac(np.zeros(ident.rank)), -fun(np.zeros(ident.rank)), rcond=None)[0]
+    solution = optimize.least_squares(
+        fun, z0, jac=jac, method="lm" if m >= ident.rank else "trf", xtol=1e-12, ftol=1e-12
+    )
+    z = solution.x
+    params = basis @ z
+    jz = jac(z)
+    weighted_res = solution.fun
+    # scipy's ``cost`` is already 0.5 * sum(f**2): the residual sum of squares is 2 * cost.
+    rss = float(2.0 * solution.cost)
+    dof = m - ident.rank
+    if sigma_known:
+        variance = 1.0
+    elif noise_variance is not None:
+        variance = float(noise_variance)
+    else:
+        variance = rss / dof
+    cov_z = np.linalg.pinv(jz.T @ jz) * variance
+    return FitResult(
+        parameter_names=tuple(problem.parameter_names),
+        parameter_units=tuple(problem.parameter_units),
+        per_user_unit=np.asarray(problem.per_user_unit, dtype=float),
+        params=params,
+        covariance=basis @ cov_z @ basis.T,
+        residuals=weighted_res / weights,
+        weights=weights,
+        rss=rss,
+        rank=ident.rank,
+        dof=dof,
+        noise_variance=max(variance, 1e-300),
+        sigma_known=sigma_known,
+        identifiability=ident,
+        user_unit_scale=float(problem.user_unit_scale),
+        jacobian_weighted=problem.jacobian(params) * weights[:, None],
+        n_function_evaluations=int(solution.nfev),
+    )

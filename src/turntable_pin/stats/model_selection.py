@@ -1,0 +1,429 @@
+"""Which catalogued effect is missing from a model: compare, rank, decide, and say so.
+
+Generic over a :class:`ModelFamily` (a base model, a catalogue of effects that extend it, and
+probes for the structure search), so the GyroWheel drift model can reuse it.
+
+Decision rule, and why. Each testable effect is fitted together with the current model and
+compared by the Bayesian information criterion, ``delta_bic = delta_chi2 + added_rank ln m``
+(sigma given) or ``m ln(rss_new / rss_old) + added_rank ln m`` (sigma estimated: the variance
+profiled out), where ``added_rank`` is the number of *new* determined combinations (parameters the
+current model already absorbs do not count) and ``m`` the number of observations. An effect is
+accepted when ``delta_bic <= -6``. On clean data the improvement is chi2-distributed with
+``added_rank`` degrees of freedom, so for m = 432 (144 positions) the false-alarm probability of
+one candidate is P(chi2_k > k ln m + 6): 5e-4 (k=1), 1.2e-4 (k=2), 2e-6 (k=4); over the whole
+catalogue well under 1 %, while an effect of a few arcsec on 1-arcsec noise lowers chi2 by
+hundreds. A plain likelihood-ratio test at a fixed level would not penalise the 8-parameter
+wobble series more than a 1-parameter sag, and BIC does.
+
+Alternatives: effects that are themselves accepted and whose fit is as good as the best one's
+(``|chi2_B - chi2_A| <= chi2_0.99(max(added_rank_A, added_rank_B))``) explain the data as well; the
+family then says whether more positions could separate them or only an independent measurement.
+
+Unexplained: the best model still fails the fit test, i.e. its chi2 p-value is below
+``FIT_TEST_ALPHA`` (sigma given), or the structure search finds a term it lacks (any sigma; the
+only test possible when sigma is estimated, because chi2 with an estimated sigma is 1 by
+construction). The structure search pays a look-elsewhere penalty of ``2 ln G`` for its G probes
+(:mod:`structure_search`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+from ..core.exceptions import IdentifiabilityError
+from .least_squares import FitResult
+from .structure_search import BIC_THRESHOLD, FoundTerm, Probe, delta_bic, search_structure
+
+FIT_TEST_ALPHA = 1e-3
+"""A model fails the chi2 goodness-of-fit test when its p-value is below this."""
+
+ALTERNATIVE_LEVEL = 0.99
+"""Quantile of chi2(added_rank) within which another effect's fit counts as equally good."""
+
+
+class ModelFamily(Protocol):
+    """What :func:`diagnose` needs: fits of base + effects, reasons, probes, separation advice."""
+
+    catalogue: tuple[Any, ...]  # effect objects with a ``name``
+
+    def fit(self, effects: Sequence[Any], noise_variance: float | None = None) -> Any:
+        """A fit object with a ``result`` (:class:`FitResult`)."""
+
+    def untestable_reason(self, effect: Any) -> str | None: ...
+
+    def probes(self, fit: Any) -> list[Probe]: ...
+
+    def separation(self, fit_a: Any, effect_b: Any) -> str: ...
+
+    def describe(self, effect: Any) -> dict: ...
+
+
+@dataclass
+class Candidate:
+    """One effect tested against the current model."""
+
+    effect: str
+    testable: bool
+    reason: str | None = None
+    fit: Any = field(default=None, repr=False)
+    added_rank: int = 0
+    delta_bic: float | None = None
+    alternatives: list[str] = field(default_factory=list)
+
+    @property
+    def significant(self) -> bool:
+        return self.delta_bic is not None and self.delta_bic <= BIC_THRESHOLD
+
+
+def _chi2(result: FitResult, noise_variance: float) -> float:
+    return result.rss / noise_variance
+
+
+def _summary(result: FitResult, noise_variance: float) -> dict:
+    from scipy import stats  # imported on use: keeps `import turntable_pin` light
+
+    chi2 = _chi2(result, noise_variance)
+    return {
+        "rms_arcsec": result.rms_user,
+        "chi2_reduced": chi2 / result.dof if result.dof > 0 else None,
+        "n_params": result.n_params,
+        "rank": result.rank,
+        "p_value": float(stats.chi2.sf(chi2, result.dof)) if result.sigma_known else None,
+    }
+
+
+def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, candidates):
+    """Fit each candidate effect on top of ``current`` and score it (delta_bic vs current)."""
+    base = current_fit.result
+    m = base.n_obs
+    known = 1.0 if base.sigma_known else None
+    out = []
+    for effect in candidates:
+        reason = family.untestable_reason(effect)
+        if reason:
+            out.append(Candidate(effect.name, False, reason))
+            continue
+        try:
+            fit = family.fit([*current, effect])
+        except IdentifiabilityError as exc:
+            out.append(Candidate(effect.name, False, f"cannot be fitted on these data: {exc}"))
+            continue
+        added = fit.result.rank - base.rank
+        if added <= 0:
+            names = [c for c in fit.result.undetermined_combinations() if effect.name in c]
+            out.append(
+                Candidate(
+                    effect.name,
+                    False,
+                    "indistinguishable from the model already fitted on these data: its "
+                    "parameters only move along " + "; ".join(names[:4]),
+                    fit=fit,
+                )
+            )
+            continue
+        dbic = delta_bic(fit.result.rss, base.rss, added, m, known)
+        out.append(Candidate(effect.name, True, None, fit, added, float(dbic)))
+    out.sort(key=lambda c: (not c.testable, c.delta_bic if c.delta_bic is not None else 0.0))
+    return out
+
+
+def _noise_variance(best: FitResult) -> float:
+    """Unit-weight noise variance used to report chi2: 1 if sigma given, else the best model's."""
+    return 1.0 if best.sigma_known else best.rss / best.dof
+
+
+def _mark_alternatives(candidates: list[Candidate], noise_variance: float) -> None:
+    from scipy import stats
+
+    accepted = [c for c in candidates if c.significant]
+    for a in accepted:
+        chi2_a = _chi2(a.fit.result, noise_variance)
+        a.alternatives = [
+            b.effect
+            for b in accepted
+            if b is not a
+            and abs(_chi2(b.fit.result, noise_variance) - chi2_a)
+            <= stats.chi2.ppf(ALTERNATIVE_LEVEL, max(a.added_rank, b.added_rank, 1))
+        ]
+
+
+@dataclass
+class Step:
+    """One step of the forward selection (``--until-explained``)."""
+
+    added: str
+    delta_bic: float
+    fit: Any = field(repr=False)
+    candidates: list[Candidate] = field(repr=False, default_factory=list)
+
+
+@dataclass
+class Diagnosis:
+    """The outcome of :func:`diagnose`.
+
+    Attributes:
+        base_fit: the base model's fit.
+        candidates: every catalogued effect tested against the base, best first.
+        steps: accepted effects in order (forward selection while delta_bic <= -6; always run,
+            because whether structure remains "that no catalogued effect removes" can only be
+            judged on the model with every significant effect).
+        best_fit: the fit of base + all accepted effects.
+        noise_variance: unit-weight variance chi2 is reported with (1 when sigma is given).
+        structure: terms the structure search finds in the best model's residuals.
+        fails_fit_test: the best model's chi2 p-value is below ``FIT_TEST_ALPHA``.
+        separations: advice per alternative of the accepted first effect.
+        until_explained: whether the verdict names every accepted effect (``missing_effects``)
+            or the first one, with the others as ``also_significant``.
+        after_first: delta_bic of each other effect on top of the first accepted one: an effect
+            that only looked significant against a base that lacked the real effect (because
+            it soaked up part of that effect's signal) is no longer significant there.
+    """
+
+    family: Any = field(repr=False)
+    base_fit: Any = field(repr=False)
+    candidates: list[Candidate]
+    steps: list[Step]
+    best_fit: Any = field(repr=False)
+    noise_variance: float
+    structure: list[FoundTerm]
+    fails_fit_test: bool
+    separations: dict[str, str]
+    until_explained: bool
+    after_first: dict[str, float | None] = field(default_factory=dict)
+
+    @property
+    def missing_effect(self) -> str | None:
+        return self.steps[0].added if self.steps else None
+
+    @property
+    def missing_effects(self) -> list[str]:
+        names = [s.added for s in self.steps]
+        return names if self.until_explained else names[:1]
+
+    @property
+    def also_significant(self) -> list[str]:
+        """Effects still significant on top of the first one (plain diagnosis only)."""
+        return [] if self.until_explained else [s.added for s in self.steps[1:]]
+
+    @property
+    def alternatives(self) -> list[str]:
+        if not self.steps:
+            return []
+        first = next(c for c in self.candidates if c.effect == self.steps[0].added)
+        return list(first.alternatives)
+
+    @property
+    def indistinguishable_from_base(self) -> list[str]:
+        """Effects the base model absorbs completely on these data (no new combination)."""
+        return [c.effect for c in self.candidates if not c.testable and c.fit is not None]
+
+    @property
+    def untestable(self) -> list[str]:
+        """Effects whose data columns are missing."""
+        return [c.effect for c in self.candidates if not c.testable and c.fit is None]
+
+    @property
+    def unexplained(self) -> bool:
+        return bool(self.fails_fit_test or self.structure)
+
+    @property
+    def sigma_known(self) -> bool:
+        return self.base_fit.result.sigma_known
+
+    def summary(self, fit) -> dict:
+        return _summary(fit.result, self.noise_variance)
+
+    def to_dict(self) -> dict:
+        """The spec's diagnosis JSON (plus steps, structure and per-effect explanations)."""
+        nv = self.noise_variance
+        candidates = []
+        for c in self.candidates:
+            entry = {
+                "effect": c.effect,
+                "testable": c.testable,
+                "delta_bic": c.delta_bic,
+                "rms_arcsec": c.fit.result.rms_user if c.fit is not None else None,
+                "chi2_reduced": _summary(c.fit.result, nv)["chi2_reduced"] if c.fit else None,
+                "added_rank": c.added_rank,
+                "significant": c.significant,
+                "alternatives": list(c.alternatives),
+            }
+            if self.steps and c.effect != self.steps[0].added:
+                entry["delta_bic_after_first"] = self.after_first.get(c.effect)
+            if c.reason:
+                entry["reason"] = c.reason
+            candidates.append(entry)
+        best = self.best_fit
+        verdict = {
+            "missing_effect": self.missing_effect,
+            "alternatives": self.alternatives,
+            "unexplained": self.unexplained,
+            "missing_effects": self.missing_effects,
+            "also_significant": self.also_significant,
+            "fails_fit_test": self.fails_fit_test,
+            "remaining_structure": [t.to_dict() for t in self.structure],
+            "separations": dict(self.separations),
+            "indistinguishable_from_base": self.indistinguishable_from_base,
+            "untestable": self.untestable,
+        }
+        if self.missing_effect:
+            verdict["effect_story"] = self.family.describe(self.missing_effect)
+        return {
+            "n_positions": self.family.n_positions,
+            "n_observations": self.base_fit.result.n_obs,
+            "sigma_source": "column" if self.sigma_known else "estimated",
+            "sigma_arcsec": float(math.sqrt(nv) * self.family.sigma_scale_arcsec),
+            "base": _summary(self.base_fit.result, nv),
+            "candidates": candidates,
+            "steps": [
+                {
+                    "added": s.added,
+                    "delta_bic": s.delta_bic,
+                    **_summary(s.fit.result, nv),
+                }
+                for s in self.steps
+            ],
+            "best": {"effects": [s.added for s in self.steps], **_summary(best.result, nv)},
+            "verdict": verdict,
+            "decision_rule": {
+                "accept_effect": f"delta_bic <= {BIC_THRESHOLD:g}",
+                "alternative": f"|chi2 difference| within the {ALTERNATIVE_LEVEL:g} quantile "
+                "of chi2(larger added_rank)",
+                "fit_test_alpha": FIT_TEST_ALPHA if self.sigma_known else None,
+            },
+        }
+
+    def report_lines(self) -> list[str]:
+        """The diagnosis in words."""
+        d = self.to_dict()
+        lines = []
+        sig = (
+            "from the sigma_arcsec column"
+            if self.sigma_known
+            else f"estimated from the best fit: {d['sigma_arcsec']:.3g} arcsec"
+        )
+        lines.append(f"{d['n_positions']} positions, {d['n_observations']} angles; noise {sig}")
+        b = d["base"]
+        lines.append(
+            f"base model: rms {b['rms_arcsec']:.3f} arcsec, chi2_reduced "
+            f"{b['chi2_reduced']:.3f}, {b['n_params']} parameters of rank {b['rank']}"
+            + (f", p-value {b['p_value']:.3g}" if b["p_value"] is not None else "")
+        )
+        lines.append("candidates (best first; delta_bic <= -6 accepts):")
+        for c in d["candidates"]:
+            if not c["testable"]:
+                lines.append(f"  {c['effect']:26s} not testable: {c['reason']}")
+                continue
+            alt = f"  same as: {', '.join(c['alternatives'])}" if c["alternatives"] else ""
+            later = c.get("delta_bic_after_first")
+            if c["significant"] and later is not None:
+                alt += f"  (on top of {self.steps[0].added}: {later:+.1f})"
+            lines.append(
+                f"  {c['effect']:26s} delta_bic {c['delta_bic']:10.1f}  rms "
+                f"{c['rms_arcsec']:.3f}  chi2_red {c['chi2_reduced']:.3f}"
+                f"{'  *' if c['significant'] else ''}{alt}"
+            )
+        if self.steps:
+            for i, s in enumerate(d["steps"], 1):
+                lines.append(
+                    f"step {i}: add {s['added']} (delta_bic {s['delta_bic']:.1f}) -> rms "
+                    f"{s['rms_arcsec']:.3f} arcsec, chi2_reduced {s['chi2_reduced']:.3f}"
+                )
+            story = self.family.describe(self.missing_effect)
+            lines.append(f"missing effect: {self.missing_effect} ({story['title']})")
+            lines.append(f"  why: {story['explanation']}")
+            lines.append(f"  confirm on the machine: {story['confirm']}")
+        else:
+            lines.append("missing effect: none (no catalogued effect improves the base fit)")
+        if self.also_significant:
+            lines.append(
+                "also significant on top of it: "
+                + ", ".join(self.also_significant)
+                + " (--until-explained names every step)"
+            )
+        for name, text in self.separations.items():
+            lines.append(f"  alternative {name}: {text}")
+        for name in self.indistinguishable_from_base:
+            lines.append(
+                f"note: {name} cannot be told apart from the base errors on these data (if "
+                "present, it is absorbed into them; see its candidate entry)"
+            )
+        if self.unexplained:
+            why = []
+            if self.fails_fit_test:
+                why.append("the best model fails the chi2 test")
+            if self.structure:
+                why.append(
+                    "structure remains: "
+                    + "; ".join(
+                        f"{t.description} ({t.amplitude:.3g} {t.unit}, delta_bic {t.delta_bic:.0f})"
+                        for t in self.structure
+                    )
+                )
+            elif self.fails_fit_test:
+                why.append(
+                    "without harmonic structure: the stated sigma may be too small or the "
+                    "missing effect is not a harmonic one"
+                )
+            lines.append("unexplained: yes, " + "; ".join(why))
+        else:
+            lines.append("unexplained: no (the residuals are consistent with the noise)")
+        return lines
+
+
+def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis:
+    """Test every catalogued effect against the base model and decide (module docstring)."""
+    base_fit = family.fit([])
+    candidates = compare_effects(family, [], base_fit, family.catalogue)
+    steps: list[Step] = []
+    current: list[Any] = []
+    current_fit = base_fit
+    round_candidates = candidates
+    after_first: dict[str, float | None] = {}
+    while True:
+        accepted = [c for c in round_candidates if c.significant]
+        if not accepted:
+            break
+        chosen = accepted[0]
+        current.append(next(e for e in family.catalogue if e.name == chosen.effect))
+        current_fit = chosen.fit
+        steps.append(Step(chosen.effect, float(chosen.delta_bic), chosen.fit, round_candidates))
+        rest = [e for e in family.catalogue if e not in current]
+        if not rest:
+            break
+        round_candidates = compare_effects(family, current, current_fit, rest)
+        if len(steps) == 1:
+            after_first = {c.effect: c.delta_bic for c in round_candidates}
+    best = current_fit.result
+    noise_variance = _noise_variance(best)
+    _mark_alternatives(candidates, noise_variance)
+    known = 1.0 if best.sigma_known else None
+    structure = search_structure(
+        best.residuals * best.weights,
+        best.jacobian_weighted,
+        family.probes(current_fit),
+        noise_variance=known,
+    )
+    fails = bool(best.sigma_known and best.dof > 0 and best.p_value < FIT_TEST_ALPHA)
+    separations = {}
+    if steps:
+        first = next(c for c in candidates if c.effect == steps[0].added)
+        for name in first.alternatives:
+            effect = next(e for e in family.catalogue if e.name == name)
+            separations[name] = family.separation(first.fit, effect)
+    return Diagnosis(
+        family=family,
+        base_fit=base_fit,
+        candidates=candidates,
+        steps=steps,
+        best_fit=current_fit,
+        noise_variance=noise_variance,
+        structure=structure,
+        fails_fit_test=fails,
+        separations=separations,
+        until_explained=until_explained,
+        after_first=after_first,
+    )

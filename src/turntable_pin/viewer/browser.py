@@ -1,0 +1,432 @@
+"""Headless Chromium as a tool: render a local HTML page to PNG, or check that its images load.
+
+Every run gets a throw-away profile (``--user-data-dir``) and ``XDG_CONFIG_HOME``/``XDG_CACHE_HOME``
+in a temporary folder, so the browser writes nothing into the home folder. The browser is started
+in its own process group and the whole group is killed and waited for before a function returns,
+even on error or timeout: no browser process outlives the call.
+
+Chromium is an external program (Debian package ``chromium``), not a Python dependency; without
+it these functions raise :class:`BrowserNotFoundError`, which the CLI turns into exit status 2.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import os
+import re
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..core.exceptions import TurntablePinError
+
+CHROMIUM_ENV = "TURNTABLE_PIN_CHROMIUM"
+"""Environment variable naming the Chromium executable to use (overrides the search)."""
+
+CHROMIUM_NAMES: tuple[str, ...] = ("chromium", "chromium-browser", "google-chrome", "chrome")
+DEBIAN_PACKAGE = "chromium"
+
+# Software WebGL: `--use-gl=swiftshader` renders a blank page with Debian chromium 156, ANGLE's
+# SwiftShader backend works. `--no-sandbox` is needed as root (CI containers); we only ever load
+# local pages that we wrote or were asked to check.
+_BASE_FLAGS: tuple[str, ...] = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--hide-scrollbars",
+    "--no-first-run",
+    "--no-default-browser-check",
+    "--disable-extensions",
+    "--disable-background-networking",
+    "--disable-sync",
+    "--mute-audio",
+)
+_CHECK_ELEMENT_ID = "__turntable_pin_image_check__"
+
+
+class BrowserNotFoundError(TurntablePinError):
+    """No headless Chromium on this machine."""
+
+
+class BrowserError(TurntablePinError):
+    """Chromium ran but did not produce what was asked (crash, timeout, no output)."""
+
+
+def find_chromium() -> str:
+    """Path of the Chromium executable: ``$TURNTABLE_PIN_CHROMIUM`` or the first on ``PATH``.
+
+    Raises:
+        BrowserNotFoundError: naming the Debian package to install.
+    """
+    override = os.environ.get(CHROMIUM_ENV)
+    if override:
+        found = shutil.which(override)
+        if found is None:
+            raise BrowserNotFoundError(
+                f"${CHROMIUM_ENV} is '{override}', which is not an executable program"
+            )
+        return found
+    for name in CHROMIUM_NAMES:
+        found = shutil.which(name)
+        if found:
+            return found
+    raise BrowserNotFoundError(
+        "headless Chromium is needed but was not found on PATH; install the Debian package "
+        f"'{DEBIAN_PACKAGE}' (apt-get install -y {DEBIAN_PACKAGE}) or set ${CHROMIUM_ENV}"
+    )
+
+
+def chromium_available() -> bool:
+    """Whether :func:`find_chromium` finds a browser."""
+    try:
+        find_chromium()
+    except BrowserNotFoundError:
+        return False
+    return True
+
+
+@dataclass(frozen=True)
+class BrowserRun:
+    """One finished Chromium run: its leader's pid (already gone), output and wall time (s)."""
+
+    pid: int
+    returncode: int
+    stdout: str
+    stderr: str
+    seconds: float
+    command: tuple[str, ...] = field(repr=False)
+
+
+@dataclass(frozen=True)
+class ProcessInfo:
+    pid: int
+    ppid: int
+    pgid: int
+    sid: int
+    alive: bool  # not a zombie
+    cmdline: str
+
+
+def process_table() -> list[ProcessInfo]:
+    """Every process of the machine, read from /proc (empty where /proc does not exist)."""
+    table = []
+    proc = Path("/proc")
+    if not proc.is_dir():
+        return table
+    for entry in proc.iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+            cmdline = (
+                (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode("utf-8", "replace")
+            )
+        except OSError:
+            continue
+        # Fields after the parenthesised command name: state ppid pgrp session ...
+        fields = stat[stat.rfind(")") + 2 :].split()
+        table.append(
+            ProcessInfo(
+                pid=int(entry.name),
+                ppid=int(fields[1]),
+                pgid=int(fields[2]),
+                sid=int(fields[3]),
+                alive=fields[0] not in ("Z", "X"),
+                cmdline=cmdline,
+            )
+        )
+    return table
+
+
+def related_processes(marker: str) -> list[int]:
+    """Live processes belonging to one browser run.
+
+    Chromium calls ``setsid`` (so killing the launcher's process group is not enough) and its
+    crash handler detaches into a session of its own; but every one of them, the launcher
+    included, names the run's temporary folder (``marker``) on its command line, or descends from
+    or shares a session or group with a process that does. Starting from the marker, not from a
+    pid, means a pid reused after the launcher was reaped is never mistaken for ours.
+    """
+    table = [p for p in process_table() if p.alive]
+    members = {p.pid for p in table if marker in p.cmdline}
+    grew = True
+    while grew:
+        before = len(members)
+        for p in table:
+            if p.ppid in members or p.sid in members or p.pgid in members:
+                members.add(p.pid)
+        grew = len(members) > before
+    alive = {p.pid for p in table}
+    return sorted(members & alive)
+
+
+def kill_related_processes(marker: str, timeout_s: float = 5.0) -> None:
+    """SIGKILL every process of :func:`related_processes` and wait until none is alive."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        pids = related_processes(marker)
+        if not pids or time.monotonic() > deadline:
+            return
+        for pid in pids:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+        time.sleep(0.02)
+
+
+def run_chromium(
+    arguments: list[str],
+    *,
+    width: int = 800,
+    height: int = 600,
+    timeout_s: float = 60.0,
+    chromium: str | None = None,
+) -> BrowserRun:
+    """Run headless Chromium with ``arguments`` in a throw-away profile; always clean up.
+
+    Raises:
+        BrowserNotFoundError: no Chromium.
+        BrowserError: the run did not end within ``timeout_s`` seconds.
+    """
+    executable = chromium or find_chromium()
+    with tempfile.TemporaryDirectory(prefix="turntable-pin-chromium-") as tmp:
+        tmp_path = Path(tmp)
+        env = dict(os.environ)
+        env["XDG_CONFIG_HOME"] = str(tmp_path / "config")
+        env["XDG_CACHE_HOME"] = str(tmp_path / "cache")
+        command = (
+            executable,
+            *_BASE_FLAGS,
+            f"--user-data-dir={tmp_path / 'profile'}",
+            f"--window-size={int(width)},{int(height)}",
+            *arguments,
+        )
+        start = time.perf_counter()
+        proc = subprocess.Popen(
+            command,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            env=env,
+            start_new_session=True,
+        )
+        try:
+            stdout, stderr = proc.communicate(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            raise BrowserError(
+                f"headless Chromium did not finish within {timeout_s:g} s and was stopped"
+            ) from None
+        finally:
+            kill_related_processes(str(tmp_path))
+            if proc.poll() is None:
+                proc.kill()
+            proc.wait()
+        seconds = time.perf_counter() - start
+    return BrowserRun(
+        pid=proc.pid,
+        returncode=proc.returncode,
+        stdout=stdout.decode("utf-8", "replace"),
+        stderr=stderr.decode("utf-8", "replace"),
+        seconds=seconds,
+        command=command,
+    )
+
+
+def _last_error_line(run: BrowserRun) -> str:
+    lines = [line for line in run.stderr.splitlines() if line.strip()]
+    errors = [line for line in lines if "ERROR" in line or "error" in line]
+    return (errors or lines or ["no message"])[-1].strip()
+
+
+def png_size(data: bytes) -> tuple[int, int]:
+    """(width, height) of PNG bytes, read from the IHDR chunk."""
+    if data[:8] != b"\x89PNG\r\n\x1a\n" or data[12:16] != b"IHDR":
+        raise BrowserError("the browser's output is not a PNG image")
+    return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+
+
+def screenshot_html(
+    page: str | Path,
+    *,
+    width: int = 800,
+    height: int = 600,
+    virtual_time_ms: int = 5000,
+    timeout_s: float = 60.0,
+    chromium: str | None = None,
+) -> tuple[bytes, BrowserRun]:
+    """Render a local HTML file to PNG bytes of ``width`` x ``height`` pixels.
+
+    ``virtual_time_ms`` is the page's own time budget (scripts, data-URL fetches, animation
+    frames) before the picture is taken; virtual time makes the picture reproducible.
+    """
+    page = Path(page).resolve()
+    if not page.is_file():
+        raise BrowserError(f"{page}: no such page to render")
+    with tempfile.TemporaryDirectory(prefix="turntable-pin-shot-") as tmp:
+        out = Path(tmp) / "shot.png"
+        run = run_chromium(
+            [
+                f"--virtual-time-budget={int(virtual_time_ms)}",
+                f"--screenshot={out}",
+                page.as_uri(),
+            ],
+            width=width,
+            height=height,
+            timeout_s=timeout_s,
+            chromium=chromium,
+        )
+        if not out.is_file() or out.stat().st_size == 0:
+            raise BrowserError(
+                f"headless Chromium wrote no screenshot (exit {run.returncode}): "
+                f"{_last_error_line(run)}"
+            )
+        data = out.read_bytes()
+    size = png_size(data)
+    if size != (width, height):
+        raise BrowserError(f"screenshot is {size[0]}x{size[1]} pixels, asked for {width}x{height}")
+    return data, run
+
+
+@dataclass(frozen=True)
+class ImageStatus:
+    """One ``<img>`` of a page as the browser saw it after loading (sizes in pixels)."""
+
+    src: str
+    complete: bool
+    natural_width: int
+    natural_height: int
+
+    @property
+    def loaded(self) -> bool:
+        return self.complete and self.natural_width > 0 and self.natural_height > 0
+
+
+@dataclass(frozen=True)
+class ImageLoadReport:
+    """Which images of a page loaded in headless Chromium."""
+
+    page: Path
+    images: tuple[ImageStatus, ...]
+    seconds: float
+
+    @property
+    def n_images(self) -> int:
+        return len(self.images)
+
+    @property
+    def failed(self) -> tuple[str, ...]:
+        """``src`` of every image that did not load."""
+        return tuple(image.src for image in self.images if not image.loaded)
+
+    @property
+    def all_loaded(self) -> bool:
+        return not self.failed
+
+    def to_dict(self) -> dict:
+        return {
+            "page": str(self.page),
+            "n_images": self.n_images,
+            "n_loaded": self.n_images - len(self.failed),
+            "failed": list(self.failed),
+            "seconds": self.seconds,
+        }
+
+
+_CHECK_SCRIPT = (
+    """
+<script>
+window.addEventListener("load", function () {
+  var images = Array.prototype.slice.call(document.images).map(function (im) {
+    var src = im.getAttribute("src") || "";
+    return {src: src.length > 120 ? src.slice(0, 120) + "..." : src,
+            complete: im.complete, w: im.naturalWidth, h: im.naturalHeight};
+  });
+  var out = document.createElement("pre");
+  out.id = "ID";
+  out.textContent = JSON.stringify(images);
+  document.body.appendChild(out);
+});
+</script>
+"""
+).replace("ID", _CHECK_ELEMENT_ID)
+
+
+def _instrumented_page(source: str, base_url: str) -> str:
+    """``source`` with a ``<base>`` (relative URLs still resolve) and the image-check script."""
+    base = "" if re.search(r"<base\s", source, re.I) else f'<base href="{html.escape(base_url)}">'
+    head = re.search(r"<head[^>]*>", source, re.I)
+    if head:
+        source = source[: head.end()] + base + source[head.end() :]
+    else:
+        source = base + source
+    closing = source.lower().rfind("</body>")
+    if closing < 0:
+        return source + _CHECK_SCRIPT
+    return source[:closing] + _CHECK_SCRIPT + source[closing:]
+
+
+def check_page_images(
+    page: str | Path,
+    *,
+    width: int = 1280,
+    height: int = 2000,
+    virtual_time_ms: int = 10000,
+    timeout_s: float = 60.0,
+    chromium: str | None = None,
+) -> ImageLoadReport:
+    """Load a local HTML page in headless Chromium and report whether every ``<img>`` loaded.
+
+    A copy of the page, with a ``<base>`` pointing at the page's folder so relative image paths
+    resolve as in the original, gets a script that records ``complete``/``naturalWidth`` of every
+    image at the window's ``load`` event into the DOM, which ``--dump-dom`` prints. The original
+    page is only read.
+
+    Raises:
+        BrowserError: the page is missing or never finished loading.
+    """
+    page = Path(page).resolve()
+    try:
+        source = page.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise BrowserError(f"{page}: cannot read the page: {exc.strerror or exc}") from None
+    base_url = page.parent.as_uri() + "/"
+    with tempfile.TemporaryDirectory(prefix="turntable-pin-check-") as tmp:
+        copy = Path(tmp) / page.name
+        copy.write_text(_instrumented_page(source, base_url), encoding="utf-8")
+        run = run_chromium(
+            [
+                "--allow-file-access-from-files",
+                f"--virtual-time-budget={int(virtual_time_ms)}",
+                "--dump-dom",
+                copy.as_uri(),
+            ],
+            width=width,
+            height=height,
+            timeout_s=timeout_s,
+            chromium=chromium,
+        )
+    match = re.search(rf'<pre id="{_CHECK_ELEMENT_ID}">(.*?)</pre>', run.stdout, re.S)
+    if match is None:
+        raise BrowserError(
+            f"{page}: the page did not finish loading in headless Chromium "
+            f"(exit {run.returncode}): {_last_error_line(run)}"
+        )
+    entries = json.loads(html.unescape(match.group(1)))
+    images = tuple(
+        ImageStatus(
+            src=str(e["src"]),
+            complete=bool(e["complete"]),
+            natural_width=int(e["w"]),
+            natural_height=int(e["h"]),
+        )
+        for e in entries
+    )
+    return ImageLoadReport(page=page, images=images, seconds=run.seconds)
