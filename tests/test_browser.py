@@ -10,6 +10,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import pytest
 
+from conftest import needs_chromium
 from process_watch import ProcessWatch
 from turntable_pin.viewer.browser import (
     CHROMIUM_ENV,
@@ -22,16 +23,6 @@ from turntable_pin.viewer.browser import (
     run_chromium,
     screenshot_html,
 )
-
-_no_chromium = pytest.mark.skipif(
-    not chromium_available(),
-    reason="headless Chromium not found: install the Debian package 'chromium'",
-)
-
-
-def needs_chromium(test):
-    """Mark a test as a browser test that skips, saying why, without Chromium."""
-    return pytest.mark.browser(_no_chromium(test))
 
 
 def _png(path, size_in=(2.0, 1.5), dpi=50):

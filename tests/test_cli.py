@@ -1,22 +1,15 @@
 """The command line: JSON output and clear errors (exit 2, no traceback) on bad input."""
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
+from conftest import run_cli
 from turntable_pin import TurntableErrors, TurntableModel
 from turntable_pin.cli import main
 from turntable_pin.core.units import ARCSEC_PER_RAD
-
-
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "turntable_pin", *args], capture_output=True, text=True, timeout=120
-    )
 
 
 def test_orientation_json_matches_the_library():

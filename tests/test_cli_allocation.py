@@ -1,12 +1,11 @@
 """``turntable-pin allocate`` and ``montecarlo``: JSON keys, Table 4, units, clear errors."""
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
+from conftest import run_cli
 from turntable_pin import ANGULAR_ERROR_NAMES
 from turntable_pin.cli import main
 from turntable_pin.cli.allocation import parse_limits
@@ -15,11 +14,6 @@ from turntable_pin.core.units import ARCMIN_PER_RAD
 
 PAPER = ["--limits-arcmin", "psi=1.4801,theta=1.56,gamma=1.4801", "--weights", "paper"]
 
-
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "turntable_pin", *args], capture_output=True, text=True, timeout=120
-    )
 
 
 def json_of(capsys, argv):

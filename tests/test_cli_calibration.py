@@ -1,22 +1,16 @@
 """``rate-error``, ``requirement``, ``calibrate`` on the command line: keys, files, bad input."""
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from conftest import run_cli
 from turntable_pin import GyroWheelModel, PositionSet, position_inputs, rate_error
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "models" / "examples" / "gyrowheel_run_example.csv"
 
-
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "turntable_pin", *args], capture_output=True, text=True, timeout=300
-    )
 
 
 def test_rate_error_json_matches_the_library():

@@ -1,21 +1,15 @@
 """The measurement commands: simulate -> fit / diagnose / report, JSON keys, bad files exit 2."""
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from conftest import run_cli
 from turntable_pin.cli import main
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "models" / "examples" / "measurements_example.csv"
 
-
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "turntable_pin", *args], capture_output=True, text=True, timeout=120
-    )
 
 
 @pytest.fixture(scope="module")

@@ -11,29 +11,12 @@ import time
 
 import pytest
 
+from conftest import cli_env, needs_chromium, run_cli
 from process_watch import ProcessWatch, alive
-from turntable_pin.viewer.browser import chromium_available
 
 pytest.importorskip("meshcat")
-_no_chromium = pytest.mark.skipif(
-    not chromium_available(),
-    reason="headless Chromium not found: install the Debian package 'chromium'",
-)
 
 
-def needs_chromium(test):
-    """Mark a test as a browser test that skips, saying why, without Chromium."""
-    return pytest.mark.browser(_no_chromium(test))
-
-
-def run_cli(*args: str, env: dict | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "turntable_pin", *args],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env=env,
-    )
 
 
 def _start_view(*args: str) -> tuple[subprocess.Popen, list[str]]:
@@ -42,6 +25,7 @@ def _start_view(*args: str) -> tuple[subprocess.Popen, list[str]]:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        env=cli_env(),
     )
     lines = []
     while not lines or not lines[-1].startswith("serving"):
@@ -78,7 +62,7 @@ def test_view_animates_a_positions_file_for_a_while(tmp_path):
     proc = subprocess.Popen(
         [sys.executable, "-m", "turntable_pin", "view", "--animate", "--positions",
          str(positions), "--frames-per-move", "3", "--frame-seconds", "0.01", "--duration", "1"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=cli_env(),
     )  # fmt: skip
     with ProcessWatch(parent_pid=proc.pid) as watch:
         out, err = proc.communicate(timeout=60)

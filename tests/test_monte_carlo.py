@@ -6,9 +6,10 @@ import pytest
 from turntable_pin import TurntableErrors, TurntableModel
 from turntable_pin.allocation import monte_carlo as mc
 from turntable_pin.allocation.capability import ManufacturingCapability
-from turntable_pin.allocation.monte_carlo import plot_monte_carlo, run_monte_carlo, sample_errors
+from turntable_pin.allocation.monte_carlo import run_monte_carlo, sample_errors
 from turntable_pin.allocation.solver import OrientationLimits, allocate_tolerances
 from turntable_pin.core.exceptions import InputError
+from turntable_pin.report.allocation_figures import plot_monte_carlo
 
 
 @pytest.fixture(scope="module")

@@ -3,13 +3,12 @@
 import base64
 import re
 
-import pytest
-
+from conftest import needs_chromium
 from turntable_pin import TurntableErrors
 from turntable_pin.measurement.diagnosis import diagnose_measurements
 from turntable_pin.measurement.simulation import simulate_measurements
 from turntable_pin.report.html_report import diagnosis_html, write_report
-from turntable_pin.viewer.browser import check_page_images, chromium_available
+from turntable_pin.viewer.browser import check_page_images
 
 
 def test_report_tells_the_whole_story(tmp_path):
@@ -35,11 +34,7 @@ def test_clean_data_report_has_no_after_section():
     assert "5. Add it" not in page and "missing effect: none" in page
 
 
-@pytest.mark.browser
-@pytest.mark.skipif(
-    not chromium_available(),
-    reason="headless Chromium not found: install the Debian package 'chromium'",
-)
+@needs_chromium
 def test_report_opens_in_the_browser_and_every_image_loads(tmp_path):
     sim = simulate_measurements(
         TurntableErrors.from_arcsec(dalpha_x1=3), {"gravity_sag": {"k": 4.0}}, seed=11

@@ -10,9 +10,9 @@ from turntable_pin.measurement.residuals import (
     analyse_residuals,
     harmonic_amplitudes,
     orientation_residuals,
-    write_residual_plots,
 )
 from turntable_pin.measurement.simulation import simulate_measurements
+from turntable_pin.report.measurement_figures import write_residual_plots
 
 
 def test_harmonic_amplitudes_of_a_pure_harmonic():

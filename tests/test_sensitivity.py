@@ -8,11 +8,11 @@ from turntable_pin import TurntableErrors, TurntableModel, small_angle_matrix
 from turntable_pin.allocation.sensitivity import (
     average_sensitivities,
     paper_style_grid_deg,
-    plot_sensitivities,
     sensitivity_matrix,
     sensitivity_matrix_fd,
     uniform_grid_deg,
 )
+from turntable_pin.report.allocation_figures import plot_sensitivities
 
 
 def test_analytic_matches_central_differences_at_large_errors(rng):

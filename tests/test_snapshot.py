@@ -12,22 +12,15 @@ import matplotlib.image as mimage
 import numpy as np
 import pytest
 
+from conftest import needs_chromium
 from process_watch import ProcessWatch, alive
 from turntable_pin import InputError, TurntableErrors
-from turntable_pin.viewer.browser import CHROMIUM_ENV, BrowserError, chromium_available
+from turntable_pin.viewer.browser import CHROMIUM_ENV, BrowserError
 from turntable_pin.viewer.scene import SetupScene
 from turntable_pin.viewer.snapshot import decorate_static_page, render_snapshot
 
 pytest.importorskip("meshcat")
-_no_chromium = pytest.mark.skipif(
-    not chromium_available(),
-    reason="headless Chromium not found: install the Debian package 'chromium'",
-)
 
-
-def needs_chromium(test):
-    """Mark a test as a browser test that skips, saying why, without Chromium."""
-    return pytest.mark.browser(_no_chromium(test))
 
 
 EXAMPLE = TurntableErrors.from_arcsec(dalpha_x1=3.0, deps_x=4.0, deps_y=-3.0, deta_mm=0.2)

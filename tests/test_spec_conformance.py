@@ -11,9 +11,7 @@ unknown columns; (d) clean files give no missing effect.
 from __future__ import annotations
 
 import json
-import os
 import subprocess
-import sys
 import zlib
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -22,6 +20,7 @@ import numpy as np
 import pytest
 
 import spec_reference as ref
+from conftest import run_cli
 from turntable_pin import TurntableErrors
 from turntable_pin.measurement.data import read_measurements
 from turntable_pin.measurement.effect_model import OrientationModel
@@ -176,16 +175,7 @@ CASES = [
 
 
 def _diagnose(path: Path) -> subprocess.CompletedProcess:
-    env = dict(os.environ)
-    src = str(Path(__file__).resolve().parents[1] / "src")
-    env["PYTHONPATH"] = src + os.pathsep + env.get("PYTHONPATH", "")
-    return subprocess.run(
-        [sys.executable, "-m", "turntable_pin", "diagnose", str(path), "--json"],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=120,
-    )
+    return run_cli("diagnose", str(path), "--json")
 
 
 @pytest.fixture(scope="module")

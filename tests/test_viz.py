@@ -4,7 +4,6 @@ in a real browser, so the examples never rot."""
 from __future__ import annotations
 
 import importlib.util
-import os
 import re
 import subprocess
 import sys
@@ -12,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from conftest import cli_env
 from turntable_pin.viewer.browser import check_page_images, chromium_available
 
 VIZ = Path(__file__).resolve().parents[1] / "viz"
@@ -29,15 +29,12 @@ def _load_make_all():
 @pytest.fixture(scope="module")
 def gallery(tmp_path_factory):
     out = tmp_path_factory.mktemp("figures")
-    env = dict(os.environ)
-    src = str(VIZ.parent / "src")
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (src, env.get("PYTHONPATH")) if p)
     proc = subprocess.run(
         [sys.executable, str(VIZ / "make_all.py"), "-o", str(out), "--fast"],
         capture_output=True,
         text=True,
         timeout=600,
-        env=env,
+        env=cli_env(),
     )
     assert proc.returncode == 0, proc.stderr
     return out, proc.stdout

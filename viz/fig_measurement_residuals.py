@@ -12,8 +12,9 @@ from pathlib import Path
 from turntable_pin.core.resources import models_dir
 from turntable_pin.measurement.data import read_measurements
 from turntable_pin.measurement.diagnosis import diagnose_measurements
-from turntable_pin.measurement.residuals import orientation_residuals, write_residual_plots
+from turntable_pin.measurement.residuals import orientation_residuals
 from turntable_pin.report.html_report import write_report
+from turntable_pin.report.measurement_figures import write_residual_plots
 
 
 def main(out_dir: Path, fast: bool = False) -> list[Path]:

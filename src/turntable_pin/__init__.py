@@ -61,8 +61,8 @@ _EXPORTS = {
     "fit_orientation": "measurement.fit",
     "orientation_requirement": "calibration.requirement",
     "paper_eq16_limits": "allocation.solver",
-    "plot_monte_carlo": "allocation.monte_carlo",
-    "plot_sensitivities": "allocation.sensitivity",
+    "plot_monte_carlo": "report.allocation_figures",
+    "plot_sensitivities": "report.allocation_figures",
     "position_inputs": "calibration.positions",
     "rate_error": "calibration.rate_error",
     "read_measurements": "measurement.data",
@@ -81,11 +81,10 @@ __version__ = "0.1.0"
 
 if TYPE_CHECKING:  # names for static checkers; nothing is imported at run time
     from .allocation.capability import ManufacturingCapability  # noqa: F401
-    from .allocation.monte_carlo import MonteCarloResult, plot_monte_carlo, run_monte_carlo  # noqa: F401
+    from .allocation.monte_carlo import MonteCarloResult, run_monte_carlo  # noqa: F401
     from .allocation.sensitivity import (  # noqa: F401
         AverageSensitivities,
         average_sensitivities,
-        plot_sensitivities,
         sensitivity_matrix,
     )
     from .allocation.solver import (  # noqa: F401
@@ -119,6 +118,7 @@ if TYPE_CHECKING:  # names for static checkers; nothing is imported at run time
     from .model.small_angle import small_angle_matrix, small_angle_orientation_error  # noqa: F401
     from .model.turntable import OrientationError, TurntableModel  # noqa: F401
     from .model.urdf_io import YourdfpyTurntable  # noqa: F401
+    from .report.allocation_figures import plot_monte_carlo, plot_sensitivities  # noqa: F401
     from .report.html_report import write_report  # noqa: F401
     from .stats.least_squares import FitResult  # noqa: F401
     from .stats.model_selection import Diagnosis  # noqa: F401

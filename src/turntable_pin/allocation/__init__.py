@@ -15,8 +15,6 @@ _EXPORTS = {
     "average_sensitivities": "sensitivity",
     "default_orientation_limits": "solver",
     "paper_eq16_limits": "solver",
-    "plot_monte_carlo": "monte_carlo",
-    "plot_sensitivities": "sensitivity",
     "run_monte_carlo": "monte_carlo",
     "sensitivity_matrix": "sensitivity",
 }

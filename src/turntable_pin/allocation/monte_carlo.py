@@ -24,7 +24,7 @@ import numpy as np
 
 from ..core.exceptions import InputError
 from ..core.progress import Progress
-from ..core.units import ARCMIN_PER_RAD, DEG_PER_RAD, arcmin_by_name
+from ..core.units import DEG_PER_RAD, arcmin_by_name
 from ..model.batch_field import ANGLE_ENTRIES, OrientationErrorField
 from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES
 from ..model.turntable import TurntableModel
@@ -223,32 +223,3 @@ def run_monte_carlo(
         elapsed_s=elapsed,
         workers=workers,
     )
-
-
-def plot_monte_carlo(result: MonteCarloResult, path):
-    """Figure 9: histograms of each turntable's largest |dpsi|, |dtheta|, |dgamma| (PNG)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from ..core.files import write_atomic
-
-    fig, axes = plt.subplots(1, 3, figsize=(12, 3.8))
-    limits = result.limits.as_array() * ARCMIN_PER_RAD
-    for k, (ax, name) in enumerate(zip(axes, ORIENTATION_ANGLES, strict=True)):
-        values = result.worst_rad[:, k] * ARCMIN_PER_RAD
-        ax.hist(values, bins=60, color="tab:blue", alpha=0.85)
-        ax.axvline(limits[k], color="tab:red", linestyle="--", label=f"limit {limits[k]:.4f}'")
-        ax.set_xlabel(f"max |d{name}| over phi2 (arcmin)")
-        ax.set_title(f"d{name}: max {values.max():.4f}'")
-        ax.legend(fontsize=8)
-    axes[0].set_ylabel("turntables")
-    fig.suptitle(
-        f"Monte Carlo: {result.n} turntables inside the allocated bounds (seed {result.seed}), "
-        f"exact chain, phi2 step {result.phi2_step_deg:g} deg"
-    )
-    fig.tight_layout()
-    write_atomic(path, lambda tmp: fig.savefig(tmp, format="png", dpi=120))
-    plt.close(fig)
-    return path

@@ -214,35 +214,3 @@ def average_sensitivities(
 
 PAPER_FIGURE8_TRIG = 0.6481
 """The paper's Figure 8 value used for every sin/cos term by ``--weights paper`` (see spec)."""
-
-
-def plot_sensitivities(average: AverageSensitivities, path, *, title: str | None = None):
-    """Figure 8: bar charts of the average sensitivities, one panel per orientation angle (PNG)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from ..core.files import write_atomic
-
-    fig, axes = plt.subplots(1, 3, figsize=(12, 3.8), sharey=True)
-    labels = [f"C{i + 1} {n}" for i, n in enumerate(ANGULAR_ERROR_NAMES)]
-    for k, (ax, angle) in enumerate(zip(axes, ORIENTATION_ANGLE_NAMES, strict=True)):
-        bars = ax.bar(range(8), average.values[k], color="tab:blue")
-        ax.set_xticks(range(8), labels, fontsize=7, rotation=40, ha="right")
-        ax.set_title(f"({'abc'[k]}) {angle}")
-        for bar, v in zip(bars, average.values[k], strict=True):
-            ax.text(
-                bar.get_x() + bar.get_width() / 2, v + 0.02, f"{v:.4f}", ha="center", fontsize=7
-            )
-        ax.set_ylim(0, 1.15)
-    axes[0].set_ylabel("mean |d angle / d error|")
-    fig.suptitle(
-        title
-        or f"Sensitivities of the orientation error (mean over {average.phi1_grid_deg.size} x "
-        f"{average.phi2_grid_deg.size} angle pairs)"
-    )
-    fig.tight_layout()
-    write_atomic(path, lambda tmp: fig.savefig(tmp, format="png", dpi=120))
-    plt.close(fig)
-    return path

@@ -6,8 +6,8 @@ import argparse
 from pathlib import Path
 
 from ..allocation.capability import ManufacturingCapability
-from ..allocation.monte_carlo import plot_monte_carlo, run_monte_carlo
-from ..allocation.sensitivity import AverageSensitivities, average_sensitivities, plot_sensitivities
+from ..allocation.monte_carlo import run_monte_carlo
+from ..allocation.sensitivity import AverageSensitivities, average_sensitivities
 from ..allocation.solver import (
     DEFAULT_ACCURACY_DPH,
     DEFAULT_LATITUDE_DEG,
@@ -166,6 +166,8 @@ def run_allocate(args: argparse.Namespace) -> int:
     allocation, sensitivities = _allocation_from_args(args)
     figure = None
     if args.plots:
+        from ..report.allocation_figures import plot_sensitivities
+
         figure = plot_sensitivities(sensitivities, args.plots / "figure8_sensitivities.png")
     if args.json:
         report = allocation.to_dict()
@@ -203,6 +205,8 @@ def run_montecarlo(args: argparse.Namespace) -> int:
     report["scale_bounds"] = args.scale_bounds
     figure = None
     if args.plots:
+        from ..report.allocation_figures import plot_monte_carlo
+
         figure = plot_monte_carlo(result, args.plots / "figure9_montecarlo.png")
         report["plot"] = str(figure)
     if args.json:

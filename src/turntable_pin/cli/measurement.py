@@ -164,11 +164,8 @@ def _fit_line(label: str, summary: dict) -> str:
 
 def run_fit(args: argparse.Namespace) -> int:
     from ..measurement.fit import fit_orientation
-    from ..measurement.residuals import (
-        analyse_residuals,
-        orientation_residuals,
-        write_residual_plots,
-    )
+    from ..measurement.residuals import analyse_residuals, orientation_residuals
+    from ..report.measurement_figures import write_residual_plots
 
     data = _read(args)
     effects = parse_effect_list(args.effects)
@@ -213,7 +210,8 @@ def run_fit(args: argparse.Namespace) -> int:
 
 def run_diagnose(args: argparse.Namespace) -> int:
     from ..measurement.diagnosis import diagnose_measurements
-    from ..measurement.residuals import orientation_residuals, write_residual_plots
+    from ..measurement.residuals import orientation_residuals
+    from ..report.measurement_figures import write_residual_plots
 
     data = _read(args)
     diagnosis = diagnose_measurements(data, until_explained=args.until_explained)

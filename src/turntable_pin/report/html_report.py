@@ -8,20 +8,15 @@ from __future__ import annotations
 
 import base64
 import html
-import io
 from pathlib import Path
 
 from ..core.files import write_text_atomic
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..measurement.data import ANGLE_NAMES
-from ..measurement.residuals import (
-    COLOURS,
-    analyse_residuals,
-    harmonics_figure,
-    orientation_residuals,
-    residual_figure,
-)
+from ..measurement.residuals import analyse_residuals, orientation_residuals
 from ..stats.model_selection import Diagnosis
+from .figures import pyplot, save_png
+from .measurement_figures import COLOURS, harmonics_figure, residual_figure
 
 _STYLE = """
 body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
@@ -53,10 +48,7 @@ def _table(header: list[str], rows: list[list], left: int = 1) -> str:
 
 def data_figure(data) -> bytes:
     """PNG: the measured angles against phi2, one panel per angle, coloured by phi1."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, axes = plt.subplots(1, 3, figsize=(14, 3.4))
     phi1 = data.phi1_rad * DEG_PER_RAD
@@ -67,10 +59,7 @@ def data_figure(data) -> bytes:
         ax.set_ylabel(f"{name} (arcsec)")
         ax.set_title(f"measured {name}", fontsize=10, color=COLOURS[i])
     fig.colorbar(sc, ax=axes, label="phi1 (deg)")
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=90, bbox_inches="tight")
-    plt.close(fig)
-    return buffer.getvalue()
+    return save_png(fig)
 
 
 def _fit_rows(diagnosis: Diagnosis, fits) -> list[list]:

@@ -10,16 +10,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from ..calibration.rate_error import orientation_error_rotation, rate_errors_dph  # noqa: E402
-from ..calibration.requirement import MAX_ANGLE_RAD, OrientationRequirement  # noqa: E402
-from ..core.files import write_atomic  # noqa: E402
-from ..core.units import deg_to_rad, rad_to_deg  # noqa: E402
+from ..calibration.rate_error import orientation_error_rotation, rate_errors_dph
+from ..calibration.requirement import MAX_ANGLE_RAD, OrientationRequirement
+from ..core.units import deg_to_rad, rad_to_deg
+from .figures import pyplot, save_png
 
 _LABELS = {"psi": r"$\Delta\psi$ (deg)", "theta": r"$\Delta\theta$ (deg)",
            "gamma": r"$\Delta\gamma$ (deg)"}  # fmt: skip
@@ -66,6 +62,7 @@ def _surfaces(result: OrientationRequirement, points: int):
 
 def plot_figure4(result: OrientationRequirement, path: str | Path, *, points: int = 41) -> Path:
     """Write Figure 4 (surfaces Gamma1, Gamma2 and one-angle slices) to ``path`` (PNG)."""
+    plt = pyplot()
     u, v, gamma1, gamma2 = _surfaces(result, points)
 
     fig = plt.figure(figsize=(15, 9))
@@ -108,11 +105,12 @@ def plot_figure4(result: OrientationRequirement, path: str | Path, *, points: in
         ax.legend(fontsize=7)
         ax.grid(alpha=0.3)
     fig.tight_layout()
-    return _save(fig, path)
+    return save_png(fig, path)
 
 
 def plot_figure5(result: OrientationRequirement, path: str | Path, *, points: int = 121) -> Path:
     """Write Figure 5 (contours ``dw = w_m`` and the requirement rectangles) to ``path``."""
+    plt = pyplot()
     u, v, gamma1, gamma2 = _surfaces(result, points)
     limits_deg = rad_to_deg(result.limits_rad)
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.5))
@@ -140,7 +138,7 @@ def plot_figure5(result: OrientationRequirement, path: str | Path, *, points: in
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="upper right")
     fig.tight_layout()
-    return _save(fig, path)
+    return save_png(fig, path)
 
 
 def write_requirement_figures(result: OrientationRequirement, directory: str | Path) -> list[Path]:
@@ -151,9 +149,3 @@ def write_requirement_figures(result: OrientationRequirement, directory: str | P
         plot_figure5(result, directory / "figure5_requirement.png"),
     ]
 
-
-def _save(fig, path: str | Path) -> Path:
-    try:
-        return write_atomic(path, lambda tmp: fig.savefig(tmp, format="png", dpi=110))
-    finally:
-        plt.close(fig)

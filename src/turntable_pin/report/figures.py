@@ -1,0 +1,52 @@
+"""The one way figures leave the package: matplotlib on the Agg backend and :func:`save_png`.
+
+Every PNG of the package (allocation, requirement, residual and report figures) goes through
+:func:`save_png`, at one resolution, written atomically when a path is given.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+__all__ = ["FIGURE_DPI", "pyplot", "save_png"]
+
+FIGURE_DPI = 110
+"""Resolution of every PNG the package writes, dots per inch."""
+
+
+def pyplot() -> Any:
+    """``matplotlib.pyplot`` on the non-interactive Agg backend (imported on first use)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save_png(fig: Any, path: str | Path | None = None, *, dpi: int = FIGURE_DPI) -> Any:
+    """Render ``fig`` to PNG and close it.
+
+    Args:
+        fig: a matplotlib figure.
+        path: where to write (atomically); ``None`` returns the PNG bytes instead.
+        dpi: resolution, dots per inch.
+
+    Returns:
+        The path written, or the PNG bytes when ``path`` is ``None``.
+    """
+    import io
+
+    from ..core.files import write_atomic
+
+    try:
+        if path is None:
+            buffer = io.BytesIO()
+            fig.savefig(buffer, format="png", dpi=dpi, bbox_inches="tight")
+            return buffer.getvalue()
+        return write_atomic(
+            path, lambda tmp: fig.savefig(tmp, format="png", dpi=dpi, bbox_inches="tight")
+        )
+    finally:
+        pyplot().close(fig)
