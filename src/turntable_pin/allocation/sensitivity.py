@@ -30,6 +30,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..core.units import DEG_PER_RAD
+from ..model.angles import ANGLE_ENTRIES, ANGLE_NAMES
 from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES, TurntableErrors
 from ..model.turntable import (
     PAYLOAD_FRAME,
@@ -39,8 +40,8 @@ from ..model.turntable import (
     error_placements,
 )
 
-ORIENTATION_ANGLE_NAMES: tuple[str, ...] = ("dpsi", "dtheta", "dgamma")
-_ENTRIES = ((0, 2), (1, 0), (2, 1))  # (row, column) of dpsi, dtheta, dgamma in dR (eq. 24)
+ORIENTATION_ANGLE_NAMES = ANGLE_NAMES
+_ENTRIES = ANGLE_ENTRIES
 _AXIS = {
     "x": np.array([1.0, 0.0, 0.0]),
     "y": np.array([0.0, 1.0, 0.0]),

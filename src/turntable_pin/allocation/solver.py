@@ -35,12 +35,13 @@ from scipy.optimize import minimize, minimize_scalar
 
 from ..core.exceptions import InfeasibleError, InputError
 from ..core.units import ARCMIN_PER_RAD, DEG_PER_RAD, arcmin_by_name
+from ..model.angles import ANGLE_SYMBOLS
 from ..model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
 from ..model.small_angle import small_angle_matrix
 from .capability import ManufacturingCapability
 from .sensitivity import PAPER_FIGURE8_TRIG, AverageSensitivities, average_sensitivities
 
-ORIENTATION_ANGLES: tuple[str, ...] = ("psi", "theta", "gamma")
+ORIENTATION_ANGLES = ANGLE_SYMBOLS  # the limit names: psi_rad, theta_rad, gamma_rad
 """Names of the three orientation angles dpsi, dtheta, dgamma as used in keys and options."""
 
 PHI2_INTERVALS_RAD: dict[str, tuple[float, float]] = {

@@ -28,6 +28,7 @@ import numpy as np
 
 from ..core.exceptions import InputError
 from ..core.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
+from ..model.angles import ANGLE_SYMBOLS
 from .gyrowheel import GyroWheelModel
 from .positions import PositionInputs, PositionSet, position_inputs
 from .rate_error import DEFINITIONS, orientation_error_rotation, rate_errors_dph
@@ -35,7 +36,7 @@ from .rate_error import DEFINITIONS, orientation_error_rotation, rate_errors_dph
 MAX_ANGLE_RAD = np.radians(10.0)
 """Search limit: beyond ten degrees the small-angle model of eq. 7 is meaningless."""
 
-ANGLE_NAMES: tuple[str, ...] = ("psi", "theta", "gamma")
+ANGLE_NAMES = ANGLE_SYMBOLS  # deprecated alias: the limits are named psi, theta, gamma
 PLANES: dict[str, tuple[str, tuple[int, int]]] = {
     "psi_theta": ("x", (0, 1)),
     "theta_gamma": ("y", (1, 2)),

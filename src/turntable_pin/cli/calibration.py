@@ -11,6 +11,7 @@ from ..calibration.positions import PositionSet, position_inputs
 from ..calibration.rate_error import DEFINITIONS, rate_error
 from ..calibration.requirement import orientation_requirement
 from ..core.units import deg_to_rad
+from ..model.angles import ANGLE_NAMES, ANGLE_SYMBOLS
 from .common import finite_float, print_json
 
 DEFAULT_LATITUDE_DEG = 45.75
@@ -61,7 +62,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Rate-sensing errors dwx, dwy (deg/h, eq. 14) of a multi-position calibration "
         "whose payload is off by (dpsi, dtheta, dgamma) at every position.",
     )
-    for name in ("dpsi", "dtheta", "dgamma"):
+    for name in ANGLE_NAMES:
         r.add_argument(f"--{name}-deg", type=finite_float, default=0.0, help=f"{name}, degrees")
     _add_setup_options(r)
     _add_model_options(r)
@@ -137,7 +138,7 @@ def run_requirement(args: argparse.Namespace) -> int:
         f"({report['n_positions']}), latitude {report['latitude_deg']:g} deg, "
         f"{args.definition.replace('_', ' ')}"
     )
-    for name in ("psi", "theta", "gamma"):
+    for name in ANGLE_SYMBOLS:
         print(
             f"|d{name}| <= I_{name} = {report[f'I_{name}_deg']:.5f} deg "
             f"({report[f'I_{name}_arcsec']:.2f} arcsec)"

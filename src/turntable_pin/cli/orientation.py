@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.units import M_PER_MM, deg_to_rad, rad_to_arcsec
+from ..model.angles import ANGLE_NAMES
 from ..model.small_angle import small_angle_orientation_error
 from .common import add_error_options, finite_float, model_from_args, print_json
 
@@ -67,7 +68,7 @@ def run_orientation(args: argparse.Namespace) -> int:
     for row in report["dR"]:
         print("  [" + "  ".join(f"{v: .12f}" for v in row) + "]")
     print(f"{'':8s}{'exact (arcsec)':>16s}{'eq. 26 (arcsec)':>18s}")
-    for name in ("dpsi", "dtheta", "dgamma"):
+    for name in ANGLE_NAMES:
         exact = report[f"{name}_arcsec"]
         small = report[f"{name}_small_angle_arcsec"]
         print(f"{name:8s}{exact:16.6f}{small:18.6f}")

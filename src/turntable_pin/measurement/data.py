@@ -26,11 +26,12 @@ import numpy as np
 from ..core.csv_table import read_csv_table
 from ..core.exceptions import InputError
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
+from ..model.angles import ANGLE_NAMES
 from .effects.base import PositionVariables
 
 REQUIRED_COLUMNS = ("phi1_deg", "phi2_deg", "dpsi_arcsec", "dtheta_arcsec", "dgamma_arcsec")
 OPTIONAL_COLUMNS = ("sigma_arcsec", "time_s", "dir1", "dir2")
-ANGLE_NAMES = ("dpsi", "dtheta", "dgamma")
+
 
 
 @dataclass(frozen=True)

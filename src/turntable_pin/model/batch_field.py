@@ -20,6 +20,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..core.rotations import axis_rotation
+from .angles import ANGLE_ENTRIES
 from .errors import ERROR_NAMES
 from .turntable import (
     INNER_JOINT,
@@ -33,7 +34,6 @@ from .turntable import (
 
 N_BASIS = 5
 _GRID_RAD = 2.0 * np.pi * np.arange(N_BASIS) / N_BASIS
-ANGLE_ENTRIES: tuple[tuple[int, int], ...] = ((0, 2), (1, 0), (2, 1))
 """(row, column) of dpsi, dtheta, dgamma in dR (eq. 24)."""
 
 
