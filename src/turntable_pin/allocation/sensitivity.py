@@ -5,9 +5,10 @@ pair of rotation angles. Two independent ways to get it:
 
 * :func:`sensitivity_matrix` (analytic): Pinocchio's kinematic regressor
   (``computeFrameKinematicRegressor``) gives the payload frame's variation for a variation of each
-  joint placement; an error factor sitting inside a placement is moved to the placement's end by
-  the adjoint of the factors after it. The payload mount is a fixed frame (not a joint), so its
-  factors act on the payload frame directly.
+  joint placement; an error factor sitting inside a placement (a link of the model's
+  :class:`~turntable_pin.model.chain.ErrorChain`) is moved to the placement's end by the adjoint
+  of the factors after it. A fixed link (the payload mount) is not a Pinocchio joint, so its
+  factors are carried to the payload frame by the placement between the two.
 * :func:`sensitivity_matrix_fd`: central finite differences of
   :meth:`TurntableModel.orientation_error`.
 
@@ -31,17 +32,22 @@ import pinocchio as pin
 
 from ..core.units import DEG_PER_RAD
 from ..model.angles import ANGLE_ENTRIES, ANGLE_NAMES
-from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES, TurntableErrors
-from ..model.turntable import (
-    PAYLOAD_FRAME,
-    PAYLOAD_MOUNT,
-    PLACEMENT_ERROR_FACTORS,
-    TurntableModel,
-    error_placements,
-)
+from ..model.chain import ROTATION
+from ..model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
+from ..model.turntable import TurntableModel
+
+__all__ = [
+    "PAPER_FIGURE8_TRIG",
+    "AverageSensitivities",
+    "average_sensitivities",
+    "paper_style_grid_deg",
+    "sensitivities_on_grid",
+    "sensitivity_matrix",
+    "sensitivity_matrix_fd",
+    "uniform_grid_deg",
+]
 
 ORIENTATION_ANGLE_NAMES = ANGLE_NAMES
-_ENTRIES = ANGLE_ENTRIES
 _AXIS = {
     "x": np.array([1.0, 0.0, 0.0]),
     "y": np.array([0.0, 1.0, 0.0]),
@@ -49,30 +55,26 @@ _AXIS = {
 }
 
 
-def _where(name: str) -> tuple[str, int]:
-    for placement, factors in PLACEMENT_ERROR_FACTORS.items():
-        for index, (_, _, factor_name) in enumerate(factors):
-            if factor_name == name:
-                return placement, index
-    raise KeyError(name)
-
-
-def _factor_twist(errors: TurntableErrors, name: str) -> tuple[str, np.ndarray]:
-    """Placement holding error ``name`` and the placement's right-trivialised variation per unit.
+def _factor_twist(model: TurntableModel, name: str) -> tuple[str, np.ndarray]:
+    """Link holding error ``name`` and the link placement's right-trivialised variation per unit.
 
     The placement is ``nominal F_1 ... F_k(e) ... F_n``; d/de of it is the placement times
     ``tail^-1 xi tail`` with ``tail = F_{k+1} ... F_n`` and ``xi`` the factor's unit twist.
     """
-    placement, index = _where(name)
-    kind, axis, _ = PLACEMENT_ERROR_FACTORS[placement][index]
-    values = errors.as_array().copy()
-    for _, _, earlier in PLACEMENT_ERROR_FACTORS[placement][: index + 1]:
-        values[ERROR_NAMES.index(earlier)] = 0.0  # identity factors leave just the tail
-    tail = error_placements(values)[placement]
+    chain = model.chain
+    link, index = chain.locate(name)
+    factor = link.factors[index]
+    values = model.errors.as_array().copy()
+    for earlier in link.factors[: index + 1]:
+        values[chain.error_names.index(earlier.error)] = 0.0  # identity factors leave the tail
+    tail = chain.error_transforms(values)[link.name]
     tail_se3 = pin.SE3(np.array(tail[:3, :3]), np.array(tail[:3, 3]))
-    unit = _AXIS[axis]
-    twist = pin.Motion(np.zeros(3), unit) if kind == "rot" else pin.Motion(unit, np.zeros(3))
-    return placement, tail_se3.actInv(twist).vector
+    unit = _AXIS[factor.axis]
+    if factor.kind == ROTATION:
+        twist = pin.Motion(np.zeros(3), unit)
+    else:
+        twist = pin.Motion(unit, np.zeros(3))
+    return link.name, tail_se3.actInv(twist).vector
 
 
 def sensitivity_matrix(model: TurntableModel, phi1_rad: float, phi2_rad: float) -> np.ndarray:
@@ -81,31 +83,29 @@ def sensitivity_matrix(model: TurntableModel, phi1_rad: float, phi2_rad: float) 
     Rows dpsi, dtheta, dgamma; columns :data:`ANGULAR_ERROR_NAMES`. Dimensionless (rad/rad).
     Exact derivative of the exact chain at the model's error set (not the small-angle model).
     """
-    pin_model, data = model.model, model.data
-    q = np.zeros(pin_model.nq)
-    q[pin_model.joints[model.outer_joint_id].idx_q] = phi1_rad
-    q[pin_model.joints[model.inner_joint_id].idx_q] = phi2_rad
+    pin_model, data = model.pin_model, model.pin_data
+    q = model.joint_vector(phi1_rad, phi2_rad)
     pin.forwardKinematics(pin_model, data, q)
     pin.updateFramePlacements(pin_model, data)
-    frame_id = pin_model.getFrameId(PAYLOAD_FRAME)
+    frame_id = model.payload_frame_id
     regressor = pin.computeFrameKinematicRegressor(pin_model, data, frame_id, pin.LOCAL)
     actual = data.oMf[frame_id].rotation
     ideal = model.ideal_pose(phi1_rad, phi2_rad).rotation
     dR = ideal.T @ actual
-    # Payload frame placement relative to the mount joint frame (both frames hang on one joint).
-    mount = pin_model.frames[pin_model.getFrameId(PAYLOAD_MOUNT)].placement
-    relative = mount.actInv(pin_model.frames[frame_id].placement)
+    payload = pin_model.frames[frame_id].placement
     out = np.empty((3, len(ANGULAR_ERROR_NAMES)))
     for col, name in enumerate(ANGULAR_ERROR_NAMES):
-        placement, twist = _factor_twist(model.errors, name)
-        if placement == PAYLOAD_MOUNT:
-            omega = relative.actInv(pin.Motion(twist)).angular
-        else:
-            block = pin_model.getJointId(placement) - 1
+        link, twist = _factor_twist(model, name)
+        if model.chain.link(link).is_joint:
+            block = pin_model.getJointId(link) - 1
             omega = (regressor[:, 6 * block : 6 * block + 6] @ twist)[3:]
+        else:
+            # Both frames hang on the last joint: the payload relative to the fixed link's frame.
+            relative = pin_model.frames[pin_model.getFrameId(link)].placement.actInv(payload)
+            omega = relative.actInv(pin.Motion(twist)).angular
         # Rt -> Rt (I + [omega]x de), so d(dR) = dR [omega]x.
         d_dR = dR @ pin.skew(omega)
-        out[:, col] = [d_dR[i, j] for i, j in _ENTRIES]
+        out[:, col] = [d_dR[i, j] for i, j in ANGLE_ENTRIES]
     return out
 
 

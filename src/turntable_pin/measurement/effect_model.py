@@ -1,13 +1,12 @@
 """The orientation error predicted by the turntable's exact chain plus catalogued effects.
 
-The chain is read off the Pinocchio model (its nominal joint placements, joint axes and payload
-mount, :meth:`TurntableModel.placement_chain`) and the error factors of each placement
-(:data:`PLACEMENT_ERROR_FACTORS`), the same data :class:`OrientationErrorField` composes. Effects
-(:mod:`turntable_pin.measurement.effects`) add to the error angles per position or insert
-rotations before or
-after ``Rt``. Every parametrised factor is a rotation about a coordinate axis by an angle *linear*
-in the parameters, so the Jacobian is exact and cheap: for ``Rt = A R_a(theta) B``,
-``dRt/dtheta = A R_a(theta) [e_a]x B``, composed from prefix and suffix products.
+The chain is the turntable's :class:`~turntable_pin.model.chain.ErrorChain` (nominal placements,
+joint axes, error factors), the same object Pinocchio evaluation and :class:`OrientationErrorField`
+read. Effects (:mod:`turntable_pin.measurement.effects`) add to the error angles per position or
+insert rotations before or after ``Rt``. Every parametrised factor is a rotation about a
+coordinate axis by an angle *linear* in the parameters, so the Jacobian is exact and cheap: for
+``Rt = A R_a(theta) B``, ``dRt/dtheta = A R_a(theta) [e_a]x B``, composed from prefix and
+suffix products.
 
 Parameters (internal units): the eight angular errors (rad) in :data:`ANGULAR_ERROR_NAMES` order,
 then each effect's parameters as ``"<effect>.<name>"``. ``deta`` is left out: it moves the payload
@@ -24,18 +23,13 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.rotations import AXIS_INDEX, axis_rotation
 from ..core.units import ARCSEC_PER_RAD
-from ..model.batch_field import ANGLE_ENTRIES
+from ..model.angles import ANGLE_ENTRIES
+from ..model.chain import ROTATION
 from ..model.errors import ANGULAR_ERROR_NAMES
-from ..model.turntable import (
-    INNER_JOINT,
-    OUTER_JOINT,
-    PAYLOAD_FRAME,
-    PAYLOAD_MOUNT,
-    PLACEMENT_ERROR_FACTORS,
-    TurntableModel,
-    joint_axis,
-)
+from ..model.turntable import TurntableModel
 from .effects.base import POST, PRE, Effect, ParameterSpec, PositionVariables
+
+__all__ = ["AXIS_INDEX", "BASE_PARAMETERS", "OrientationModel"]
 
 BASE_PARAMETERS: tuple[ParameterSpec, ...] = tuple(
     ParameterSpec(name, "arcsec", 1.0 / ARCSEC_PER_RAD, name) for name in ANGULAR_ERROR_NAMES
@@ -111,7 +105,6 @@ class OrientationModel:
 
     def _build_chain(self, turntable: TurntableModel, terms_by_effect):
         n = self.variables.n
-        nominal = turntable.nominal_model
         pre, post = [], []
         error_gain = {}
         for name in ANGULAR_ERROR_NAMES:
@@ -128,32 +121,23 @@ class OrientationModel:
                 else:
                     error_gain[term.site] = error_gain[term.site] + gain
 
-        def error_factors(placement: str) -> list[_Factor]:
-            return [
-                _Factor(axis=axis, gain=error_gain[name])
-                for kind, axis, name in PLACEMENT_ERROR_FACTORS[placement]
-                if kind == "rot"
-            ]
-
-        angles = {OUTER_JOINT: self.variables.phi1_rad, INNER_JOINT: self.variables.phi2_rad}
+        joint_angles = iter((self.variables.phi1_rad, self.variables.phi2_rad))
         chain: list[_Factor] = list(pre)
         ideal = np.broadcast_to(np.eye(3), (n, 3, 3))
-        for joint in (OUTER_JOINT, INNER_JOINT):
-            jid = nominal.getJointId(joint)
-            placement = nominal.jointPlacements[jid].rotation[None]
-            rotation = axis_rotation(joint_axis(nominal, jid), np.asarray(angles[joint], float))
+        for link in turntable.chain.links:
+            placement = link.nominal[None, :3, :3]
             chain.append(_Factor(fixed=placement))
-            chain.extend(error_factors(joint))
-            chain.append(_Factor(fixed=rotation))
-            ideal = ideal @ placement @ rotation
-        mount_id = nominal.getFrameId(PAYLOAD_MOUNT)
-        mount = nominal.frames[mount_id].placement
-        relative = mount.actInv(nominal.frames[nominal.getFrameId(PAYLOAD_FRAME)].placement)
-        chain.append(_Factor(fixed=mount.rotation[None]))
-        chain.extend(error_factors(PAYLOAD_MOUNT))
-        chain.append(_Factor(fixed=relative.rotation[None]))
+            chain.extend(
+                _Factor(axis=f.axis, gain=error_gain[f.error])
+                for f in link.factors
+                if f.kind == ROTATION
+            )
+            ideal = ideal @ placement
+            if link.is_joint:
+                rotation = axis_rotation(link.axis, np.asarray(next(joint_angles), float))
+                chain.append(_Factor(fixed=rotation))
+                ideal = ideal @ rotation
         chain.extend(post)
-        ideal = ideal @ mount.rotation @ relative.rotation
         return chain, np.swapaxes(ideal, -1, -2).copy()
 
     def _matrices(self, params: np.ndarray) -> list[np.ndarray]:
@@ -214,4 +198,3 @@ class OrientationModel:
         return p
 
 
-__all__ = ["AXIS_INDEX", "BASE_PARAMETERS", "OrientationModel"]

@@ -7,34 +7,26 @@ angle: ``phi1`` enters only through the outer joint's rotation in ``Rt`` and in 
     dR_ij(phi1, phi2) = u(phi1)^T C_ij u(phi2),   u(a) = [1, cos a, sin a, cos 2a, sin 2a],
 
 with a 5x5 coefficient matrix ``C_ij`` per entry. The coefficients are obtained by composing the
-Pinocchio model's own placement chain (joint placements, joint axes, payload frame placement; see
-:meth:`TurntableModel.placement_chain`) on a 5x5 grid of equally spaced angles and inverting the
-(orthogonal) trigonometric basis there. Evaluating ``dR`` at N angle pairs then costs two small
-matrix products, which is what makes allocation, Monte Carlo and fitting fast.
+placement chain (the Pinocchio model's own placements, :meth:`TurntableModel.placement_chain`, or
+the :class:`~turntable_pin.model.chain.ErrorChain` with many error sets) on a 5x5 grid of equally
+spaced angles and inverting the (orthogonal) trigonometric basis there. Evaluating ``dR`` at N
+angle pairs then costs two small matrix products, which is what makes allocation, Monte Carlo
+and fitting fast.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import numpy as np
 
-from ..core.rotations import axis_rotation
 from .angles import ANGLE_ENTRIES
+from .chain import compose_rotation
 from .errors import ERROR_NAMES
-from .turntable import (
-    INNER_JOINT,
-    OUTER_JOINT,
-    PAYLOAD_FRAME,
-    PAYLOAD_MOUNT,
-    TurntableModel,
-    error_placements,
-    joint_axis,
-)
+from .turntable import TurntableModel
+
+__all__ = ["N_BASIS", "OrientationErrorField", "trig_basis"]
 
 N_BASIS = 5
 _GRID_RAD = 2.0 * np.pi * np.arange(N_BASIS) / N_BASIS
-"""(row, column) of dpsi, dtheta, dgamma in dR (eq. 24)."""
 
 
 _CHUNK = 8192  # angle pairs per block: keeps the intermediates in cache
@@ -80,25 +72,12 @@ def _outer_basis_blocks(phi1_rad: np.ndarray, phi2_rad: np.ndarray):
 _BASIS_INV = np.linalg.inv(trig_basis(_GRID_RAD))  # rows: grid points, cols: basis functions
 
 
-def _compose(chain: Sequence[tuple[np.ndarray, np.ndarray | None]], q_rad: Sequence) -> np.ndarray:
-    """Rotation of a placement chain at joint values ``q_rad`` (broadcast over leading dims)."""
-    result = None
-    qi = 0
-    for placement, axis in chain:
-        rot = np.asarray(placement)[..., :3, :3]
-        result = rot if result is None else result @ rot
-        if axis is not None:
-            result = result @ axis_rotation(axis, q_rad[qi])
-            qi += 1
-    return result
-
-
 def _coefficients(actual_chain, ideal_chain) -> np.ndarray:
     """Coefficients C (K, 3, 3, 5, 5) of dR for chains whose placements have a leading dim K."""
     g1, g2 = np.meshgrid(_GRID_RAD, _GRID_RAD, indexing="ij")  # (5, 5)
     # Placements (K, 4, 4) broadcast against the (5, 5) grid of joint values.
-    rt = _compose([(p[:, None, None], a) for p, a in actual_chain], (g1, g2))
-    rd = _compose([(p[:, None, None], a) for p, a in ideal_chain], (g1, g2))
+    rt = compose_rotation([(p[:, None, None], a) for p, a in actual_chain], (g1, g2))
+    rd = compose_rotation([(p[:, None, None], a) for p, a in ideal_chain], (g1, g2))
     dR = np.swapaxes(rd, -1, -2) @ rt  # (K, 5, 5, 3, 3)
     # dR[k, a, b] = sum_mn B[a, m] C[m, n] B[b, n]  ->  C = Binv dR Binv^T on the grid axes.
     return np.einsum("ma,kabij,nb->kijmn", _BASIS_INV, dR, _BASIS_INV)
@@ -130,8 +109,8 @@ class OrientationErrorField:
     @classmethod
     def from_model(cls, model: TurntableModel) -> OrientationErrorField:
         """The field of one :class:`TurntableModel`, read off its Pinocchio placements."""
-        actual = [(p[None], a) for p, a in model.placement_chain(model.model)]
-        ideal = [(p[None], a) for p, a in model.placement_chain(model.nominal_model)]
+        actual = [(p[None], a) for p, a in model.placement_chain(model.pin_model)]
+        ideal = [(p[None], a) for p, a in model.placement_chain(model.nominal_pin_model)]
         return cls(_coefficients(actual, ideal))
 
     @classmethod
@@ -140,30 +119,16 @@ class OrientationErrorField:
     ) -> OrientationErrorField:
         """The fields of K error sets, ``error_values`` of shape (K, 9) (rad, deta in m).
 
-        The placements are the nominal model's with :func:`error_placements` applied, the same
-        construction :class:`TurntableModel` writes into Pinocchio.
+        The placements are the model's :class:`ErrorChain` with each error set applied
+        (:meth:`ErrorChain.placements`), the same construction :class:`TurntableModel` writes
+        into Pinocchio.
         """
         model = model or TurntableModel()
         values = np.atleast_2d(np.asarray(error_values, dtype=float))
         if values.shape[-1] == len(ERROR_NAMES) - 1:
             values = np.concatenate([values, np.zeros((values.shape[0], 1))], axis=1)
-        transforms = error_placements(values)
-        nominal = model.nominal_model
-        mount_id = nominal.getFrameId(PAYLOAD_MOUNT)
-        payload = nominal.frames[nominal.getFrameId(PAYLOAD_FRAME)]
-        relative = nominal.frames[mount_id].placement.actInv(payload.placement).homogeneous
-        actual = []
-        for name in (OUTER_JOINT, INNER_JOINT):
-            jid = nominal.getJointId(name)
-            actual.append(
-                (
-                    nominal.jointPlacements[jid].homogeneous @ transforms[name],
-                    joint_axis(nominal, jid),
-                )
-            )
-        mount = nominal.frames[mount_id].placement.homogeneous
-        actual.append((mount @ transforms[PAYLOAD_MOUNT] @ relative, None))
-        ideal = [(np.broadcast_to(p, (1, 4, 4)), a) for p, a in model.placement_chain(nominal)]
+        actual = model.chain.placements(values)
+        ideal = [(p[None], a) for p, a in model.chain.placements()]
         return cls(_coefficients(actual, ideal))
 
     # ---- evaluation --------------------------------------------------------------------------

@@ -34,31 +34,45 @@ import pinocchio as pin
 
 from ..core.exceptions import InputError, ModelError
 from ..core.resources import default_urdf_path
-from ..core.rotations import AXIS_INDEX, axis_rotation
+from .angles import ANGLE_ENTRIES
+from .chain import ErrorChain, joint_axis
 from .errors import ERROR_NAMES, TurntableErrors
+from .paper_table import (
+    INNER_JOINT,
+    OUTER_JOINT,
+    PAYLOAD_FRAME,
+    PAYLOAD_MOUNT,
+    PLACEMENT_ERROR_FACTORS,
+    PLACEMENT_ORDER,
+)
 
-OUTER_JOINT = "outer_axis"
-INNER_JOINT = "inner_axis"
-PAYLOAD_MOUNT = "payload_mount"
-PAYLOAD_FRAME = "gyrowheel"
+__all__ = [
+    "INNER_JOINT",
+    "OUTER_JOINT",
+    "PAYLOAD_FRAME",
+    "PAYLOAD_MOUNT",
+    "PLACEMENT_ERROR_FACTORS",
+    "PLACEMENT_ORDER",
+    "OrientationError",
+    "TurntableModel",
+    "error_placements",
+    "joint_axis",
+    "paper_chain",
+]
 
-# (kind, axis, error name) factors of each placement, in the order they are applied.
-PLACEMENT_ERROR_FACTORS: dict[str, tuple[tuple[str, str, str], ...]] = {
-    OUTER_JOINT: (("rot", "y", "dphi_y1"),),
-    INNER_JOINT: (
-        ("rot", "z", "dalpha_z1"),
-        ("rot", "x", "dalpha_x1"),
-        ("trans", "x", "deta"),
-        ("rot", "y", "deps_y"),
-        ("rot", "x", "deps_x"),
-    ),
-    PAYLOAD_MOUNT: (
-        ("rot", "y", "dalpha_y2"),
-        ("rot", "z", "dphi_z2"),
-        ("rot", "x", "dalpha_x2"),
-    ),
-}
-PLACEMENT_ORDER: tuple[str, ...] = (OUTER_JOINT, INNER_JOINT, PAYLOAD_MOUNT)
+@lru_cache(maxsize=8)
+def _load_nominal(urdf_path: str) -> tuple[pin.Model, ErrorChain]:
+    try:
+        model = pin.buildModelFromUrdf(urdf_path)
+    except (RuntimeError, ValueError) as exc:
+        raise ModelError(f"{urdf_path}: Pinocchio cannot read this URDF: {exc}") from None
+    _check_structure(model, urdf_path)
+    return model, paper_chain(model)
+
+
+def paper_chain(model: pin.Model) -> ErrorChain:
+    """The :class:`ErrorChain` of the paper's table: ``model``'s chain with the Table 3 factors."""
+    return ErrorChain.from_pinocchio(model, PAYLOAD_FRAME, PLACEMENT_ERROR_FACTORS, ERROR_NAMES)
 
 
 def error_placements(error_values: np.ndarray) -> dict[str, np.ndarray]:
@@ -69,39 +83,9 @@ def error_placements(error_values: np.ndarray) -> dict[str, np.ndarray]:
 
     Returns:
         ``{placement name: array (..., 4, 4)}``: the factors of :data:`PLACEMENT_ERROR_FACTORS`
-        multiplied in order. The nominal placement is to be applied before them.
+        multiplied in order (see :meth:`ErrorChain.error_transforms`).
     """
-    values = np.asarray(error_values, dtype=float)
-    if values.shape[-1] != len(ERROR_NAMES):
-        raise ValueError(f"expected {len(ERROR_NAMES)} error values, got shape {values.shape}")
-    lead = values.shape[:-1]
-    out = {}
-    for placement, factors in PLACEMENT_ERROR_FACTORS.items():
-        total = np.broadcast_to(np.eye(4), lead + (4, 4)).copy()
-        for kind, axis, name in factors:
-            value = values[..., ERROR_NAMES.index(name)]
-            step = np.broadcast_to(np.eye(4), lead + (4, 4)).copy()
-            if kind == "rot":
-                step[..., :3, :3] = axis_rotation(axis, value)
-            else:
-                step[..., AXIS_INDEX[axis], 3] = value
-            total = total @ step
-        out[placement] = total
-    return out
-
-
-def _se3(homogeneous: np.ndarray) -> pin.SE3:
-    return pin.SE3(np.array(homogeneous[:3, :3]), np.array(homogeneous[:3, 3]))
-
-
-@lru_cache(maxsize=8)
-def _load_nominal(urdf_path: str) -> pin.Model:
-    try:
-        model = pin.buildModelFromUrdf(urdf_path)
-    except (RuntimeError, ValueError) as exc:
-        raise ModelError(f"{urdf_path}: Pinocchio cannot read this URDF: {exc}") from None
-    _check_structure(model, urdf_path)
-    return model
+    return _load_nominal(str(default_urdf_path().resolve()))[1].error_transforms(error_values)
 
 
 def _check_structure(model: pin.Model, source: str) -> None:
@@ -119,17 +103,8 @@ def _check_structure(model: pin.Model, source: str) -> None:
         raise ModelError(f"{source}: '{INNER_JOINT}' must be a child of '{OUTER_JOINT}'")
 
 
-def joint_axis(model: pin.Model, joint_id: int) -> np.ndarray:
-    """Unit rotation axis of a revolute joint of ``model``, in the joint frame."""
-    joint = model.joints[joint_id]
-    short = joint.shortname()
-    if short in ("JointModelRX", "JointModelRY", "JointModelRZ"):
-        axis = np.zeros(3)
-        axis[AXIS_INDEX[short[-1].lower()]] = 1.0
-        return axis
-    if short == "JointModelRevoluteUnaligned":
-        return np.array(joint.extract().axis, dtype=float)
-    raise ModelError(f"joint '{model.names[joint_id]}' is {short}, not a revolute joint")
+def _se3(homogeneous: np.ndarray) -> pin.SE3:
+    return pin.SE3(np.array(homogeneous[:3, :3]), np.array(homogeneous[:3, 3]))
 
 
 @dataclass(frozen=True)
@@ -156,8 +131,14 @@ class TurntableModel:
         errors: the turntable errors (default: none).
         urdf_path: the nominal URDF (default: the bundled ``models/turntable.urdf``).
 
-    The nominal model (errors of the URDF as given) gives the ideal orientation ``Rd``; the
-    error model gives the actual ``Rt``; both by Pinocchio forward kinematics.
+    Attributes:
+        chain: the :class:`ErrorChain` (nominal placements, error factors, joint axes) that every
+            layer reads.
+        pin_model, pin_data: the Pinocchio model with the errors in its placements, and its data.
+        nominal_pin_model: the Pinocchio model of the URDF as given (the ideal table).
+
+    The nominal model gives the ideal orientation ``Rd``; the error model gives the actual
+    ``Rt``; both by Pinocchio forward kinematics.
     """
 
     def __init__(
@@ -167,18 +148,30 @@ class TurntableModel:
         if not self.urdf_path.is_file():
             raise InputError("no such URDF file", path=self.urdf_path)
         self.errors = errors if errors is not None else TurntableErrors.zero()
-        self.nominal_model = _load_nominal(str(self.urdf_path.resolve()))
-        self.model = self.nominal_model.copy()
+        self.nominal_pin_model, self.chain = _load_nominal(str(self.urdf_path.resolve()))
+        self.pin_model = self.nominal_pin_model.copy()
         self._apply_errors()
-        self.data = self.model.createData()
-        self._nominal_data = self.nominal_model.createData()
-        self.payload_frame_id = self.model.getFrameId(PAYLOAD_FRAME)
-        self.outer_joint_id = self.model.getJointId(OUTER_JOINT)
-        self.inner_joint_id = self.model.getJointId(INNER_JOINT)
-        self._q_index = (
-            self.model.joints[self.outer_joint_id].idx_q,
-            self.model.joints[self.inner_joint_id].idx_q,
-        )
+        self.pin_data = self.pin_model.createData()
+        self._nominal_data = self.nominal_pin_model.createData()
+        self.payload_frame_id = self.pin_model.getFrameId(PAYLOAD_FRAME)
+        self.outer_joint_id = self.pin_model.getJointId(OUTER_JOINT)
+        self.inner_joint_id = self.pin_model.getJointId(INNER_JOINT)
+
+    # Names of earlier versions (the README's changelog lists them).
+    @property
+    def model(self) -> pin.Model:
+        """Alias of :attr:`pin_model`."""
+        return self.pin_model
+
+    @property
+    def data(self) -> pin.Data:
+        """Alias of :attr:`pin_data`."""
+        return self.pin_data
+
+    @property
+    def nominal_model(self) -> pin.Model:
+        """Alias of :attr:`nominal_pin_model`."""
+        return self.nominal_pin_model
 
     def with_errors(self, errors: TurntableErrors) -> TurntableModel:
         """The same URDF with another error set."""
@@ -186,19 +179,25 @@ class TurntableModel:
 
     # ---- building ---------------------------------------------------------------------------
     def _apply_errors(self) -> None:
-        transforms = error_placements(self.errors.as_array())
-        for name in (OUTER_JOINT, INNER_JOINT):
-            jid = self.model.getJointId(name)
-            nominal = self.nominal_model.jointPlacements[jid]
-            self.model.jointPlacements[jid] = nominal * _se3(transforms[name])
-        mount = self.model.getFrameId(PAYLOAD_MOUNT)
-        nominal_mount = self.nominal_model.frames[mount].placement
-        actual_mount = nominal_mount * _se3(transforms[PAYLOAD_MOUNT])
-        # Pinocchio folds the fixed joint into frames: the joint frame and the child body frame.
-        for frame_name in (PAYLOAD_MOUNT, PAYLOAD_FRAME):
-            fid = self.model.getFrameId(frame_name)
-            relative = nominal_mount.actInv(self.nominal_model.frames[fid].placement)
-            self.model.frames[fid].placement = actual_mount * relative
+        transforms = self.chain.error_transforms(self.errors.as_array())
+        nominal, model = self.nominal_pin_model, self.pin_model
+        for link in self.chain.joints:
+            if link.name in transforms:
+                jid = model.getJointId(link.name)
+                model.jointPlacements[jid] = nominal.jointPlacements[jid] * _se3(
+                    transforms[link.name]
+                )
+        # Pinocchio folds fixed joints into frames (the joint frame and the child body frame), all
+        # placed relative to the last joint: compose them in chain order with their errors.
+        actual, previous = pin.SE3.Identity(), pin.SE3.Identity()
+        for name in self.chain.frame_path:
+            fid = model.getFrameId(name)
+            placement = nominal.frames[fid].placement
+            actual = actual * previous.actInv(placement)
+            if name in transforms:
+                actual = actual * _se3(transforms[name])
+            model.frames[fid].placement = actual
+            previous = placement
 
     def placement_chain(
         self, model: pin.Model | None = None
@@ -206,36 +205,33 @@ class TurntableModel:
         """The kinematic chain from the base to the payload frame as read off ``model``.
 
         Returns ``[(placement 4x4, joint axis or None), ...]``: for each joint from the root its
-        placement and axis, then the payload frame's placement (axis ``None``). Batch evaluation
-        composes this list; it is the Pinocchio model's own data, not a second copy of the chain.
+        placement and axis, then the payload frame's placement (axis ``None``), as Pinocchio
+        holds them (default: :attr:`pin_model`, the model with errors).
         """
-        model = self.model if model is None else model
+        model = self.pin_model if model is None else model
         frame = model.frames[model.getFrameId(PAYLOAD_FRAME)]
-        joints = []
-        jid = frame.parentJoint
-        while jid > 0:
-            joints.append(jid)
-            jid = model.parents[jid]
-        chain = [(model.jointPlacements[j].homogeneous, joint_axis(model, j)) for j in joints[::-1]]
+        chain = [
+            (model.jointPlacements[model.getJointId(link.name)].homogeneous, link.axis)
+            for link in self.chain.joints
+        ]
         chain.append((frame.placement.homogeneous, None))
         return chain
 
     # ---- evaluation --------------------------------------------------------------------------
-    def _q(self, phi1_rad: float, phi2_rad: float) -> np.ndarray:
-        q = np.zeros(self.model.nq)
-        q[self._q_index[0]] = phi1_rad
-        q[self._q_index[1]] = phi2_rad
-        return q
+    def joint_vector(self, phi1_rad: float, phi2_rad: float) -> np.ndarray:
+        """Pinocchio's configuration vector for commanded angles (phi1, phi2), radians."""
+        return self.chain.joint_vector(phi1_rad, phi2_rad)
 
     def payload_pose(self, phi1_rad: float, phi2_rad: float) -> pin.SE3:
         """Actual payload pose in the base frame (Pinocchio forward kinematics)."""
-        pin.framesForwardKinematics(self.model, self.data, self._q(phi1_rad, phi2_rad))
-        return self.data.oMf[self.payload_frame_id].copy()
+        q = self.joint_vector(phi1_rad, phi2_rad)
+        pin.framesForwardKinematics(self.pin_model, self.pin_data, q)
+        return self.pin_data.oMf[self.payload_frame_id].copy()
 
     def ideal_pose(self, phi1_rad: float, phi2_rad: float) -> pin.SE3:
         """Ideal payload pose in the base frame, from the nominal (error-free) model."""
-        q = self._q(phi1_rad, phi2_rad)
-        pin.framesForwardKinematics(self.nominal_model, self._nominal_data, q)
+        q = self.joint_vector(phi1_rad, phi2_rad)
+        pin.framesForwardKinematics(self.nominal_pin_model, self._nominal_data, q)
         return self._nominal_data.oMf[self.payload_frame_id].copy()
 
     def orientation_error(self, phi1_rad: float, phi2_rad: float) -> OrientationError:
@@ -246,11 +242,12 @@ class TurntableModel:
         actual = self.payload_pose(phi1_rad, phi2_rad)
         ideal = self.ideal_pose(phi1_rad, phi2_rad)
         dR = ideal.rotation.T @ actual.rotation
+        dpsi, dtheta, dgamma = (float(dR[i, j]) for i, j in ANGLE_ENTRIES)
         return OrientationError(
             dR=dR,
-            dpsi_rad=float(dR[0, 2]),
-            dtheta_rad=float(dR[1, 0]),
-            dgamma_rad=float(dR[2, 1]),
+            dpsi_rad=dpsi,
+            dtheta_rad=dtheta,
+            dgamma_rad=dgamma,
             payload_origin_m=np.array(actual.translation),
         )
 
@@ -259,4 +256,4 @@ class TurntableModel:
         """Write a URDF whose joint ``<origin>``s carry this model's errors (via yourdfpy)."""
         from .urdf_io import write_error_urdf
 
-        return write_error_urdf(self, path)
+        return write_error_urdf(self.urdf_path, self.chain, self.errors.as_array(), path)

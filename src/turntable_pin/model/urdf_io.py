@@ -8,23 +8,15 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..core.exceptions import InputError, ModelError
 from ..core.files import write_atomic
-from .turntable import (
-    INNER_JOINT,
-    OUTER_JOINT,
-    PAYLOAD_FRAME,
-    PAYLOAD_MOUNT,
-    PLACEMENT_ORDER,
-    error_placements,
-)
+from .chain import ErrorChain
+from .paper_table import INNER_JOINT, OUTER_JOINT, PAYLOAD_FRAME, PAYLOAD_MOUNT
 
-if TYPE_CHECKING:
-    from .turntable import TurntableModel
+__all__ = ["YourdfpyTurntable", "write_error_urdf"]
 
 
 def _load_yourdfpy(path: str | Path):
@@ -43,17 +35,23 @@ def _load_yourdfpy(path: str | Path):
         raise ModelError(f"{path}: yourdfpy cannot read this URDF: {exc}") from None
 
 
-def write_error_urdf(model: TurntableModel, path: str | Path) -> Path:
-    """Write ``model``'s nominal URDF with its error placements in the joint origins.
+def write_error_urdf(
+    urdf_path: str | Path, chain: ErrorChain, error_values: np.ndarray, path: str | Path
+) -> Path:
+    """Write the nominal URDF ``urdf_path`` with ``chain``'s error transforms in its joint origins.
 
-    The file is written atomically; the nominal URDF is never overwritten.
+    Args:
+        urdf_path: the nominal URDF (never overwritten).
+        chain: the error chain read off that URDF.
+        error_values: the errors in ``chain.error_names`` order (rad, m).
+        path: the output file, written atomically.
     """
-    path = Path(path)
-    if path.exists() and path.resolve() == model.urdf_path.resolve():
+    path, urdf_path = Path(path), Path(urdf_path)
+    if path.exists() and path.resolve() == urdf_path.resolve():
         raise InputError("refusing to overwrite the input URDF", path=path)
-    urdf = _load_yourdfpy(model.urdf_path)
-    transforms = error_placements(model.errors.as_array())
-    for joint_name in PLACEMENT_ORDER:
+    urdf = _load_yourdfpy(urdf_path)
+    transforms = chain.error_transforms(np.asarray(error_values, dtype=float))
+    for joint_name in transforms:
         joint = urdf.joint_map[joint_name]
         nominal = np.eye(4) if joint.origin is None else np.asarray(joint.origin, dtype=float)
         joint.origin = nominal @ transforms[joint_name]

@@ -121,14 +121,6 @@ def _rotation(matrix: np.ndarray) -> np.ndarray:
     return out
 
 
-def _configuration(model: TurntableModel, phi1_rad: float, phi2_rad: float) -> np.ndarray:
-    """Pinocchio configuration q of commanded angles, mapped by joint (not by position in q)."""
-    q = np.zeros(model.model.nq)
-    q[model.model.joints[model.outer_joint_id].idx_q] = phi1_rad
-    q[model.model.joints[model.inner_joint_id].idx_q] = phi2_rad
-    return q
-
-
 # meshcat cylinders lie along their y axis: these turn y onto x, y and z.
 _Y_ONTO = (_rotation(rot_z(-math.pi / 2)), np.eye(4), _rotation(rot_x(math.pi / 2)))
 
@@ -162,7 +154,7 @@ class SetupScene:
         # Built against the magnified model: the payload's visuals hang on the fixed mount, and
         # Pinocchio folds that mount's (magnified) error into their placements.
         self.visual_model = pin.buildGeomFromUrdf(
-            self.model.model, str(self.model.urdf_path), pin.GeometryType.VISUAL
+            self.model.pin_model, str(self.model.urdf_path), pin.GeometryType.VISUAL
         )
         self._true_model = TurntableModel(self.errors, self.model.urdf_path)
         self._viz = None
@@ -173,9 +165,9 @@ class SetupScene:
         """Poses of the triads and inner-axis rods at commanded angles (phi1, phi2), radians."""
         actual = self.model.payload_pose(phi1_rad, phi2_rad).homogeneous
         ideal = self.model.ideal_pose(phi1_rad, phi2_rad).homogeneous
-        q = _configuration(self.model, phi1_rad, phi2_rad)
+        q = self.model.joint_vector(phi1_rad, phi2_rad)
         axes = []
-        for model in (self.model.model, self.model.nominal_model):
+        for model in (self.model.pin_model, self.model.nominal_pin_model):
             data = model.createData()
             pin.forwardKinematics(model, data, q)
             axes.append(data.oMi[model.getJointId(INNER_JOINT)].homogeneous)
@@ -210,7 +202,7 @@ class SetupScene:
         from pinocchio.visualize import MeshcatVisualizer
 
         self._vis = visualizer
-        viz = MeshcatVisualizer(self.model.model, None, self.visual_model)
+        viz = MeshcatVisualizer(self.model.pin_model, None, self.visual_model)
         viz.initViewer(viewer=visualizer)
         viz.loadViewerModel(rootNodeName=f"{ROOT}/machine")
         self._viz = viz
@@ -243,7 +235,7 @@ class SetupScene:
         """Move the drawn scene to commanded angles (phi1, phi2), radians."""
         if self._viz is None:
             raise RuntimeError("draw() the scene into a visualizer first")
-        self._viz.display(_configuration(self.model, phi1_rad, phi2_rad))
+        self._viz.display(self.model.joint_vector(phi1_rad, phi2_rad))
         poses = self.poses(phi1_rad, phi2_rad)
         self._vis[f"{ROOT}/actual_triad"].set_transform(poses.actual_payload)
         self._vis[f"{ROOT}/ideal_triad"].set_transform(poses.ideal_payload)

@@ -1,0 +1,314 @@
+"""The error chain: the one description of a turntable's kinematic chain with its error factors.
+
+A turntable is a serial chain from the base to the payload frame. Each *link* of the chain is a
+placement (the nominal URDF ``<origin>``, read off the Pinocchio model) followed by the link's
+*error factors* (elementary rotations and translations by error parameters, applied in the moving
+frame) and, for a joint, the joint's own rotation about its axis::
+
+    Rt(q) = prod_links  N_link E_link(errors) R_axis(q_link)        (R = I for a fixed link)
+
+Every consumer reads this one object: :class:`~turntable_pin.model.turntable.TurntableModel`
+writes ``N E`` into Pinocchio's placements, the URDF writer into the joint ``<origin>``s,
+:class:`~turntable_pin.model.batch_field.OrientationErrorField` composes it for the trigonometric
+coefficients, the measurement fit composes its rotations factor by factor (with effect terms
+inserted) for exact Jacobians, and the sensitivity layer moves each factor's twist through the
+Pinocchio regressor. Nothing here knows the paper's names: the factor table comes from the caller.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.exceptions import InputError, ModelError
+from ..core.rotations import AXIS_INDEX, axis_rotation
+
+__all__ = ["ROTATION", "TRANSLATION", "ChainLink", "ErrorChain", "ErrorFactor", "joint_axis"]
+
+ROTATION = "rot"
+"""Kind of an error factor that rotates about a coordinate axis of the moving frame."""
+
+TRANSLATION = "trans"
+"""Kind of an error factor that translates along a coordinate axis of the moving frame."""
+
+
+@dataclass(frozen=True)
+class ErrorFactor:
+    """One elementary motion by an error parameter: ``kind`` about/along ``axis`` by ``error``.
+
+    Attributes:
+        kind: :data:`ROTATION` (radians) or :data:`TRANSLATION` (metres).
+        axis: ``"x"``, ``"y"`` or ``"z"`` of the moving frame.
+        error: the error parameter's name.
+    """
+
+    kind: str
+    axis: str
+    error: str
+
+
+@dataclass(frozen=True)
+class ChainLink:
+    """One link of the chain: nominal placement, error factors, joint axis (None when fixed).
+
+    Attributes:
+        name: the joint's name (a revolute joint or a fixed joint folded into a frame), or the
+            payload frame's name for the last link.
+        nominal: 4x4 nominal placement relative to the previous link's frame (read-only).
+        factors: the error factors applied after ``nominal``, in order.
+        axis: unit rotation axis of a revolute joint in its own frame; ``None`` for a fixed link.
+        q_index: index of the joint's value in Pinocchio's configuration vector (-1 when fixed).
+    """
+
+    name: str
+    nominal: np.ndarray
+    factors: tuple[ErrorFactor, ...]
+    axis: np.ndarray | None
+    q_index: int = -1
+
+    @property
+    def is_joint(self) -> bool:
+        """Whether the link rotates with a joint value."""
+        return self.axis is not None
+
+
+def joint_axis(model, joint_id: int) -> np.ndarray:
+    """Unit rotation axis of a revolute joint of the Pinocchio ``model``, in the joint frame."""
+    joint = model.joints[joint_id]
+    short = joint.shortname()
+    if short in ("JointModelRX", "JointModelRY", "JointModelRZ"):
+        axis = np.zeros(3)
+        axis[AXIS_INDEX[short[-1].lower()]] = 1.0
+        return axis
+    if short == "JointModelRevoluteUnaligned":
+        return np.array(joint.extract().axis, dtype=float)
+    raise ModelError(f"joint '{model.names[joint_id]}' is {short}, not a revolute joint")
+
+
+def _readonly(array: np.ndarray) -> np.ndarray:
+    out = np.array(array, dtype=float)
+    out.setflags(write=False)
+    return out
+
+
+def _frame_path(model, frame_id: int) -> list[int]:
+    """Frame ids after the payload's parent joint frame, down to ``frame_id`` (inclusive)."""
+    import pinocchio as pin
+
+    path = [frame_id]
+    while True:
+        parent = model.frames[path[-1]].parentFrame
+        if parent == path[-1] or model.frames[parent].type == pin.FrameType.JOINT:
+            return path[::-1]
+        if model.frames[parent].parentJoint != model.frames[frame_id].parentJoint:
+            return path[::-1]
+        path.append(parent)
+
+
+class ErrorChain:
+    """The serial chain from the base to a payload frame of a Pinocchio model, with error factors.
+
+    Args:
+        links: the links from the base to the payload frame (see :class:`ChainLink`).
+        error_names: the error parameters, in the order of the value arrays the methods take.
+        nq: size of Pinocchio's configuration vector.
+        frame_path: names of the Pinocchio frames after the last joint, down to the payload frame
+            (their placements change with the fixed links' errors).
+
+    Build it with :meth:`from_pinocchio`.
+    """
+
+    def __init__(
+        self,
+        links: Sequence[ChainLink],
+        error_names: Sequence[str],
+        nq: int,
+        frame_path: Sequence[str] = (),
+    ) -> None:
+        self.links = tuple(links)
+        self.frame_path = tuple(frame_path)
+        self.error_names = tuple(error_names)
+        self.nq = int(nq)
+        self._index = {name: i for i, name in enumerate(self.error_names)}
+        for link in self.links:
+            for factor in link.factors:
+                if factor.error not in self._index:
+                    raise ModelError(f"link '{link.name}': unknown error '{factor.error}'")
+
+    # ---- construction -------------------------------------------------------------------------
+    @classmethod
+    def from_pinocchio(
+        cls,
+        model,
+        payload_frame: str,
+        factors: Mapping[str, Sequence[tuple[str, str, str]]],
+        error_names: Sequence[str],
+    ) -> ErrorChain:
+        """Read the chain ending at ``payload_frame`` off the nominal Pinocchio ``model``.
+
+        Args:
+            model: the nominal ``pinocchio.Model`` (no errors in its placements).
+            payload_frame: name of the payload frame.
+            factors: ``{joint or fixed-joint name: ((kind, axis, error name), ...)}``.
+            error_names: order of the error values.
+
+        Joints are read from the root to the payload frame's parent joint; the fixed joints that
+        Pinocchio folded into frames between that joint and the payload frame become fixed links
+        (their placement relative to the previous one), and the payload frame closes the chain.
+        """
+        import pinocchio as pin
+
+        if not model.existFrame(payload_frame):
+            raise ModelError(
+                f"no frame '{payload_frame}'; frames are {[f.name for f in model.frames]}"
+            )
+        frame_id = model.getFrameId(payload_frame)
+        joints = []
+        jid = model.frames[frame_id].parentJoint
+        while jid > 0:
+            joints.append(jid)
+            jid = model.parents[jid]
+        links = []
+        for jid in joints[::-1]:
+            name = model.names[jid]
+            links.append(
+                ChainLink(
+                    name,
+                    _readonly(model.jointPlacements[jid].homogeneous),
+                    tuple(ErrorFactor(*f) for f in factors.get(name, ())),
+                    _readonly(joint_axis(model, jid)),
+                    model.joints[jid].idx_q,
+                )
+            )
+        previous = np.eye(4)  # frame placements are relative to the parent joint's frame
+        path = _frame_path(model, frame_id)
+        for fid in path:
+            frame = model.frames[fid]
+            if fid != frame_id and frame.type != pin.FrameType.FIXED_JOINT:
+                continue  # a body frame sits where its fixed joint is: no placement of its own
+            placement = frame.placement.homogeneous
+            links.append(
+                ChainLink(
+                    frame.name,
+                    _readonly(np.linalg.solve(previous, placement)),
+                    tuple(ErrorFactor(*f) for f in factors.get(frame.name, ())),
+                    None,
+                )
+            )
+            previous = placement
+        known = {link.name for link in links}
+        for name in factors:
+            if name not in known:
+                raise ModelError(
+                    f"error factors for '{name}', which is not on the chain to "
+                    f"'{payload_frame}' ({', '.join(link.name for link in links)})"
+                )
+        return cls(links, error_names, model.nq, [model.frames[f].name for f in path])
+
+    # ---- names and vectors --------------------------------------------------------------------
+    @property
+    def joints(self) -> tuple[ChainLink, ...]:
+        """The joint links, from the base."""
+        return tuple(link for link in self.links if link.is_joint)
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Names of the joints, from the base (the order of the angles everywhere)."""
+        return tuple(link.name for link in self.joints)
+
+    def link(self, name: str) -> ChainLink:
+        """The link ``name``."""
+        for link in self.links:
+            if link.name == name:
+                return link
+        raise KeyError(name)
+
+    def locate(self, error: str) -> tuple[ChainLink, int]:
+        """The link holding error ``error`` and the factor's index within the link."""
+        for link in self.links:
+            for index, factor in enumerate(link.factors):
+                if factor.error == error:
+                    return link, index
+        raise KeyError(error)
+
+    def joint_vector(self, *angles_rad: float) -> np.ndarray:
+        """Pinocchio's configuration vector q for joint angles in chain order, radians."""
+        joints = self.joints
+        if len(angles_rad) != len(joints):
+            raise InputError(f"expected {len(joints)} joint angles, got {len(angles_rad)}")
+        q = np.zeros(self.nq)
+        for link, value in zip(joints, angles_rad, strict=True):
+            q[link.q_index] = value
+        return q
+
+    # ---- error transforms ---------------------------------------------------------------------
+    def error_transforms(self, error_values: np.ndarray) -> dict[str, np.ndarray]:
+        """Homogeneous 4x4 error transforms of each link with factors, vectorised over sets.
+
+        Args:
+            error_values: shape (..., E), the errors in :attr:`error_names` order (rad, m).
+
+        Returns:
+            ``{link name: array (..., 4, 4)}``: the link's factors multiplied in order. The
+            nominal placement is to be applied before them.
+        """
+        values = np.asarray(error_values, dtype=float)
+        if values.shape[-1] != len(self.error_names):
+            raise ValueError(
+                f"expected {len(self.error_names)} error values, got shape {values.shape}"
+            )
+        lead = values.shape[:-1]
+        out = {}
+        for link in self.links:
+            if not link.factors:
+                continue
+            total = np.broadcast_to(np.eye(4), lead + (4, 4)).copy()
+            for factor in link.factors:
+                value = values[..., self._index[factor.error]]
+                step = np.broadcast_to(np.eye(4), lead + (4, 4)).copy()
+                if factor.kind == ROTATION:
+                    step[..., :3, :3] = axis_rotation(factor.axis, value)
+                else:
+                    step[..., AXIS_INDEX[factor.axis], 3] = value
+                total = total @ step
+            out[link.name] = total
+        return out
+
+    def placements(self, error_values: np.ndarray | None = None) -> list[tuple[np.ndarray, object]]:
+        """``[(placement (..., 4, 4), joint axis or None), ...]`` of every link with its errors.
+
+        ``error_values`` of shape (..., E) (``None``: the nominal chain, each placement (4, 4)).
+        """
+        if error_values is None:
+            return [(link.nominal, link.axis) for link in self.links]
+        transforms = self.error_transforms(error_values)
+        out = []
+        for link in self.links:
+            if link.name in transforms:
+                out.append((link.nominal @ transforms[link.name], link.axis))
+            else:
+                lead = np.asarray(error_values).shape[:-1]
+                out.append((np.broadcast_to(link.nominal, lead + (4, 4)), link.axis))
+        return out
+
+
+def compose_rotation(chain: Sequence[tuple[np.ndarray, object]], q_rad: Sequence) -> np.ndarray:
+    """Rotation of a placement chain at joint values ``q_rad`` (broadcast over leading dims).
+
+    ``chain`` is ``[(placement (..., 4, 4), joint axis or None), ...]`` as
+    :meth:`ErrorChain.placements` returns; ``q_rad`` holds one value (or array) per joint.
+    """
+    result = None
+    qi = 0
+    for placement, axis in chain:
+        rot = np.asarray(placement)[..., :3, :3]
+        result = rot if result is None else result @ rot
+        if axis is not None:
+            result = result @ axis_rotation(axis, q_rad[qi])
+            qi += 1
+    return result
+
+
+__all__ += ["compose_rotation"]
