@@ -33,6 +33,7 @@ from functools import lru_cache
 import numpy as np
 from scipy.optimize import minimize, minimize_scalar
 
+from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.exceptions import InfeasibleError, InputError
 from ..core.units import ARCMIN_PER_RAD, DEG_PER_RAD, arcmin_by_name
 from ..model.angles import ANGLE_SYMBOLS
@@ -91,8 +92,6 @@ DEFAULT_ACCURACY_DPH = 0.01
 """Calibration accuracy behind the default limits: the paper's example, 0.01 deg/h."""
 DEFAULT_POSITIONS = "grid:30"
 """Position scheme behind the default limits (the calibration layer's reference scheme)."""
-DEFAULT_LATITUDE_DEG = 45.75
-"""Latitude behind the default limits (Harbin; an assumption, the paper states none)."""
 
 
 def paper_eq16_limits() -> OrientationLimits:
@@ -119,9 +118,7 @@ def default_orientation_limits(
     requirement = orientation_requirement(
         accuracy_dph, PositionSet.parse(positions), math.radians(latitude_deg)
     )
-    return OrientationLimits(
-        requirement.I_psi_rad, requirement.I_theta_rad, requirement.I_gamma_rad
-    )
+    return OrientationLimits(*requirement.limits_rad)
 
 
 # ---- the linear model of each angle ----------------------------------------------------------

@@ -26,6 +26,7 @@ from ..core.csv_table import read_csv_table
 from ..core.exceptions import InputError
 from ..core.units import deg_to_rad, rad_to_deg
 from ..model.turntable import TurntableModel
+from .site import DEFAULT_LATITUDE_DEG  # noqa: F401  (re-exported)
 
 EARTH_RATE_DPH = 15.041067
 """Earth rotation rate used by the paper (eq. 3), deg/h."""

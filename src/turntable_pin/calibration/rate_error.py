@@ -135,9 +135,24 @@ def rate_errors_dph(
     rotations: np.ndarray,
     *,
     definition: str = "true_coefficients",
-    per_position: bool = False,
-):
+) -> np.ndarray:
     """Rate-sensing errors for K orientation errors at once (vectorised eqs. 8-14).
+
+    Same arguments as :func:`rate_error_vectors_dph`. Returns the (K, 2) array ``[dwx, dwy]`` in
+    deg/h: the infinity norms over the positions of the per-position vectors.
+    """
+    dw = rate_error_vectors_dph(gyrowheel, inputs, rotations, definition=definition)
+    return np.max(np.abs(dw), axis=-2)
+
+
+def rate_error_vectors_dph(
+    gyrowheel: GyroWheelModel,
+    inputs: PositionInputs,
+    rotations: np.ndarray,
+    *,
+    definition: str = "true_coefficients",
+) -> np.ndarray:
+    """Rate-sensing error vectors for K orientation errors at the N positions (eqs. 8-14).
 
     Args:
         gyrowheel: the true drift coefficients ``beta``.
@@ -145,11 +160,9 @@ def rate_errors_dph(
         rotations: ``dR`` of shape (K, 3, 3) (one per case, the same at every position) or
             (K, N, 3, 3) (per position).
         definition: one of :data:`DEFINITIONS`.
-        per_position: also return the (K, N, 2) error vectors ``dw`` (deg/h).
 
     Returns:
-        (K, 2) array ``[dwx, dwy]`` in deg/h (infinity norms over the positions), and the
-        per-position vectors when asked.
+        (K, N, 2) array of ``[dwx, dwy]`` at each position, deg/h.
     """
     if definition not in DEFINITIONS:
         raise InputError(f"unknown rate-error definition '{definition}'; expected {DEFINITIONS}")
@@ -180,9 +193,7 @@ def rate_errors_dph(
             beta1 = (b1 - w[:, index]) @ _pinv_checked(design, axis).T
             dw = b1 - beta1 @ design.T - b2_act
         errors.append(dw)
-    dw_all = np.stack(errors, axis=-1)
-    norms = np.max(np.abs(dw_all), axis=-2)
-    return (norms, dw_all) if per_position else norms
+    return np.stack(errors, axis=-1)
 
 
 @dataclass(frozen=True)
@@ -249,9 +260,8 @@ def rate_error(
         if not np.isfinite(value):
             raise InputError(f"{name} must be a finite number, got {value!r}")
     rotation = orientation_error_rotation(dpsi_rad, dtheta_rad, dgamma_rad, exact=exact)
-    norms, dw = rate_errors_dph(
-        gyrowheel, inputs, rotation[None], definition=definition, per_position=True
-    )
+    dw = rate_error_vectors_dph(gyrowheel, inputs, rotation[None], definition=definition)
+    norms = np.max(np.abs(dw), axis=-2)
     a, w = inputs.specific_force_g, inputs.earth_rate_dph
     a_act, w_act = a @ rotation, w @ rotation
     beta1, beta2, conds = {}, {}, {}

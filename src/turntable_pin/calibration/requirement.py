@@ -252,7 +252,8 @@ class OrientationRequirement:
 
     Attributes:
         accuracy_dph: the required accuracy ``w_m``, deg/h.
-        I_psi_rad, I_theta_rad, I_gamma_rad: the limits, radians.
+        psi_rad, theta_rad, gamma_rad: the limits I_psi, I_theta, I_gamma, radians (the names
+            of :class:`~turntable_pin.allocation.solver.OrientationLimits`).
         binding_plane: the plane whose rectangle set ``I_theta``.
         rectangles: the largest-area rectangle of each plane before ``I_theta`` was shared.
         box_dwx_dph, box_dwy_dph: largest ``dwx``, ``dwy`` over the eight corners of the box
@@ -261,9 +262,9 @@ class OrientationRequirement:
     """
 
     accuracy_dph: float
-    I_psi_rad: float
-    I_theta_rad: float
-    I_gamma_rad: float
+    psi_rad: float
+    theta_rad: float
+    gamma_rad: float
     binding_plane: str
     rectangles: tuple[PlaneRectangle, PlaneRectangle]
     box_dwx_dph: float
@@ -284,7 +285,24 @@ class OrientationRequirement:
 
     @property
     def limits_rad(self) -> np.ndarray:
-        return np.array([self.I_psi_rad, self.I_theta_rad, self.I_gamma_rad])
+        """``[I_psi, I_theta, I_gamma]``, radians."""
+        return np.array([self.psi_rad, self.theta_rad, self.gamma_rad])
+
+    # Names of earlier versions (the README's changelog lists them).
+    @property
+    def I_psi_rad(self) -> float:  # noqa: N802
+        """Alias of :attr:`psi_rad`."""
+        return self.psi_rad
+
+    @property
+    def I_theta_rad(self) -> float:  # noqa: N802
+        """Alias of :attr:`theta_rad`."""
+        return self.theta_rad
+
+    @property
+    def I_gamma_rad(self) -> float:  # noqa: N802
+        """Alias of :attr:`gamma_rad`."""
+        return self.gamma_rad
 
     def to_dict(self) -> dict:
         out = {
@@ -374,9 +392,9 @@ def orientation_requirement(
     ).max(axis=0)  # fmt: skip
     return OrientationRequirement(
         accuracy_dph=float(accuracy_dph),
-        I_psi_rad=float(psi),
-        I_theta_rad=float(theta),
-        I_gamma_rad=float(gamma),
+        psi_rad=float(psi),
+        theta_rad=float(theta),
+        gamma_rad=float(gamma),
         binding_plane=binding,
         rectangles=(rect_x, rect_y),
         box_dwx_dph=float(box[0]),

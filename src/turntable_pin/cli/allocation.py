@@ -10,7 +10,6 @@ from ..allocation.monte_carlo import run_monte_carlo
 from ..allocation.sensitivity import AverageSensitivities, average_sensitivities
 from ..allocation.solver import (
     DEFAULT_ACCURACY_DPH,
-    DEFAULT_LATITUDE_DEG,
     DEFAULT_POSITIONS,
     ORIENTATION_ANGLES,
     WEIGHT_SCHEMES,
@@ -19,6 +18,7 @@ from ..allocation.solver import (
     allocate_tolerances,
     default_orientation_limits,
 )
+from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.exceptions import InputError
 from ..core.units import ARCMIN_PER_RAD
 from .common import finite_float, positive_int, print_json
@@ -107,7 +107,6 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
 def register(subparsers: argparse._SubParsersAction) -> None:
     a = subparsers.add_parser(
         "allocate",
-        help="allocate the eight angular turntable errors to meet orientation limits",
         description="Error allocation of paper section 4.2 (eqs. 29-34): three weighted problems "
         "with their constraints over phi2 solved exactly, combined by eq. 34. Prints the upper "
         "bounds, J, the active constraints and the worst-case orientation error the bounds allow.",
@@ -118,7 +117,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     m = subparsers.add_parser(
         "montecarlo",
-        help="allocate, then check the bounds with random turntables on the exact chain",
         description="Allocate as `allocate` does, draw N turntables with error magnitudes uniform "
         "in [lower, upper] bound and random signs, evaluate the exact orientation error over a "
         "phi2 grid and compare the largest |dpsi|, |dtheta|, |dgamma| with the limits (Figure 9). "

@@ -10,12 +10,10 @@ from ..calibration.gyrowheel import GyroWheelModel
 from ..calibration.positions import PositionSet, position_inputs
 from ..calibration.rate_error import DEFINITIONS, rate_error
 from ..calibration.requirement import orientation_requirement
+from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.units import deg_to_rad
 from ..model.angles import ANGLE_NAMES, ANGLE_SYMBOLS
 from .common import finite_float, print_json
-
-DEFAULT_LATITUDE_DEG = 45.75
-"""Harbin, the paper's authors' city: an assumption, the paper does not state its latitude."""
 
 
 def positive_float(text: str) -> float:
@@ -58,7 +56,6 @@ def _add_model_options(parser: argparse.ArgumentParser) -> None:
 def register(subparsers: argparse._SubParsersAction) -> None:
     r = subparsers.add_parser(
         "rate-error",
-        help="GyroWheel rate-sensing errors caused by an orientation error (eqs. 7-14)",
         description="Rate-sensing errors dwx, dwy (deg/h, eq. 14) of a multi-position calibration "
         "whose payload is off by (dpsi, dtheta, dgamma) at every position.",
     )
@@ -70,7 +67,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     q = subparsers.add_parser(
         "requirement",
-        help="orientation requirement I_psi, I_theta, I_gamma for an accuracy (eqs. 15-16)",
         description="Largest centred rectangles inside dwx <= w_m over (dpsi, dtheta) and "
         "dwy <= w_m over (dtheta, dgamma), sharing dtheta; Figures 4 and 5 with --plots.",
     )
@@ -85,7 +81,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     c = subparsers.add_parser(
         "calibrate",
-        help="fit the 2 x 7 drift coefficients to a calibration run (eqs. 5-6)",
         description="Least-squares calibration of a run CSV (phi1_deg, phi2_deg, out_x_dph, "
         "out_y_dph[, sigma_dph, time_s]): coefficients, standard errors, residuals per position.",
     )

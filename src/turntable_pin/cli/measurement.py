@@ -19,7 +19,6 @@ APPROACHES = ("random", "motion", "positive")
 def register(subparsers: argparse._SubParsersAction) -> None:
     s = subparsers.add_parser(
         "simulate",
-        help="simulate orientation measurements with hidden effects",
         description="Simulate a measurement run (the CSV of spec/measurements.md): turntable "
         "errors, catalogued effects with their parameters, a position schedule, noise, time "
         "stamps and approach directions; the seed and the truth go into comment lines. "
@@ -53,7 +52,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     f = subparsers.add_parser(
         "fit",
-        help="fit the error model (plus effects) to measurements",
         description="Weighted least squares of the base error model plus the chosen effects; "
         "rank, determined combinations with standard errors, rms, chi2_reduced, p-value; "
         "before (base) and after (with the effects), and where the fit fails.",
@@ -66,7 +64,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     d = subparsers.add_parser(
         "diagnose",
-        help="which catalogued physical effect is missing",
         description="Test every catalogued effect against the base fit (BIC, delta <= -6), "
         "rank them, name the missing effect, its equivalent alternatives, and whether "
         "structure remains that nothing in the catalogue explains.",
@@ -78,7 +75,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     r = subparsers.add_parser(
         "report",
-        help="one self-contained HTML page with the whole story",
         description="Data, base fit, where it fails, diagnosis, fit with the missing effect, "
         "parameters; plots embedded.",
     )

@@ -16,7 +16,6 @@ from .common import add_error_options, finite_float, model_from_args, print_json
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "orientation",
-        help="orientation error dR of the payload at one position",
         description="Orientation error dR = Rd^T Rt of the payload (Pinocchio forward kinematics "
         "of the URDF with the errors in its joint placements), the angles dpsi, dtheta, dgamma "
         "(eq. 24) beside their small-angle values (eq. 26), and the payload origin.",
@@ -29,7 +28,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     u = subparsers.add_parser(
         "urdf",
-        help="write the URDF with the errors in its joint placements",
         description="Write the turntable URDF whose joint <origin>s carry the errors; plain "
         "pinocchio.buildModelFromUrdf(OUT) gives the same dR.",
     )

@@ -39,7 +39,6 @@ def _add_scene_options(p: argparse.ArgumentParser) -> None:
 def register(subparsers: argparse._SubParsersAction) -> None:
     v = subparsers.add_parser(
         "view",
-        help="show the turntable and its (magnified) errors in a meshcat 3-D viewer",
         description="Serve a meshcat 3-D view of the turntable URDF with its errors magnified, "
         "the ideal and the actual payload frames as triads and the ideal and actual inner axis. "
         "Prints the URL and serves until Ctrl-C (or --duration). Needs the extra 'viz' (meshcat).",
@@ -72,7 +71,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     s = subparsers.add_parser(
         "snapshot",
-        help="render the 3-D view of the setup to a PNG (headless Chromium)",
         description="Render the same scene as 'view' to a PNG with headless Chromium (Debian "
         "package 'chromium'); no server or browser is left running afterwards.",
     )
