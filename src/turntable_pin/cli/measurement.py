@@ -207,6 +207,7 @@ def run_fit(args: argparse.Namespace) -> int:
 def run_diagnose(args: argparse.Namespace) -> int:
     from ..measurement.diagnosis import diagnose_measurements
     from ..measurement.residuals import orientation_residuals
+    from ..report.diagnosis_text import diagnosis_lines
     from ..report.measurement_figures import write_residual_plots
 
     data = _read(args)
@@ -221,7 +222,7 @@ def run_diagnose(args: argparse.Namespace) -> int:
     if args.json:
         print_json(out)
         return 0
-    print("\n".join(diagnosis.report_lines()))
+    print("\n".join(diagnosis_lines(out)))
     for p in out.get("plots", []):
         print(f"wrote {p}")
     return 0

@@ -41,6 +41,9 @@ def _max_order(angle_rad: np.ndarray) -> int:
 class OrientationFamily:
     """Orientation data, the base error model, and the effect catalogue (a ``ModelFamily``)."""
 
+    record_label = "positions"
+    observation_unit = "arcsec"
+
     def __init__(
         self,
         data: OrientationMeasurements,
@@ -50,8 +53,8 @@ class OrientationFamily:
         self.data = data
         self.catalogue = tuple(catalogue if catalogue is not None else EFFECTS.values())
         self.turntable = turntable or TurntableModel()
-        self.n_positions = data.n_positions
-        self.sigma_scale_arcsec = (
+        self.n_records = data.n_positions
+        self.sigma_scale = (
             float(np.median(data.sigma_rad) * ARCSEC_PER_RAD)
             if data.sigma_rad is not None
             else ARCSEC_PER_RAD

@@ -1,9 +1,13 @@
-"""Presentation: the one PNG saver, figures, and the HTML report rendered from structured results.
+"""Presentation: the one PNG saver, figures, and the text and HTML reports, each rendered from the
+structured results (``to_dict()``) of the layers below, never from another renderer's output.
 """
 
 from ..core.lazy import lazy_exports
 
 _EXPORTS = {
+    "diagnosis_html": "html_report",
+    "diagnosis_lines": "diagnosis_text",
+    "save_png": "figures",
     "write_report": "html_report",
 }
 

@@ -15,6 +15,7 @@ from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..measurement.data import ANGLE_NAMES
 from ..measurement.residuals import analyse_residuals, orientation_residuals
 from ..stats.model_selection import Diagnosis
+from .diagnosis_text import verdict_lines
 from .figures import pyplot, save_png
 from .measurement_figures import COLOURS, harmonics_figure, residual_figure
 
@@ -180,9 +181,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
              for c in d["candidates"] if c.get("reason")]  # fmt: skip
     if notes:
         parts.append("<p>Not testable here:</p><ul>" + "".join(notes) + "</ul>")
-    lines = diagnosis.report_lines()
-    start = next((i for i, ln in enumerate(lines) if ln.startswith(("step ", "missing effect"))), 0)
-    words = "<br>".join(html.escape(line) for line in lines[start:])
+    words = "<br>".join(html.escape(line) for line in verdict_lines(d))
     parts.append(f'<div class="{cls}">{words}</div>')
     if verdict["missing_effect"]:
         story = verdict["effect_story"]

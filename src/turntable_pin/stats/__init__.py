@@ -1,7 +1,7 @@
 """Generic statistics: weighted least squares with identifiability, model selection by BIC and the
 structure search over candidate terms.
 
-Free of turntable names and units: callers pass names, scales and unit labels in.
+Free of the names and units of any application: callers pass names, scales and unit labels in.
 """
 
 from ..core.lazy import lazy_exports

@@ -1,7 +1,8 @@
 """Weighted nonlinear least squares with identifiability analysis, for any model of the protocol.
 
-The machinery is not tied to orientation data: any :class:`FitProblem` (observations, their
-sigmas, parameter names and units, ``predict`` and ``jacobian``) can be fitted, and the result
+The machinery is not tied to any kind of data: any :class:`FitProblem` (observations, their
+sigmas, parameter names and units, the unit of the observations, ``predict`` and ``jacobian``)
+can be fitted, and the result
 knows its rank, the parameter combinations the data determine and those they cannot, their
 standard errors, and its goodness of fit.
 
@@ -11,7 +12,7 @@ parameters (the models here are first-order exact there; second-order terms of s
 are flat directions. The fit then runs in the coordinates of the determined subspace, which gives
 the minimum-norm (in normalised units) representative of the family of equivalent solutions; the
 determined combinations are the reduced row-echelon form of the row space, so they read
-like ``dphi_y1 + deps_y``.
+like ``a + b`` when only the sum of two parameters is determined.
 
 Noise: with sigmas given, ``chi2 = sum((r / sigma)^2)`` and its p-value test the fit. Without
 them the observations get unit weights and the noise variance is estimated (``rss / dof`` of this
@@ -28,6 +29,16 @@ import numpy as np
 
 from ..core.exceptions import IdentifiabilityError
 
+__all__ = [
+    "RANK_RTOL",
+    "FitProblem",
+    "FitResult",
+    "Identifiability",
+    "analyse_identifiability",
+    "combination_name",
+    "fit_least_squares",
+]
+
 RANK_RTOL = 1e-6
 """Singular values of the normalised Jacobian below this fraction of the largest are flat."""
 
@@ -40,11 +51,14 @@ class FitProblem(Protocol):
     per_user_unit: np.ndarray  # internal value of one user unit, per parameter
     observed: np.ndarray  # (m,)
     sigma: np.ndarray | None  # (m,) or None (unknown: unit weights, variance estimated)
-    user_unit_scale: float  # user units (e.g. arcsec) per internal unit of an observation
+    user_unit_scale: float  # user units per internal unit of an observation
+    observation_unit: str  # name of that user unit: the key suffix of ``rms_<unit>``
 
-    def predict(self, params: np.ndarray) -> np.ndarray: ...  # (m,)
+    def predict(self, params: np.ndarray) -> np.ndarray:
+        """Predicted observations (m,) for parameters in internal units."""
 
-    def jacobian(self, params: np.ndarray) -> np.ndarray: ...  # (m, n)
+    def jacobian(self, params: np.ndarray) -> np.ndarray:
+        """Derivative of :meth:`predict` with respect to the parameters, (m, n)."""
 
 
 def _rref(matrix: np.ndarray, tol: float = 1e-9) -> np.ndarray:
@@ -70,7 +84,7 @@ def _rref(matrix: np.ndarray, tol: float = 1e-9) -> np.ndarray:
 
 
 def combination_name(coefficients: np.ndarray, names: tuple[str, ...]) -> str:
-    """``"dphi_y1 + deps_y"``, ``"dphi_y1 - 0.5 backlash.b1"``, from coefficients per name."""
+    """``"a + b"``, ``"a - 0.5 c.d"``, from coefficients per name."""
     parts = []
     for c, name in zip(coefficients, names, strict=True):
         if c == 0:
@@ -169,21 +183,26 @@ class FitResult:
     user_unit_scale: float
     jacobian_weighted: np.ndarray = field(repr=False)
     n_function_evaluations: int = 0
+    observation_unit: str = ""
 
     @property
     def n_obs(self) -> int:
+        """Number of observations m."""
         return int(self.residuals.size)
 
     @property
     def n_params(self) -> int:
+        """Number of parameters n."""
         return len(self.parameter_names)
 
     @property
     def chi2(self) -> float:
+        """Weighted residual sum of squares over the unit-weight noise variance."""
         return self.rss / self.noise_variance
 
     @property
     def chi2_reduced(self) -> float:
+        """chi2 per degree of freedom (nan without a degree of freedom)."""
         return self.chi2 / self.dof if self.dof > 0 else float("nan")
 
     @property
@@ -196,8 +215,13 @@ class FitResult:
         return float(stats.chi2.sf(self.chi2, self.dof))
 
     @property
+    def rms_key(self) -> str:
+        """``rms_<observation unit>`` (``rms`` when the unit has no name): the result's key."""
+        return f"rms_{self.observation_unit}" if self.observation_unit else "rms"
+
+    @property
     def rms_user(self) -> float:
-        """Root mean square of the (unweighted) residuals, in user units (arcsec)."""
+        """Root mean square of the (unweighted) residuals, in the observations' user unit."""
         return float(np.sqrt(np.mean(self.residuals**2)) * self.user_unit_scale)
 
     def with_noise_variance(self, noise_variance: float) -> FitResult:
@@ -286,10 +310,10 @@ class FitResult:
         return out
 
     def to_dict(self) -> dict:
-        """The fit as a JSON-ready dictionary (user units; keys of the spec)."""
+        """The fit as a JSON-ready dictionary (user units; ``rms_<observation unit>``)."""
         return {
             "n_observations": self.n_obs,
-            "rms_arcsec": self.rms_user,
+            self.rms_key: self.rms_user,
             "chi2": self.chi2,
             "chi2_reduced": self.chi2_reduced,
             "dof": self.dof,
@@ -385,6 +409,7 @@ def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = Non
         sigma_known=sigma_known,
         identifiability=ident,
         user_unit_scale=float(problem.user_unit_scale),
+        observation_unit=str(getattr(problem, "observation_unit", "")),
         jacobian_weighted=problem.jacobian(params) * weights[:, None],
         n_function_evaluations=int(solution.nfev),
     )

@@ -9,15 +9,15 @@ compared by the Bayesian information criterion, ``delta_bic = delta_chi2 + added
 profiled out), where ``added_rank`` is the number of *new* determined combinations (parameters the
 current model already absorbs do not count) and ``m`` the number of observations. An effect is
 accepted when ``delta_bic <= -6``. On clean data the improvement is chi2-distributed with
-``added_rank`` degrees of freedom, so for m = 432 (144 positions) the false-alarm probability of
+``added_rank`` degrees of freedom, so for m = 432 observations the false-alarm probability of
 one candidate is P(chi2_k > k ln m + 6): 5e-4 (k=1), 1.2e-4 (k=2), 2e-6 (k=4); over the whole
-catalogue well under 1 %, while an effect of a few arcsec on 1-arcsec noise lowers chi2 by
-hundreds. A plain likelihood-ratio test at a fixed level would not penalise the 8-parameter
+catalogue well under 1 %, while an effect of a few sigma lowers chi2 by hundreds. A plain
+likelihood-ratio test at a fixed level would not penalise the 8-parameter
 wobble series more than a 1-parameter sag, and BIC does.
 
 Alternatives: effects that are themselves accepted and whose fit is as good as the best one's
 (``|chi2_B - chi2_A| <= chi2_0.99(max(added_rank_A, added_rank_B))``) explain the data as well; the
-family then says whether more positions could separate them or only an independent measurement.
+family then says whether more data could separate them or only an independent measurement.
 
 Unexplained: the best model still fails the fit test, i.e. its chi2 p-value is below
 ``FIT_TEST_ALPHA`` (sigma given), or the structure search finds a term it lacks (any sigma; the
@@ -37,6 +37,17 @@ from ..core.exceptions import IdentifiabilityError
 from .least_squares import FitResult
 from .structure_search import BIC_THRESHOLD, FoundTerm, Probe, delta_bic, search_structure
 
+__all__ = [
+    "ALTERNATIVE_LEVEL",
+    "FIT_TEST_ALPHA",
+    "Candidate",
+    "Diagnosis",
+    "ModelFamily",
+    "Step",
+    "compare_effects",
+    "diagnose",
+]
+
 FIT_TEST_ALPHA = 1e-3
 """A model fails the chi2 goodness-of-fit test when its p-value is below this."""
 
@@ -45,20 +56,36 @@ ALTERNATIVE_LEVEL = 0.99
 
 
 class ModelFamily(Protocol):
-    """What :func:`diagnose` needs: fits of base + effects, reasons, probes, separation advice."""
+    """What :func:`diagnose` needs: fits of base + effects, reasons, probes, separation advice.
 
-    catalogue: tuple[Any, ...]  # effect objects with a ``name``
+    Attributes:
+        catalogue: the candidate effects (objects with a ``name``), in catalogue order.
+        n_records: number of data records (e.g. rows of a data file).
+        record_label: what a record is, for the key ``n_<label>`` of :meth:`Diagnosis.to_dict`.
+        observation_unit: name of the observations' user unit (key suffix of ``rms_``/``sigma_``).
+        sigma_scale: the observations' typical sigma in user units (the unit-weight noise).
+    """
+
+    catalogue: tuple[Any, ...]
+    n_records: int
+    record_label: str
+    observation_unit: str
+    sigma_scale: float
 
     def fit(self, effects: Sequence[Any], noise_variance: float | None = None) -> Any:
         """A fit object with a ``result`` (:class:`FitResult`)."""
 
-    def untestable_reason(self, effect: Any) -> str | None: ...
+    def untestable_reason(self, effect: Any) -> str | None:
+        """Why ``effect`` cannot be tested on these data, or None."""
 
-    def probes(self, fit: Any) -> list[Probe]: ...
+    def probes(self, fit: Any) -> list[Probe]:
+        """Candidate shapes for the structure search in the residuals of ``fit``."""
 
-    def separation(self, fit_a: Any, effect_b: Any) -> str: ...
+    def separation(self, fit_a: Any, effect_b: Any) -> str:
+        """Whether more data could separate the fitted effect of ``fit_a`` from ``effect_b``."""
 
-    def describe(self, effect: Any) -> dict: ...
+    def describe(self, effect: Any) -> dict:
+        """The effect's story (``title``, ``explanation``, ``confirm``...) for the reports."""
 
 
 @dataclass
@@ -75,6 +102,7 @@ class Candidate:
 
     @property
     def significant(self) -> bool:
+        """Whether the effect lowers BIC by at least the threshold."""
         return self.delta_bic is not None and self.delta_bic <= BIC_THRESHOLD
 
 
@@ -87,7 +115,7 @@ def _summary(result: FitResult, noise_variance: float) -> dict:
 
     chi2 = _chi2(result, noise_variance)
     return {
-        "rms_arcsec": result.rms_user,
+        result.rms_key: result.rms_user,
         "chi2_reduced": chi2 / result.dof if result.dof > 0 else None,
         "n_params": result.n_params,
         "rank": result.rank,
@@ -196,10 +224,12 @@ class Diagnosis:
 
     @property
     def missing_effect(self) -> str | None:
+        """The first accepted effect (the headline of the verdict), or None."""
         return self.steps[0].added if self.steps else None
 
     @property
     def missing_effects(self) -> list[str]:
+        """Every accepted effect with ``until_explained``, else the first one."""
         names = [s.added for s in self.steps]
         return names if self.until_explained else names[:1]
 
@@ -210,6 +240,7 @@ class Diagnosis:
 
     @property
     def alternatives(self) -> list[str]:
+        """Effects that explain the data as well as the first accepted one."""
         if not self.steps:
             return []
         first = next(c for c in self.candidates if c.effect == self.steps[0].added)
@@ -227,13 +258,16 @@ class Diagnosis:
 
     @property
     def unexplained(self) -> bool:
+        """Whether the best model fails the fit test or structure remains."""
         return bool(self.fails_fit_test or self.structure)
 
     @property
     def sigma_known(self) -> bool:
+        """Whether the observations' sigmas were given (not estimated)."""
         return self.base_fit.result.sigma_known
 
     def summary(self, fit) -> dict:
+        """rms, chi2_reduced, rank and p-value of ``fit`` judged with this noise variance."""
         return _summary(fit.result, self.noise_variance)
 
     def to_dict(self) -> dict:
@@ -245,7 +279,7 @@ class Diagnosis:
                 "effect": c.effect,
                 "testable": c.testable,
                 "delta_bic": c.delta_bic,
-                "rms_arcsec": c.fit.result.rms_user if c.fit is not None else None,
+                self.base_fit.result.rms_key: c.fit.result.rms_user if c.fit is not None else None,
                 "chi2_reduced": _summary(c.fit.result, nv)["chi2_reduced"] if c.fit else None,
                 "added_rank": c.added_rank,
                 "significant": c.significant,
@@ -271,11 +305,12 @@ class Diagnosis:
         }
         if self.missing_effect:
             verdict["effect_story"] = self.family.describe(self.missing_effect)
+        unit = self.family.observation_unit
         return {
-            "n_positions": self.family.n_positions,
+            f"n_{self.family.record_label}": self.family.n_records,
             "n_observations": self.base_fit.result.n_obs,
             "sigma_source": "column" if self.sigma_known else "estimated",
-            "sigma_arcsec": float(math.sqrt(nv) * self.family.sigma_scale_arcsec),
+            f"sigma_{unit}" if unit else "sigma": float(math.sqrt(nv) * self.family.sigma_scale),
             "base": _summary(self.base_fit.result, nv),
             "candidates": candidates,
             "steps": [
@@ -295,83 +330,6 @@ class Diagnosis:
                 "fit_test_alpha": FIT_TEST_ALPHA if self.sigma_known else None,
             },
         }
-
-    def report_lines(self) -> list[str]:
-        """The diagnosis in words."""
-        d = self.to_dict()
-        lines = []
-        sig = (
-            "from the sigma_arcsec column"
-            if self.sigma_known
-            else f"estimated from the best fit: {d['sigma_arcsec']:.3g} arcsec"
-        )
-        lines.append(f"{d['n_positions']} positions, {d['n_observations']} angles; noise {sig}")
-        b = d["base"]
-        lines.append(
-            f"base model: rms {b['rms_arcsec']:.3f} arcsec, chi2_reduced "
-            f"{b['chi2_reduced']:.3f}, {b['n_params']} parameters of rank {b['rank']}"
-            + (f", p-value {b['p_value']:.3g}" if b["p_value"] is not None else "")
-        )
-        lines.append("candidates (best first; delta_bic <= -6 accepts):")
-        for c in d["candidates"]:
-            if not c["testable"]:
-                lines.append(f"  {c['effect']:26s} not testable: {c['reason']}")
-                continue
-            alt = f"  same as: {', '.join(c['alternatives'])}" if c["alternatives"] else ""
-            later = c.get("delta_bic_after_first")
-            if c["significant"] and later is not None:
-                alt += f"  (on top of {self.steps[0].added}: {later:+.1f})"
-            lines.append(
-                f"  {c['effect']:26s} delta_bic {c['delta_bic']:10.1f}  rms "
-                f"{c['rms_arcsec']:.3f}  chi2_red {c['chi2_reduced']:.3f}"
-                f"{'  *' if c['significant'] else ''}{alt}"
-            )
-        if self.steps:
-            for i, s in enumerate(d["steps"], 1):
-                lines.append(
-                    f"step {i}: add {s['added']} (delta_bic {s['delta_bic']:.1f}) -> rms "
-                    f"{s['rms_arcsec']:.3f} arcsec, chi2_reduced {s['chi2_reduced']:.3f}"
-                )
-            story = self.family.describe(self.missing_effect)
-            lines.append(f"missing effect: {self.missing_effect} ({story['title']})")
-            lines.append(f"  why: {story['explanation']}")
-            lines.append(f"  confirm on the machine: {story['confirm']}")
-        else:
-            lines.append("missing effect: none (no catalogued effect improves the base fit)")
-        if self.also_significant:
-            lines.append(
-                "also significant on top of it: "
-                + ", ".join(self.also_significant)
-                + " (--until-explained names every step)"
-            )
-        for name, text in self.separations.items():
-            lines.append(f"  alternative {name}: {text}")
-        for name in self.indistinguishable_from_base:
-            lines.append(
-                f"note: {name} cannot be told apart from the base errors on these data (if "
-                "present, it is absorbed into them; see its candidate entry)"
-            )
-        if self.unexplained:
-            why = []
-            if self.fails_fit_test:
-                why.append("the best model fails the chi2 test")
-            if self.structure:
-                why.append(
-                    "structure remains: "
-                    + "; ".join(
-                        f"{t.description} ({t.amplitude:.3g} {t.unit}, delta_bic {t.delta_bic:.0f})"
-                        for t in self.structure
-                    )
-                )
-            elif self.fails_fit_test:
-                why.append(
-                    "without harmonic structure: the stated sigma may be too small or the "
-                    "missing effect is not a harmonic one"
-                )
-            lines.append("unexplained: yes, " + "; ".join(why))
-        else:
-            lines.append("unexplained: no (the residuals are consistent with the noise)")
-        return lines
 
 
 def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis:

@@ -1,15 +1,15 @@
 """A generic search for structure left in fit residuals: which shape is still missing.
 
 Telescope pointing analysts, when their physical terms do not suffice, search harmonic terms in
-either axis angle to name the *shape* of what is missing. This module does that for any fit:
-the model family supplies *probes* (groups of columns, each a candidate shape such as "a 3/rev
-term in phi2 of the inner-axis position error"), and a greedy forward search adds the probe that
-removes most of the weighted residual sum of squares, *after* projecting out what the fitted
-model can already absorb, while it lowers BIC by at least ``-BIC_THRESHOLD + 2 ln G`` for G
-probes: searching G shapes at once is G chances of a false alarm, and ``2 ln G`` is the
-likelihood-scale form of a Bonferroni correction (on clean 144-position data with about 130
-probes, the chance of any false term falls from about 1.5 % to about 0.01 %, while a 3 arcsec
-harmonic on 1 arcsec noise lowers chi2 by several hundred).
+either axis angle to name the *shape* of what is missing. This module does that for any fit: the
+model family supplies *probes* (groups of columns, each a candidate shape such as "a 3/rev
+harmonic of one model parameter in one input variable"), and a greedy forward search adds the
+probe that removes most of the weighted residual sum of squares, *after* projecting out what the
+fitted model can already absorb, while it lowers BIC by at least ``-BIC_THRESHOLD + 2 ln G`` for
+G probes: searching G shapes at once is G chances of a false alarm, and ``2 ln G`` is the
+likelihood-scale form of a Bonferroni correction (on clean data of 432 observations with about
+130 probes, the chance of any false term falls from about 1.5 % to about 0.01 %, while a term of
+3 sigma amplitude lowers chi2 by several hundred).
 """
 
 from __future__ import annotations
@@ -20,6 +20,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+__all__ = [
+    "BIC_THRESHOLD",
+    "NEW_FRACTION",
+    "FoundTerm",
+    "Probe",
+    "delta_bic",
+    "search_structure",
+]
+
 BIC_THRESHOLD = -6.0
 """A term is accepted when it lowers BIC by at least 6 (strong evidence on the Kass-Raftery
 scale; the acceptance rule of telescope-pointing practice)."""
@@ -27,8 +36,9 @@ scale; the acceptance rule of telescope-pointing practice)."""
 NEW_FRACTION = 1e-2
 """A probe direction counts as new only if more than this fraction of it (relative to the probe's
 own largest singular value) survives projecting out the model and the terms already found. Shapes
-the model spans to first order leave only second-order remainders (about the size of the errors,
-1e-5..1e-3 rad); fitting one of those to the residuals gave absurd amplitudes (1e5 arcsec)."""
+the model spans to first order leave only second-order remainders (of the relative size of the
+fitted parameters, 1e-5..1e-3); fitting one of those to the residuals gave absurd amplitudes
+(1e5 times the noise)."""
 
 
 @dataclass(frozen=True)
@@ -36,7 +46,7 @@ class Probe:
     """One candidate shape: weighted columns (m, g) and how to describe them.
 
     Attributes:
-        name: short id (``dphi_z2~3/rev(phi2)``).
+        name: short id (``a 3/rev in x``).
         description: for people.
         columns: (m, g) weighted like the residuals (divided by sigma).
         unit_scale: user units per internal unit of the probe's coefficients (for amplitudes).
@@ -62,6 +72,7 @@ class FoundTerm:
     coefficients: tuple[float, ...]
 
     def to_dict(self) -> dict:
+        """The term as a JSON-ready dictionary."""
         return {
             "term": self.name,
             "description": self.description,

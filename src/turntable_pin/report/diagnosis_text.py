@@ -1,0 +1,102 @@
+"""The diagnosis in words: the text rendering of the diagnosis JSON (``Diagnosis.to_dict()``).
+
+The text report, the JSON and the HTML page are three views of one structured result: this module
+reads only the dictionary, never another renderer's output. :func:`verdict_lines` is the verdict
+part, which the HTML report shows in its verdict box.
+"""
+
+from __future__ import annotations
+
+__all__ = ["diagnosis_lines", "header_lines", "verdict_lines"]
+
+
+def header_lines(d: dict) -> list[str]:
+    """The data, the base fit and the table of candidates."""
+    lines = []
+    sig = (
+        "from the sigma_arcsec column"
+        if d["sigma_source"] == "column"
+        else f"estimated from the best fit: {d['sigma_arcsec']:.3g} arcsec"
+    )
+    lines.append(f"{d['n_positions']} positions, {d['n_observations']} angles; noise {sig}")
+    b = d["base"]
+    lines.append(
+        f"base model: rms {b['rms_arcsec']:.3f} arcsec, chi2_reduced "
+        f"{b['chi2_reduced']:.3f}, {b['n_params']} parameters of rank {b['rank']}"
+        + (f", p-value {b['p_value']:.3g}" if b["p_value"] is not None else "")
+    )
+    lines.append("candidates (best first; delta_bic <= -6 accepts):")
+    first = d["steps"][0]["added"] if d["steps"] else None
+    for c in d["candidates"]:
+        if not c["testable"]:
+            lines.append(f"  {c['effect']:26s} not testable: {c['reason']}")
+            continue
+        alt = f"  same as: {', '.join(c['alternatives'])}" if c["alternatives"] else ""
+        later = c.get("delta_bic_after_first")
+        if c["significant"] and later is not None:
+            alt += f"  (on top of {first}: {later:+.1f})"
+        lines.append(
+            f"  {c['effect']:26s} delta_bic {c['delta_bic']:10.1f}  rms "
+            f"{c['rms_arcsec']:.3f}  chi2_red {c['chi2_reduced']:.3f}"
+            f"{'  *' if c['significant'] else ''}{alt}"
+        )
+    return lines
+
+
+def verdict_lines(d: dict) -> list[str]:
+    """The steps of the forward selection, the missing effect and whether anything remains."""
+    verdict = d["verdict"]
+    lines = []
+    if d["steps"]:
+        for i, s in enumerate(d["steps"], 1):
+            lines.append(
+                f"step {i}: add {s['added']} (delta_bic {s['delta_bic']:.1f}) -> rms "
+                f"{s['rms_arcsec']:.3f} arcsec, chi2_reduced {s['chi2_reduced']:.3f}"
+            )
+        story = verdict["effect_story"]
+        lines.append(f"missing effect: {verdict['missing_effect']} ({story['title']})")
+        lines.append(f"  why: {story['explanation']}")
+        lines.append(f"  confirm on the machine: {story['confirm']}")
+    else:
+        lines.append("missing effect: none (no catalogued effect improves the base fit)")
+    if verdict["also_significant"]:
+        lines.append(
+            "also significant on top of it: "
+            + ", ".join(verdict["also_significant"])
+            + " (--until-explained names every step)"
+        )
+    for name, text in verdict["separations"].items():
+        lines.append(f"  alternative {name}: {text}")
+    for name in verdict["indistinguishable_from_base"]:
+        lines.append(
+            f"note: {name} cannot be told apart from the base errors on these data (if "
+            "present, it is absorbed into them; see its candidate entry)"
+        )
+    if verdict["unexplained"]:
+        why = []
+        structure = verdict["remaining_structure"]
+        if verdict["fails_fit_test"]:
+            why.append("the best model fails the chi2 test")
+        if structure:
+            why.append(
+                "structure remains: "
+                + "; ".join(
+                    f"{t['description']} ({t['amplitude']:.3g} {t['unit']}, "
+                    f"delta_bic {t['delta_bic']:.0f})"
+                    for t in structure
+                )
+            )
+        elif verdict["fails_fit_test"]:
+            why.append(
+                "without harmonic structure: the stated sigma may be too small or the "
+                "missing effect is not a harmonic one"
+            )
+        lines.append("unexplained: yes, " + "; ".join(why))
+    else:
+        lines.append("unexplained: no (the residuals are consistent with the noise)")
+    return lines
+
+
+def diagnosis_lines(d: dict) -> list[str]:
+    """The whole diagnosis in words: :func:`header_lines` then :func:`verdict_lines`."""
+    return header_lines(d) + verdict_lines(d)
