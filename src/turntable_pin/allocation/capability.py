@@ -20,6 +20,8 @@ from ..core.resources import default_lower_bounds_path
 from ..core.units import ARCSEC_PER_RAD
 from ..model.errors import ANGULAR_ERROR_NAMES, parse_error_value
 
+__all__ = ["ManufacturingCapability"]
+
 
 @dataclass(frozen=True)
 class ManufacturingCapability:
@@ -84,6 +86,7 @@ class ManufacturingCapability:
         return cls(values, {str(k): str(v) for k, v in reasoning.items()}, str(path))
 
     def to_dict(self) -> dict:
+        """Source, lower bounds by name (arcsec) and reasoning, as a JSON-ready dict."""
         return {
             "source": self.source,
             "lower_bounds_arcsec": {

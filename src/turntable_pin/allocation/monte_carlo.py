@@ -30,6 +30,15 @@ from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES
 from ..model.turntable import TurntableModel
 from .solver import ORIENTATION_ANGLES, OrientationLimits
 
+__all__ = [
+    "CHUNK_SIZE",
+    "PHI1_TOLERANCE",
+    "MonteCarloResult",
+    "phi1_dependence",
+    "run_monte_carlo",
+    "sample_errors",
+]
+
 CHUNK_SIZE = 2000  # turntables per block: the (chunk, 3, 360) intermediates stay small
 # Relative size of phi1 harmonics in dR below which phi1 is taken to drop out (rounding of the
 # 5x5 trigonometric fit is ~1e-16 of the largest coefficient, which is ~1).
@@ -109,6 +118,7 @@ class MonteCarloResult:
 
     @property
     def all_within(self) -> bool:
+        """Whether every turntable stays within the limits on every angle."""
         return bool(np.all(self.max_abs_rad <= self.limits.as_array()))
 
     @property
@@ -117,6 +127,7 @@ class MonteCarloResult:
         return self.n * int(round(360.0 / self.phi2_step_deg)) * len(self.phi1_evaluated_deg)
 
     def to_dict(self) -> dict:
+        """The outcome as a JSON-ready dict (angles in arcmin, steps in degrees, time in s)."""
         limits = self.limits.as_array()
         return {
             "max_abs_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.max_abs_rad),

@@ -37,6 +37,7 @@ from ..model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
 from ..model.turntable import TurntableModel
 
 __all__ = [
+    "ORIENTATION_ANGLE_NAMES",
     "PAPER_FIGURE8_TRIG",
     "AverageSensitivities",
     "average_sensitivities",
@@ -48,6 +49,7 @@ __all__ = [
 ]
 
 ORIENTATION_ANGLE_NAMES = ANGLE_NAMES
+"""Alias of :data:`turntable_pin.model.angles.ANGLE_NAMES` (rows of the sensitivities)."""
 _AXIS = {
     "x": np.array([1.0, 0.0, 0.0]),
     "y": np.array([0.0, 1.0, 0.0]),
@@ -162,6 +164,7 @@ class AverageSensitivities:
         )
 
     def to_dict(self) -> dict:
+        """Grids (degrees), error set, phi1 variation and sensitivities by name, JSON-ready."""
         return {
             "averaging": "mean of |dC/dchi| over every (phi1, phi2) pair of the grids",
             "phi1_grid_deg": self.phi1_grid_deg.tolist(),
@@ -214,4 +217,5 @@ def average_sensitivities(
 
 
 PAPER_FIGURE8_TRIG = 0.6481
-"""The paper's Figure 8 value used for every sin/cos term by ``--weights paper`` (see spec)."""
+"""The paper's Figure 8 value used for every sin/cos term by ``--weights paper``
+(see docs/model.md)."""

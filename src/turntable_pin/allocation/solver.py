@@ -42,6 +42,26 @@ from ..model.small_angle import small_angle_matrix
 from .capability import ManufacturingCapability
 from .sensitivity import PAPER_FIGURE8_TRIG, AverageSensitivities, average_sensitivities
 
+__all__ = [
+    "DEFAULT_ACCURACY_DPH",
+    "DEFAULT_POSITIONS",
+    "ORIENTATION_ANGLES",
+    "PHI2_INTERVALS_RAD",
+    "WEIGHT_SCHEMES",
+    "Allocation",
+    "LinearAngleModel",
+    "OrientationLimits",
+    "SubproblemResult",
+    "allocate_tolerances",
+    "allocation_weights",
+    "default_orientation_limits",
+    "interval_max",
+    "linear_angle_models",
+    "paper_eq16_limits",
+    "solve_subproblem",
+    "worst_case_full_circle",
+]
+
 ORIENTATION_ANGLES = ANGLE_SYMBOLS  # the limit names: psi_rad, theta_rad, gamma_rad
 """Names of the three orientation angles dpsi, dtheta, dgamma as used in keys and options."""
 
@@ -50,7 +70,9 @@ PHI2_INTERVALS_RAD: dict[str, tuple[float, float]] = {
     "theta": (0.0, 2.0 * math.pi),  # eq. 32 has no phi2; the whole turn is the same constraint
     "psi": (1.5 * math.pi, 2.0 * math.pi),  # eq. 33
 }
+"""The phi2 interval ``(lo, hi)`` of each angle's constraint (eqs. 31-33), radians."""
 WEIGHT_SCHEMES: tuple[str, ...] = ("model", "paper", "equal")
+"""The weight schemes :func:`allocation_weights` knows."""
 
 # Eq. 16: 0.027 deg on each angle keeps the GyroWheel calibration error under 0.01 deg/h.
 _EQ16_LIMIT_DEG = 0.027
@@ -73,10 +95,12 @@ class OrientationLimits:
 
     @classmethod
     def from_arcmin(cls, psi: float, theta: float, gamma: float) -> OrientationLimits:
+        """The limits from values in arc minutes."""
         return cls(psi / ARCMIN_PER_RAD, theta / ARCMIN_PER_RAD, gamma / ARCMIN_PER_RAD)
 
     @classmethod
     def from_deg(cls, psi: float, theta: float, gamma: float) -> OrientationLimits:
+        """The limits from values in degrees."""
         return cls(psi / DEG_PER_RAD, theta / DEG_PER_RAD, gamma / DEG_PER_RAD)
 
     def as_array(self) -> np.ndarray:
@@ -269,6 +293,7 @@ class SubproblemResult:
     method: str
 
     def to_dict(self) -> dict:
+        """The optimum as a JSON-ready dict (errors and limit in arcmin, phi2 in degrees)."""
         return {
             "angle": self.angle,
             "solution_arcmin": arcmin_by_name(self.error_names, self.solution_rad),
@@ -488,6 +513,7 @@ class Allocation:
         return TurntableErrors.from_array(self.upper_bounds_rad)
 
     def to_dict(self) -> dict:
+        """Bounds, objectives, worst case and every sub-problem as a JSON-ready dict (arcmin)."""
         return {
             "upper_bounds_arcmin": arcmin_by_name(ANGULAR_ERROR_NAMES, self.upper_bounds_rad),
             "J": self.J,

@@ -31,8 +31,23 @@ from .gyrowheel import (
 )
 from .positions import PositionInputs, PositionSet, position_inputs
 
+__all__ = [
+    "RUN_OPTIONAL_COLUMNS",
+    "RUN_REQUIRED_COLUMNS",
+    "AxisCalibration",
+    "CalibrationResult",
+    "calibrate",
+    "calibrate_run",
+    "check_identifiable",
+    "fit_axis",
+    "simulate_run",
+    "write_simulated_run",
+]
+
 RUN_REQUIRED_COLUMNS: tuple[str, ...] = ("phi1_deg", "phi2_deg", "out_x_dph", "out_y_dph")
+"""Columns every calibration run CSV must have (angles in degrees, outputs in deg/h)."""
 RUN_OPTIONAL_COLUMNS: tuple[str, ...] = ("sigma_dph", "time_s")
+"""Columns read when present: 1-sigma output noise (deg/h) and time (s)."""
 
 
 @dataclass(frozen=True)
@@ -62,13 +77,16 @@ class AxisCalibration:
 
     @property
     def names(self) -> tuple[str, ...]:
+        """The seven coefficient names of this axis, in fit order."""
         return TERM_NAMES[self.axis]
 
     @property
     def rms_dph(self) -> float:
+        """Root mean square of the residuals, deg/h."""
         return float(np.sqrt(np.mean(self.residuals_dph**2)))
 
     def to_dict(self) -> dict:
+        """The fit as a JSON-ready dict (coefficients and standard errors by name, deg/h)."""
         return {
             "coefficients_dph": dict(zip(self.names, self.coefficients_dph, strict=True)),
             "standard_errors_dph": dict(zip(self.names, self.standard_errors_dph, strict=True)),
@@ -89,6 +107,7 @@ class CalibrationResult:
     inputs: PositionInputs
 
     def axis(self, name: str) -> AxisCalibration:
+        """The fit of axis ``name`` (``"x"`` or ``"y"``)."""
         return getattr(self, name)
 
     def model(self, source: str = "calibration") -> GyroWheelModel:
@@ -100,6 +119,7 @@ class CalibrationResult:
         )
 
     def to_dict(self) -> dict:
+        """Both fits and the residual per position as a JSON-ready dict (degrees, deg/h)."""
         positions = self.inputs.positions
         return {
             "positions": positions.name,

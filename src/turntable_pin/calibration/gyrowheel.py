@@ -24,6 +24,15 @@ from ..core.exceptions import InputError
 from ..core.files import read_yaml
 from ..core.resources import default_gyrowheel_path
 
+__all__ = [
+    "AXES",
+    "N_COEFFICIENTS",
+    "TERM_NAMES",
+    "DriftCoefficients",
+    "GyroWheelModel",
+    "regressor_matrix",
+]
+
 AXES: tuple[str, ...] = ("x", "y")
 """The two sensing axes of the GyroWheel."""
 
@@ -34,6 +43,7 @@ TERM_NAMES: dict[str, tuple[str, ...]] = {
 """Coefficient names of each axis in regressor-column order (Table 1 / eq. 2 order)."""
 
 N_COEFFICIENTS = 7
+"""Drift coefficients per sensing axis."""
 
 
 @dataclass(frozen=True)
@@ -61,6 +71,7 @@ class DriftCoefficients:
 
     @property
     def names(self) -> tuple[str, ...]:
+        """The coefficient names of this axis, in :data:`TERM_NAMES` order."""
         return TERM_NAMES[self.axis]
 
     @classmethod
@@ -101,6 +112,7 @@ class DriftCoefficients:
         return np.array(self.values_dph, dtype=float)
 
     def to_dict(self) -> dict[str, float]:
+        """``{name: value}`` of the seven coefficients (deg/h-based units)."""
         return dict(zip(self.names, self.values_dph, strict=True))
 
 
@@ -153,6 +165,7 @@ class GyroWheelModel:
         )
 
     def to_dict(self) -> dict:
+        """Both axes' coefficients by name and the source, as a JSON-ready dict."""
         return {"x": self.x.to_dict(), "y": self.y.to_dict(), "source": self.source}
 
 

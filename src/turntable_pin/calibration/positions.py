@@ -28,6 +28,15 @@ from ..core.units import deg_to_rad, rad_to_deg
 from ..model.turntable import TurntableModel
 from .site import DEFAULT_LATITUDE_DEG  # noqa: F401  (re-exported)
 
+__all__ = [
+    "DEFAULT_LATITUDE_DEG",
+    "EARTH_RATE_DPH",
+    "PositionInputs",
+    "PositionSet",
+    "base_frame_inputs",
+    "position_inputs",
+]
+
 EARTH_RATE_DPH = 15.041067
 """Earth rotation rate used by the paper (eq. 3), deg/h."""
 
@@ -119,6 +128,7 @@ class PositionSet:
         return int(np.unique(wrapped, axis=0).shape[0])
 
     def to_dict(self) -> dict:
+        """Name, count and the angles in degrees, as a dict."""
         return {
             "name": self.name,
             "n_positions": len(self),

@@ -7,7 +7,7 @@ From these outputs:
 
 - ``beta1 = A^+ (b1 - b2)`` (eq. 6): the calibration that believes the orientation is ideal;
 - ``beta2 = A'^+ (b1 - b2')`` (eq. 11): the calibration with the true inputs (it returns ``beta``);
-- ``dw = b1 - A beta2 - b2'`` (eq. 13, as printed in the paper and stated in issue 3) and
+- ``dw = b1 - A beta2 - b2'`` (eq. 13, as printed in the paper) and
   ``dwx = ||dw||_inf`` (eq. 14); likewise ``dwy``.
 
 Eq. 13 as printed equals ``(A' - A) beta``: the drift predicted from the ideal inputs misses the
@@ -32,6 +32,15 @@ from ..core.units import rad_to_arcsec
 from ..model.small_angle import small_angle_rotation
 from .gyrowheel import AXES, N_COEFFICIENTS, GyroWheelModel, regressor_matrix
 from .positions import PositionInputs
+
+__all__ = [
+    "DEFINITIONS",
+    "RateErrorResult",
+    "orientation_error_rotation",
+    "rate_error",
+    "rate_error_vectors_dph",
+    "rate_errors_dph",
+]
 
 DEFINITIONS: tuple[str, ...] = ("true_coefficients", "calibrated_coefficients")
 """``true_coefficients``: eq. 13 as printed (beta2). ``calibrated_coefficients``: with beta1."""
@@ -228,6 +237,7 @@ class RateErrorResult:
     condition_numbers: dict
 
     def to_dict(self) -> dict:
+        """The result as a JSON-ready dict (errors in deg/h, angles in arcsec and degrees)."""
         return {
             "dwx_dph": self.dwx_dph,
             "dwy_dph": self.dwy_dph,

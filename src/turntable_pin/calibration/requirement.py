@@ -33,6 +33,17 @@ from .gyrowheel import GyroWheelModel
 from .positions import PositionInputs, PositionSet, position_inputs
 from .rate_error import DEFINITIONS, orientation_error_rotation, rate_errors_dph
 
+__all__ = [
+    "ANGLE_NAMES",
+    "MAX_ANGLE_RAD",
+    "PLANES",
+    "OrientationRequirement",
+    "PlaneRateError",
+    "PlaneRectangle",
+    "largest_rectangle",
+    "orientation_requirement",
+]
+
 MAX_ANGLE_RAD = np.radians(10.0)
 """Search limit: beyond ten degrees the small-angle model of eq. 7 is meaningless."""
 
@@ -180,6 +191,7 @@ class PlaneRectangle:
     capped: bool
 
     def to_dict(self) -> dict:
+        """The rectangle as a JSON-ready dict (half-widths and intercepts in degrees)."""
         names = self.plane.split("_")
         return {
             "plane": self.plane,
@@ -305,6 +317,7 @@ class OrientationRequirement:
         return self.gamma_rad
 
     def to_dict(self) -> dict:
+        """The limits (degrees, arcmin, arcsec), the set-up and both rectangles, JSON-ready."""
         out = {
             f"I_{n}_deg": rad_to_deg(v) for n, v in zip(ANGLE_NAMES, self.limits_rad, strict=True)
         }

@@ -23,6 +23,8 @@ from ..core.exceptions import InputError
 from ..core.units import ARCMIN_PER_RAD
 from .common import finite_float, positive_int, print_json
 
+__all__ = ["parse_limits", "register"]
+
 
 def parse_limits(text: str, unit: str) -> OrientationLimits:
     """``psi=P,theta=T,gamma=G`` (or one number for all three) in ``arcmin`` or ``deg``."""
@@ -105,6 +107,7 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``allocate`` and ``montecarlo`` subcommands to ``subparsers``."""
     a = subparsers.add_parser(
         "allocate",
         description="Error allocation of paper section 4.2 (eqs. 29-34): three weighted problems "

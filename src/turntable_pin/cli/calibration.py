@@ -15,6 +15,8 @@ from ..core.units import deg_to_rad
 from ..model.angles import ANGLE_NAMES, ANGLE_SYMBOLS
 from .common import finite_float, print_json
 
+__all__ = ["register"]
+
 
 def positive_float(text: str) -> float:
     """argparse type: a finite number > 0."""
@@ -54,6 +56,7 @@ def _add_model_options(parser: argparse.ArgumentParser) -> None:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``rate-error``, ``requirement`` and ``calibrate`` subcommands to ``subparsers``."""
     r = subparsers.add_parser(
         "rate-error",
         description="Rate-sensing errors dwx, dwy (deg/h, eq. 14) of a multi-position calibration "

@@ -14,6 +14,15 @@ from ..core.exceptions import InputError
 from ..model.errors import TurntableErrors, parse_error_value
 from ..model.turntable import TurntableModel
 
+__all__ = [
+    "add_error_options",
+    "errors_from_args",
+    "finite_float",
+    "model_from_args",
+    "positive_int",
+    "print_json",
+]
+
 
 def finite_float(text: str) -> float:
     """argparse type: a finite float (NaN and inf are refused with a clear message)."""

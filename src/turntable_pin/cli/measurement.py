@@ -10,6 +10,8 @@ from ..measurement.data import read_measurements
 from ..measurement.effects import EFFECT_NAMES, get_effect, parse_effect_list
 from .common import add_error_options, errors_from_args, finite_float, positive_int, print_json
 
+__all__ = ["register"]
+
 # The fitting, plotting and report modules (scipy, matplotlib) are imported inside the commands
 # that need them, so that every other subcommand starts fast.
 ORDERS = ("grid", "random")
@@ -17,11 +19,12 @@ APPROACHES = ("random", "motion", "positive")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``simulate``, ``fit``, ``diagnose`` and ``report`` to ``subparsers``."""
     s = subparsers.add_parser(
         "simulate",
-        description="Simulate a measurement run (the CSV of spec/measurements.md): turntable "
-        "errors, catalogued effects with their parameters, a position schedule, noise, time "
-        "stamps and approach directions; the seed and the truth go into comment lines. "
+        description="Simulate a measurement run (the CSV described in docs/measurements.md): "
+        "turntable errors, catalogued effects with their parameters, a position schedule, noise, "
+        "time stamps and approach directions; the seed and the truth go into comment lines. "
         f"Effects: {', '.join(EFFECT_NAMES)}.",
     )
     add_error_options(s)

@@ -12,8 +12,11 @@ from ..model.angles import ANGLE_NAMES
 from ..model.small_angle import small_angle_orientation_error
 from .common import add_error_options, finite_float, model_from_args, print_json
 
+__all__ = ["register"]
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``orientation`` and ``urdf`` subcommands to ``subparsers``."""
     p = subparsers.add_parser(
         "orientation",
         description="Orientation error dR = Rd^T Rt of the payload (Pinocchio forward kinematics "

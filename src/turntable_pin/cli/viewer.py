@@ -16,6 +16,8 @@ from ..core.units import deg_to_rad
 from ..viewer.scene import Exaggeration, SetupScene, animation_frames_rad, default_positions_deg
 from .common import add_error_options, errors_from_args, finite_float, positive_int, print_json
 
+__all__ = ["register"]
+
 
 def _add_scene_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--phi1-deg", type=finite_float, default=30.0, help="outer-axis angle, degrees")
@@ -37,6 +39,7 @@ def _add_scene_options(p: argparse.ArgumentParser) -> None:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``view`` and ``snapshot`` subcommands to ``subparsers``."""
     v = subparsers.add_parser(
         "view",
         description="Serve a meshcat 3-D view of the turntable URDF with its errors magnified, "

@@ -16,6 +16,8 @@ import numpy as np
 
 from .exceptions import InputError
 
+__all__ = ["CsvTable", "read_csv_table", "write_csv_table"]
+
 
 @dataclass(frozen=True)
 class CsvTable:

@@ -7,6 +7,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
+__all__ = [
+    "IdentifiabilityError",
+    "InfeasibleError",
+    "InputError",
+    "ModelError",
+    "TurntablePinError",
+]
+
 
 class TurntablePinError(Exception):
     """Base class of every error this package raises on purpose."""

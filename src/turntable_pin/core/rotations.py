@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+__all__ = ["AXIS_INDEX", "axis_rotation", "rot_x", "rot_y", "rot_z"]
+
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
+"""Axis name -> index of its coordinate (x 0, y 1, z 2)."""
 
 
 def axis_rotation(axis: str | np.ndarray, angle_rad) -> np.ndarray:

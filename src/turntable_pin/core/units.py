@@ -6,10 +6,28 @@ import math
 
 import numpy as np
 
+__all__ = [
+    "ARCMIN_PER_RAD",
+    "ARCSEC_PER_RAD",
+    "DEG_PER_RAD",
+    "M_PER_MM",
+    "arcmin_by_name",
+    "arcmin_to_rad",
+    "arcsec_to_rad",
+    "deg_to_rad",
+    "rad_to_arcmin",
+    "rad_to_arcsec",
+    "rad_to_deg",
+]
+
 ARCSEC_PER_RAD = 180.0 / math.pi * 3600.0
+"""Arc seconds in one radian."""
 ARCMIN_PER_RAD = 180.0 / math.pi * 60.0
+"""Arc minutes in one radian."""
 DEG_PER_RAD = 180.0 / math.pi
+"""Degrees in one radian."""
 M_PER_MM = 1e-3
+"""Metres in one millimetre."""
 
 
 def _scaled(value, factor: float):

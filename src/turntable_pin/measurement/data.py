@@ -1,4 +1,4 @@
-"""Orientation measurements: the CSV of ``spec/measurements.md``, read and validated.
+"""Orientation measurements: the CSV of ``docs/measurements.md``, read and validated.
 
 Required columns ``phi1_deg, phi2_deg, dpsi_arcsec, dtheta_arcsec, dgamma_arcsec``; optional
 ``sigma_arcsec``, ``time_s``, ``dir1``, ``dir2``; other columns are ignored. Beyond the shared
@@ -29,9 +29,18 @@ from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.angles import ANGLE_NAMES
 from .effects.base import PositionVariables
 
-REQUIRED_COLUMNS = ("phi1_deg", "phi2_deg", "dpsi_arcsec", "dtheta_arcsec", "dgamma_arcsec")
-OPTIONAL_COLUMNS = ("sigma_arcsec", "time_s", "dir1", "dir2")
+__all__ = [
+    "ANGLE_NAMES",
+    "OPTIONAL_COLUMNS",
+    "REQUIRED_COLUMNS",
+    "OrientationMeasurements",
+    "read_measurements",
+]
 
+REQUIRED_COLUMNS = ("phi1_deg", "phi2_deg", "dpsi_arcsec", "dtheta_arcsec", "dgamma_arcsec")
+"""Columns every measurement CSV must have (angles in degrees, errors in arcsec)."""
+OPTIONAL_COLUMNS = ("sigma_arcsec", "time_s", "dir1", "dir2")
+"""Columns read when present: 1-sigma noise (arcsec), time (s), approach directions (+1/-1)."""
 
 
 @dataclass(frozen=True)
@@ -77,10 +86,12 @@ class OrientationMeasurements:
 
     @property
     def n_positions(self) -> int:
+        """Number of positions N."""
         return int(self.phi1_rad.size)
 
     @property
     def has_sigma(self) -> bool:
+        """Whether the data give a 1-sigma noise per row."""
         return self.sigma_rad is not None
 
     def variables(self) -> PositionVariables:
@@ -88,7 +99,7 @@ class OrientationMeasurements:
         return PositionVariables(self.phi1_rad, self.phi2_rad, self.time_s, self.dir1, self.dir2)
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The spec's CSV columns in user units (degrees, arcsec, s)."""
+        """The CSV columns of ``docs/measurements.md`` in user units (degrees, arcsec, s)."""
         out = {
             # Rounded to 1e-9 deg so that a 30-degree grid is written as 30.0, not 29.999999...
             "phi1_deg": np.round(self.phi1_rad * DEG_PER_RAD, 9),

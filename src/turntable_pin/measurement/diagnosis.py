@@ -28,6 +28,8 @@ from .effects import EFFECTS, get_effect
 from .effects.base import Effect, PositionVariables
 from .fit import OrientationFit, fit_orientation
 
+__all__ = ["MAX_HARMONIC", "SEPARATION_CHI2", "OrientationFamily", "diagnose_measurements"]
+
 MAX_HARMONIC = 5
 SEPARATION_CHI2 = 25.0
 """Noise-free misfit chi2 above which a denser design is said to separate two effects."""
@@ -62,18 +64,21 @@ class OrientationFamily:
         self._cache: dict[tuple[str, ...], OrientationFit] = {}
 
     def fit(self, effects: Sequence[Effect], noise_variance: float | None = None) -> OrientationFit:
+        """The fit of the base errors plus ``effects`` (cached per effect list)."""
         key = tuple(e.name for e in effects)
         if key not in self._cache:
             self._cache[key] = fit_orientation(self.data, effects, turntable=self.turntable)
         return self._cache[key]
 
     def untestable_reason(self, effect: Effect) -> str | None:
+        """Why ``effect`` cannot be tested here (its data columns are missing), or None."""
         missing = effect.missing_columns(self.data.variables())
         if missing:
             return f"needs the column(s) {', '.join(missing)}, absent from the data"
         return None
 
     def describe(self, effect: Effect | str) -> dict:
+        """The effect's story: title, definition, explanation, how to confirm it."""
         return (get_effect(effect) if isinstance(effect, str) else effect).describe()
 
     def _measured_angle_probes(self, trig: np.ndarray, shape: str, w: np.ndarray) -> list[Probe]:
@@ -94,6 +99,7 @@ class OrientationFamily:
         return probes
 
     def probes(self, fit: OrientationFit) -> list[Probe]:
+        """The structure-search probes, weighted like the residuals of ``fit`` (see the module)."""
         data = self.data
         w = fit.result.weights.reshape(-1, 3)
         jac = fit.model.jacobian(fit.result.params)  # (N, 3, n)

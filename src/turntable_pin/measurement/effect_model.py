@@ -95,6 +95,7 @@ class OrientationModel:
 
     @property
     def n_params(self) -> int:
+        """Number of parameters: the base errors plus every effect's parameters."""
         return len(self.parameter_names)
 
     def _gain(self, weights: dict[str, np.ndarray], prefix: str) -> np.ndarray:

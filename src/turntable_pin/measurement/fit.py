@@ -1,9 +1,9 @@
 """Fitting orientation measurements with the base error model plus chosen effects.
 
 :class:`OrientationFitProblem` adapts :class:`OrientationModel` and :class:`OrientationMeasurements`
-to the generic :class:`FitProblem` of :mod:`least_squares_fit` (observations flattened position by
-position as ``dpsi, dtheta, dgamma``); :func:`fit_orientation` fits and returns an
-:class:`OrientationFit` that knows its data, model, residuals and parameters.
+to the generic :class:`FitProblem` of :mod:`turntable_pin.stats.least_squares` (observations
+flattened position by position as ``dpsi, dtheta, dgamma``); :func:`fit_orientation` fits and
+returns an :class:`OrientationFit` that knows its data, model, residuals and parameters.
 """
 
 from __future__ import annotations
@@ -20,11 +20,14 @@ from .data import OrientationMeasurements
 from .effect_model import OrientationModel
 from .effects.base import Effect
 
+__all__ = ["OrientationFit", "OrientationFitProblem", "fit_orientation"]
+
 
 class OrientationFitProblem:
     """A :class:`FitProblem`: orientation data and a base + effects model."""
 
     user_unit_scale = ARCSEC_PER_RAD
+    observation_unit = "arcsec"
 
     def __init__(self, data: OrientationMeasurements, model: OrientationModel) -> None:
         self.data = data
@@ -36,9 +39,11 @@ class OrientationFitProblem:
         self.sigma = None if data.sigma_rad is None else np.repeat(data.sigma_rad, 3)
 
     def predict(self, params: np.ndarray) -> np.ndarray:
+        """Predicted ``dpsi, dtheta, dgamma`` flattened position by position, (3N,), rad."""
         return self.model.predict(params).reshape(-1)
 
     def jacobian(self, params: np.ndarray) -> np.ndarray:
+        """Derivative of :meth:`predict` with respect to the parameters, (3N, n_params)."""
         return self.model.jacobian(params).reshape(-1, self.model.n_params)
 
 
@@ -52,10 +57,12 @@ class OrientationFit:
 
     @property
     def effects(self) -> tuple[Effect, ...]:
+        """The effects fitted besides the base errors."""
         return self.model.effects
 
     @property
     def effect_names(self) -> tuple[str, ...]:
+        """The catalogue names of :attr:`effects`."""
         return tuple(e.name for e in self.model.effects)
 
     @property
@@ -88,6 +95,7 @@ class OrientationFit:
         )
 
     def to_dict(self) -> dict:
+        """The fit as a JSON-ready dict (the generic result plus effects and sigma in arcsec)."""
         out = {
             "n_positions": self.data.n_positions,
             "effects": list(self.effect_names),

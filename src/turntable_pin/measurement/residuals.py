@@ -1,8 +1,9 @@
-"""Where a fit fails: residuals per position and component, against each variable, harmonics, plots.
+"""Where a fit fails: residuals per position and component, against each variable, harmonics.
 
 Generic over a :class:`ResidualSet` (components such as ``dpsi, dtheta, dgamma``, their residuals
 and normalised residuals, the angles to look for harmonics in and any other variables such as
 time or approach direction); :func:`orientation_residuals` builds one from an orientation fit.
+The plots are drawn by :mod:`turntable_pin.report.measurement_figures`.
 """
 
 from __future__ import annotations
@@ -13,6 +14,15 @@ import numpy as np
 
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from .data import ANGLE_NAMES
+
+__all__ = [
+    "ResidualAnalysis",
+    "ResidualSet",
+    "analyse_residuals",
+    "failing_positions",
+    "harmonic_amplitudes",
+    "orientation_residuals",
+]
 
 
 @dataclass(frozen=True)
@@ -121,6 +131,7 @@ class ResidualAnalysis:
         return out
 
     def to_dict(self, *, per_position: bool = False) -> dict:
+        """The summary as a JSON-ready dict, in the set's unit (every position if asked)."""
         rs = self.residual_set
         extra = {"per_position": self.per_position()} if per_position else {}
         return {

@@ -3,7 +3,7 @@
 Users rehearse a measurement campaign with it and the tests make data with known, hidden effects.
 The truth goes through the same exact chain the fit uses (:class:`OrientationModel`), with the
 chosen effect parameters; noise is Gaussian with the stated sigma on each of the three angles.
-The output is the CSV of ``spec/measurements.md`` with the seed and the truth in comment lines.
+The output is the CSV of ``docs/measurements.md`` with the seed and the truth in comment lines.
 """
 
 from __future__ import annotations
@@ -24,8 +24,18 @@ from .effect_model import OrientationModel
 from .effects import get_effect
 from .effects.base import PositionVariables
 
+__all__ = [
+    "APPROACHES",
+    "ORDERS",
+    "Schedule",
+    "SimulatedMeasurements",
+    "simulate_measurements",
+]
+
 ORDERS = ("grid", "random")
+"""Measurement orders a :class:`Schedule` knows."""
 APPROACHES = ("random", "motion", "positive")
+"""Approach-direction rules a :class:`Schedule` knows."""
 
 
 @dataclass(frozen=True)
@@ -100,6 +110,7 @@ class SimulatedMeasurements:
         effects: ``{effect: {parameter: value in user units}}`` hidden in the data.
         noise_arcsec: the noise sigma.
         seed: the random seed.
+        schedule: the :class:`Schedule` measured.
         truth_rad: noise-free ``dpsi, dtheta, dgamma`` (N, 3).
     """
 
@@ -142,7 +153,7 @@ class SimulatedMeasurements:
     def write_csv(
         self, path: str | Path, *, with_sigma: bool = True, hide_truth: bool = False
     ) -> Path:
-        """Write the spec's CSV (atomically) with the seed (and the truth) as comments."""
+        """Write the CSV of ``docs/measurements.md`` atomically, seed (and truth) as comments."""
         columns = self.data.columns()
         if not with_sigma:
             columns.pop("sigma_arcsec", None)

@@ -19,6 +19,16 @@ from ..core.exceptions import InputError
 from ..core.files import read_yaml, write_text_atomic
 from ..core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, M_PER_MM
 
+__all__ = [
+    "ANGULAR_ERROR_NAMES",
+    "DEFAULT_ANGLE_UNIT",
+    "DEFAULT_LENGTH_UNIT",
+    "ERROR_DESCRIPTIONS",
+    "ERROR_NAMES",
+    "TurntableErrors",
+    "parse_error_value",
+]
+
 ANGULAR_ERROR_NAMES: tuple[str, ...] = (
     "dphi_y1",
     "dphi_z2",
@@ -45,6 +55,7 @@ ERROR_DESCRIPTIONS: dict[str, str] = {
     "deps_y": "orthogonality error between the axes about y",
     "deta": "intersection error: offset of the inner axis along x",
 }
+"""One line saying what each of :data:`ERROR_NAMES` is."""
 
 # Factor that turns a value in the named unit into radians / metres.
 _ANGLE_UNITS = {
@@ -55,7 +66,9 @@ _ANGLE_UNITS = {
 }
 _LENGTH_UNITS = {"mm": M_PER_MM, "um": 1e-6, "m": 1.0}
 DEFAULT_ANGLE_UNIT = "arcsec"
+"""Unit of an angular error given without a unit suffix."""
 DEFAULT_LENGTH_UNIT = "mm"
+"""Unit of ``deta`` given without a unit suffix."""
 
 
 def _to_float(value: object, what: str) -> float:

@@ -11,6 +11,8 @@ import numpy as np
 
 from .errors import ANGULAR_ERROR_NAMES, TurntableErrors
 
+__all__ = ["small_angle_matrix", "small_angle_orientation_error", "small_angle_rotation"]
+
 
 def small_angle_matrix(phi2_rad) -> np.ndarray:
     """``S(phi2)`` of eq. 26, shape S + (3, 8) for ``phi2_rad`` of shape S.

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from ..allocation.monte_carlo import MonteCarloResult
-from ..allocation.sensitivity import ORIENTATION_ANGLE_NAMES, AverageSensitivities
+from ..allocation.sensitivity import AverageSensitivities
 from ..allocation.solver import ORIENTATION_ANGLES
 from ..core.units import ARCMIN_PER_RAD
+from ..model.angles import ANGLE_NAMES as ORIENTATION_ANGLE_NAMES
 from ..model.errors import ANGULAR_ERROR_NAMES
 from .figures import pyplot, save_png
 

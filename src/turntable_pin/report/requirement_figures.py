@@ -17,6 +17,8 @@ from ..calibration.requirement import MAX_ANGLE_RAD, OrientationRequirement
 from ..core.units import deg_to_rad, rad_to_deg
 from .figures import pyplot, save_png
 
+__all__ = ["plot_figure4", "plot_figure5", "plot_span_deg", "write_requirement_figures"]
+
 _LABELS = {"psi": r"$\Delta\psi$ (deg)", "theta": r"$\Delta\theta$ (deg)",
            "gamma": r"$\Delta\gamma$ (deg)"}  # fmt: skip
 

@@ -210,7 +210,7 @@ class FitResult:
         """Probability of a chi2 at least this large if the model were right (sigma known)."""
         if not self.sigma_known or self.dof <= 0:
             return None
-        from scipy import stats  # imported on use: keeps `import turntable_pin` light
+        from scipy import stats  # imported on use: keeps the package's import light
 
         return float(stats.chi2.sf(self.chi2, self.dof))
 
@@ -352,7 +352,7 @@ def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = Non
     Raises:
         IdentifiabilityError: no parameter is determined, or no degree of freedom is left.
     """
-    from scipy import optimize  # imported on use: keeps `import turntable_pin` light
+    from scipy import optimize  # imported on use: keeps the package's import light
 
     sigma_known = problem.sigma is not None
     weights = 1.0 / problem.sigma if sigma_known else np.ones_like(problem.observed)

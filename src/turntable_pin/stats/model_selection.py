@@ -1,7 +1,7 @@
 """Which catalogued effect is missing from a model: compare, rank, decide, and say so.
 
 Generic over a :class:`ModelFamily` (a base model, a catalogue of effects that extend it, and
-probes for the structure search), so the GyroWheel drift model can reuse it.
+probes for the structure search), so any model with a catalogue of extensions can use it.
 
 Decision rule, and why. Each testable effect is fitted together with the current model and
 compared by the Bayesian information criterion, ``delta_bic = delta_chi2 + added_rank ln m``
@@ -111,7 +111,7 @@ def _chi2(result: FitResult, noise_variance: float) -> float:
 
 
 def _summary(result: FitResult, noise_variance: float) -> dict:
-    from scipy import stats  # imported on use: keeps `import turntable_pin` light
+    from scipy import stats  # imported on use: keeps the package's import light
 
     chi2 = _chi2(result, noise_variance)
     return {

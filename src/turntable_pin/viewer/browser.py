@@ -25,11 +25,34 @@ from pathlib import Path
 
 from ..core.exceptions import TurntablePinError
 
+__all__ = [
+    "CHROMIUM_ENV",
+    "CHROMIUM_NAMES",
+    "DEBIAN_PACKAGE",
+    "BrowserError",
+    "BrowserNotFoundError",
+    "BrowserRun",
+    "ImageLoadReport",
+    "ImageStatus",
+    "ProcessInfo",
+    "check_page_images",
+    "chromium_available",
+    "find_chromium",
+    "kill_related_processes",
+    "png_size",
+    "process_table",
+    "related_processes",
+    "run_chromium",
+    "screenshot_html",
+]
+
 CHROMIUM_ENV = "TURNTABLE_PIN_CHROMIUM"
 """Environment variable naming the Chromium executable to use (overrides the search)."""
 
 CHROMIUM_NAMES: tuple[str, ...] = ("chromium", "chromium-browser", "google-chrome", "chrome")
+"""Executable names searched on ``PATH``, in order."""
 DEBIAN_PACKAGE = "chromium"
+"""The Debian package that provides Chromium (named in the not-found message)."""
 
 # Software WebGL: `--use-gl=swiftshader` renders a blank page with Debian chromium 156, ANGLE's
 # SwiftShader backend works. `--no-sandbox` is needed as root (CI containers); we only ever load
@@ -106,6 +129,8 @@ class BrowserRun:
 
 @dataclass(frozen=True)
 class ProcessInfo:
+    """One process of :func:`process_table`: ids, whether it is alive, its command line."""
+
     pid: int
     ppid: int
     pgid: int
@@ -306,6 +331,7 @@ class ImageStatus:
 
     @property
     def loaded(self) -> bool:
+        """Whether the image finished loading with a non-empty size."""
         return self.complete and self.natural_width > 0 and self.natural_height > 0
 
 
@@ -319,6 +345,7 @@ class ImageLoadReport:
 
     @property
     def n_images(self) -> int:
+        """Number of ``<img>`` elements on the page."""
         return len(self.images)
 
     @property
@@ -328,9 +355,11 @@ class ImageLoadReport:
 
     @property
     def all_loaded(self) -> bool:
+        """Whether every image loaded."""
         return not self.failed
 
     def to_dict(self) -> dict:
+        """Page, image counts, failed sources and time (s) as a JSON-ready dict."""
         return {
             "page": str(self.page),
             "n_images": self.n_images,

@@ -15,6 +15,14 @@ import signal
 
 from ..core.exceptions import TurntablePinError
 
+__all__ = [
+    "REPLY_TIMEOUT_S",
+    "MeshcatMissingError",
+    "MeshcatServer",
+    "MeshcatServerError",
+    "import_meshcat",
+]
+
 
 class MeshcatMissingError(TurntablePinError):
     """The optional dependency meshcat is not installed."""
@@ -83,6 +91,7 @@ class MeshcatServer:
 
     @property
     def running(self) -> bool:
+        """Whether the server process is still running."""
         return self.visualizer is not None and self.visualizer.window.server_proc.poll() is None
 
     def stop(self) -> None:

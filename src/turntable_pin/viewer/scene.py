@@ -29,17 +29,41 @@ from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD, M_PER_MM
 from ..model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
 from ..model.turntable import INNER_JOINT, TurntableModel
 
+__all__ = [
+    "ACTUAL_AXIS_COLOR",
+    "ACTUAL_TRIAD_COLORS",
+    "AXIS_LENGTH_M",
+    "CAMERA_OFFSET_M",
+    "CAMERA_TARGET_M",
+    "DEFAULT_DISPLAY_ANGLE_RAD",
+    "DEFAULT_DISPLAY_OFFSET_M",
+    "IDEAL_COLOR",
+    "ROOT",
+    "TRIAD_LENGTH_M",
+    "Exaggeration",
+    "ScenePoses",
+    "SetupScene",
+    "animation_frames_rad",
+    "default_positions_deg",
+]
+
 DEFAULT_DISPLAY_ANGLE_RAD = math.radians(3.0)
 """The largest angular error is magnified to this angle by default."""
 DEFAULT_DISPLAY_OFFSET_M = 0.03
 """The intersection error is magnified to at most this length by default."""
 
 ROOT = "turntable_pin"
+"""The meshcat path under which the scene draws everything."""
 TRIAD_LENGTH_M = 0.3
+"""Length of the payload-frame triads, metres."""
 AXIS_LENGTH_M = 0.7
+"""Length of the inner-axis rods, metres."""
 ACTUAL_TRIAD_COLORS = (0xD62728, 0x2CA02C, 0x1F77B4)  # x, y, z
+"""Colours (RGB) of the actual triad's x, y, z axes: red, green, blue."""
 IDEAL_COLOR = 0x303030
+"""Colour (RGB) of the ideal triad and the ideal inner axis: dark grey."""
 ACTUAL_AXIS_COLOR = 0xC000C0
+"""Colour (RGB) of the actual inner axis: magenta."""
 # Camera: look at the table centre from north-east and above (base frame x north, y west, z up).
 CAMERA_TARGET_M = (0.0, 0.0, -0.2)
 CAMERA_OFFSET_M = (0.84, -0.64, 0.34)
@@ -92,6 +116,7 @@ class Exaggeration:
         return TurntableErrors.from_array(values)
 
     def to_dict(self) -> dict:
+        """Both factors as a dict."""
         return {"angle_factor": self.angle_factor, "length_factor": self.length_factor}
 
 
@@ -189,6 +214,7 @@ class SetupScene:
         ]
 
     def to_dict(self) -> dict:
+        """True errors (arcsec, mm), magnification and URDF path, as a JSON-ready dict."""
         return {
             "errors": self.errors.to_user_units(),
             "exaggeration": self.exaggeration.to_dict(),

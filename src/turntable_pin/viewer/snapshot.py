@@ -4,8 +4,8 @@ The scene is drawn into a short-lived meshcat server, which hands back a self-co
 (``static_html``, about 0.9 MB, works offline); the server is then stopped. The page gets the
 controls panel hidden and a legend, and headless Chromium renders it to PNG
 (:func:`turntable_pin.viewer.browser.screenshot_html`). Neither the server nor the browser
-outlives the
-call, also on error. The same scene and angles give a byte-identical PNG (virtual time).
+outlives the call, also on error. The same scene and angles give a byte-identical PNG (virtual
+time).
 """
 
 from __future__ import annotations
@@ -23,8 +23,19 @@ from .browser import find_chromium, screenshot_html
 from .meshcat_server import MeshcatServer, import_meshcat
 from .scene import SetupScene
 
+__all__ = [
+    "MAX_SIZE_PX",
+    "MIN_SIZE_PX",
+    "SnapshotResult",
+    "decorate_static_page",
+    "render_snapshot",
+    "scene_page",
+]
+
 MIN_SIZE_PX = 64
+"""Smallest snapshot width or height, pixels."""
 MAX_SIZE_PX = 4096
+"""Largest snapshot width or height, pixels."""
 
 _PAGE_STYLE = """
 <style>
@@ -54,6 +65,7 @@ class SnapshotResult:
     browser_pid: int
 
     def to_dict(self) -> dict:
+        """The result as a JSON-ready dict (sizes in px, angles in deg, times in s; no pids)."""
         return {
             "path": str(self.path),
             "width_px": self.width,

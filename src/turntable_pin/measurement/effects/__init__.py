@@ -1,4 +1,4 @@
-"""The catalogue of candidate physical effects for orientation data (spec: measurements.md).
+"""The catalogue of candidate physical effects for orientation data (``docs/measurements.md``).
 
 Each effect is one module holding one :class:`Effect` subclass. Adding an effect is a new module
 and one line in :data:`_REGISTRY`; nothing else changes.
@@ -31,9 +31,10 @@ _REGISTRY: tuple[type[Effect], ...] = (
 )
 
 EFFECTS: dict[str, Effect] = {cls.name: cls() for cls in _REGISTRY}
-"""Every catalogued effect by its spec name, in catalogue order."""
+"""Every catalogued effect by its catalogue name, in catalogue order."""
 
 EFFECT_NAMES: tuple[str, ...] = tuple(EFFECTS)
+"""The catalogue names, in catalogue order."""
 
 
 def get_effect(name: str) -> Effect:
@@ -52,7 +53,6 @@ def parse_effect_list(text: str) -> tuple[Effect, ...]:
     if len(set(names)) != len(names):
         raise InputError(f"an effect is listed twice in '{text}'")
     return tuple(get_effect(n) for n in names)
-
 
 __all__ = [
     "EFFECTS",

@@ -6,8 +6,12 @@ import numpy as np
 
 from .base import ARCSEC, ChainTerm, Effect, ParameterSpec, PositionVariables
 
+__all__ = ["Backlash"]
+
 
 class Backlash(Effect):
+    """Approach-direction dependence: half the backlash ``b`` (arcsec) times ``dir``, per axis."""
+
     name = "backlash"
     title = "backlash (approach-direction dependence)"
     definition = "dphi_y1 += b1 dir1 / 2, dphi_z2 += b2 dir2 / 2"
@@ -26,6 +30,7 @@ class Backlash(Effect):
     any_column = True
 
     def parameters(self, variables: PositionVariables):
+        """``b1`` and/or ``b2`` (arcsec), for each of ``dir1``/``dir2`` the data have."""
         out = []
         if variables.has("dir1"):
             out.append(ParameterSpec("b1", "arcsec", ARCSEC, "outer-axis backlash"))
@@ -34,6 +39,7 @@ class Backlash(Effect):
         return tuple(out)
 
     def chain_terms(self, variables: PositionVariables):
+        """``b1 dir1 / 2`` added to ``dphi_y1`` and ``b2 dir2 / 2`` to ``dphi_z2``."""
         terms = []
         if variables.has("dir1"):
             terms.append(ChainTerm("dphi_y1", None, {"b1": 0.5 * np.asarray(variables.dir1)}))

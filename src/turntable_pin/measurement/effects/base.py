@@ -1,7 +1,7 @@
 """What a candidate physical effect is: parameters, how it changes the kinematic chain, its story.
 
-An effect changes the exact rotation chain of ``model.md`` in one of three ways, each *linear in
-its parameters* (the angles it adds are ``sum_k weight_k(position) * p_k``):
+An effect changes the exact rotation chain of ``docs/model.md`` in one of three ways, each *linear
+in its parameters* (the angles it adds are ``sum_k weight_k(position) * p_k``):
 
 - ``ChainTerm(site=<error name>, ...)``: adds to one of the eight turntable error angles, per
   position (encoder harmonics, wobble harmonics, backlash);
@@ -22,8 +22,22 @@ import numpy as np
 
 from ...core.units import ARCSEC_PER_RAD
 
+__all__ = [
+    "ARCSEC",
+    "POST",
+    "PRE",
+    "ChainTerm",
+    "Effect",
+    "ParameterSpec",
+    "PositionVariables",
+    "harmonic_parameters",
+    "harmonic_weights",
+]
+
 PRE = "pre"
+"""Site of a :class:`ChainTerm` applied before ``Rt`` (in the base frame)."""
 POST = "post"
+"""Site of a :class:`ChainTerm` applied after ``Rt`` (in the payload frame)."""
 
 
 @dataclass(frozen=True)
@@ -44,6 +58,7 @@ class ParameterSpec:
 
 
 ARCSEC = 1.0 / ARCSEC_PER_RAD
+"""One arc second in radians."""
 
 
 @dataclass(frozen=True)
@@ -76,9 +91,11 @@ class PositionVariables:
 
     @property
     def n(self) -> int:
+        """Number of positions N."""
         return int(np.asarray(self.phi1_rad).size)
 
     def has(self, column: str) -> bool:
+        """Whether the optional column ``column`` (``time_s``, ``dir1``, ``dir2``) is present."""
         return getattr(self, column) is not None
 
 
@@ -110,9 +127,9 @@ class Effect:
     Subclasses set the class attributes and implement :meth:`parameters` and :meth:`chain_terms`.
 
     Attributes:
-        name: the catalogue name of the spec (``inner_encoder_harmonics``).
+        name: the catalogue name (``inner_encoder_harmonics``; ``docs/measurements.md``, section 4).
         title: a few words for people.
-        definition: the spec's definition (how it changes the chain).
+        definition: how it changes the chain, as ``docs/measurements.md`` defines it.
         explanation: one paragraph of physics.
         confirm: how to confirm it on the machine.
         required_columns: data columns it needs; with ``any_column=True`` one of them suffices.

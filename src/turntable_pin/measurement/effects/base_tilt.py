@@ -6,8 +6,12 @@ import numpy as np
 
 from .base import ARCSEC, PRE, ChainTerm, Effect, ParameterSpec, PositionVariables
 
+__all__ = ["BaseTilt"]
+
 
 class BaseTilt(Effect):
+    """Base not level with the reference: a constant rotation about x and z before ``Rt``."""
+
     name = "base_tilt"
     title = "base not level with the reference"
     definition = "Rt -> Rx(tx) Rz(tz) Rt"
@@ -24,11 +28,13 @@ class BaseTilt(Effect):
     )
 
     def parameters(self, variables: PositionVariables):
+        """``tx`` and ``tz``, arcsec."""
         return (
             ParameterSpec("tx", "arcsec", ARCSEC, "tilt of the base about x (north)"),
             ParameterSpec("tz", "arcsec", ARCSEC, "rotation of the base about z (up)"),
         )
 
     def chain_terms(self, variables: PositionVariables):
+        """The rotations ``Rx(tx) Rz(tz)`` before ``Rt``, the same at every position."""
         one = np.ones(variables.n)
         return (ChainTerm(PRE, "x", {"tx": one}), ChainTerm(PRE, "z", {"tz": one}))

@@ -6,8 +6,12 @@ import numpy as np
 
 from .base import ARCSEC, POST, ChainTerm, Effect, ParameterSpec, PositionVariables
 
+__all__ = ["GravitySag"]
+
 
 class GravitySag(Effect):
+    """Payload tilt under gravity: a compliance ``k`` (arcsec/g) times the lateral force."""
+
     name = "gravity_sag"
     title = "payload sag under gravity"
     definition = (
@@ -28,9 +32,11 @@ class GravitySag(Effect):
     )
 
     def parameters(self, variables: PositionVariables):
+        """The compliance ``k``, arcsec/g."""
         return (ParameterSpec("k", "arcsec/g", ARCSEC, "tilt compliance per g of lateral force"),)
 
     def chain_terms(self, variables: PositionVariables):
+        """The rotations ``Rx(-k ay) Ry(k ax)`` after ``Rt`` (``ax``, ``ay``: specific force, g)."""
         s1 = np.sin(variables.phi1_rad)
         ax = -s1 * np.cos(variables.phi2_rad)
         ay = s1 * np.sin(variables.phi2_rad)

@@ -4,8 +4,12 @@ from __future__ import annotations
 
 from .base import ChainTerm, Effect, PositionVariables, harmonic_parameters, harmonic_weights
 
+__all__ = ["InnerWobbleHarmonics"]
+
 
 class InnerWobbleHarmonics(Effect):
+    """Inner-bearing runout: the inner wobble angles vary with phi2 (1/rev and 2/rev)."""
+
     name = "inner_wobble_harmonics"
     title = "angle-dependent wobble of the inner axis"
     definition = (
@@ -24,11 +28,13 @@ class InnerWobbleHarmonics(Effect):
     )
 
     def parameters(self, variables: PositionVariables):
+        """Harmonic coefficients ``x_c1 ... x_s2`` and ``y_c1 ... y_s2``, arcsec."""
         return harmonic_parameters("x_", "inner wobble about x", "phi2") + harmonic_parameters(
             "y_", "inner wobble about y", "phi2"
         )
 
     def chain_terms(self, variables: PositionVariables):
+        """``h_x(phi2)`` added to ``dalpha_x2`` and ``h_y(phi2)`` to ``dalpha_y2``."""
         return (
             ChainTerm("dalpha_x2", None, harmonic_weights(variables.phi2_rad, "x_")),
             ChainTerm("dalpha_y2", None, harmonic_weights(variables.phi2_rad, "y_")),

@@ -4,8 +4,12 @@ from __future__ import annotations
 
 from .base import ChainTerm, Effect, PositionVariables, harmonic_parameters, harmonic_weights
 
+__all__ = ["OuterEncoderHarmonics"]
+
 
 class OuterEncoderHarmonics(Effect):
+    """Outer-axis encoder eccentricity and ellipticity: a 1/rev and 2/rev error in phi1."""
+
     name = "outer_encoder_harmonics"
     title = "outer-axis encoder eccentricity and ellipticity"
     definition = "dphi_y1 -> dphi_y1 + h(phi1), h(a) = c1 cos a + s1 sin a + c2 cos 2a + s2 sin 2a"
@@ -23,7 +27,9 @@ class OuterEncoderHarmonics(Effect):
     )
 
     def parameters(self, variables: PositionVariables):
+        """The four harmonic coefficients ``c1, s1, c2, s2``, arcsec."""
         return harmonic_parameters("", "outer-axis position error", "phi1")
 
     def chain_terms(self, variables: PositionVariables):
+        """``h(phi1)`` added to ``dphi_y1``."""
         return (ChainTerm("dphi_y1", None, harmonic_weights(variables.phi1_rad)),)

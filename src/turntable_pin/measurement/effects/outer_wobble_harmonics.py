@@ -4,8 +4,12 @@ from __future__ import annotations
 
 from .base import ChainTerm, Effect, PositionVariables, harmonic_parameters, harmonic_weights
 
+__all__ = ["OuterWobbleHarmonics"]
+
 
 class OuterWobbleHarmonics(Effect):
+    """Outer-bearing runout: the outer wobble angles vary with phi1 (1/rev and 2/rev)."""
+
     name = "outer_wobble_harmonics"
     title = "angle-dependent wobble of the outer axis"
     definition = (
@@ -27,11 +31,13 @@ class OuterWobbleHarmonics(Effect):
     )
 
     def parameters(self, variables: PositionVariables):
+        """Harmonic coefficients ``x_c1 ... x_s2`` and ``z_c1 ... z_s2``, arcsec."""
         return harmonic_parameters("x_", "outer wobble about x", "phi1") + harmonic_parameters(
             "z_", "outer wobble about z", "phi1"
         )
 
     def chain_terms(self, variables: PositionVariables):
+        """``h_x(phi1)`` added to ``dalpha_x1`` and ``h_z(phi1)`` to ``dalpha_z1``."""
         return (
             ChainTerm("dalpha_x1", None, harmonic_weights(variables.phi1_rad, "x_")),
             ChainTerm("dalpha_z1", None, harmonic_weights(variables.phi1_rad, "z_")),

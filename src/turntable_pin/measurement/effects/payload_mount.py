@@ -6,8 +6,12 @@ import numpy as np
 
 from .base import ARCSEC, POST, ChainTerm, Effect, ParameterSpec, PositionVariables
 
+__all__ = ["PayloadMount"]
+
 
 class PayloadMount(Effect):
+    """Payload mounted askew: a constant rotation after ``Rt`` (same as inner-frame errors)."""
+
     name = "payload_mount"
     title = "payload mounted askew"
     definition = "Rt -> Rt Rz(mz) Ry(my) Rx(mx)"
@@ -25,6 +29,7 @@ class PayloadMount(Effect):
     )
 
     def parameters(self, variables: PositionVariables):
+        """``mz``, ``my`` and ``mx``, arcsec."""
         return (
             ParameterSpec("mz", "arcsec", ARCSEC, "mount rotation about z"),
             ParameterSpec("my", "arcsec", ARCSEC, "mount rotation about y"),
@@ -32,6 +37,7 @@ class PayloadMount(Effect):
         )
 
     def chain_terms(self, variables: PositionVariables):
+        """The rotations ``Rz(mz) Ry(my) Rx(mx)`` after ``Rt``, the same at every position."""
         one = np.ones(variables.n)
         return (
             ChainTerm(POST, "z", {"mz": one}),

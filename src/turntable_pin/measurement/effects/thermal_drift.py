@@ -8,8 +8,12 @@ from .base import ARCSEC, POST, ChainTerm, Effect, ParameterSpec, PositionVariab
 
 _ARCSEC_PER_HOUR = ARCSEC / 3600.0  # rad/s of one arcsec/h
 
+__all__ = ["ThermalDrift"]
+
 
 class ThermalDrift(Effect):
+    """Slow thermal drift: a payload rotation growing linearly with ``time_s`` (arcsec/h)."""
+
     name = "thermal_drift"
     title = "slow thermal drift of the payload"
     definition = "Rt -> Rt Rz(rz t) Ry(ry t) Rx(rx t), t = time_s"
@@ -27,6 +31,7 @@ class ThermalDrift(Effect):
     required_columns = ("time_s",)
 
     def parameters(self, variables: PositionVariables):
+        """The drift rates ``rz``, ``ry`` and ``rx``, arcsec/h."""
         return (
             ParameterSpec("rz", "arcsec/h", _ARCSEC_PER_HOUR, "drift rate about z"),
             ParameterSpec("ry", "arcsec/h", _ARCSEC_PER_HOUR, "drift rate about y"),
@@ -34,6 +39,7 @@ class ThermalDrift(Effect):
         )
 
     def chain_terms(self, variables: PositionVariables):
+        """The rotations ``Rz(rz t) Ry(ry t) Rx(rx t)`` after ``Rt``, ``t`` the time in s."""
         t = np.asarray(variables.time_s, dtype=float)
         return (
             ChainTerm(POST, "z", {"rz": t}),

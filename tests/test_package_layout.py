@@ -1,0 +1,186 @@
+"""The package's shape: one-way layers, no import cycle (not even a lazy one), a light import,
+and every module saying what it is for and what it exports."""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conftest import cli_env
+
+PACKAGE = Path(__file__).resolve().parents[1] / "src" / "turntable_pin"
+
+# A module may import from its own layer and from layers of lower rank, never upward.
+LAYER_RANK = {
+    "core": 0,
+    "stats": 1,
+    "model": 1,
+    "calibration": 2,
+    "measurement": 3,
+    "allocation": 3,
+    "report": 4,
+    "viewer": 4,
+    "cli": 5,
+}
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = list(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        out[".".join(parts)] = path
+    return out
+
+
+def _imports(name: str, path: Path, known: set[str]) -> set[str]:
+    """Every package module ``name`` imports, at the top or inside functions (lazy)."""
+    tree = ast.parse(path.read_text())
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[: len(base) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            candidates = [target] + [f"{target}.{a.name}" for a in node.names]
+        elif isinstance(node, ast.Import):
+            candidates = [a.name for a in node.names]
+        else:
+            continue
+        for c in candidates:
+            if c in known and c != name:
+                found.add(c)
+    # string-named lazy exports (core.lazy) are imports too
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Assign) and any(
+            isinstance(t, ast.Name) and t.id == "_EXPORTS" for t in node.targets
+        ):
+            for value in ast.literal_eval(node.value).values():
+                target = f"{name}.{value}"
+                if target in known:
+                    found.add(target)
+    return found
+
+
+def _graph() -> dict[str, set[str]]:
+    modules = _modules()
+    known = set(modules)
+    return {name: _imports(name, path, known) for name, path in modules.items()}
+
+
+def _layer(module: str) -> str | None:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else None
+
+
+def test_layers_import_only_downwards():
+    wrong = []
+    for module, targets in _graph().items():
+        layer = _layer(module)
+        if layer is None or layer == "__main__":
+            continue
+        for target in targets:
+            other = _layer(target)
+            if other is None or other == layer:
+                continue
+            if LAYER_RANK[other] > LAYER_RANK[layer] or (
+                LAYER_RANK[other] == LAYER_RANK[layer]
+            ):
+                wrong.append(f"{module} -> {target}")
+    assert not wrong, "upward or sideways imports: " + ", ".join(sorted(wrong))
+
+
+def test_no_import_cycle_even_lazy():
+    graph = _graph()
+    # package __init__ files only re-export their own modules: leave them out of the cycle check
+    graph = {m: {t for t in ts if not (m.startswith(t + "."))} for m, ts in graph.items()}
+    state: dict[str, int] = {}
+    cycle: list[str] = []
+
+    def visit(node: str, stack: list[str]) -> bool:
+        state[node] = 1
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == 1:
+                cycle.extend([*stack, node, nxt])
+                return True
+            if state.get(nxt) is None and visit(nxt, stack + [node]):
+                return True
+        state[node] = 2
+        return False
+
+    for node in sorted(graph):
+        if state.get(node) is None and visit(node, []):
+            break
+    assert not cycle, "import cycle: " + " -> ".join(cycle)
+
+
+def test_the_statistics_layer_knows_no_turntable():
+    words = ("arcsec", "dpsi", "dtheta", "dgamma", "phi1", "phi2", "turntable", "gyrowheel")
+    hits = []
+    for path in (PACKAGE / "stats").glob("*.py"):
+        text = path.read_text().lower()
+        hits += [f"{path.name}: {w}" for w in words if w in text]
+    assert not hits, hits
+
+
+@pytest.mark.parametrize("name", sorted(_modules()))
+def test_every_module_has_a_docstring_and_all(name):
+    if name.endswith("__main__"):  # runs the command line when imported
+        assert '"""' in _modules()[name].read_text().split("\n", 1)[0]
+        return
+    module = importlib.import_module(name)
+    assert (module.__doc__ or "").strip(), f"{name} has no docstring"
+    assert hasattr(module, "__all__"), f"{name} declares no __all__"
+    missing = []
+    for public in module.__all__:
+        value = getattr(module, public)
+        if not callable(value) or getattr(value, "__module__", name) != name:
+            continue  # constants, and names re-exported from their defining module
+        if not (value.__doc__ or "").strip():
+            missing.append(public)
+        if isinstance(value, type):
+            for attr, member in vars(value).items():
+                if attr.startswith("_") or not (callable(member) or isinstance(member, property)):
+                    continue
+                if isinstance(member, (staticmethod, classmethod)):
+                    member = member.__func__
+                if not (getattr(member, "__doc__", None) or "").strip():
+                    missing.append(f"{public}.{attr}")
+    assert not missing, f"{name}: public definitions without a docstring: {missing}"
+
+
+def test_import_and_help_pay_for_no_heavy_library():
+    code = (
+        "import sys, io, contextlib, turntable_pin, turntable_pin.cli as c\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    try:\n        c.main(['--help'])\n    except SystemExit:\n        pass\n"
+        "heavy = [m for m in ('numpy', 'scipy', 'pinocchio', 'matplotlib', 'yourdfpy', 'meshcat')"
+        " if m in sys.modules]\n"
+        "print(','.join(heavy))\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=cli_env(), check=True)  # fmt: skip
+    assert proc.stdout.strip() == ""
+
+
+def test_orientation_does_not_load_scipy_or_matplotlib():
+    code = (
+        "import sys, contextlib, io\nfrom turntable_pin.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    main(['orientation', '--phi1-deg', '30'])\n"
+        "print(','.join(m for m in ('scipy', 'matplotlib', 'yourdfpy', 'meshcat')"
+        " if m in sys.modules))\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=cli_env(), check=True)  # fmt: skip
+    assert proc.stdout.strip() == ""
