@@ -1,5 +1,12 @@
-"""Shared test helpers: seeded random error sets, the CLI runners (child process and in-process)
-and the skip of browser tests without Chromium."""
+"""Shared test helpers: seeded random error sets, the repository's paths, a file writer, the CLI
+runners (child process and in-process) and the skip of browser tests without Chromium.
+
+The test folders mirror the package's subpackages (tests/core, tests/model, ...) and hold no
+``__init__.py``: with pytest's default import mode every test module is imported by its basename,
+so basenames are unique across folders. ``tests`` is on ``pythonpath`` (pyproject.toml), so the
+modules here (``from conftest import ...``, ``spec_reference``, ``process_watch``) import from any
+folder.
+"""
 
 from __future__ import annotations
 
@@ -28,10 +35,21 @@ def rng() -> np.random.Generator:
     return np.random.default_rng(20261122)
 
 
+# --- the repository's paths and a file writer ---------------------------------------------------
+REPO_DIR = Path(__file__).resolve().parents[1]
+SRC_DIR = REPO_DIR / "src"
+EXAMPLES_DIR = REPO_DIR / "models" / "examples"
+VIZ_DIR = REPO_DIR / "viz"
+
+
+def write_file(folder: Path, text: str, name: str = "data.csv") -> Path:
+    """Write ``text`` to ``folder/name`` and return the path."""
+    path = folder / name
+    path.write_text(text)
+    return path
+
+
 # --- command-line runners and the browser skip, shared by every test module -----------------------
-SRC_DIR = Path(__file__).resolve().parents[1] / "src"
-
-
 def cli_env(extra: dict | None = None) -> dict:
     """The environment for a child ``python -m turntable_pin``: this checkout's ``src`` first."""
     env = dict(os.environ if extra is None else extra)
@@ -42,7 +60,11 @@ def cli_env(extra: dict | None = None) -> dict:
 def run_cli(
     *args: str, env: dict | None = None, timeout: float = 120
 ) -> subprocess.CompletedProcess:
-    """Run ``turntable-pin ARGS`` in a child process (for what needs the process boundary)."""
+    """Run ``python -m turntable_pin ARGS`` in a child process.
+
+    Only for what needs the process boundary: the module entry point itself, signals, start-up
+    imports, and checks that no process or temporary folder outlives the command.
+    """
     return subprocess.run(
         [sys.executable, "-m", "turntable_pin", *args],
         capture_output=True, text=True, timeout=timeout, env=cli_env(env),

@@ -7,19 +7,17 @@ import importlib.util
 import re
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
-from conftest import cli_env
+from conftest import VIZ_DIR, cli_env, needs_chromium
 from turntable_pin.viewer.browser import check_page_images, chromium_available
 
-VIZ = Path(__file__).resolve().parents[1] / "viz"
-SCRIPTS = sorted(VIZ.glob("fig_*.py"))
+SCRIPTS = sorted(VIZ_DIR.glob("fig_*.py"))
 
 
 def _load_make_all():
-    spec = importlib.util.spec_from_file_location("viz_make_all", VIZ / "make_all.py")
+    spec = importlib.util.spec_from_file_location("viz_make_all", VIZ_DIR / "make_all.py")
     module = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = module  # dataclasses look their module up there
     spec.loader.exec_module(module)
@@ -30,7 +28,7 @@ def _load_make_all():
 def gallery(tmp_path_factory):
     out = tmp_path_factory.mktemp("figures")
     proc = subprocess.run(
-        [sys.executable, str(VIZ / "make_all.py"), "-o", str(out), "--fast"],
+        [sys.executable, str(VIZ_DIR / "make_all.py"), "-o", str(out), "--fast"],
         capture_output=True,
         text=True,
         timeout=600,
@@ -40,6 +38,7 @@ def gallery(tmp_path_factory):
     return out, proc.stdout
 
 
+@pytest.mark.slow
 def test_every_figure_script_ran_and_is_on_the_index(gallery):
     out, stdout = gallery
     assert len(SCRIPTS) >= 3
@@ -54,11 +53,8 @@ def test_every_figure_script_ran_and_is_on_the_index(gallery):
         assert re.search(r'class="skip">skipped: [^<]*chromium', page, re.IGNORECASE)
 
 
-@pytest.mark.browser
-@pytest.mark.skipif(
-    not chromium_available(),
-    reason="headless Chromium not found: install the Debian package 'chromium'",
-)
+@pytest.mark.slow
+@needs_chromium
 def test_every_image_of_the_index_loads_in_the_browser(gallery):
     out, _ = gallery
     report = check_page_images(out / "index.html")

@@ -1,12 +1,11 @@
 """Least-squares calibration (eqs. 5-6): recovery of Table 1, standard errors, identifiability."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from conftest import EXAMPLES_DIR
 from turntable_pin import IdentifiabilityError, InputError
 from turntable_pin.calibration.drift_fit import (
     calibrate,
@@ -18,7 +17,7 @@ from turntable_pin.calibration.gyrowheel import GyroWheelModel
 from turntable_pin.calibration.positions import PositionSet, position_inputs
 
 LAT_RAD = np.radians(45.75)
-EXAMPLE = Path(__file__).resolve().parents[1] / "models" / "examples" / "gyrowheel_run_example.csv"
+EXAMPLE = EXAMPLES_DIR / "gyrowheel_run_example.csv"
 
 
 @pytest.mark.parametrize("scheme", ["grid:30", "grid:45", "grid:60", "grid:45x30"])

@@ -85,6 +85,7 @@ def test_image_check_of_a_page_without_head_or_images(tmp_path):
     assert report.n_images == 0 and report.all_loaded
 
 
+@pytest.mark.slow
 @needs_chromium
 def test_screenshot_has_the_asked_size_and_is_reproducible(tmp_path):
     page = tmp_path / "red.html"
@@ -96,6 +97,7 @@ def test_screenshot_has_the_asked_size_and_is_reproducible(tmp_path):
     assert run.seconds > 0
 
 
+@pytest.mark.slow
 @needs_chromium
 def test_no_browser_process_survives_a_timeout(tmp_path):
     page = tmp_path / "slow.html"

@@ -8,6 +8,7 @@ extra rotation matrices multiplied explicitly.
 import numpy as np
 import pytest
 
+import spec_reference as ref
 from turntable_pin import TurntableErrors, TurntableModel
 from turntable_pin.core.exceptions import InputError
 from turntable_pin.core.rotations import rot_x, rot_y, rot_z
@@ -39,25 +40,21 @@ def _variables(rng, n=7):
     )  # fmt: skip
 
 
-def _h(a, c1, s1, c2, s2):
-    return c1 * np.cos(a) + s1 * np.sin(a) + c2 * np.cos(2 * a) + s2 * np.sin(2 * a)
-
-
 def _independent(effect, v, base, p, i):
     """dpsi, dtheta, dgamma at position i from the spec's words, via per-call Pinocchio."""
     e = dict(zip(ANGULAR_ERROR_NAMES, base, strict=True))
     phi1, phi2 = v.phi1_rad[i], v.phi2_rad[i]
     pre, post = np.eye(3), np.eye(3)
     if effect == "outer_encoder_harmonics":
-        e["dphi_y1"] += _h(phi1, p["c1"], p["s1"], p["c2"], p["s2"])
+        e["dphi_y1"] += ref.h(phi1, p["c1"], p["s1"], p["c2"], p["s2"])
     elif effect == "inner_encoder_harmonics":
-        e["dphi_z2"] += _h(phi2, p["c1"], p["s1"], p["c2"], p["s2"])
+        e["dphi_z2"] += ref.h(phi2, p["c1"], p["s1"], p["c2"], p["s2"])
     elif effect == "outer_wobble_harmonics":
-        e["dalpha_x1"] += _h(phi1, p["x_c1"], p["x_s1"], p["x_c2"], p["x_s2"])
-        e["dalpha_z1"] += _h(phi1, p["z_c1"], p["z_s1"], p["z_c2"], p["z_s2"])
+        e["dalpha_x1"] += ref.h(phi1, p["x_c1"], p["x_s1"], p["x_c2"], p["x_s2"])
+        e["dalpha_z1"] += ref.h(phi1, p["z_c1"], p["z_s1"], p["z_c2"], p["z_s2"])
     elif effect == "inner_wobble_harmonics":
-        e["dalpha_x2"] += _h(phi2, p["x_c1"], p["x_s1"], p["x_c2"], p["x_s2"])
-        e["dalpha_y2"] += _h(phi2, p["y_c1"], p["y_s1"], p["y_c2"], p["y_s2"])
+        e["dalpha_x2"] += ref.h(phi2, p["x_c1"], p["x_s1"], p["x_c2"], p["x_s2"])
+        e["dalpha_y2"] += ref.h(phi2, p["y_c1"], p["y_s1"], p["y_c2"], p["y_s2"])
     elif effect == "gravity_sag":
         ax = -np.sin(phi1) * np.cos(phi2)
         ay = np.sin(phi1) * np.sin(phi2)

@@ -3,16 +3,11 @@
 import numpy as np
 import pytest
 
+from conftest import write_file
 from turntable_pin import InputError
 from turntable_pin.measurement.data import read_measurements
 
 HEAD = "phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec"
-
-
-def write(tmp_path, text, name="m.csv"):
-    path = tmp_path / name
-    path.write_text(text)
-    return path
 
 
 def grid_rows(extra=lambda i: ""):
@@ -26,7 +21,7 @@ def test_reads_columns_in_any_order_with_extras(tmp_path):
     text = "# comment\nnote,dgamma_arcsec,phi2_deg,phi1_deg,dtheta_arcsec,dpsi_arcsec,"
     text += "sigma_arcsec,time_s,dir1\n"
     text += "x,3,45,30,2,1,0.5,10,-1\ny,6,90,30,5,4,0.5,20,1\n"
-    data = read_measurements(write(tmp_path, text))
+    data = read_measurements(write_file(tmp_path, text))
     assert data.n_positions == 2
     np.testing.assert_allclose(np.degrees(data.phi1_rad), [30, 30])
     np.testing.assert_allclose(data.angles_rad[0] * 206264.80624709636, [1, 2, 3])
@@ -51,16 +46,16 @@ def test_reads_columns_in_any_order_with_extras(tmp_path):
 )  # fmt: skip
 def test_bad_files_name_row_and_column(tmp_path, text, fragment):
     with pytest.raises(InputError) as info:
-        read_measurements(write(tmp_path, text))
+        read_measurements(write_file(tmp_path, text, "m.csv"))
     assert fragment in str(info.value)
     assert "m.csv" in str(info.value)
 
 
 def test_repeats_at_different_times_or_directions_are_fine(tmp_path):
     text = HEAD + ",time_s\n0,0,1,1,1,10\n0,0,1.2,1,1,20\n"
-    assert read_measurements(write(tmp_path, text)).n_positions == 2
+    assert read_measurements(write_file(tmp_path, text)).n_positions == 2
     text = HEAD + ",dir1\n0,0,1,1,1,1\n0,0,1.2,1,1,-1\n"
-    assert read_measurements(write(tmp_path, text)).n_positions == 2
+    assert read_measurements(write_file(tmp_path, text)).n_positions == 2
 
 
 def test_radians_in_a_degree_column_are_refused(tmp_path):
@@ -72,12 +67,12 @@ def test_radians_in_a_degree_column_are_refused(tmp_path):
     with pytest.raises(
         InputError, match="row 2, column 'phi1_deg': these angles look like radians"
     ):
-        read_measurements(write(tmp_path, "\n".join(lines) + "\n"))
+        read_measurements(write_file(tmp_path, "\n".join(lines) + "\n"))
     # Irregular values spread over a radian-sized range.
     rng = np.random.default_rng(3)
     lines = [HEAD] + [f"{a},{b},1,1,1" for a, b in rng.uniform(0, 2 * np.pi, (20, 2))]
     with pytest.raises(InputError, match="look like radians"):
-        read_measurements(write(tmp_path, "\n".join(lines) + "\n"))
+        read_measurements(write_file(tmp_path, "\n".join(lines) + "\n"))
 
 
 def test_small_angle_degree_data_are_not_mistaken_for_radians(tmp_path):
@@ -85,7 +80,7 @@ def test_small_angle_degree_data_are_not_mistaken_for_radians(tmp_path):
     for a in (-3, -1.5, 0, 1.5, 3):
         for b in (-2.25, 0, 2.25, 4.5):
             lines.append(f"{a},{b},1,1,1")
-    data = read_measurements(write(tmp_path, "\n".join(lines) + "\n"))
+    data = read_measurements(write_file(tmp_path, "\n".join(lines) + "\n"))
     assert data.n_positions == 20
     # A whole-degree grid is never flagged.
-    assert read_measurements(write(tmp_path, HEAD + "\n" + grid_rows())).n_positions == 9
+    assert read_measurements(write_file(tmp_path, HEAD + "\n" + grid_rows())).n_positions == 9

@@ -6,33 +6,19 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import random_errors
+from spec_reference import Rx, Ry, Rz
 from turntable_pin import ANGULAR_ERROR_NAMES, TurntableErrors, TurntableModel, YourdfpyTurntable
 from turntable_pin.model.small_angle import small_angle_matrix, small_angle_orientation_error
-
-
-def _rx(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
-
-
-def _ry(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-
-
-def _rz(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
 
 
 def table3_chain(e: TurntableErrors, phi1, phi2):
     """Paper Table 3 written out factor by factor, independent of the package's chain."""
     rt = (
-        _ry(phi1) @ _ry(e.dphi_y1) @ _rz(e.dalpha_z1) @ _rx(e.dalpha_x1)
-        @ _ry(e.deps_y) @ _rx(e.deps_x)
-        @ _rz(phi2) @ _ry(e.dalpha_y2) @ _rz(e.dphi_z2) @ _rx(e.dalpha_x2)
+        Ry(phi1) @ Ry(e.dphi_y1) @ Rz(e.dalpha_z1) @ Rx(e.dalpha_x1)
+        @ Ry(e.deps_y) @ Rx(e.deps_x)
+        @ Rz(phi2) @ Ry(e.dalpha_y2) @ Rz(e.dphi_z2) @ Rx(e.dalpha_x2)
     )  # fmt: skip
-    rd = _ry(phi1) @ _rz(phi2)
+    rd = Ry(phi1) @ Rz(phi2)
     return rd.T @ rt
 
 
@@ -113,7 +99,7 @@ def test_written_urdf_reloads_in_pinocchio_and_yourdfpy(tmp_path, rng):
         for phi1, phi2 in rng.uniform(-7, 7, size=(10, 2)):
             expected = model.orientation_error(phi1, phi2)
             pin.framesForwardKinematics(plain, data, np.array([phi1, phi2]))
-            rd = _ry(phi1) @ _rz(phi2)
+            rd = Ry(phi1) @ Rz(phi2)
             np.testing.assert_allclose(rd.T @ data.oMf[frame].rotation, expected.dR, atol=1e-12)
             np.testing.assert_allclose(
                 other.orientation_error_matrix(phi1, phi2), expected.dR, atol=1e-12

@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from conftest import run_cli
+from conftest import cli
 from turntable_pin import ANGULAR_ERROR_NAMES
 from turntable_pin.cli import main
 from turntable_pin.cli.allocation import parse_limits
@@ -13,7 +13,6 @@ from turntable_pin.core.exceptions import InputError
 from turntable_pin.core.units import ARCMIN_PER_RAD
 
 PAPER = ["--limits-arcmin", "psi=1.4801,theta=1.56,gamma=1.4801", "--weights", "paper"]
-
 
 
 def json_of(capsys, argv):
@@ -44,6 +43,7 @@ def test_limits_in_degrees_equal_limits_in_arcmin(capsys):
         )
 
 
+@pytest.mark.slow
 def test_default_limits_are_the_orientation_requirement(capsys):
     from turntable_pin import PositionSet, orientation_requirement
 
@@ -87,7 +87,7 @@ def test_montecarlo_beyond_the_bounds_fails_with_status_1(capsys):
 def test_infeasible_lower_bounds_exit_2_with_one_line(tmp_path):
     lb = tmp_path / "lb.yaml"
     lb.write_text("lower_bounds:\n  dalpha_x2_arcmin: 2.0\n")
-    proc = run_cli("allocate", *PAPER, "--lower-bounds", str(lb))
+    proc = cli("allocate", *PAPER, "--lower-bounds", str(lb))
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
     assert "dgamma" in proc.stderr and "above the limit" in proc.stderr

@@ -1,15 +1,13 @@
 """The measurement commands: simulate -> fit / diagnose / report, JSON keys, bad files exit 2."""
 
 import json
-from pathlib import Path
 
 import pytest
 
-from conftest import run_cli
+from conftest import EXAMPLES_DIR, cli, run_cli
 from turntable_pin.cli import main
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "models" / "examples" / "measurements_example.csv"
-
+EXAMPLE = EXAMPLES_DIR / "measurements_example.csv"
 
 
 @pytest.fixture(scope="module")
@@ -24,6 +22,8 @@ def sim_file(tmp_path_factory):
 
 
 def test_bundled_example_diagnosis_names_its_hidden_effect_and_the_error_falls():
+    # The README's main job, run as `python -m turntable_pin` in a child process: the one test of
+    # the module entry point end to end (the other commands are run in-process with `cli`).
     proc = run_cli("diagnose", str(EXAMPLE), "--json")
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
@@ -47,6 +47,7 @@ def test_fit_json_keys_and_before_after(sim_file, capsys, tmp_path):
     assert (tmp_path / "plots" / "residuals.png").read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow
 def test_diagnose_until_explained_text_and_report(sim_file, capsys, tmp_path):
     assert main(["diagnose", str(sim_file), "--until-explained"]) == 0
     text = capsys.readouterr().out
@@ -84,7 +85,7 @@ def test_bad_files_exit_2_naming_row_and_column(kind, tmp_path, capsys):
     text, fragment = BAD[kind]
     path = tmp_path / "bad.csv"
     path.write_text(text)
-    proc = run_cli("diagnose", str(path), "--json")
+    proc = cli("diagnose", str(path), "--json")
     assert proc.returncode == 2
     assert fragment in proc.stderr and "bad.csv" in proc.stderr
     assert "Traceback" not in proc.stderr and proc.stdout == ""
@@ -98,7 +99,7 @@ def test_bad_files_exit_2_naming_row_and_column(kind, tmp_path, capsys):
 def test_report_never_overwrites_its_input(sim_file, capsys):
     before = sim_file.read_bytes()
     assert main(["report", str(sim_file), "-o", str(sim_file)]) == 2
-    assert "is an input file" in capsys.readouterr().err
+    assert "refusing to write --output" in capsys.readouterr().err
     assert sim_file.read_bytes() == before
 
 

@@ -7,7 +7,7 @@ effects of a few arcsec, random approach directions and a time stamp per positio
 import numpy as np
 import pytest
 
-from conftest import random_errors
+from conftest import EXAMPLES_DIR, random_errors
 from turntable_pin.core.units import ARCSEC_PER_RAD
 from turntable_pin.measurement.data import OrientationMeasurements
 from turntable_pin.measurement.diagnosis import diagnose_measurements
@@ -71,6 +71,7 @@ def test_payload_mount_is_absorbed_by_the_base_and_said_so():
     assert 0.8 < d["base"]["chi2_reduced"] < 1.25
 
 
+@pytest.mark.slow
 def test_clean_data_false_alarm_rate(capsys):
     alarms = {"column": 0, "estimated": 0}
     n_seeds = 20
@@ -183,11 +184,9 @@ def test_a_partial_explanation_is_not_an_alternative():
 
 
 def test_a_spurious_first_round_candidate_is_shown_not_significant_on_top_of_the_real_one():
-    from pathlib import Path
-
     from turntable_pin.measurement.data import read_measurements
 
-    example = Path(__file__).resolve().parents[1] / "models/examples/measurements_example.csv"
+    example = EXAMPLES_DIR / "measurements_example.csv"
     d = diagnose_measurements(read_measurements(example)).to_dict()
     first = d["verdict"]["missing_effect"]
     spurious = [c for c in d["candidates"] if c["significant"] and c["effect"] != first]

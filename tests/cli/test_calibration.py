@@ -1,20 +1,18 @@
 """``rate-error``, ``requirement``, ``calibrate`` on the command line: keys, files, bad input."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from conftest import run_cli
+from conftest import EXAMPLES_DIR, cli, write_file
 from turntable_pin import GyroWheelModel, PositionSet, position_inputs, rate_error
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "models" / "examples" / "gyrowheel_run_example.csv"
-
+EXAMPLE = EXAMPLES_DIR / "gyrowheel_run_example.csv"
 
 
 def test_rate_error_json_matches_the_library():
-    proc = run_cli(
+    proc = cli(
         "rate-error", "--dpsi-deg", "0.02", "--dtheta-deg", "0.01", "--dgamma-deg", "-0.015",
         "--positions", "grid:90", "--latitude-deg", "45.75", "--json",
     )  # fmt: skip
@@ -28,14 +26,15 @@ def test_rate_error_json_matches_the_library():
 
 
 def test_rate_error_text_output():
-    proc = run_cli("rate-error", "--dpsi-deg", "0.02", "--positions", "grid:45", "--exact")
+    proc = cli("rate-error", "--dpsi-deg", "0.02", "--positions", "grid:45", "--exact")
     assert proc.returncode == 0, proc.stderr
     assert "dwx = " in proc.stdout and "exact rotation" in proc.stdout
 
 
+@pytest.mark.slow
 def test_requirement_json_and_plots(tmp_path):
     plots = tmp_path / "figs"
-    proc = run_cli(
+    proc = cli(
         "requirement", "--accuracy-dph", "0.01", "--positions", "grid:45",
         "--latitude-deg", "45.75", "--json", "--plots", str(plots),
     )  # fmt: skip
@@ -49,7 +48,7 @@ def test_requirement_json_and_plots(tmp_path):
 
 
 def test_calibrate_example_json():
-    proc = run_cli("calibrate", str(EXAMPLE), "--latitude-deg", "45.75", "--json")
+    proc = cli("calibrate", str(EXAMPLE), "--latitude-deg", "45.75", "--json")
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
     assert out["x"]["coefficients_dph"]["DF"] == pytest.approx(-93.3, abs=0.01)
@@ -60,15 +59,9 @@ def test_calibrate_example_json():
 
 
 def test_calibrate_text_report():
-    proc = run_cli("calibrate", str(EXAMPLE))
+    proc = cli("calibrate", str(EXAMPLE))
     assert proc.returncode == 0, proc.stderr
     assert "DxDF" in proc.stdout and "res_x_dph" in proc.stdout
-
-
-def write(tmp_path, name, text):
-    path = tmp_path / name
-    path.write_text(text)
-    return str(path)
 
 
 @pytest.mark.parametrize(
@@ -86,7 +79,7 @@ def write(tmp_path, name, text):
     ],
 )  # fmt: skip
 def test_calibrate_bad_runs_exit_2(tmp_path, content, fragment):
-    proc = run_cli("calibrate", write(tmp_path, "run.csv", content))
+    proc = cli("calibrate", str(write_file(tmp_path, content, "run.csv")))
     assert proc.returncode == 2
     assert fragment in proc.stderr
     assert "run.csv" in proc.stderr
@@ -106,7 +99,7 @@ def test_calibrate_bad_runs_exit_2(tmp_path, content, fragment):
     ],
 )  # fmt: skip
 def test_bad_arguments_exit_2(args, fragment):
-    proc = run_cli(*args)
+    proc = cli(*args)
     assert proc.returncode == 2
     assert fragment in proc.stderr
     assert "Traceback" not in proc.stderr

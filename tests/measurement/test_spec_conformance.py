@@ -4,8 +4,8 @@ The project's simulator and fitter share one chain, so a misread convention woul
 test. Here (a) the project's model is compared, to rounding, with :mod:`spec_reference` (written
 from model.md / measurements.md with plain numpy) for random errors and every catalogued effect;
 (b) files written by the reference, with a hidden effect of a few arcsec and 1 arcsec noise, are
-diagnosed through the CLI; (c) the same with sigma absent, rows shuffled, columns shuffled and
-unknown columns; (d) clean files give no missing effect.
+diagnosed through the CLI (in-process); (c) the same with sigma absent, rows shuffled, columns
+shuffled and unknown columns; (d) clean files give no missing effect.
 """
 
 from __future__ import annotations
@@ -13,14 +13,13 @@ from __future__ import annotations
 import json
 import subprocess
 import zlib
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import spec_reference as ref
-from conftest import run_cli
+from conftest import cli
 from turntable_pin import TurntableErrors
 from turntable_pin.measurement.data import read_measurements
 from turntable_pin.measurement.effect_model import OrientationModel
@@ -31,7 +30,7 @@ from turntable_pin.measurement.simulation import Schedule, simulate_measurements
 from turntable_pin.model.batch_field import OrientationErrorField
 from turntable_pin.model.turntable import TurntableModel
 
-SEEDS = (3, 11)  # the CLI part takes ~20 s on 2 cores; more seeds were tried by hand
+SEEDS = (3, 11)  # the CLI part takes ~10 s; more seeds were tried by hand
 
 
 @pytest.fixture(scope="module")
@@ -174,29 +173,22 @@ CASES = [
 ]
 
 
-def _diagnose(path: Path) -> subprocess.CompletedProcess:
-    return run_cli("diagnose", str(path), "--json")
-
-
-@pytest.fixture(scope="module")
-def diagnoses(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("conformance")
-    paths = []
-    for n, (seed, effect, design_name, variant) in enumerate(CASES):
-        rng = np.random.default_rng(1000 * seed + n)
-        errors = dict(zip(ref.ERROR_NAMES, rng.uniform(-10, 10, 8) * ref.ARCSEC, strict=True))
-        effects = {} if effect is None else {effect: ref.random_effect_parameters(effect, rng)}
-        columns = ref.make_run(rng, design_name, errors, effects, noise_arcsec=1.0)
-        paths.append(ref.write_csv(folder / f"case{n}.csv", columns, rng, **VARIANTS[variant]))
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        runs = list(pool.map(_diagnose, paths))
-    return dict(zip(CASES, runs, strict=True))
+def _diagnose(folder: Path, case) -> subprocess.CompletedProcess:
+    """Write the reference file of ``case`` and run ``turntable-pin diagnose FILE --json``."""
+    n = CASES.index(case)
+    seed, effect, design_name, variant = case
+    rng = np.random.default_rng(1000 * seed + n)
+    errors = dict(zip(ref.ERROR_NAMES, rng.uniform(-10, 10, 8) * ref.ARCSEC, strict=True))
+    effects = {} if effect is None else {effect: ref.random_effect_parameters(effect, rng)}
+    columns = ref.make_run(rng, design_name, errors, effects, noise_arcsec=1.0)
+    path = ref.write_csv(folder / f"case{n}.csv", columns, rng, **VARIANTS[variant])
+    return cli("diagnose", str(path), "--json")
 
 
 @pytest.mark.parametrize("case", CASES, ids=lambda c: f"s{c[0]}-{c[1]}-{c[2]}-v{c[3]}")
-def test_reference_file_is_diagnosed(diagnoses, case):
+def test_reference_file_is_diagnosed(tmp_path, case):
     _, effect, _, _ = case
-    run = diagnoses[case]
+    run = _diagnose(tmp_path, case)
     assert run.returncode == 0, run.stderr
     report = json.loads(run.stdout)
     verdict = report["verdict"]

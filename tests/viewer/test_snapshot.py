@@ -22,7 +22,6 @@ from turntable_pin.viewer.snapshot import decorate_static_page, render_snapshot
 pytest.importorskip("meshcat")
 
 
-
 EXAMPLE = TurntableErrors.from_arcsec(dalpha_x1=3.0, deps_x=4.0, deps_y=-3.0, deta_mm=0.2)
 # The URDF's material gyrowheel_orange, rgba 1.0 0.55 0.0: its hue, in degrees.
 PAYLOAD_HUE_DEG = mcolors.rgb_to_hsv((1.0, 0.55, 0.0))[0] * 360.0
@@ -50,6 +49,7 @@ def shots(tmp_path_factory):
     return {"first": first, "again": again, "other": other, "watch": watch}
 
 
+@pytest.mark.slow
 @needs_chromium
 def test_snapshot_is_a_real_picture_of_the_setup(shots):
     result = shots["first"]
@@ -62,6 +62,7 @@ def test_snapshot_is_a_real_picture_of_the_setup(shots):
     assert result.to_dict()["exaggeration"]["angle_factor"] == pytest.approx(2700.0)
 
 
+@pytest.mark.slow
 @needs_chromium
 def test_same_angles_same_picture_other_angles_other_picture(shots):
     a = shots["first"].path.read_bytes()
@@ -72,6 +73,7 @@ def test_same_angles_same_picture_other_angles_other_picture(shots):
     assert _payload_pixels(other) > 200
 
 
+@pytest.mark.slow
 @needs_chromium
 def test_no_server_or_browser_remains(shots):
     watch, result = shots["watch"], shots["first"]

@@ -69,6 +69,7 @@ def test_rectangles_are_inside_and_maximal_for_the_calibrated_definition(calibra
     check_inside_and_maximal(calibrated_requirement)
 
 
+@pytest.mark.slow
 def test_each_plane_rectangle_has_the_largest_area_brute_force(requirement):
     for index, rect in enumerate(requirement.rectangles):
         u_limit, v_limit = rect.axis_limits_rad

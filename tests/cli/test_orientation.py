@@ -6,14 +6,14 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import run_cli
+from conftest import cli
 from turntable_pin import TurntableErrors, TurntableModel
 from turntable_pin.cli import main
 from turntable_pin.core.units import ARCSEC_PER_RAD
 
 
 def test_orientation_json_matches_the_library():
-    proc = run_cli(
+    proc = cli(
         "orientation", "--phi1-deg", "30", "--phi2-deg", "45",
         "--error", "dphi_y1=3", "--error", "deps_x=-2", "--error", "deta=0.2", "--json",
     )  # fmt: skip
@@ -61,7 +61,7 @@ def test_urdf_command_writes_a_model_pinocchio_reads(tmp_path):
     ],
 )
 def test_bad_input_exits_2_with_a_message(args, fragment):
-    proc = run_cli(*args)
+    proc = cli(*args)
     assert proc.returncode == 2
     assert fragment in proc.stderr
     assert "Traceback" not in proc.stderr
@@ -70,7 +70,7 @@ def test_bad_input_exits_2_with_a_message(args, fragment):
 def test_unreadable_yaml(tmp_path):
     bad = tmp_path / "errors.yaml"
     bad.write_text("errors: {dphi_y1: [1,\n")
-    proc = run_cli("orientation", "--errors", str(bad))
+    proc = cli("orientation", "--errors", str(bad))
     assert proc.returncode == 2
     assert "errors.yaml" in proc.stderr and "YAML" in proc.stderr
     assert "Traceback" not in proc.stderr

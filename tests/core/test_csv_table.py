@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from conftest import write_file
 from turntable_pin import InputError
 from turntable_pin.core.csv_table import read_csv_table, write_csv_table
 
@@ -8,14 +9,9 @@ REQ = ("phi1_deg", "phi2_deg", "dpsi_arcsec")
 HEAD = "phi1_deg,phi2_deg,dpsi_arcsec\n"
 
 
-def write(tmp_path, text, name="data.csv"):
-    path = tmp_path / name
-    path.write_text(text)
-    return path
-
-
 def test_reads_required_and_optional_columns(tmp_path):
-    path = write(tmp_path, "# comment\nphi2_deg,phi1_deg,dpsi_arcsec,extra,time_s\n0,90,1.5,x,3\n")
+    text = "# comment\nphi2_deg,phi1_deg,dpsi_arcsec,extra,time_s\n0,90,1.5,x,3\n"
+    path = write_file(tmp_path, text)
     table = read_csv_table(path, REQ, ("time_s", "sigma_arcsec"))
     assert len(table) == 1 and table.has("time_s") and not table.has("sigma_arcsec")
     assert table["phi1_deg"][0] == 90 and table.rows.tolist() == [3]
@@ -35,7 +31,7 @@ def test_reads_required_and_optional_columns(tmp_path):
     ],
 )  # fmt: skip
 def test_problems_name_file_row_and_column(tmp_path, text, fragment):
-    path = write(tmp_path, text)
+    path = write_file(tmp_path, text)
     with pytest.raises(InputError) as info:
         read_csv_table(path, REQ)
     assert str(path) in str(info.value)
