@@ -3,7 +3,8 @@
 A thread samples /proc while the call runs and records (a) meshcat servers and (b) headless
 Chromium processes started on behalf of this test process: a Chromium launcher that is a child
 of this process names its throw-away folder on its command line, and every Chromium process of
-that run (renderers, GPU, crash handler) names the same folder.
+that run (renderers, GPU, crash handler) names the same folder. With ``descendants=True`` it also
+records every process the parent started, directly or not (pool workers, say).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import threading
 import time
 from pathlib import Path
 
-from turntable_pin.viewer.browser import process_table
+from turntable_pin.viewer.browser import descendant_processes, process_table
 
 _RUN_DIR = re.compile(r"--user-data-dir=(/\S*turntable-pin-chromium-[^/\s]+)/profile")
 
@@ -31,11 +32,15 @@ def alive(pid: int) -> bool:
 class ProcessWatch:
     """Context manager collecting ``server_pids`` and ``browser_pids`` seen while it is open."""
 
-    def __init__(self, parent_pid: int | None = None, interval_s: float = 0.02) -> None:
+    def __init__(
+        self, parent_pid: int | None = None, interval_s: float = 0.02, descendants: bool = False
+    ) -> None:
         self.parent_pid = parent_pid or os.getpid()
         self.interval_s = interval_s
+        self.descendants = descendants
         self.server_pids: set[int] = set()
         self.browser_pids: set[int] = set()
+        self.descendant_pids: set[int] = set()
         self._run_dirs: set[str] = set()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._loop, daemon=True)
@@ -51,6 +56,8 @@ class ProcessWatch:
         for p in table:
             if any(run_dir in p.cmdline for run_dir in self._run_dirs):
                 self.browser_pids.add(p.pid)
+        if self.descendants:
+            self.descendant_pids.update(descendant_processes(self.parent_pid))
 
     def _loop(self) -> None:
         while not self._stop.is_set():
@@ -67,4 +74,17 @@ class ProcessWatch:
 
     def survivors(self) -> list[int]:
         """Recorded pids still running."""
-        return sorted(pid for pid in self.server_pids | self.browser_pids if alive(pid))
+        seen = self.server_pids | self.browser_pids | self.descendant_pids
+        return sorted(pid for pid in seen if alive(pid))
+
+
+def catches_signal(pid: int, signum: int) -> bool:
+    """Whether process ``pid`` has a handler installed for ``signum`` (``SigCgt`` of its status)."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    for line in status.splitlines():
+        if line.startswith("SigCgt:"):
+            return bool(int(line.split()[1], 16) >> (signum - 1) & 1)
+    return False

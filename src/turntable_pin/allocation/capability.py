@@ -60,16 +60,27 @@ class ManufacturingCapability:
     def from_yaml(cls, path: str | Path) -> ManufacturingCapability:
         """Read ``lower_bounds: {name[_unit]: value}`` and optional ``reasoning: {name: text}``.
 
-        Names without a unit suffix are arc seconds; missing names get no lower bound (0).
+        Names without a unit suffix are arc seconds; missing names get no lower bound (0). Values
+        are at most ``MAX_ANGULAR_ERROR_DEG`` (5 deg), like every angular error.
 
         Raises:
-            InputError: unreadable file, not YAML, unknown name, negative or non-numeric value.
+            InputError: unreadable file, not YAML, a key given twice (also as two spellings of one
+                error), an unknown top-level key, an unknown name, a negative or non-numeric
+                value, a value beyond the small-error range, reasoning that is not text.
         """
         path = Path(path)
         data = read_yaml(path)
         if not isinstance(data, Mapping) or not isinstance(data.get("lower_bounds"), Mapping):
             raise InputError("expected a mapping 'lower_bounds: {name: value}'", path=path)
+        extra = [str(k) for k in data if k not in ("lower_bounds", "reasoning")]
+        if extra:
+            raise InputError(
+                f"unknown top-level key(s) {', '.join(repr(k) for k in extra)}; the file holds "
+                "'lower_bounds:' and optionally 'reasoning:'",
+                path=path,
+            )
         values = np.zeros(len(ANGULAR_ERROR_NAMES))
+        given: dict[str, str] = {}
         for key, raw in data["lower_bounds"].items():
             try:
                 name, value = parse_error_value(str(key), raw)
@@ -77,12 +88,26 @@ class ManufacturingCapability:
                 raise InputError(f"lower_bounds: {exc.detail}", path=path) from None
             if name not in ANGULAR_ERROR_NAMES:
                 raise InputError(f"lower_bounds: '{key}' is not an angular error", path=path)
+            if name in given:
+                raise InputError(
+                    f"lower_bounds: '{key}' and '{given[name]}' both give {name}", path=path
+                )
+            given[name] = str(key)
             if value < 0.0:
                 raise InputError(f"lower_bounds: '{key}' is negative ({raw})", path=path)
             values[ANGULAR_ERROR_NAMES.index(name)] = value
         reasoning = data.get("reasoning") or {}
         if not isinstance(reasoning, Mapping):
             raise InputError("'reasoning' must map error names to text", path=path)
+        for key, text in reasoning.items():
+            if str(key) not in ANGULAR_ERROR_NAMES:
+                raise InputError(
+                    f"reasoning: '{key}' is not an angular error; known: "
+                    f"{', '.join(ANGULAR_ERROR_NAMES)}",
+                    path=path,
+                )
+            if isinstance(text, (Mapping, list)):
+                raise InputError(f"reasoning: '{key}' must be text", path=path)
         return cls(values, {str(k): str(v) for k, v in reasoning.items()}, str(path))
 
     def to_dict(self) -> dict:

@@ -9,7 +9,9 @@ phi1 harmonics of the coefficients) and, should some effect make it depend on ph
 grid as well. The result keeps each turntable's largest ``|dpsi|, |dtheta|, |dgamma|``.
 
 Chunks draw their samples from ``SeedSequence(seed).spawn(...)``, so the result depends on the seed
-only, not on the number of worker processes.
+only, not on the number of worker processes. Worker processes never outlive the run: on an error or
+an interruption (SIGINT, SIGTERM) they are killed at once, not waited for; Ctrl-C, which reaches
+the whole process group, is left to the parent.
 """
 
 from __future__ import annotations
@@ -22,8 +24,10 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..core.exceptions import InputError
+from ..core.exceptions import InputError, check_seed
+from ..core.interrupts import deferred, register_cleanup, signals_blocked, worker_initializer
 from ..core.progress import Progress
+from ..core.sizes import MAX_MONTE_CARLO_TURNTABLES, check_count
 from ..core.units import DEG_PER_RAD, arcmin_by_name
 from ..model.batch_field import ANGLE_ENTRIES, OrientationErrorField
 from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES
@@ -31,6 +35,7 @@ from ..model.turntable import TurntableModel
 from .solver import ORIENTATION_ANGLES, OrientationLimits
 
 __all__ = [
+    "TURNTABLE_BYTES",
     "CHUNK_SIZE",
     "PHI1_TOLERANCE",
     "MonteCarloResult",
@@ -40,6 +45,10 @@ __all__ = [
 ]
 
 CHUNK_SIZE = 2000  # turntables per block: the (chunk, 3, 360) intermediates stay small
+
+TURNTABLE_BYTES = 64
+"""Memory a turntable of the run keeps (its three worst angles, its share of the tasks), bytes."""
+
 # Relative size of phi1 harmonics in dR below which phi1 is taken to drop out (rounding of the
 # 5x5 trigonometric fit is ~1e-16 of the largest coefficient, which is ~1).
 PHI1_TOLERANCE = 1e-12
@@ -83,6 +92,21 @@ def _run_chunk(args) -> tuple[np.ndarray, float]:
         angles = field.angles_on_phi2_grid(phi1, phi2_grid_rad)  # (n, 3, M)
         np.maximum(worst, np.maximum(angles.max(axis=2), -angles.min(axis=2)), out=worst)
     return worst, dependence
+
+
+def _stop_workers(pools: list[ProcessPoolExecutor]) -> None:
+    """Kill the worker processes of ``pools`` (SIGKILL; no chunk is waited for) and shut the
+    pools down. Idempotent; a no-op for a pool already shut down normally."""
+    with deferred():
+        for pool in pools:
+            processes = list((getattr(pool, "_processes", None) or {}).values())
+            for process in processes:
+                if process.exitcode is None:
+                    process.kill()
+            for process in processes:
+                process.join()
+            pool.shutdown(wait=True, cancel_futures=True)
+        pools.clear()
 
 
 @dataclass(frozen=True)
@@ -187,6 +211,8 @@ def run_monte_carlo(
         raise InputError("every lower bound must be between 0 and its upper bound")
     if n < 1:
         raise InputError(f"the number of turntables must be at least 1, got {n}")
+    check_count(n, MAX_MONTE_CARLO_TURNTABLES, "random turntables", TURNTABLE_BYTES)
+    seed = check_seed(seed)
     for name, step in (("phi2", phi2_step_deg), ("phi1", phi1_step_deg)):
         if not 0.0 < step <= 90.0:
             raise InputError(f"{name} grid step must be in (0, 90] degrees, got {step}")
@@ -203,22 +229,36 @@ def run_monte_carlo(
     start = time.perf_counter()
     worst = np.empty((n, 3))
     dependence = 0.0
-    with Progress(n, "Monte Carlo", enabled=progress) as bar:
-        if workers == 1:
-            results = map(_run_chunk, tasks)
-        else:
-            pool = ProcessPoolExecutor(max_workers=workers)
-            results = pool.map(_run_chunk, tasks)
-        offset = 0
-        try:
+    pools: list[ProcessPoolExecutor] = []
+    # Registered before the workers start: an interruption at any moment still stops them.
+    unregister = register_cleanup(lambda: _stop_workers(pools))
+    try:
+        with Progress(n, "Monte Carlo", enabled=progress) as bar:
+            if workers == 1:
+                results = map(_run_chunk, tasks)
+            else:
+                # Workers start with SIGINT/SIGTERM blocked and set up their own handling.
+                with deferred(), signals_blocked():
+                    pools.append(
+                        ProcessPoolExecutor(max_workers=workers, initializer=worker_initializer)
+                    )
+                    # Not pool.map: its generator cancels the futures when interrupted, and
+                    # Python 3.11's pool then fails (a traceback) marking them broken.
+                    futures = [pools[0].submit(_run_chunk, task) for task in tasks]
+                results = (future.result() for future in futures)
+            offset = 0
             for (chunk_worst, chunk_dependence), size in zip(results, sizes, strict=True):
                 worst[offset : offset + size] = chunk_worst
                 dependence = max(dependence, chunk_dependence)
                 offset += size
                 bar.update(size)
-        finally:
-            if workers > 1:
+        with deferred():
+            for pool in pools:  # every chunk is done: the workers are idle
                 pool.shutdown(cancel_futures=True)
+            pools.clear()
+    finally:
+        _stop_workers(pools)  # on error or interruption: kill them, do not wait for their chunk
+        unregister()
     elapsed = time.perf_counter() - start
     phi1_used = (0.0,) if dependence <= PHI1_TOLERANCE else tuple(phi1_grid * DEG_PER_RAD)
     return MonteCarloResult(

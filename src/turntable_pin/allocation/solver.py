@@ -37,7 +37,7 @@ from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.exceptions import InfeasibleError, InputError
 from ..core.units import ARCMIN_PER_RAD, DEG_PER_RAD, arcmin_by_name
 from ..model.angles import ANGLE_SYMBOLS
-from ..model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
+from ..model.errors import ANGULAR_ERROR_NAMES, MAX_ANGULAR_ERROR_DEG, TurntableErrors
 from ..model.small_angle import small_angle_matrix
 from .capability import ManufacturingCapability
 from .sensitivity import PAPER_FIGURE8_TRIG, AverageSensitivities, average_sensitivities
@@ -80,7 +80,11 @@ _EQ16_LIMIT_DEG = 0.027
 
 @dataclass(frozen=True)
 class OrientationLimits:
-    """Required bounds I_psi, I_theta, I_gamma on |dpsi|, |dtheta|, |dgamma|, radians (> 0)."""
+    """Required bounds I_psi, I_theta, I_gamma on |dpsi|, |dtheta|, |dgamma|, radians.
+
+    Each is > 0 and at most ``MAX_ANGULAR_ERROR_DEG`` (5 deg, ``model.errors``): the allocation
+    is one of small errors (eq. 26), and a limit of more than a few degrees is not a small one.
+    """
 
     psi_rad: float
     theta_rad: float
@@ -91,6 +95,11 @@ class OrientationLimits:
             value = float(getattr(self, f"{name}_rad"))
             if not math.isfinite(value) or value <= 0.0:
                 raise InputError(f"orientation limit for {name} must be a positive number")
+            if value > MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD * (1.0 + 1e-12):
+                raise InputError(
+                    f"orientation limit for {name} is {value * DEG_PER_RAD:g} deg; it must be at "
+                    f"most {MAX_ANGULAR_ERROR_DEG:g} deg (a small orientation error)"
+                )
             object.__setattr__(self, f"{name}_rad", value)
 
     @classmethod

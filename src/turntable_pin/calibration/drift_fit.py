@@ -8,7 +8,12 @@ number of ``A``; a position set that cannot determine all seven coefficients rai
 
 Calibration run files (CSV, one row per position): ``phi1_deg, phi2_deg, out_x_dph, out_y_dph``
 and optionally ``sigma_dph`` (1-sigma output noise of the row) and ``time_s``; the latitude is a
-parameter of the run.
+parameter of the run. A run is refused, naming file, row and column, when an output or a
+``sigma_dph`` is beyond :data:`MAX_RUN_OUTPUT_DPH`, a ``sigma_dph`` is <= 0 or below
+:data:`MIN_RUN_SIGMA_DPH`, a ``time_s`` is negative, a commanded angle is beyond
+``MAX_COMMANDED_ANGLE_DEG``, or two rows are the same measurement (equal ``phi1_deg, phi2_deg``
+and, when present, ``time_s``: a copied row), as the measurement reader does (positions too few to
+determine the coefficients are reported before a copied row).
 """
 
 from __future__ import annotations
@@ -19,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.csv_table import read_csv_table, write_csv_table
-from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.exceptions import IdentifiabilityError, InputError, check_seed
 from ..core.units import deg_to_rad, rad_to_deg
 from .gyrowheel import (
     AXES,
@@ -29,9 +34,11 @@ from .gyrowheel import (
     GyroWheelModel,
     regressor_matrix,
 )
-from .positions import PositionInputs, PositionSet, position_inputs
+from .positions import PositionInputs, PositionSet, check_commanded_angles, position_inputs
 
 __all__ = [
+    "MAX_RUN_OUTPUT_DPH",
+    "MIN_RUN_SIGMA_DPH",
     "RUN_OPTIONAL_COLUMNS",
     "RUN_REQUIRED_COLUMNS",
     "AxisCalibration",
@@ -48,6 +55,13 @@ RUN_REQUIRED_COLUMNS: tuple[str, ...] = ("phi1_deg", "phi2_deg", "out_x_dph", "o
 """Columns every calibration run CSV must have (angles in degrees, outputs in deg/h)."""
 RUN_OPTIONAL_COLUMNS: tuple[str, ...] = ("sigma_dph", "time_s")
 """Columns read when present: 1-sigma output noise (deg/h) and time (s)."""
+MAX_RUN_OUTPUT_DPH = 1e6
+"""Largest ``|out_x_dph|``, ``|out_y_dph|`` and ``sigma_dph`` of a run, deg/h: the earth rate
+(15 deg/h) plus seven drift terms each within ``MAX_COEFFICIENT_DPH`` at 1 g stay below it; more
+is a unit mix-up (deg/s or rad/s written as deg/h), and the fit's squares would overflow."""
+MIN_RUN_SIGMA_DPH = 1e-9
+"""Smallest ``sigma_dph``, deg/h: far below any rate sensor's noise; a smaller sigma is a typo,
+and its weight 1/sigma would overflow the fit."""
 
 
 @dataclass(frozen=True)
@@ -272,6 +286,17 @@ def calibrate(
 def calibrate_run(path: str | Path, latitude_rad: float) -> CalibrationResult:
     """Read a calibration run CSV and fit it (see the module docstring for the format)."""
     table = read_csv_table(path, RUN_REQUIRED_COLUMNS, RUN_OPTIONAL_COLUMNS)
+    check_commanded_angles(table)
+    for column in ("out_x_dph", "out_y_dph", "sigma_dph"):
+        if not table.has(column):
+            continue
+        values = table[column]
+        bad = np.flatnonzero(np.abs(values) > MAX_RUN_OUTPUT_DPH)
+        if bad.size:
+            raise InputError(
+                f"must be within +-{MAX_RUN_OUTPUT_DPH:g} deg/h, found {values[bad[0]]:g}",
+                path=table.path, row=int(table.rows[bad[0]]), column=column,
+            )  # fmt: skip
     if table.has("sigma_dph"):
         bad = np.flatnonzero(table["sigma_dph"] <= 0)
         if bad.size:
@@ -279,12 +304,26 @@ def calibrate_run(path: str | Path, latitude_rad: float) -> CalibrationResult:
                 "sigma_dph must be positive", path=path, row=int(table.rows[bad[0]]),
                 column="sigma_dph",
             )  # fmt: skip
+        bad = np.flatnonzero(table["sigma_dph"] < MIN_RUN_SIGMA_DPH)
+        if bad.size:
+            raise InputError(
+                f"sigma_dph must be at least {MIN_RUN_SIGMA_DPH:g} deg/h, found "
+                f"{table['sigma_dph'][bad[0]]:g}",
+                path=table.path, row=int(table.rows[bad[0]]), column="sigma_dph",
+            )  # fmt: skip
+    if table.has("time_s"):
+        bad = np.flatnonzero(table["time_s"] < 0)
+        if bad.size:
+            raise InputError(
+                f"time since the start of the run must be >= 0, found {table['time_s'][bad[0]]:g}",
+                path=table.path, row=int(table.rows[bad[0]]), column="time_s",
+            )  # fmt: skip
     positions = PositionSet(
         deg_to_rad(table["phi1_deg"]), deg_to_rad(table["phi2_deg"]), name=str(path)
     )
     inputs = position_inputs(positions, latitude_rad)
     try:
-        return calibrate(
+        result = calibrate(
             inputs,
             table["out_x_dph"],
             table["out_y_dph"],
@@ -292,6 +331,24 @@ def calibrate_run(path: str | Path, latitude_rad: float) -> CalibrationResult:
         )
     except IdentifiabilityError as exc:
         raise IdentifiabilityError(f"{path}: {exc}") from None
+    # After the fit: positions that cannot determine the coefficients are the first problem.
+    _refuse_copied_rows(table)
+    return result
+
+
+def _refuse_copied_rows(table) -> None:
+    """Refuse two rows with equal ``phi1_deg, phi2_deg`` (and ``time_s`` when present)."""
+    key_columns = [c for c in ("phi1_deg", "phi2_deg", "time_s") if table.has(c)]
+    seen: dict[tuple, int] = {}
+    for i in range(len(table)):
+        key = tuple(round(float(table[c][i]), 9) for c in key_columns)
+        if key in seen:
+            raise InputError(
+                f"the same position as row {seen[key]} ({', '.join(key_columns)} all equal); "
+                "a copied row counts one measurement twice (repeats must differ in time_s)",
+                path=table.path, row=int(table.rows[i]), column="phi1_deg",
+            )  # fmt: skip
+        seen[key] = int(table.rows[i])
 
 
 def simulate_run(
@@ -301,8 +358,16 @@ def simulate_run(
     noise_dph: float,
     seed: int,
 ) -> dict[str, np.ndarray]:
-    """Outputs of eq. 1 at the ideal orientation plus seeded Gaussian noise, as run columns."""
-    rng = np.random.default_rng(seed)
+    """Outputs of eq. 1 at the ideal orientation plus seeded Gaussian noise, as run columns.
+
+    ``noise_dph`` is a finite number in [0, :data:`MAX_RUN_OUTPUT_DPH`]; ``seed`` a whole number
+    0 <= seed < 2**63.
+    """
+    if not 0.0 <= float(noise_dph) <= MAX_RUN_OUTPUT_DPH:
+        raise InputError(
+            f"noise_dph must be in [0, {MAX_RUN_OUTPUT_DPH:g}] deg/h, got {noise_dph!r}"
+        )
+    rng = np.random.default_rng(check_seed(seed))
     outputs = gyrowheel.outputs_dph(inputs.specific_force_g, inputs.earth_rate_dph)
     outputs = outputs + rng.normal(0.0, noise_dph, size=outputs.shape)
     columns = {

@@ -26,6 +26,7 @@ from ..core.resources import default_gyrowheel_path
 
 __all__ = [
     "AXES",
+    "MAX_COEFFICIENT_DPH",
     "N_COEFFICIENTS",
     "TERM_NAMES",
     "DriftCoefficients",
@@ -44,6 +45,11 @@ TERM_NAMES: dict[str, tuple[str, ...]] = {
 
 N_COEFFICIENTS = 7
 """Drift coefficients per sensing axis."""
+
+MAX_COEFFICIENT_DPH = 1e5
+"""Largest ``|coefficient|`` of a drift model, deg/h (deg/h/g, deg/h/g^2 for the g terms): paper
+Table 1 has values up to 105 deg/h; 1e5 deg/h (28 deg/s) of drift is no rate sensor, it is a
+unit mix-up (deg/s written as deg/h) or a typo."""
 
 
 @dataclass(frozen=True)
@@ -67,6 +73,12 @@ class DriftCoefficients:
             raise InputError(f"axis {self.axis}: expected 7 coefficients, got {len(values)}")
         if not all(math.isfinite(v) for v in values):
             raise InputError(f"axis {self.axis}: coefficients must be finite, got {values}")
+        for name, value in zip(TERM_NAMES[self.axis], values, strict=True):
+            if abs(value) > MAX_COEFFICIENT_DPH:
+                raise InputError(
+                    f"axis '{self.axis}', coefficient '{name}': {value:g} is beyond "
+                    f"+-{MAX_COEFFICIENT_DPH:g} deg/h (no rate sensor drifts that much)"
+                )
         object.__setattr__(self, "values_dph", values)
 
     @property
@@ -105,7 +117,10 @@ class DriftCoefficients:
                     f"got {value!r}"
                 )
             values.append(number)
-        return cls(axis, tuple(values))
+        try:
+            return cls(axis, tuple(values))
+        except InputError as exc:
+            raise InputError(f"{prefix}{exc}") from None
 
     def as_array(self) -> np.ndarray:
         """The coefficients as a float array of shape (7,), deg/h-based units."""

@@ -24,21 +24,33 @@ import numpy as np
 
 from ..core.csv_table import read_csv_table
 from ..core.exceptions import InputError
+from ..core.sizes import MAX_POSITIONS, check_count, turn_grid_count
 from ..core.units import deg_to_rad, rad_to_deg
 from ..model.turntable import TurntableModel
-from .site import DEFAULT_LATITUDE_DEG  # noqa: F401  (re-exported)
+from .site import DEFAULT_LATITUDE_DEG, MAX_LATITUDE_DEG  # noqa: F401  (re-exported)
 
 __all__ = [
     "DEFAULT_LATITUDE_DEG",
     "EARTH_RATE_DPH",
+    "MAX_COMMANDED_ANGLE_DEG",
+    "POSITION_BYTES",
     "PositionInputs",
     "PositionSet",
     "base_frame_inputs",
+    "check_commanded_angles",
     "position_inputs",
 ]
 
 EARTH_RATE_DPH = 15.041067
 """Earth rotation rate used by the paper (eq. 3), deg/h."""
+
+MAX_COMMANDED_ANGLE_DEG = 3600.0
+"""Largest ``|phi1|``, ``|phi2|`` a position may command, degrees (ten turns either way): angles
+are taken as written (a table may log its turns), but beyond ten turns a value is a unit mix-up
+or a typo, and trigonometry of huge angles only returns rounding noise."""
+
+POSITION_BYTES = 4096
+"""Memory a position costs in the calibration layer's computations (rough upper bound), bytes."""
 
 _GRID = re.compile(r"^grid:\s*([0-9.eE+-]+)(?:\s*x\s*([0-9.eE+-]+))?$")
 
@@ -63,8 +75,15 @@ class PositionSet:
             raise InputError(f"positions: {phi1.size} phi1 values but {phi2.size} phi2 values")
         if phi1.size == 0:
             raise InputError("positions: the set is empty")
+        check_count(phi1.size, MAX_POSITIONS, "positions", POSITION_BYTES)
         if not (np.all(np.isfinite(phi1)) and np.all(np.isfinite(phi2))):
             raise InputError("positions: angles must be finite numbers")
+        largest = float(max(np.max(np.abs(phi1)), np.max(np.abs(phi2))))
+        if largest > deg_to_rad(MAX_COMMANDED_ANGLE_DEG):
+            raise InputError(
+                f"positions: an angle of {rad_to_deg(largest):g} deg; commanded angles must be "
+                f"within +-{MAX_COMMANDED_ANGLE_DEG:g} deg"
+            )
         phi1.setflags(write=False)
         phi2.setflags(write=False)
         object.__setattr__(self, "phi1_rad", phi1)
@@ -80,6 +99,12 @@ class PositionSet:
         for step in (step1_deg, step2_deg):
             if not (np.isfinite(step) and 0 < step <= 360):
                 raise InputError(f"grid step must be in (0, 360] degrees, got {step!r}")
+        check_count(
+            float(turn_grid_count(step1_deg)) * turn_grid_count(step2_deg),
+            MAX_POSITIONS,
+            f"positions of grid:{step1_deg:g}x{step2_deg:g}",
+            POSITION_BYTES,
+        )
         phi1 = np.arange(0.0, 360.0 - 1e-9, step1_deg)
         phi2 = np.arange(0.0, 360.0 - 1e-9, step2_deg)
         p1, p2 = np.meshgrid(phi1, phi2, indexing="ij")
@@ -92,6 +117,7 @@ class PositionSet:
     def from_csv(cls, path: str | Path) -> PositionSet:
         """Read columns ``phi1_deg, phi2_deg`` (other columns are ignored)."""
         table = read_csv_table(path, ("phi1_deg", "phi2_deg"))
+        check_commanded_angles(table)
         return cls(deg_to_rad(table["phi1_deg"]), deg_to_rad(table["phi2_deg"]), str(path))
 
     @classmethod
@@ -159,6 +185,22 @@ class PositionInputs:
         return len(self.positions)
 
 
+def check_commanded_angles(table, columns=("phi1_deg", "phi2_deg")) -> None:
+    """Refuse a commanded angle beyond :data:`MAX_COMMANDED_ANGLE_DEG` in a :class:`CsvTable`,
+    naming the file, row and column."""
+    for column in columns:
+        values = table[column]
+        bad = np.flatnonzero(np.abs(values) > MAX_COMMANDED_ANGLE_DEG)
+        if bad.size:
+            raise InputError(
+                f"a commanded angle must be within +-{MAX_COMMANDED_ANGLE_DEG:g} deg (ten turns), "
+                f"found {values[bad[0]]:g}",
+                path=table.path,
+                row=int(table.rows[bad[0]]),
+                column=column,
+            )
+
+
 def base_frame_inputs(latitude_rad: float) -> tuple[np.ndarray, np.ndarray]:
     """Specific force (g) and earth rate (deg/h) in the base frame F0 (x north, y west, z up)."""
     force = np.array([0.0, 0.0, 1.0])
@@ -177,8 +219,12 @@ def position_inputs(
         model: the turntable whose *ideal* (nominal) payload orientation is used; default the
             bundled URDF. Orientation errors enter later (eq. 8), not here.
     """
-    if not (np.isfinite(latitude_rad) and abs(latitude_rad) <= np.pi / 2 + 1e-12):
-        raise InputError(f"latitude must be within +-90 degrees, got {rad_to_deg(latitude_rad)!r}")
+    largest = deg_to_rad(MAX_LATITUDE_DEG) + 1e-12
+    if not (np.isfinite(latitude_rad) and abs(latitude_rad) <= largest):
+        raise InputError(
+            f"latitude must be within +-{MAX_LATITUDE_DEG:g} degrees, got "
+            f"{rad_to_deg(latitude_rad)!r}"
+        )
     model = model if model is not None else TurntableModel()
     rotations = np.array(
         [

@@ -28,7 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.exceptions import IdentifiabilityError, InputError
-from ..core.units import rad_to_arcsec
+from ..core.units import DEG_PER_RAD, rad_to_arcsec
+from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from ..model.small_angle import small_angle_rotation
 from .gyrowheel import AXES, N_COEFFICIENTS, GyroWheelModel, regressor_matrix
 from .positions import PositionInputs
@@ -265,10 +266,19 @@ def rate_error(
     exact: bool = False,
     definition: str = "true_coefficients",
 ) -> RateErrorResult:
-    """Eqs. 7-14 for one orientation error, with beta1 and beta2 reported."""
+    """Eqs. 7-14 for one orientation error, with beta1 and beta2 reported.
+
+    Each angle must be finite and at most ``MAX_ANGULAR_ERROR_DEG`` (5 deg) in magnitude: the
+    model is one of small orientation errors.
+    """
     for name, value in (("dpsi", dpsi_rad), ("dtheta", dtheta_rad), ("dgamma", dgamma_rad)):
         if not np.isfinite(value):
             raise InputError(f"{name} must be a finite number, got {value!r}")
+        if abs(value) > MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD:
+            raise InputError(
+                f"{name} = {value:g} rad is not a small orientation error: it must be within "
+                f"+-{MAX_ANGULAR_ERROR_DEG:g} deg ({MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD:.6g} rad)"
+            )
     rotation = orientation_error_rotation(dpsi_rad, dtheta_rad, dgamma_rad, exact=exact)
     dw = rate_error_vectors_dph(gyrowheel, inputs, rotation[None], definition=definition)
     norms = np.max(np.abs(dw), axis=-2)

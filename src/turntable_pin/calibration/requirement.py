@@ -34,6 +34,7 @@ from .positions import PositionInputs, PositionSet, position_inputs
 from .rate_error import DEFINITIONS, orientation_error_rotation, rate_errors_dph
 
 __all__ = [
+    "ACCURACY_RANGE_DPH",
     "ANGLE_NAMES",
     "MAX_ANGLE_RAD",
     "PLANES",
@@ -46,6 +47,12 @@ __all__ = [
 
 MAX_ANGLE_RAD = np.radians(10.0)
 """Search limit: beyond ten degrees the small-angle model of eq. 7 is meaningless."""
+
+ACCURACY_RANGE_DPH: tuple[float, float] = (1e-6, 1.0)
+"""Accepted required calibration accuracy ``w_m``, deg/h (ends included). The requirement scales
+with ``w_m`` (about 0.01 deg for the paper's 0.01 deg/h): at 1 deg/h it is already about a degree,
+the end of the small-angle model's range; at 1e-6 deg/h it is a few thousandths of an arc second,
+below what any turntable or autocollimator resolves."""
 
 ANGLE_NAMES = ANGLE_SYMBOLS  # deprecated alias: the limits are named psi, theta, gamma
 PLANES: dict[str, tuple[str, tuple[int, int]]] = {
@@ -362,7 +369,8 @@ def orientation_requirement(
     """The orientation requirement (eqs. 15-16) for accuracy ``w_m`` on a position set.
 
     Args:
-        accuracy_dph: required calibration accuracy ``w_m``, deg/h (> 0).
+        accuracy_dph: required calibration accuracy ``w_m``, deg/h (in
+            :data:`ACCURACY_RANGE_DPH`).
         positions: the test positions.
         latitude_rad: latitude of the test site, radians.
         gyrowheel: the drift coefficients (default: paper Table 1).
@@ -371,6 +379,12 @@ def orientation_requirement(
     """
     if not (np.isfinite(accuracy_dph) and accuracy_dph > 0):
         raise InputError(f"the required accuracy must be a positive number, got {accuracy_dph!r}")
+    low, high = ACCURACY_RANGE_DPH
+    if not low <= accuracy_dph <= high:
+        raise InputError(
+            f"the required accuracy must be between {low:g} and {high:g} deg/h, "
+            f"got {accuracy_dph!r}"
+        )
     if definition not in DEFINITIONS:
         raise InputError(f"unknown rate-error definition '{definition}'; expected {DEFINITIONS}")
     gyrowheel = gyrowheel if gyrowheel is not None else GyroWheelModel.nominal()

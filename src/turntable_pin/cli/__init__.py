@@ -4,16 +4,29 @@ Each subcommand lives in a module of this package with a ``register(subparsers)`
 one is a line in :data:`COMMANDS` (its module and one-line help) and the module. Only the module of
 the command being run is imported (``turntable-pin --help`` imports none), so start-up pays for
 nothing but what the command uses. Every :class:`TurntablePinError` becomes a one-line message on
-stderr and exit status 2, never a traceback.
+stderr and exit status 2, never a traceback; SIGINT and SIGTERM (:mod:`..core.interrupts`) end
+every command within a second with status 130 / 143 and a one-line message, leaving no helper
+process (meshcat server, Chromium, pool workers) and no temporary folder behind.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
+import signal
 import sys
 
 from ..core.exceptions import TurntablePinError
+from ..core.interrupts import (
+    Interrupted,
+    exit_on_signal,
+    first_signal,
+    install_handlers,
+    interruption_handled,
+    run_cleanups,
+    signal_name,
+)
 
 __all__ = ["COMMANDS", "build_parser", "main"]
 
@@ -86,25 +99,76 @@ def _command(argv: list[str]) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the console script; returns the exit status."""
-    argv = sys.argv[1:] if argv is None else list(argv)
-    command = _command(argv)
-    # --help lists every command from the table alone; an unknown command gets argparse's message.
-    parser = _parser(set()) if command is None else build_parser(command)
-    args = parser.parse_args(argv)
-    try:
-        return int(args.func(args) or 0)
-    except TurntablePinError as exc:
-        print(f"turntable-pin {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    except BrokenPipeError:  # output piped into e.g. `head`: not an error of ours
-        import os
+    """Entry point of the console script; returns the exit status.
 
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
-    except KeyboardInterrupt:
-        print(f"turntable-pin {args.command}: interrupted", file=sys.stderr)
-        return 130
+    SIGINT and SIGTERM end every command with status 130 / 143 and a one-line message, after every
+    helper process it started is stopped and every temporary folder removed. Called without
+    ``argv`` (the console script) the handlers stay installed to the end of the process and an
+    interrupted command ends the process at once (``os._exit``, after the cleanup); with ``argv``
+    (from Python) the status is returned and the previous handlers are restored.
+    """
+    console = argv is None
+    restore = None
+    command = None
+    try:
+        restore = install_handlers()  # first, before the command's (heavy) imports
+        argv = sys.argv[1:] if argv is None else list(argv)
+        command = _command(argv)
+        # --help lists every command from the table alone; an unknown command: argparse's message.
+        parser = _parser(set()) if command is None else build_parser(command)
+        args = parser.parse_args(argv)
+        command = args.command
+        from .common import refuse_inputs_as_outputs  # no output may be one of the inputs
+
+        refuse_inputs_as_outputs(args)
+        status = int(args.func(args) or 0)
+        if first_signal() is not None:  # an interruption that some library swallowed
+            raise Interrupted(first_signal())
+        return status
+    except BaseException as exc:
+        # After a signal, whatever comes out is the interruption: some libraries swallow it and
+        # fail later in its wake (trimesh half-imported), which must not look like an error.
+        if isinstance(exc, KeyboardInterrupt) or first_signal() is not None:
+            return _interrupted(exc, command, console)
+        if isinstance(exc, TurntablePinError):
+            print(f"turntable-pin {command}: error: {exc}", file=sys.stderr)
+            return 2
+        if isinstance(exc, BrokenPipeError):  # output piped into e.g. `head`: not our error
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            return 0
+        raise
+    finally:
+        if console:  # cleanup done: a late signal just ends the process
+            exit_on_signal(f"turntable-pin {command}" if command else "turntable-pin")
+        elif restore is not None:
+            restore()
+
+
+def _interrupted(exc: BaseException, command: str | None, console: bool) -> int:
+    """Finish the cleanups an interruption cut short, say so in one line; the exit status."""
+    interruption_handled()
+    signum = first_signal() or getattr(exc, "signum", signal.SIGINT)
+    run_cleanups()
+    if console:  # the last resort: no helper process of this command outlives it
+        from ..viewer.browser import kill_descendant_processes
+
+        kill_descendant_processes()
+    name = f"turntable-pin {command}" if command else "turntable-pin"
+    print(f"{name}: interrupted ({signal_name(signum)})", file=sys.stderr)
+    if console:
+        # Everything is cleaned up; the interpreter's own teardown of pinocchio, meshcat, ...
+        # would take a few tenths of a second more, which an interrupted program does not owe.
+        # The atexit functions (say, a coverage tool's) still run.
+        import atexit
+
+        atexit._run_exitfuncs()
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        os._exit(128 + signum)
+    return 128 + signum
 
 
 if __name__ == "__main__":

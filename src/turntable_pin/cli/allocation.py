@@ -19,9 +19,20 @@ from ..allocation.solver import (
     default_orientation_limits,
 )
 from ..calibration.site import DEFAULT_LATITUDE_DEG
-from ..core.exceptions import InputError
-from ..core.units import ARCMIN_PER_RAD
-from .common import finite_float, positive_int, print_json
+from ..core.exceptions import InfeasibleError, InputError
+from ..core.units import ARCMIN_PER_RAD, DEG_PER_RAD
+from ..model.errors import MAX_ANGULAR_ERROR_DEG
+from .common import (
+    accuracy_dph,
+    bounded_float,
+    finite_float,
+    latitude_deg,
+    one_line_errors,
+    positive_float,
+    positive_int,
+    print_json,
+    seed,
+)
 
 __all__ = ["parse_limits", "register"]
 
@@ -63,6 +74,7 @@ def _number(text: str, option: str) -> float:
 
 
 def _add_allocation_options(p: argparse.ArgumentParser) -> None:
+    one_line_errors(p)
     limits = p.add_mutually_exclusive_group()
     limits.add_argument(
         "--limits-arcmin",
@@ -74,7 +86,7 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
     limits.add_argument("--limits-deg", metavar="psi=P,theta=T,gamma=G", help="... in degrees")
     p.add_argument(
         "--accuracy-dph",
-        type=finite_float,
+        type=accuracy_dph,
         default=DEFAULT_ACCURACY_DPH,
         help=f"calibration accuracy behind the default limits, deg/h ({DEFAULT_ACCURACY_DPH})",
     )
@@ -85,7 +97,7 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--latitude-deg",
-        type=finite_float,
+        type=latitude_deg,
         default=DEFAULT_LATITUDE_DEG,
         help=f"latitude behind the default limits, degrees ({DEFAULT_LATITUDE_DEG})",
     )
@@ -127,13 +139,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     _add_allocation_options(m)
     m.add_argument("-n", type=positive_int, default=10000, help="number of turntables (10000)")
-    m.add_argument("--seed", type=int, default=0, help="random seed, recorded in the output (0)")
+    m.add_argument("--seed", type=seed, default=0, help="random seed, recorded in the output (0)")
     m.add_argument(
-        "--phi2-step-deg", type=finite_float, default=1.0, help="phi2 grid step, degrees (1)"
+        "--phi2-step-deg",
+        type=bounded_float(0.0, 90.0, "deg", low_open=True),
+        default=1.0,
+        help="phi2 grid step, degrees (1)",
     )
     m.add_argument(
         "--scale-bounds",
-        type=finite_float,
+        type=positive_float,
         default=1.0,
         metavar="K",
         help="sample inside K times the allocated upper bounds (K > 1 shows the bounds are tight)",
@@ -148,10 +163,13 @@ def _allocation_from_args(args: argparse.Namespace) -> tuple[Allocation, Average
     """The allocation the options ask for and the sensitivities behind Figure 8."""
     if args.limits_arcmin is not None:
         limits = parse_limits(args.limits_arcmin, "arcmin")
+        given = f"--limits-arcmin {args.limits_arcmin}"
     elif args.limits_deg is not None:
         limits = parse_limits(args.limits_deg, "deg")
+        given = f"--limits-deg {args.limits_deg}"
     else:
         limits = default_orientation_limits(args.accuracy_dph, args.positions, args.latitude_deg)
+        given = f"the limits of --accuracy-dph {args.accuracy_dph:g}"
     capability = (
         ManufacturingCapability.from_yaml(args.lower_bounds)
         if args.lower_bounds
@@ -159,7 +177,11 @@ def _allocation_from_args(args: argparse.Namespace) -> tuple[Allocation, Average
     )
     # phi1 drops out of dR (tested), so one phi1 value is enough for the averages.
     sensitivities = average_sensitivities(phi1_grid_deg=[0.0])
-    allocation = allocate_tolerances(limits, args.weights, capability, sensitivities)
+    try:
+        allocation = allocate_tolerances(limits, args.weights, capability, sensitivities)
+    except InfeasibleError as exc:  # name the two inputs that conflict
+        source = capability.source
+        raise InfeasibleError(f"{given} with the lower bounds of {source}: {exc}") from None
     return allocation, sensitivities
 
 
@@ -188,6 +210,12 @@ def run_montecarlo(args: argparse.Namespace) -> int:
         raise InputError(f"--scale-bounds must be positive, got {args.scale_bounds}")
     allocation, _ = _allocation_from_args(args)
     upper = allocation.upper_bounds_rad * args.scale_bounds
+    if float(upper.max()) > MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD:
+        raise InputError(
+            f"--scale-bounds {args.scale_bounds:g}: the scaled bounds reach "
+            f"{float(upper.max()) * DEG_PER_RAD:g} deg, beyond the {MAX_ANGULAR_ERROR_DEG:g} deg "
+            "of a small error"
+        )
     lower = allocation.capability.lower_bounds_rad
     if args.scale_bounds < 1.0:
         lower = lower * args.scale_bounds

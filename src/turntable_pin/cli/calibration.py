@@ -13,17 +13,16 @@ from ..calibration.requirement import orientation_requirement
 from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.units import deg_to_rad
 from ..model.angles import ANGLE_NAMES, ANGLE_SYMBOLS
-from .common import finite_float, print_json
+from ..model.errors import MAX_ANGULAR_ERROR_DEG
+from .common import (
+    accuracy_dph,
+    bounded_float,
+    latitude_deg,
+    one_line_errors,
+    print_json,
+)
 
 __all__ = ["register"]
-
-
-def positive_float(text: str) -> float:
-    """argparse type: a finite number > 0."""
-    value = finite_float(text)
-    if value <= 0:
-        raise argparse.ArgumentTypeError(f"expected a number > 0, got '{text}'")
-    return value
 
 
 def _add_setup_options(parser: argparse.ArgumentParser, *, positions: bool = True) -> None:
@@ -34,7 +33,7 @@ def _add_setup_options(parser: argparse.ArgumentParser, *, positions: bool = Tru
             "grid:STEP1xSTEP2, or a CSV with phi1_deg, phi2_deg (default grid:30)",
         )  # fmt: skip
     parser.add_argument(
-        "--latitude-deg", type=finite_float, default=DEFAULT_LATITUDE_DEG,
+        "--latitude-deg", type=latitude_deg, default=DEFAULT_LATITUDE_DEG,
         help=f"latitude of the test site, degrees (default {DEFAULT_LATITUDE_DEG}, Harbin)",
     )  # fmt: skip
 
@@ -62,8 +61,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Rate-sensing errors dwx, dwy (deg/h, eq. 14) of a multi-position calibration "
         "whose payload is off by (dpsi, dtheta, dgamma) at every position.",
     )
+    one_line_errors(r)
+    small = bounded_float(
+        -MAX_ANGULAR_ERROR_DEG, MAX_ANGULAR_ERROR_DEG, "deg", why="a small orientation error"
+    )
     for name in ANGLE_NAMES:
-        r.add_argument(f"--{name}-deg", type=finite_float, default=0.0, help=f"{name}, degrees")
+        r.add_argument(f"--{name}-deg", type=small, default=0.0, help=f"{name}, degrees")
     _add_setup_options(r)
     _add_model_options(r)
     r.set_defaults(func=run_rate_error)
@@ -73,8 +76,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Largest centred rectangles inside dwx <= w_m over (dpsi, dtheta) and "
         "dwy <= w_m over (dtheta, dgamma), sharing dtheta; Figures 4 and 5 with --plots.",
     )
+    one_line_errors(q)
     q.add_argument(
-        "--accuracy-dph", type=positive_float, default=0.01,
+        "--accuracy-dph", type=accuracy_dph, default=0.01,
         help="required calibration accuracy w_m, deg/h (default 0.01)",
     )  # fmt: skip
     _add_setup_options(q)
@@ -87,6 +91,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Least-squares calibration of a run CSV (phi1_deg, phi2_deg, out_x_dph, "
         "out_y_dph[, sigma_dph, time_s]): coefficients, standard errors, residuals per position.",
     )
+    one_line_errors(c)
     c.add_argument("run", type=Path, metavar="RUN.csv")
     _add_setup_options(c, positions=False)
     c.add_argument("--json", action="store_true", help="print one JSON object")

@@ -5,22 +5,31 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from ..core.exceptions import InputError
+from ..core.exceptions import SEED_LIMIT, InputError, one_line
 from ..model.errors import TurntableErrors, parse_error_value
 from ..model.turntable import TurntableModel
 
 __all__ = [
+    "OUTPUT_OPTIONS",
+    "accuracy_dph",
     "add_error_options",
+    "bounded_float",
     "errors_from_args",
     "finite_float",
+    "latitude_deg",
     "model_from_args",
+    "one_line_errors",
+    "positive_float",
     "positive_int",
     "print_json",
+    "seed",
+    "refuse_inputs_as_outputs",
 ]
 
 
@@ -46,6 +55,89 @@ def positive_int(text: str) -> int:
     return value
 
 
+def positive_float(text: str) -> float:
+    """argparse type: a finite number > 0."""
+    value = finite_float(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got '{text}'")
+    return value
+
+
+def latitude_deg(text: str) -> float:
+    """argparse type: a latitude in degrees, within +-``MAX_LATITUDE_DEG`` (90)."""
+    from ..calibration.site import MAX_LATITUDE_DEG
+
+    value = finite_float(text)
+    if abs(value) > MAX_LATITUDE_DEG:
+        raise argparse.ArgumentTypeError(
+            f"latitude must be within +-{MAX_LATITUDE_DEG:g} degrees, got '{text}'"
+        )
+    return value
+
+
+def accuracy_dph(text: str) -> float:
+    """argparse type: a required calibration accuracy in ``ACCURACY_RANGE_DPH`` (deg/h)."""
+    from ..calibration.requirement import ACCURACY_RANGE_DPH
+
+    value = positive_float(text)
+    low, high = ACCURACY_RANGE_DPH
+    if not low <= value <= high:
+        raise argparse.ArgumentTypeError(
+            f"expected an accuracy in [{low:g}, {high:g}] deg/h, got '{text}'"
+        )
+    return value
+
+
+def seed(text: str) -> int:
+    """argparse type: a random seed, a whole number 0 <= seed < 2**63."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a whole number 0 <= seed < 2**63, got '{text}'"
+        ) from None
+    if not 0 <= value < SEED_LIMIT:
+        raise argparse.ArgumentTypeError(f"expected a whole number 0 <= seed < 2**63, got '{text}'")
+    return value
+
+
+def bounded_float(
+    low: float, high: float, unit: str = "", *, low_open: bool = False, why: str = ""
+):
+    """argparse type factory: a finite float in ``[low, high]`` (``(low, high]`` if ``low_open``).
+
+    ``unit`` and ``why`` (a few words on the range) go into the message of a refused value.
+    """
+    left = "(" if low_open else "["
+    suffix = f" {unit}" if unit else ""
+    reason = f" ({why})" if why else ""
+
+    def parse(text: str) -> float:
+        value = finite_float(text)
+        if value > high or value < low or (low_open and value == low):
+            raise argparse.ArgumentTypeError(
+                f"expected a number in {left}{low:g}, {high:g}]{suffix}{reason}, got '{text}'"
+            )
+        return value
+
+    parse.__name__ = "number"
+    return parse
+
+
+def one_line_errors(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """Make ``parser`` report a bad argument in one line (no usage block), exit status 2.
+
+    The line names the option, like every other error of the command line; ``--help`` still
+    shows the usage.
+    """
+
+    def error(message: str):
+        parser.exit(2, f"{parser.prog}: error: {one_line(message)} (see {parser.prog} --help)\n")
+
+    parser.error = error  # type: ignore[method-assign]
+    return parser
+
+
 def add_error_options(parser: argparse.ArgumentParser) -> None:
     """``--error NAME=VALUE`` (repeatable), ``--errors FILE.yaml`` and ``--urdf FILE``."""
     parser.add_argument(
@@ -68,11 +160,18 @@ def errors_from_args(args: argparse.Namespace) -> TurntableErrors:
     """The error set of ``--errors`` overridden entry by entry by ``--error``."""
     base = TurntableErrors.from_yaml(args.errors) if args.errors else TurntableErrors.zero()
     values = base.as_dict()
+    given: dict[str, str] = {}
     for item in args.error:
         if "=" not in item:
             raise InputError(f"--error '{item}': expected NAME=VALUE")
         key, _, text = item.partition("=")
-        name, value = parse_error_value(key, text)
+        try:
+            name, value = parse_error_value(key, text)
+        except InputError as exc:
+            raise InputError(f"--error '{item}': {exc.detail}") from None
+        if name in given:
+            raise InputError(f"--error '{item}': {name} is given twice (also '{given[name]}')")
+        given[name] = item
         values[name] = value
     return TurntableErrors(**values)
 
@@ -105,3 +204,40 @@ def print_json(payload: dict) -> None:
     """Print one JSON object (numpy values converted, NaN/inf as null)."""
     json.dump(_jsonable(payload), sys.stdout, indent=2, allow_nan=False)
     sys.stdout.write("\n")
+
+
+OUTPUT_OPTIONS: tuple[str, ...] = ("output", "plots")
+"""Destinations of the options through which a command writes (a file, or a folder of files)."""
+
+
+def _same_path(a: Path, b: Path) -> bool:
+    try:
+        return a.exists() and b.exists() and os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def refuse_inputs_as_outputs(args: argparse.Namespace) -> None:
+    """Refuse a command whose output path is one of its inputs (every other path option).
+
+    An output file may not be an input file (nor the same file under another name: links count);
+    a plots folder may not be an input file either. Raises :class:`InputError` naming both.
+    """
+    inputs: list[tuple[str, Path]] = []
+    for dest, value in vars(args).items():
+        if dest in OUTPUT_OPTIONS:
+            continue
+        for item in value if isinstance(value, (list, tuple)) else [value]:
+            if isinstance(item, Path):
+                inputs.append((dest, item))
+    for dest in OUTPUT_OPTIONS:
+        output = getattr(args, dest, None)
+        if not isinstance(output, Path):
+            continue
+        for name, item in inputs:
+            if output.resolve() == item.resolve() or _same_path(output, item):
+                option = "the data file" if name == "data" else f"--{name.replace('_', '-')}"
+                raise InputError(
+                    f"refusing to write --{dest} {output}: it is {option} {item}, an input of "
+                    "this command (choose another output name)"
+                )

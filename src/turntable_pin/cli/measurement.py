@@ -6,9 +6,18 @@ import argparse
 from pathlib import Path
 
 from ..core.exceptions import InputError
-from ..measurement.data import read_measurements
-from ..measurement.effects import EFFECT_NAMES, get_effect, parse_effect_list
-from .common import add_error_options, errors_from_args, finite_float, positive_int, print_json
+from ..measurement.data import MAX_TIME_S, MIN_SIGMA_ARCSEC, read_measurements
+from ..measurement.effects import EFFECT_NAMES, parse_effect_list, parse_effect_spec
+from .common import (
+    add_error_options,
+    bounded_float,
+    errors_from_args,
+    one_line_errors,
+    positive_float,
+    positive_int,
+    print_json,
+    seed,
+)
 
 __all__ = ["register"]
 
@@ -27,22 +36,29 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "time stamps and approach directions; the seed and the truth go into comment lines. "
         f"Effects: {', '.join(EFFECT_NAMES)}.",
     )
+    one_line_errors(s)
     add_error_options(s)
     s.add_argument(
         "--effect",
         action="append",
         default=[],
-        metavar="NAME[:P=V,...]",
+        metavar="NAME:P=V[,P=V...]",
         help="a hidden effect and its parameters in user units (arcsec, arcsec/g, arcsec/h), "
         "e.g. inner_encoder_harmonics:c1=3,s2=-2; repeatable",
     )
-    s.add_argument("--noise-arcsec", type=finite_float, default=1.0, help="1-sigma noise")
-    s.add_argument("--seed", type=int, default=0, help="random seed (recorded in the file)")
-    s.add_argument("--phi1-step-deg", type=finite_float, default=30.0)
-    s.add_argument("--phi2-step-deg", type=finite_float, default=30.0)
+    step = bounded_float(0.0, 360.0, "deg", low_open=True)
+    s.add_argument("--noise-arcsec", type=_noise_arcsec, default=1.0, help="1-sigma noise")
+    s.add_argument("--seed", type=seed, default=0, help="random seed (recorded in the file)")
+    s.add_argument("--phi1-step-deg", type=step, default=30.0)
+    s.add_argument("--phi2-step-deg", type=step, default=30.0)
     s.add_argument("--order", choices=ORDERS, default="grid")
     s.add_argument("--repeats", type=positive_int, default=1)
-    s.add_argument("--dwell-s", type=finite_float, default=60.0, help="time per position")
+    s.add_argument(
+        "--dwell-s",
+        type=bounded_float(0.0, MAX_TIME_S, "s", low_open=True),
+        default=60.0,
+        help="time per position",
+    )
     s.add_argument("--approach", choices=APPROACHES, default="random")
     s.add_argument("--no-sigma", action="store_true", help="leave out the sigma_arcsec column")
     s.add_argument(
@@ -59,10 +75,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "rank, determined combinations with standard errors, rms, chi2_reduced, p-value; "
         "before (base) and after (with the effects), and where the fit fails.",
     )
+    one_line_errors(f)
     _add_data_options(f)
     f.add_argument("--effects", default="", metavar="A,B", help="effects to add to the base")
     f.add_argument("--plots", type=Path, metavar="DIR", help="write residual plots (PNG) here")
-    f.add_argument("--k-sigma", type=finite_float, default=3.0, help="failing threshold")
+    f.add_argument("--k-sigma", type=positive_float, default=3.0, help="failing threshold (> 0)")
     f.set_defaults(func=run_fit)
 
     d = subparsers.add_parser(
@@ -71,6 +88,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "rank them, name the missing effect, its equivalent alternatives, and whether "
         "structure remains that nothing in the catalogue explains.",
     )
+    one_line_errors(d)
     _add_data_options(d)
     d.add_argument("--until-explained", action="store_true", help="add effects while significant")
     d.add_argument("--plots", type=Path, metavar="DIR", help="write residual plots (PNG) here")
@@ -81,11 +99,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Data, base fit, where it fails, diagnosis, fit with the missing effect, "
         "parameters; plots embedded.",
     )
+    one_line_errors(r)
     r.add_argument("data", type=Path, metavar="DATA.csv")
     r.add_argument("--ignore-sigma", action="store_true")
     r.add_argument("--until-explained", action="store_true")
     r.add_argument("-o", "--output", type=Path, required=True, metavar="report.html")
     r.set_defaults(func=run_report)
+
+
+def _noise_arcsec(text: str) -> float:
+    """argparse type of ``--noise-arcsec``: the simulator's noise range (imported when used)."""
+    from ..measurement.simulation import MAX_NOISE_ARCSEC
+
+    return bounded_float(MIN_SIGMA_ARCSEC, MAX_NOISE_ARCSEC, "arcsec")(text)
 
 
 def _add_data_options(p: argparse.ArgumentParser) -> None:
@@ -103,32 +129,24 @@ def _read(args: argparse.Namespace):
     return data.without_sigma() if args.ignore_sigma else data
 
 
-def _not_an_input(output: Path, *inputs: Path | None) -> None:
-    for item in inputs:
-        if item is not None and Path(output).resolve() == Path(item).resolve():
-            raise InputError(f"the output {output} is an input file; choose another name")
-
-
-def _parse_effect_option(text: str) -> tuple[str, dict[str, float]]:
-    name, _, rest = text.partition(":")
-    effect = get_effect(name)
-    params: dict[str, float] = {}
-    for item in filter(None, (x.strip() for x in rest.split(","))):
-        key, eq, value = item.partition("=")
-        if not eq:
-            raise InputError(f"--effect '{text}': expected NAME:P=V,... , got '{item}'")
+def _parse_effect_options(texts: list[str]) -> dict[str, dict[str, float]]:
+    """The ``--effect`` options as ``{effect: {parameter: value}}``; each effect at most once."""
+    effects: dict[str, dict[str, float]] = {}
+    for text in texts:
         try:
-            params[key.strip()] = finite_float(value)
-        except argparse.ArgumentTypeError as exc:
-            raise InputError(f"--effect '{text}', parameter '{key}': {exc}") from None
-    return effect.name, params
+            name, params = parse_effect_spec(text)
+        except InputError as exc:
+            raise InputError(f"--effect '{text}': {exc}") from None
+        if name in effects:
+            raise InputError(f"--effect '{text}': effect '{name}' is given twice")
+        effects[name] = params
+    return effects
 
 
 def run_simulate(args: argparse.Namespace) -> int:
     from ..measurement.simulation import Schedule, simulate_measurements
 
-    _not_an_input(args.output, args.errors, args.urdf)
-    effects = dict(_parse_effect_option(t) for t in args.effect)
+    effects = _parse_effect_options(args.effect)
     schedule = Schedule(
         phi1_step_deg=args.phi1_step_deg,
         phi2_step_deg=args.phi2_step_deg,
@@ -137,6 +155,11 @@ def run_simulate(args: argparse.Namespace) -> int:
         dwell_s=args.dwell_s,
         approach=args.approach,
     )
+    if schedule.duration_s() > MAX_TIME_S:
+        raise InputError(
+            f"--dwell-s {args.dwell_s:g}: the run would last {schedule.duration_s():.7g} s, more "
+            f"than {MAX_TIME_S:.7g} s (a year)"
+        )
     from ..model.turntable import TurntableModel
 
     sim = simulate_measurements(
@@ -235,7 +258,6 @@ def run_report(args: argparse.Namespace) -> int:
     from ..measurement.diagnosis import diagnose_measurements
     from ..report.html_report import write_report
 
-    _not_an_input(args.output, args.data)
     data = read_measurements(args.data)
     if args.ignore_sigma:
         data = data.without_sigma()

@@ -7,10 +7,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..calibration.positions import MAX_COMMANDED_ANGLE_DEG
 from ..core.units import M_PER_MM, deg_to_rad, rad_to_arcsec
 from ..model.angles import ANGLE_NAMES
 from ..model.small_angle import small_angle_orientation_error
-from .common import add_error_options, finite_float, model_from_args, print_json
+from .common import add_error_options, bounded_float, model_from_args, one_line_errors, print_json
 
 __all__ = ["register"]
 
@@ -23,8 +24,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "of the URDF with the errors in its joint placements), the angles dpsi, dtheta, dgamma "
         "(eq. 24) beside their small-angle values (eq. 26), and the payload origin.",
     )
-    p.add_argument("--phi1-deg", type=finite_float, default=0.0, help="outer-axis angle, degrees")
-    p.add_argument("--phi2-deg", type=finite_float, default=0.0, help="inner-axis angle, degrees")
+    one_line_errors(p)
+    angle = bounded_float(-MAX_COMMANDED_ANGLE_DEG, MAX_COMMANDED_ANGLE_DEG, "deg", why="ten turns")
+    p.add_argument("--phi1-deg", type=angle, default=0.0, help="outer-axis angle, degrees")
+    p.add_argument("--phi2-deg", type=angle, default=0.0, help="inner-axis angle, degrees")
     add_error_options(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run_orientation)
@@ -34,6 +37,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Write the turntable URDF whose joint <origin>s carry the errors; plain "
         "pinocchio.buildModelFromUrdf(OUT) gives the same dR.",
     )
+    one_line_errors(u)
     add_error_options(u)
     u.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.urdf")
     u.set_defaults(func=run_urdf)

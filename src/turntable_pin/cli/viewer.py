@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
 import time
 from pathlib import Path
@@ -102,10 +101,6 @@ def _schedule_rad(args: argparse.Namespace) -> np.ndarray:
     return animation_frames_rad(positions, args.frames_per_move)
 
 
-def _raise_interrupt(signum, frame):
-    raise KeyboardInterrupt
-
-
 def run_view(args: argparse.Namespace) -> int:
     from ..viewer.meshcat_server import MeshcatServer
 
@@ -116,31 +111,25 @@ def run_view(args: argparse.Namespace) -> int:
         raise InputError(f"--frame-seconds must be > 0, got {args.frame_seconds:g}")
     if args.duration is not None and args.duration < 0:
         raise InputError(f"--duration must be >= 0, got {args.duration:g}")
-    # A plain `kill` must shut the server down too, not orphan it.
-    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
-    try:
-        with MeshcatServer() as server:
-            scene.draw(server.visualizer)
-            scene.set_position(phi1_rad, phi2_rad)
-            print(f"meshcat viewer: {server.url}")
-            for line in scene.legend(phi1_rad, phi2_rad)[1:]:
-                print(f"  {line}")
-            until = f"for {args.duration:g} s" if args.duration is not None else "until Ctrl-C"
-            print(f"serving {until}", flush=True)
-            deadline = None if args.duration is None else time.monotonic() + args.duration
-            i = 0
-            try:
-                while deadline is None or time.monotonic() < deadline:
-                    if frames is not None:
-                        scene.set_position(*frames[i % len(frames)])
-                        i += 1
-                        time.sleep(args.frame_seconds)
-                    else:
-                        time.sleep(0.1)
-            except KeyboardInterrupt:
-                pass
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+    # Ctrl-C and a plain `kill` raise out of the loop (cli.main turns them into 130 / 143); the
+    # `with` block stops the server on the way out.
+    with MeshcatServer() as server:
+        scene.draw(server.visualizer)
+        scene.set_position(phi1_rad, phi2_rad)
+        print(f"meshcat viewer: {server.url}")
+        for line in scene.legend(phi1_rad, phi2_rad)[1:]:
+            print(f"  {line}")
+        until = f"for {args.duration:g} s" if args.duration is not None else "until Ctrl-C"
+        print(f"serving {until}", flush=True)
+        deadline = None if args.duration is None else time.monotonic() + args.duration
+        i = 0
+        while deadline is None or time.monotonic() < deadline:
+            if frames is not None:
+                scene.set_position(*frames[i % len(frames)])
+                i += 1
+                time.sleep(args.frame_seconds)
+            else:
+                time.sleep(0.1)
     print("meshcat server stopped", file=sys.stderr)
     return 0
 

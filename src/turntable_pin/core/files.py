@@ -1,7 +1,9 @@
-"""Small I/O helpers shared by every layer: atomic writes that never leave half a file behind."""
+"""Small I/O helpers shared by every layer: atomic writes that never leave half a file behind,
+and a YAML reader that refuses a key given twice."""
 
 from __future__ import annotations
 
+import functools
 import os
 import tempfile
 from collections.abc import Callable
@@ -59,17 +61,65 @@ def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
 
 
 def read_yaml(path: str | Path):
-    """Parse a YAML file; an unreadable file or invalid YAML raises :class:`InputError`."""
+    """Parse a YAML file; an unreadable file or invalid YAML raises :class:`InputError`.
+
+    A key given twice in one mapping is refused, naming the file and the line of the second one
+    (plain YAML readers keep the last value and silently drop the first).
+    """
     import yaml
 
     from .exceptions import InputError
 
     path = Path(path)
     try:
-        return yaml.safe_load(path.read_text(encoding="utf-8"))
+        text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
     except UnicodeDecodeError:
         raise InputError("not a text (UTF-8) YAML file", path=path) from None
+    try:
+        return yaml.load(text, Loader=_unique_key_loader())  # noqa: S506 (a SafeLoader)
+    except _DuplicateKey as dup:
+        raise InputError(
+            f"key '{dup.key}' is given twice (first on line {dup.first_line}); give each key once",
+            path=path,
+            line=dup.line,
+        ) from None
     except yaml.YAMLError as exc:
         raise InputError(f"not valid YAML: {str(exc).splitlines()[0]}", path=path) from None
+    except (ValueError, OverflowError, RecursionError) as exc:  # e.g. a date 2020-13-45
+        raise InputError(f"not valid YAML: {exc}", path=path) from None
+
+
+class _DuplicateKey(Exception):
+    """A mapping of a YAML document holds one key twice."""
+
+    def __init__(self, key: object, line: int, first_line: int) -> None:
+        super().__init__(key)
+        self.key, self.line, self.first_line = key, line, first_line
+
+
+@functools.lru_cache(maxsize=1)
+def _unique_key_loader():
+    """A ``yaml.SafeLoader`` subclass that raises :class:`_DuplicateKey` on a repeated key."""
+    import yaml
+
+    class UniqueKeyLoader(yaml.SafeLoader):
+        def construct_mapping(self, node, deep=False):
+            if isinstance(node, yaml.MappingNode):
+                seen: dict[object, int] = {}
+                for key_node, _ in node.value:
+                    if key_node.tag == "tag:yaml.org,2002:merge":
+                        continue
+                    key = self.construct_object(key_node, deep=True)
+                    try:
+                        first = seen.get(key)
+                    except TypeError:  # unhashable: the base class says so
+                        continue
+                    line = key_node.start_mark.line + 1
+                    if first is not None:
+                        raise _DuplicateKey(key, line, first)
+                    seen[key] = line
+            return super().construct_mapping(node, deep)
+
+    return UniqueKeyLoader

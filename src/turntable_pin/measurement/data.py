@@ -4,7 +4,11 @@ Required columns ``phi1_deg, phi2_deg, dpsi_arcsec, dtheta_arcsec, dgamma_arcsec
 ``sigma_arcsec``, ``time_s``, ``dir1``, ``dir2``; other columns are ignored. Beyond the shared
 reader's checks (missing columns, non-numbers, NaN), a file is refused, naming row and column, when:
 
-- a ``sigma_arcsec`` is <= 0, a ``time_s`` is negative, a ``dir1``/``dir2`` is not +1 or -1;
+- a value is outside its valid range: ``|phi1_deg|``, ``|phi2_deg|`` above
+  :data:`MAX_COMMANDED_ANGLE_DEG`; ``|dpsi|, |dtheta|, |dgamma|`` above
+  :data:`MAX_MEASURED_ANGLE_ARCSEC` (the small-error limit); a ``sigma_arcsec`` <= 0, below
+  :data:`MIN_SIGMA_ARCSEC` or above the small-error limit; a ``time_s`` negative or above
+  :data:`MAX_TIME_S`; a ``dir1``/``dir2`` not +1 or -1;
 - two rows are the same measurement: equal ``phi1_deg, phi2_deg`` and equal values of every
   present ``dir1, dir2, time_s`` column. Repeats of a position are legitimate when they differ in
   time or approach direction; a file without ``time_s`` that repeats a position with the same
@@ -23,14 +27,20 @@ from pathlib import Path
 
 import numpy as np
 
+from ..calibration.positions import MAX_COMMANDED_ANGLE_DEG, check_commanded_angles
 from ..core.csv_table import read_csv_table
 from ..core.exceptions import InputError
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.angles import ANGLE_NAMES
+from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from .effects.base import PositionVariables
 
 __all__ = [
     "ANGLE_NAMES",
+    "MAX_COMMANDED_ANGLE_DEG",
+    "MAX_MEASURED_ANGLE_ARCSEC",
+    "MAX_TIME_S",
+    "MIN_SIGMA_ARCSEC",
     "OPTIONAL_COLUMNS",
     "REQUIRED_COLUMNS",
     "OrientationMeasurements",
@@ -41,6 +51,15 @@ REQUIRED_COLUMNS = ("phi1_deg", "phi2_deg", "dpsi_arcsec", "dtheta_arcsec", "dga
 """Columns every measurement CSV must have (angles in degrees, errors in arcsec)."""
 OPTIONAL_COLUMNS = ("sigma_arcsec", "time_s", "dir1", "dir2")
 """Columns read when present: 1-sigma noise (arcsec), time (s), approach directions (+1/-1)."""
+
+MAX_MEASURED_ANGLE_ARCSEC = MAX_ANGULAR_ERROR_DEG * 3600.0
+"""Largest ``|dpsi|, |dtheta|, |dgamma|`` and ``sigma_arcsec`` of a row, arc seconds (5 deg):
+the model's small-error limit (:data:`~turntable_pin.model.errors.MAX_ANGULAR_ERROR_DEG`)."""
+MIN_SIGMA_ARCSEC = 1e-9
+"""Smallest ``sigma_arcsec``, arc seconds: five femtoradians, the rounding of a double-precision
+angle; a smaller sigma is no noise level, and its weight 1/sigma^2 would overflow the fit."""
+MAX_TIME_S = 366 * 86400.0
+"""Largest ``time_s``, seconds (a year): a longer run is a unit mix-up (ms written as s)."""
 
 
 @dataclass(frozen=True)
@@ -143,6 +162,19 @@ def _looks_like_radians(values_deg: np.ndarray) -> str | None:
     return None
 
 
+def _check_at_most(table, column: str, limit: float, rule: str) -> None:
+    """Refuse the first ``|value| > limit`` of ``column``, naming file, row and column."""
+    values = table[column]
+    bad = np.flatnonzero(np.abs(values) > limit)
+    if bad.size:
+        raise InputError(
+            f"{rule}, found {values[bad[0]]:g}",
+            path=table.path,
+            row=int(table.rows[bad[0]]),
+            column=column,
+        )
+
+
 def read_measurements(path: str | Path) -> OrientationMeasurements:
     """Read and validate an orientation measurement CSV (see the module docstring).
 
@@ -151,6 +183,14 @@ def read_measurements(path: str | Path) -> OrientationMeasurements:
     """
     table = read_csv_table(path, REQUIRED_COLUMNS, OPTIONAL_COLUMNS, min_rows=1)
     rows = table.rows
+    check_commanded_angles(table)
+    limit = MAX_MEASURED_ANGLE_ARCSEC
+    for column in (f"{n}_arcsec" for n in ANGLE_NAMES):
+        _check_at_most(
+            table, column, limit,
+            f"a measured orientation error must be within +-{limit:g} arcsec "
+            f"({MAX_ANGULAR_ERROR_DEG:g} deg; more is not a small error)",
+        )  # fmt: skip
     for column in ("phi1_deg", "phi2_deg"):
         why = _looks_like_radians(table[column])
         if why:
@@ -170,6 +210,17 @@ def read_measurements(path: str | Path) -> OrientationMeasurements:
                 row=int(rows[bad[0]]),
                 column="sigma_arcsec",
             )
+        bad = np.flatnonzero(table["sigma_arcsec"] < MIN_SIGMA_ARCSEC)
+        if bad.size:
+            raise InputError(
+                f"sigma must be at least {MIN_SIGMA_ARCSEC:g} arcsec, found "
+                f"{table['sigma_arcsec'][bad[0]]:g}",
+                path=table.path, row=int(rows[bad[0]]), column="sigma_arcsec",
+            )  # fmt: skip
+        _check_at_most(
+            table, "sigma_arcsec", limit,
+            f"sigma must be at most {limit:g} arcsec ({MAX_ANGULAR_ERROR_DEG:g} deg)",
+        )  # fmt: skip
     if table.has("time_s"):
         bad = np.flatnonzero(table["time_s"] < 0)
         if bad.size:
@@ -179,6 +230,10 @@ def read_measurements(path: str | Path) -> OrientationMeasurements:
                 row=int(rows[bad[0]]),
                 column="time_s",
             )
+        _check_at_most(
+            table, "time_s", MAX_TIME_S,
+            f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
+        )  # fmt: skip
     for column in ("dir1", "dir2"):
         if table.has(column):
             bad = np.flatnonzero(np.abs(table[column]) != 1)

@@ -17,9 +17,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD
 from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_DESCRIPTIONS
 from ..model.turntable import TurntableModel
+from ..stats.least_squares import RANK_RTOL
 from ..stats.model_selection import Diagnosis, diagnose
 from ..stats.structure_search import Probe
 from .data import ANGLE_NAMES, OrientationMeasurements
@@ -81,17 +83,53 @@ class OrientationFamily:
         """The effect's story: title, definition, explanation, how to confirm it."""
         return (get_effect(effect) if isinstance(effect, str) else effect).describe()
 
+    def design_warnings(self, base_fit: OrientationFit) -> list[str]:
+        """Warn when the positions determine fewer error combinations than a full grid does.
+
+        The base model's rank on the data is compared with its rank on a 15-degree grid of both
+        axes; fewer means some turntable errors (and any effect that varies with phi1 or phi2)
+        cannot be told apart here, so a step with ``dir`` or a drift with ``time_s`` may stand for
+        whatever changed between the rows.
+        """
+        data = self.data
+        rank = base_fit.result.rank
+        dense = OrientationModel(self._dense_variables(), (), self.turntable)
+        jac = dense.jacobian(np.zeros(dense.n_params)).reshape(-1, dense.n_params)
+        singular = np.linalg.svd(jac / np.linalg.norm(jac, axis=0).clip(1e-300), compute_uv=False)
+        full_rank = int(np.sum(singular > RANK_RTOL * singular[0]))
+        if rank >= full_rank:
+            return []
+        wrapped = np.round(np.mod(np.degrees([data.phi1_rad, data.phi2_rad]), 360.0), 6) % 360.0
+        distinct = np.unique(wrapped.T, axis=0)
+        where = (
+            f"all {data.n_positions} rows are at one position (phi1 {distinct[0, 0]:g}, phi2 "
+            f"{distinct[0, 1]:g} deg)"
+            if len(distinct) == 1
+            else f"the {data.n_positions} rows are at {len(distinct)} distinct positions"
+        )
+        return [
+            f"{where}: they determine {rank} of the {full_rank} combinations of the turntable "
+            "errors that a grid over both axes determines, so effects that vary with phi1 or phi2 "
+            "cannot be tested, and an effect named here (a step with dir, a drift in time) may "
+            "stand for any error that changed between the rows; measure more positions over the "
+            "full turn of both axes"
+        ]
+
     def _measured_angle_probes(self, trig: np.ndarray, shape: str, w: np.ndarray) -> list[Probe]:
         """One probe per measured angle: the harmonic pair ``trig`` (N, 2) added to that angle."""
         probes = []
         for a, angle in enumerate(ANGLE_NAMES):
-            cols = np.zeros((self.data.n_positions, 3, 2))
-            cols[:, a, :] = trig
+
+            def columns(a=a):
+                cols = np.zeros((self.data.n_positions, 3, 2))
+                cols[:, a, :] = trig * w[:, a, None]
+                return cols.reshape(-1, 2)
+
             probes.append(
                 Probe(
                     f"{angle} {shape}",
                     f"a {shape.replace('/rev', '/rev term', 1)} of {angle} itself",
-                    (cols * w[:, :, None]).reshape(-1, 2),
+                    columns,
                     ARCSEC_PER_RAD,
                     "arcsec",
                 )
@@ -109,12 +147,17 @@ class OrientationFamily:
             for k in range(1, _max_order(phi) + 1):
                 trig = np.stack([np.cos(k * phi), np.sin(k * phi)], axis=-1)  # (N, 2)
                 for e, name in enumerate(ANGULAR_ERROR_NAMES):
-                    cols = jac[:, :, e, None] * trig[:, None, :] * w[:, :, None]
+
+                    def columns(e=e, trig=trig):
+                        return (jac[:, :, e, None] * trig[:, None, :] * w[:, :, None]).reshape(
+                            -1, 2
+                        )
+
                     probes.append(
                         Probe(
                             f"{name} {k}/rev in {var}",
                             f"a {k}/rev term in {var} of {name} ({ERROR_DESCRIPTIONS[name]})",
-                            cols.reshape(-1, 2),
+                            columns,
                             ARCSEC_PER_RAD,
                             "arcsec",
                         )
@@ -138,14 +181,18 @@ class OrientationFamily:
                               [value]))  # fmt: skip
         for label, text, columns in extra:
             for a, angle in enumerate(ANGLE_NAMES):
-                cols = np.zeros((data.n_positions, 3, len(columns)))
-                for j, c in enumerate(columns):
-                    cols[:, a, j] = c
+
+                def matrix(a=a, columns=columns):
+                    cols = np.zeros((data.n_positions, 3, len(columns)))
+                    for j, c in enumerate(columns):
+                        cols[:, a, j] = c * w[:, a]
+                    return cols.reshape(-1, len(columns))
+
                 probes.append(
                     Probe(
                         f"{angle} {label}",
                         f"{text} in {angle}",
-                        (cols * w[:, :, None]).reshape(-1, len(columns)),
+                        matrix,
                         ARCSEC_PER_RAD,
                         "arcsec",
                     )
@@ -200,5 +247,10 @@ def diagnose_measurements(
     catalogue: Sequence[Effect] | None = None,
     turntable: TurntableModel | None = None,
 ) -> Diagnosis:
-    """Diagnose orientation measurements against the effect catalogue (see :mod:`diagnosis`)."""
+    """Diagnose orientation measurements against the effect catalogue (see :mod:`diagnosis`).
+
+    Raises:
+        InputError: more rows than :data:`~turntable_pin.core.sizes.MAX_DIAGNOSED_ROWS`.
+    """
+    check_count(data.n_positions, MAX_DIAGNOSED_ROWS, "measurement rows", DIAGNOSIS_ROW_BYTES)
     return diagnose(OrientationFamily(data, catalogue, turntable), until_explained=until_explained)

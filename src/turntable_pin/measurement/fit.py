@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.sizes import FIT_ROW_BYTES, MAX_FITTED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD
 from ..model.turntable import TurntableModel
 from ..stats.least_squares import FitResult, fit_least_squares
@@ -120,7 +121,11 @@ def fit_orientation(
         noise_variance: for data without sigmas, the unit-weight variance (rad^2) to judge the fit
             with (default: estimated from this fit).
         turntable: the Pinocchio model whose chain is used (default: bundled URDF).
+
+    Raises:
+        InputError: more rows than :data:`~turntable_pin.core.sizes.MAX_FITTED_ROWS`.
     """
+    check_count(data.n_positions, MAX_FITTED_ROWS, "measurement rows", FIT_ROW_BYTES)
     model = OrientationModel(data.variables(), effects, turntable)
     result = fit_least_squares(OrientationFitProblem(data, model), noise_variance=noise_variance)
     return OrientationFit(data, model, result)

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.exceptions import InputError
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from .data import ANGLE_NAMES
 
@@ -148,7 +149,12 @@ class ResidualAnalysis:
 
 
 def analyse_residuals(rs: ResidualSet, k_sigma: float = 3.0) -> ResidualAnalysis:
-    """Failing positions, rms per component and per angle value, harmonic content per axis."""
+    """Failing positions, rms per component and per angle value, harmonic content per axis.
+
+    ``k_sigma`` (> 0): a residual beyond ``k_sigma`` sigmas marks its position as failing.
+    """
+    if not (np.isfinite(k_sigma) and k_sigma > 0):
+        raise InputError(f"k_sigma must be a number > 0, got {k_sigma!r}")
     rms = {c: float(np.sqrt(np.mean(rs.residuals[:, i] ** 2))) for i, c in enumerate(rs.components)}
     by_angle, harmonics = {}, {}
     for name, angle in rs.angles_deg.items():

@@ -8,6 +8,7 @@ The output is the CSV of ``docs/measurements.md`` with the seed and the truth in
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,17 +16,25 @@ from pathlib import Path
 import numpy as np
 
 from ..core.csv_table import write_csv_table
-from ..core.exceptions import InputError
+from ..core.exceptions import InputError, check_seed
+from ..core.sizes import MAX_SIMULATED_ROWS, check_count, turn_grid_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
 from ..model.turntable import TurntableModel
-from .data import OrientationMeasurements
+from .data import (
+    MAX_MEASURED_ANGLE_ARCSEC,
+    MAX_TIME_S,
+    MIN_SIGMA_ARCSEC,
+    OrientationMeasurements,
+)
 from .effect_model import OrientationModel
 from .effects import get_effect
 from .effects.base import PositionVariables
 
 __all__ = [
+    "ROW_BYTES",
     "APPROACHES",
+    "MAX_NOISE_ARCSEC",
     "ORDERS",
     "Schedule",
     "SimulatedMeasurements",
@@ -36,6 +45,13 @@ ORDERS = ("grid", "random")
 """Measurement orders a :class:`Schedule` knows."""
 APPROACHES = ("random", "motion", "positive")
 """Approach-direction rules a :class:`Schedule` knows."""
+
+MAX_NOISE_ARCSEC = MAX_MEASURED_ANGLE_ARCSEC / 10.0
+"""Largest simulated noise sigma, arc seconds (1800, half a degree): a tenth of the largest angle
+a measurement file may hold, so that noise alone never makes a file that cannot be read back."""
+
+ROW_BYTES = 1024
+"""Memory a simulated row costs while it is built and written (rough upper bound), bytes."""
 
 
 @dataclass(frozen=True)
@@ -72,8 +88,21 @@ class Schedule:
             raise InputError(f"approach must be one of {', '.join(APPROACHES)}")
         if self.repeats < 1:
             raise InputError(f"repeats must be >= 1, got {self.repeats}")
+        check_count(
+            float(turn_grid_count(self.phi1_step_deg))
+            * turn_grid_count(self.phi2_step_deg)
+            * self.repeats,
+            MAX_SIMULATED_ROWS,
+            "rows of simulated measurements",
+            ROW_BYTES,
+        )
         if self.dwell_s <= 0:
             raise InputError(f"dwell_s must be > 0, got {self.dwell_s:g}")
+
+    def duration_s(self) -> float:
+        """Time from the first to the last measurement, seconds (``time_s`` of the last row)."""
+        count = turn_grid_count(self.phi1_step_deg) * turn_grid_count(self.phi2_step_deg)
+        return (count * self.repeats - 1) * float(self.dwell_s)
 
     def positions_deg(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
         """Commanded (phi1, phi2) in degrees, in measurement order."""
@@ -176,18 +205,52 @@ def simulate_measurements(
         effects: ``{effect name: {parameter name: value in user units}}`` (parameters not given
             are zero; units are the effect's, e.g. arcsec, arcsec/g, arcsec/h).
         schedule: positions, order, time and approach directions (default: 30-degree grid).
-        noise_arcsec: 1-sigma Gaussian noise on each angle (> 0).
-        seed: seed of every random choice (order, directions, noise).
+        noise_arcsec: 1-sigma Gaussian noise on each angle (in ``[MIN_SIGMA_ARCSEC,
+            MAX_NOISE_ARCSEC]``: the file must read back).
+        seed: seed of every random choice (order, directions, noise): a whole number
+            0 <= seed < 2**63.
+
+    Every effect needs at least one parameter, each within ``+-MAX_MEASURED_ANGLE_ARCSEC`` in its
+    user unit; the run may last at most ``MAX_TIME_S`` and the simulated angles must stay within
+    what a measurement file may hold, or :class:`InputError` says which.
         turntable: the Pinocchio model (default: bundled URDF).
     """
+    limit = MAX_MEASURED_ANGLE_ARCSEC
     if not noise_arcsec > 0:
         raise InputError(f"noise_arcsec must be > 0, got {noise_arcsec:g}")
+    if not MIN_SIGMA_ARCSEC <= noise_arcsec <= MAX_NOISE_ARCSEC:
+        raise InputError(
+            f"noise_arcsec must be in [{MIN_SIGMA_ARCSEC:g}, {MAX_NOISE_ARCSEC:g}], got "
+            f"{noise_arcsec:g}"
+        )
+    seed = check_seed(seed)
     errors = errors or TurntableErrors.zero()
     schedule = schedule or Schedule()
     effects = {name: dict(params) for name, params in (effects or {}).items()}
+    for name, params in effects.items():
+        if not params:
+            raise InputError(
+                f"effect '{name}' is given without parameters, so it would simulate nothing; "
+                "give at least one"
+            )
+        for pname, value in params.items():
+            try:
+                number = float(value)
+            except (TypeError, ValueError):
+                number = math.nan
+            if not abs(number) <= limit:
+                raise InputError(
+                    f"effect '{name}', parameter '{pname}' = {value!r}: must be a number within "
+                    f"+-{limit:g} (in its user unit: arcsec, arcsec/g or arcsec/h)"
+                )
     rng = np.random.default_rng(seed)
     phi1_deg, phi2_deg = schedule.positions_deg(rng)
     n = phi1_deg.size
+    if schedule.duration_s() > MAX_TIME_S:
+        raise InputError(
+            f"dwell_s {schedule.dwell_s:g}: the run of {n} measurements would last "
+            f"{schedule.duration_s():.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
+        )
     variables = PositionVariables(
         phi1_rad=phi1_deg / DEG_PER_RAD,
         phi2_rad=phi2_deg / DEG_PER_RAD,
@@ -210,6 +273,13 @@ def simulate_measurements(
     truth = model.predict(model.parameter_vector(values))
     sigma_rad = noise_arcsec / ARCSEC_PER_RAD
     measured = truth + rng.normal(0.0, sigma_rad, truth.shape)
+    largest = float(np.max(np.abs(measured))) * ARCSEC_PER_RAD
+    if not largest <= limit:
+        raise InputError(
+            f"the simulated orientation errors reach {largest:g} arcsec, beyond the +-{limit:g} "
+            "arcsec a measurement may have (docs/measurements.md); give smaller errors, effect "
+            "parameters or noise"
+        )
     data = OrientationMeasurements(
         phi1_rad=variables.phi1_rad,
         phi2_rad=variables.phi2_rad,

@@ -2,7 +2,8 @@
 
 Inside the set, the eight angular errors are radians and the intersection error ``deta`` is
 metres. Readers take user units: arc seconds (or ``_arcmin``, ``_deg``, ``_rad`` suffixes) for
-angles, millimetres (or ``_m``) for ``deta``.
+angles, millimetres (or ``_m``) for ``deta``. Readers refuse values beyond the small-error range
+(:data:`MAX_ANGULAR_ERROR_DEG`, :data:`MAX_DETA_M`).
 """
 
 from __future__ import annotations
@@ -25,6 +26,8 @@ __all__ = [
     "DEFAULT_LENGTH_UNIT",
     "ERROR_DESCRIPTIONS",
     "ERROR_NAMES",
+    "MAX_ANGULAR_ERROR_DEG",
+    "MAX_DETA_M",
     "TurntableErrors",
     "parse_error_value",
 ]
@@ -70,6 +73,17 @@ DEFAULT_ANGLE_UNIT = "arcsec"
 DEFAULT_LENGTH_UNIT = "mm"
 """Unit of ``deta`` given without a unit suffix."""
 
+MAX_ANGULAR_ERROR_DEG = 5.0
+"""Largest angle the small-error model takes, degrees: a turntable error (user input), an
+orientation error (``rate-error``, a measured ``dpsi/dtheta/dgamma``, a noise sigma) and an
+orientation limit (``allocate``). The model is first order in these angles (eq. 26 drops terms of
+order angle^2, 0.4 % of the angle at 5 degrees); an error of more than a few degrees is a broken
+or misassembled table, not a small error, and a value beyond this is refused as a typo or a unit
+mix-up (degrees written as arc seconds)."""
+MAX_DETA_M = 0.01
+"""Largest intersection error ``|deta|``, metres (10 mm): the axes of a bench-top table are
+centimetres apart at worst; more is a unit mix-up (metres written as millimetres)."""
+
 
 def _to_float(value: object, what: str) -> float:
     if isinstance(value, bool):
@@ -90,7 +104,8 @@ def parse_error_value(key: str, value: object) -> tuple[str, float]:
     Without a suffix angles are arc seconds and ``deta`` is millimetres.
 
     Raises:
-        InputError: unknown name or unit, or a value that is not a finite number.
+        InputError: unknown name or unit, a value that is not a finite number, an angle beyond
+            :data:`MAX_ANGULAR_ERROR_DEG` or a ``deta`` beyond :data:`MAX_DETA_M`.
     """
     key = key.strip()
     name, unit = key, None
@@ -107,7 +122,20 @@ def parse_error_value(key: str, value: object) -> tuple[str, float]:
     unit = unit or (DEFAULT_LENGTH_UNIT if name == "deta" else DEFAULT_ANGLE_UNIT)
     if unit not in units:
         raise InputError(f"'{key}': unit '{unit}' is not one of {', '.join(units)}")
-    return name, _to_float(value, f"error '{key}'") * units[unit]
+    number = _to_float(value, f"error '{key}'")
+    si_value = number * units[unit]
+    if name == "deta":
+        if not abs(si_value) <= MAX_DETA_M:
+            raise InputError(
+                f"error '{key}' = {number:g} {unit} is beyond the range of the model: "
+                f"|deta| must be at most {MAX_DETA_M / M_PER_MM:g} mm"
+            )
+    elif not abs(si_value) <= MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD:
+        raise InputError(
+            f"error '{key}' = {number:g} {unit} is not a small error: an angular error must be "
+            f"at most {MAX_ANGULAR_ERROR_DEG:g} deg ({MAX_ANGULAR_ERROR_DEG * 3600:g} arcsec)"
+        )
+    return name, si_value
 
 
 @dataclass(frozen=True)
@@ -178,6 +206,13 @@ class TurntableErrors:
         path = Path(path)
         data = read_yaml(path)
         if isinstance(data, Mapping) and "errors" in data:
+            extra = [str(k) for k in data if k != "errors"]
+            if extra:
+                raise InputError(
+                    f"unknown top-level key(s) {', '.join(repr(k) for k in extra)} beside "
+                    "'errors:'; the file holds either 'errors:' alone or the error names",
+                    path=path,
+                )
             data = data["errors"]
         if data is None:
             data = {}

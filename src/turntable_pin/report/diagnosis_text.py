@@ -25,6 +25,7 @@ def header_lines(d: dict) -> list[str]:
         f"{b['chi2_reduced']:.3f}, {b['n_params']} parameters of rank {b['rank']}"
         + (f", p-value {b['p_value']:.3g}" if b["p_value"] is not None else "")
     )
+    lines += [f"warning: {text}" for text in d.get("warnings", [])]
     lines.append("candidates (best first; delta_bic <= -6 accepts):")
     first = d["steps"][0]["added"] if d["steps"] else None
     for c in d["candidates"]:

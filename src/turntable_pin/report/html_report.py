@@ -96,6 +96,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
         )
         + "</p>"
     )
+    parts += [f'<p class="verdict warn">warning: {html.escape(w)}</p>' for w in d["warnings"]]
     parts.append("<h2>1. The data</h2>" + _img(data_figure(data), "measured angles"))
     b = d["base"]
     parts.append(

@@ -87,6 +87,9 @@ class ModelFamily(Protocol):
     def describe(self, effect: Any) -> dict:
         """The effect's story (``title``, ``explanation``, ``confirm``...) for the reports."""
 
+    def design_warnings(self, base_fit: Any) -> list[str]:
+        """What the data's design cannot tell (e.g. too few distinct inputs), in words."""
+
 
 @dataclass
 class Candidate:
@@ -208,6 +211,7 @@ class Diagnosis:
         after_first: delta_bic of each other effect on top of the first accepted one: an effect
             that only looked significant against a base that lacked the real effect (because
             it soaked up part of that effect's signal) is no longer significant there.
+        warnings: what the data's design cannot tell (the family's ``design_warnings``).
     """
 
     family: Any = field(repr=False)
@@ -221,6 +225,7 @@ class Diagnosis:
     separations: dict[str, str]
     until_explained: bool
     after_first: dict[str, float | None] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def missing_effect(self) -> str | None:
@@ -323,6 +328,7 @@ class Diagnosis:
             ],
             "best": {"effects": [s.added for s in self.steps], **_summary(best.result, nv)},
             "verdict": verdict,
+            "warnings": list(self.warnings),
             "decision_rule": {
                 "accept_effect": f"delta_bic <= {BIC_THRESHOLD:g}",
                 "alternative": f"|chi2 difference| within the {ALTERNATIVE_LEVEL:g} quantile "
@@ -384,4 +390,5 @@ def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis
         separations=separations,
         until_explained=until_explained,
         after_first=after_first,
+        warnings=list(family.design_warnings(base_fit)),
     )

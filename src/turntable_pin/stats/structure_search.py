@@ -15,7 +15,7 @@ likelihood-scale form of a Bonferroni correction (on clean data of 432 observati
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,16 +48,22 @@ class Probe:
     Attributes:
         name: short id (``a 3/rev in x``).
         description: for people.
-        columns: (m, g) weighted like the residuals (divided by sigma).
+        columns: (m, g) weighted like the residuals (divided by sigma), or a function without
+            arguments that returns them: the search then holds one probe's columns at a time,
+            so its memory stays that of a few columns however many probes there are.
         unit_scale: user units per internal unit of the probe's coefficients (for amplitudes).
         unit: the user unit of the coefficients.
     """
 
     name: str
     description: str
-    columns: np.ndarray
+    columns: np.ndarray | Callable[[], np.ndarray]
     unit_scale: float = 1.0
     unit: str = ""
+
+    def matrix(self) -> np.ndarray:
+        """The (m, g) columns (computed now when they were given as a function)."""
+        return np.asarray(self.columns() if callable(self.columns) else self.columns, dtype=float)
 
 
 @dataclass(frozen=True)
@@ -131,8 +137,9 @@ def search_structure(
         rss = float(r @ r)
         best = None
         for probe in remaining:
-            scale = np.linalg.norm(probe.columns, 2) if probe.columns.size else 0.0
-            t = probe.columns - q @ (q.T @ probe.columns)
+            columns = probe.matrix()
+            scale = np.linalg.norm(columns, 2) if columns.size else 0.0
+            t = columns - q @ (q.T @ columns)
             u, s, vt = np.linalg.svd(t, full_matrices=False)
             keep = s > NEW_FRACTION * scale
             if not keep.any():

@@ -1,9 +1,10 @@
 """Headless Chromium as a tool: render a local HTML page to PNG, or check that its images load.
 
 Every run gets a throw-away profile (``--user-data-dir``) and ``XDG_CONFIG_HOME``/``XDG_CACHE_HOME``
-in a temporary folder, so the browser writes nothing into the home folder. The browser is started
-in its own process group and the whole group is killed and waited for before a function returns,
-even on error or timeout: no browser process outlives the call.
+in a temporary folder (its ``TMPDIR`` too), so the browser writes nothing into the home folder.
+The browser is started in its own process group and the whole group is killed and waited for, and
+the folder removed, before a function returns, even on error, timeout or interruption (SIGINT,
+SIGTERM: see :mod:`turntable_pin.core.interrupts`): no browser process outlives the call.
 
 Chromium is an external program (Debian package ``chromium``), not a Python dependency; without
 it these functions raise :class:`BrowserNotFoundError`, which the CLI turns into exit status 2.
@@ -18,12 +19,12 @@ import re
 import shutil
 import signal
 import subprocess
-import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..core.exceptions import TurntablePinError
+from ..core.interrupts import deferred, register_cleanup, temporary_folder
 
 __all__ = [
     "CHROMIUM_ENV",
@@ -37,7 +38,9 @@ __all__ = [
     "ProcessInfo",
     "check_page_images",
     "chromium_available",
+    "descendant_processes",
     "find_chromium",
+    "kill_descendant_processes",
     "kill_related_processes",
     "png_size",
     "process_table",
@@ -170,6 +173,20 @@ def process_table() -> list[ProcessInfo]:
     return table
 
 
+def _grown(table: list[ProcessInfo], members: set[int]) -> set[int]:
+    """``members`` plus every process of ``table`` descending from one of them or in a session or
+    process group that one of them leads."""
+    members = set(members)
+    grew = True
+    while grew:
+        before = len(members)
+        for p in table:
+            if p.ppid in members or p.sid in members or p.pgid in members:
+                members.add(p.pid)
+        grew = len(members) > before
+    return members
+
+
 def related_processes(marker: str) -> list[int]:
     """Live processes belonging to one browser run.
 
@@ -180,23 +197,26 @@ def related_processes(marker: str) -> list[int]:
     pid, means a pid reused after the launcher was reaped is never mistaken for ours.
     """
     table = [p for p in process_table() if p.alive]
-    members = {p.pid for p in table if marker in p.cmdline}
-    grew = True
-    while grew:
-        before = len(members)
-        for p in table:
-            if p.ppid in members or p.sid in members or p.pgid in members:
-                members.add(p.pid)
-        grew = len(members) > before
+    members = _grown(table, {p.pid for p in table if marker in p.cmdline})
     alive = {p.pid for p in table}
     return sorted(members & alive)
 
 
-def kill_related_processes(marker: str, timeout_s: float = 5.0) -> None:
-    """SIGKILL every process of :func:`related_processes` and wait until none is alive."""
+def descendant_processes(pid: int | None = None) -> list[int]:
+    """Live processes started by ``pid`` (default: this process), directly or not, and those in a
+    session or process group one of them leads (children that called ``setsid``); not ``pid``."""
+    pid = os.getpid() if pid is None else pid
+    table = [p for p in process_table() if p.alive]
+    members = _grown(table, {pid}) - {pid}
+    alive = {p.pid for p in table}
+    return sorted(members & alive)
+
+
+def _kill_until_gone(find, timeout_s: float) -> None:
+    """SIGKILL every pid ``find()`` returns until it returns none (or ``timeout_s`` passed)."""
     deadline = time.monotonic() + timeout_s
     while True:
-        pids = related_processes(marker)
+        pids = find()
         if not pids or time.monotonic() > deadline:
             return
         for pid in pids:
@@ -205,6 +225,19 @@ def kill_related_processes(marker: str, timeout_s: float = 5.0) -> None:
             except (ProcessLookupError, PermissionError):
                 pass
         time.sleep(0.02)
+
+
+def kill_related_processes(marker: str, timeout_s: float = 5.0) -> None:
+    """SIGKILL every process of :func:`related_processes` and wait until none is alive."""
+    _kill_until_gone(lambda: related_processes(marker), timeout_s)
+
+
+def kill_descendant_processes(pid: int | None = None, timeout_s: float = 5.0) -> None:
+    """SIGKILL every process of :func:`descendant_processes` and wait until none is alive.
+
+    The last resort of an interrupted command line: no helper it started may outlive it.
+    """
+    _kill_until_gone(lambda: descendant_processes(pid), timeout_s)
 
 
 def run_chromium(
@@ -222,11 +255,11 @@ def run_chromium(
         BrowserError: the run did not end within ``timeout_s`` seconds.
     """
     executable = chromium or find_chromium()
-    with tempfile.TemporaryDirectory(prefix="turntable-pin-chromium-") as tmp:
-        tmp_path = Path(tmp)
+    with temporary_folder("turntable-pin-chromium-") as tmp_path:
         env = dict(os.environ)
         env["XDG_CONFIG_HOME"] = str(tmp_path / "config")
         env["XDG_CACHE_HOME"] = str(tmp_path / "cache")
+        env["TMPDIR"] = str(tmp_path)  # Chromium's own scratch folders go with the run's folder
         command = (
             executable,
             *_BASE_FLAGS,
@@ -234,26 +267,45 @@ def run_chromium(
             f"--window-size={int(width)},{int(height)}",
             *arguments,
         )
-        start = time.perf_counter()
-        proc = subprocess.Popen(
-            command,
-            stdin=subprocess.DEVNULL,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            env=env,
-            start_new_session=True,
-        )
+        started: list[subprocess.Popen] = []
+
+        def stop() -> None:
+            """Kill every process of the run (found by its folder) and reap the launcher."""
+            with deferred():
+                kill_related_processes(str(tmp_path))
+                for proc in started:
+                    if proc.poll() is None:
+                        proc.kill()
+                    proc.wait()
+
+        # Registered before the launch: an interruption at any moment still finds the browser.
+        unregister = register_cleanup(stop)
         try:
-            stdout, stderr = proc.communicate(timeout=timeout_s)
-        except subprocess.TimeoutExpired:
-            raise BrowserError(
-                f"headless Chromium did not finish within {timeout_s:g} s and was stopped"
-            ) from None
+            start = time.perf_counter()
+            with deferred():
+                started.append(
+                    subprocess.Popen(
+                        command,
+                        stdin=subprocess.DEVNULL,
+                        stdout=subprocess.PIPE,
+                        stderr=subprocess.PIPE,
+                        env=env,
+                        start_new_session=True,
+                    )
+                )
+            proc = started[0]
+            # Chromium runs in a session of its own: Ctrl-C never reaches it, so an interrupted
+            # communicate() need not wait the 0.25 s it grants a child to end on that signal.
+            proc._sigint_wait_secs = 0.0
+            try:
+                stdout, stderr = proc.communicate(timeout=timeout_s)
+            except subprocess.TimeoutExpired:
+                raise BrowserError(
+                    f"headless Chromium did not finish within {timeout_s:g} s and was stopped"
+                ) from None
         finally:
-            kill_related_processes(str(tmp_path))
-            if proc.poll() is None:
-                proc.kill()
-            proc.wait()
+            stop()
+            unregister()
         seconds = time.perf_counter() - start
     return BrowserRun(
         pid=proc.pid,
@@ -295,8 +347,8 @@ def screenshot_html(
     page = Path(page).resolve()
     if not page.is_file():
         raise BrowserError(f"{page}: no such page to render")
-    with tempfile.TemporaryDirectory(prefix="turntable-pin-shot-") as tmp:
-        out = Path(tmp) / "shot.png"
+    with temporary_folder("turntable-pin-shot-") as tmp:
+        out = tmp / "shot.png"
         run = run_chromium(
             [
                 f"--virtual-time-budget={int(virtual_time_ms)}",
@@ -427,8 +479,8 @@ def check_page_images(
     except OSError as exc:
         raise BrowserError(f"{page}: cannot read the page: {exc.strerror or exc}") from None
     base_url = page.parent.as_uri() + "/"
-    with tempfile.TemporaryDirectory(prefix="turntable-pin-check-") as tmp:
-        copy = Path(tmp) / page.name
+    with temporary_folder("turntable-pin-check-") as tmp:
+        copy = tmp / page.name
         copy.write_text(_instrumented_page(source, base_url), encoding="utf-8")
         run = run_chromium(
             [

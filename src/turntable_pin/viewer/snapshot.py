@@ -3,21 +3,21 @@
 The scene is drawn into a short-lived meshcat server, which hands back a self-contained HTML page
 (``static_html``, about 0.9 MB, works offline); the server is then stopped. The page gets the
 controls panel hidden and a legend, and headless Chromium renders it to PNG
-(:func:`turntable_pin.viewer.browser.screenshot_html`). Neither the server nor the browser
-outlives the call, also on error. The same scene and angles give a byte-identical PNG (virtual
-time).
+(:func:`turntable_pin.viewer.browser.screenshot_html`). Neither the server nor the browser nor a
+temporary folder outlives the call, also on error or interruption. The same scene and angles give
+a byte-identical PNG (virtual time).
 """
 
 from __future__ import annotations
 
 import html
-import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..core.exceptions import InputError
 from ..core.files import write_bytes_atomic
+from ..core.interrupts import temporary_folder
 from ..core.units import DEG_PER_RAD
 from .browser import find_chromium, screenshot_html
 from .meshcat_server import MeshcatServer, import_meshcat
@@ -141,8 +141,8 @@ def render_snapshot(
     start = time.perf_counter()
     page, server_pid = scene_page(scene, phi1_rad, phi2_rad, legend=legend)
     scene_seconds = time.perf_counter() - start
-    with tempfile.TemporaryDirectory(prefix="turntable-pin-scene-") as tmp:
-        page_path = Path(tmp) / "scene.html"
+    with temporary_folder("turntable-pin-scene-") as tmp:
+        page_path = tmp / "scene.html"
         page_path.write_text(page, encoding="utf-8")
         data, run = screenshot_html(
             page_path, width=width, height=height, timeout_s=timeout_s, chromium=chromium
