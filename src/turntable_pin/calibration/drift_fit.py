@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.csv_table import read_csv_table, write_csv_table
+from ..core.csv_table import read_csv_table, refuse_repeated_rows, write_csv_table
 from ..core.exceptions import IdentifiabilityError, InputError, check_seed
 from ..core.units import deg_to_rad, rad_to_deg
 from .gyrowheel import (
@@ -332,23 +332,12 @@ def calibrate_run(path: str | Path, latitude_rad: float) -> CalibrationResult:
     except IdentifiabilityError as exc:
         raise IdentifiabilityError(f"{path}: {exc}") from None
     # After the fit: positions that cannot determine the coefficients are the first problem.
-    _refuse_copied_rows(table)
+    refuse_repeated_rows(
+        table,
+        ("phi1_deg", "phi2_deg", "time_s"),
+        "a copied row counts one measurement twice (repeats must differ in time_s)",
+    )
     return result
-
-
-def _refuse_copied_rows(table) -> None:
-    """Refuse two rows with equal ``phi1_deg, phi2_deg`` (and ``time_s`` when present)."""
-    key_columns = [c for c in ("phi1_deg", "phi2_deg", "time_s") if table.has(c)]
-    seen: dict[tuple, int] = {}
-    for i in range(len(table)):
-        key = tuple(round(float(table[c][i]), 9) for c in key_columns)
-        if key in seen:
-            raise InputError(
-                f"the same position as row {seen[key]} ({', '.join(key_columns)} all equal); "
-                "a copied row counts one measurement twice (repeats must differ in time_s)",
-                path=table.path, row=int(table.rows[i]), column="phi1_deg",
-            )  # fmt: skip
-        seen[key] = int(table.rows[i])
 
 
 def simulate_run(

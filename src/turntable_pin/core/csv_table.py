@@ -16,7 +16,7 @@ import numpy as np
 
 from .exceptions import InputError
 
-__all__ = ["CsvTable", "read_csv_table", "write_csv_table"]
+__all__ = ["CsvTable", "read_csv_table", "refuse_repeated_rows", "write_csv_table"]
 
 
 @dataclass(frozen=True)
@@ -138,6 +138,25 @@ def read_csv_table(
         header=header,
         rows=np.asarray(row_numbers, dtype=int),
     )
+
+
+def refuse_repeated_rows(table: CsvTable, key_columns: Sequence[str], advice: str) -> None:
+    """Refuse two rows equal in every present column of ``key_columns`` (to 1e-9).
+
+    A copied row counts one measurement twice; the error names the second row, the first one and
+    the columns compared, then ``advice`` (what makes repeats legitimate).
+    """
+    present = [c for c in key_columns if table.has(c)]
+    seen: dict[tuple, int] = {}
+    for i in range(len(table)):
+        key = tuple(round(float(table[c][i]), 9) for c in present)
+        row = int(table.rows[i])
+        if key in seen:
+            raise InputError(
+                f"the same position as row {seen[key]} ({', '.join(present)} all equal); {advice}",
+                path=table.path, row=row, column=present[0],
+            )  # fmt: skip
+        seen[key] = row
 
 
 def write_csv_table(

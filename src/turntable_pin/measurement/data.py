@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..calibration.positions import MAX_COMMANDED_ANGLE_DEG, check_commanded_angles
-from ..core.csv_table import read_csv_table
+from ..core.csv_table import read_csv_table, refuse_repeated_rows
 from ..core.exceptions import InputError
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.angles import ANGLE_NAMES
@@ -244,19 +244,11 @@ def read_measurements(path: str | Path) -> OrientationMeasurements:
                     row=int(rows[bad[0]]),
                     column=column,
                 )
-    key_columns = [c for c in ("phi1_deg", "phi2_deg", "dir1", "dir2", "time_s") if table.has(c)]
-    seen: dict[tuple, int] = {}
-    for i in range(len(table)):
-        key = tuple(round(float(table[c][i]), 9) for c in key_columns)
-        if key in seen:
-            raise InputError(
-                f"the same position as row {seen[key]} ({', '.join(key_columns)} all equal); "
-                "repeats must differ in time_s or approach direction",
-                path=table.path,
-                row=int(rows[i]),
-                column="phi1_deg",
-            )
-        seen[key] = int(rows[i])
+    refuse_repeated_rows(
+        table,
+        ("phi1_deg", "phi2_deg", "dir1", "dir2", "time_s"),
+        "repeats must differ in time_s or approach direction",
+    )
     angles = np.stack([table[f"{n}_arcsec"] for n in ANGLE_NAMES], axis=1) / ARCSEC_PER_RAD
     return OrientationMeasurements(
         phi1_rad=table["phi1_deg"] / DEG_PER_RAD,
