@@ -50,11 +50,6 @@ __all__ = [
 
 ORIENTATION_ANGLE_NAMES = ANGLE_NAMES
 """Alias of :data:`turntable_pin.model.angles.ANGLE_NAMES` (rows of the sensitivities)."""
-_AXIS = {
-    "x": np.array([1.0, 0.0, 0.0]),
-    "y": np.array([0.0, 1.0, 0.0]),
-    "z": np.array([0.0, 0.0, 1.0]),
-}
 
 
 def _factor_twist(model: TurntableModel, name: str) -> tuple[str, np.ndarray]:
@@ -71,7 +66,7 @@ def _factor_twist(model: TurntableModel, name: str) -> tuple[str, np.ndarray]:
         values[chain.error_names.index(earlier.error)] = 0.0  # identity factors leave the tail
     tail = chain.error_transforms(values)[link.name]
     tail_se3 = pin.SE3(np.array(tail[:3, :3]), np.array(tail[:3, 3]))
-    unit = _AXIS[factor.axis]
+    unit = factor.unit
     if factor.kind == ROTATION:
         twist = pin.Motion(np.zeros(3), unit)
     else:

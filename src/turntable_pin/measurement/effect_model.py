@@ -24,7 +24,7 @@ from ..core.exceptions import InputError
 from ..core.rotations import AXIS_INDEX, axis_rotation
 from ..core.units import ARCSEC_PER_RAD
 from ..model.angles import ANGLE_ENTRIES
-from ..model.chain import ROTATION
+from ..model.chain import ROTATION, skew
 from ..model.errors import ANGULAR_ERROR_NAMES
 from ..model.turntable import TurntableModel
 from .effects.base import POST, PRE, Effect, ParameterSpec, PositionVariables
@@ -184,7 +184,10 @@ class OrientationModel:
         for f, factor in enumerate(self._factors):
             if factor.fixed is not None:
                 continue
-            d = prefix[f + 1] @ _GENERATORS[factor.axis] @ suffix[f + 1]
+            generator = (
+                _GENERATORS[factor.axis] if isinstance(factor.axis, str) else skew(factor.axis)
+            )
+            d = prefix[f + 1] @ generator @ suffix[f + 1]
             entries = np.stack([d[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)  # (N, 3)
             jac += entries[:, :, None] * factor.gain[:, None, :]
         return jac

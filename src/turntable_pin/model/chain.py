@@ -25,7 +25,17 @@ import numpy as np
 from ..core.exceptions import InputError, ModelError
 from ..core.rotations import AXIS_INDEX, axis_rotation
 
-__all__ = ["ROTATION", "TRANSLATION", "ChainLink", "ErrorChain", "ErrorFactor", "joint_axis"]
+__all__ = [
+    "ROTATION",
+    "TRANSLATION",
+    "ChainLink",
+    "ErrorChain",
+    "ErrorFactor",
+    "apply_chain_errors",
+    "joint_axis",
+    "skew",
+    "unit_vector",
+]
 
 ROTATION = "rot"
 """Kind of an error factor that rotates about a coordinate axis of the moving frame."""
@@ -40,13 +50,18 @@ class ErrorFactor:
 
     Attributes:
         kind: :data:`ROTATION` (radians) or :data:`TRANSLATION` (metres).
-        axis: ``"x"``, ``"y"`` or ``"z"`` of the moving frame.
+        axis: ``"x"``, ``"y"`` or ``"z"`` of the moving frame, or a unit 3-vector (a tuple) in it.
         error: the error parameter's name.
     """
 
     kind: str
-    axis: str
+    axis: str | tuple[float, float, float]
     error: str
+
+    @property
+    def unit(self) -> np.ndarray:
+        """The axis as a unit 3-vector of the moving frame."""
+        return unit_vector(self.axis)
 
 
 @dataclass(frozen=True)
@@ -60,6 +75,7 @@ class ChainLink:
         factors: the error factors applied after ``nominal``, in order.
         axis: unit rotation axis of a revolute joint in its own frame; ``None`` for a fixed link.
         q_index: index of the joint's value in Pinocchio's configuration vector (-1 when fixed).
+        unbounded: a continuous joint: Pinocchio holds ``(cos q, sin q)`` at ``q_index``.
     """
 
     name: str
@@ -67,6 +83,7 @@ class ChainLink:
     factors: tuple[ErrorFactor, ...]
     axis: np.ndarray | None
     q_index: int = -1
+    unbounded: bool = False
 
     @property
     def is_joint(self) -> bool:
@@ -74,15 +91,32 @@ class ChainLink:
         return self.axis is not None
 
 
+def unit_vector(axis) -> np.ndarray:
+    """``"x"``, ``"y"``, ``"z"`` or a 3-vector, as a unit 3-vector."""
+    if isinstance(axis, str):
+        out = np.zeros(3)
+        out[AXIS_INDEX[axis]] = 1.0
+        return out
+    out = np.asarray(axis, dtype=float).reshape(3)
+    return out / np.linalg.norm(out)
+
+
+def skew(vector) -> np.ndarray:
+    """The cross-product matrix ``[v]x`` of a 3-vector (the generator of rotations about it)."""
+    x, y, z = np.asarray(vector, dtype=float).reshape(3)
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
 def joint_axis(model, joint_id: int) -> np.ndarray:
     """Unit rotation axis of a revolute joint of the Pinocchio ``model``, in the joint frame."""
     joint = model.joints[joint_id]
     short = joint.shortname()
-    if short in ("JointModelRX", "JointModelRY", "JointModelRZ"):
+    if short in ("JointModelRX", "JointModelRY", "JointModelRZ",
+                 "JointModelRUBX", "JointModelRUBY", "JointModelRUBZ"):  # fmt: skip
         axis = np.zeros(3)
         axis[AXIS_INDEX[short[-1].lower()]] = 1.0
         return axis
-    if short == "JointModelRevoluteUnaligned":
+    if short in ("JointModelRevoluteUnaligned", "JointModelRevoluteUnboundedUnaligned"):
         return np.array(joint.extract().axis, dtype=float)
     raise ModelError(f"joint '{model.names[joint_id]}' is {short}, not a revolute joint")
 
@@ -180,6 +214,7 @@ class ErrorChain:
                     tuple(ErrorFactor(*f) for f in factors.get(name, ())),
                     _readonly(joint_axis(model, jid)),
                     model.joints[jid].idx_q,
+                    model.joints[jid].nq == 2,
                 )
             )
         previous = np.eye(4)  # frame placements are relative to the parent joint's frame
@@ -240,7 +275,10 @@ class ErrorChain:
             raise InputError(f"expected {len(joints)} joint angles, got {len(angles_rad)}")
         q = np.zeros(self.nq)
         for link, value in zip(joints, angles_rad, strict=True):
-            q[link.q_index] = value
+            if link.unbounded:
+                q[link.q_index : link.q_index + 2] = np.cos(value), np.sin(value)
+            else:
+                q[link.q_index] = value
         return q
 
     # ---- error transforms ---------------------------------------------------------------------
@@ -270,8 +308,10 @@ class ErrorChain:
                 step = np.broadcast_to(np.eye(4), lead + (4, 4)).copy()
                 if factor.kind == ROTATION:
                     step[..., :3, :3] = axis_rotation(factor.axis, value)
-                else:
+                elif isinstance(factor.axis, str):
                     step[..., AXIS_INDEX[factor.axis], 3] = value
+                else:
+                    step[..., :3, 3] = value[..., None] * factor.unit
                 total = total @ step
             out[link.name] = total
         return out
@@ -292,6 +332,36 @@ class ErrorChain:
                 lead = np.asarray(error_values).shape[:-1]
                 out.append((np.broadcast_to(link.nominal, lead + (4, 4)), link.axis))
         return out
+
+
+def apply_chain_errors(
+    chain: ErrorChain, nominal, model, error_values: np.ndarray
+) -> None:
+    """Write ``chain``'s error transforms for ``error_values`` into the placements of ``model``.
+
+    ``model`` is a copy of the Pinocchio model ``nominal`` the chain was read off. Joint
+    placements become ``nominal * E``; the frames Pinocchio folded the fixed joints into (all
+    placed relative to the last joint) are composed again in chain order with their errors.
+    """
+    import pinocchio as pin
+
+    def _se3(homogeneous: np.ndarray):
+        return pin.SE3(np.array(homogeneous[:3, :3]), np.array(homogeneous[:3, 3]))
+
+    transforms = chain.error_transforms(np.asarray(error_values, dtype=float))
+    for link in chain.joints:
+        if link.name in transforms:
+            jid = model.getJointId(link.name)
+            model.jointPlacements[jid] = nominal.jointPlacements[jid] * _se3(transforms[link.name])
+    actual, previous = pin.SE3.Identity(), pin.SE3.Identity()
+    for name in chain.frame_path:
+        fid = model.getFrameId(name)
+        placement = nominal.frames[fid].placement
+        actual = actual * previous.actInv(placement)
+        if name in transforms:
+            actual = actual * _se3(transforms[name])
+        model.frames[fid].placement = actual
+        previous = placement
 
 
 def compose_rotation(chain: Sequence[tuple[np.ndarray, object]], q_rad: Sequence) -> np.ndarray:

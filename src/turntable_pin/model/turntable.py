@@ -35,7 +35,7 @@ import pinocchio as pin
 from ..core.exceptions import InputError, ModelError
 from ..core.resources import default_urdf_path
 from .angles import ANGLE_ENTRIES
-from .chain import ErrorChain, joint_axis
+from .chain import ErrorChain, apply_chain_errors, joint_axis
 from .errors import ERROR_NAMES, TurntableErrors
 from .paper_table import (
     INNER_JOINT,
@@ -101,10 +101,6 @@ def _check_structure(model: pin.Model, source: str) -> None:
             raise ModelError(f"{source}: no frame '{frame}'; frames are {frame_names}")
     if model.parents[model.getJointId(INNER_JOINT)] != model.getJointId(OUTER_JOINT):
         raise ModelError(f"{source}: '{INNER_JOINT}' must be a child of '{OUTER_JOINT}'")
-
-
-def _se3(homogeneous: np.ndarray) -> pin.SE3:
-    return pin.SE3(np.array(homogeneous[:3, :3]), np.array(homogeneous[:3, 3]))
 
 
 @dataclass(frozen=True)
@@ -179,25 +175,9 @@ class TurntableModel:
 
     # ---- building ---------------------------------------------------------------------------
     def _apply_errors(self) -> None:
-        transforms = self.chain.error_transforms(self.errors.as_array())
-        nominal, model = self.nominal_pin_model, self.pin_model
-        for link in self.chain.joints:
-            if link.name in transforms:
-                jid = model.getJointId(link.name)
-                model.jointPlacements[jid] = nominal.jointPlacements[jid] * _se3(
-                    transforms[link.name]
-                )
-        # Pinocchio folds fixed joints into frames (the joint frame and the child body frame), all
-        # placed relative to the last joint: compose them in chain order with their errors.
-        actual, previous = pin.SE3.Identity(), pin.SE3.Identity()
-        for name in self.chain.frame_path:
-            fid = model.getFrameId(name)
-            placement = nominal.frames[fid].placement
-            actual = actual * previous.actInv(placement)
-            if name in transforms:
-                actual = actual * _se3(transforms[name])
-            model.frames[fid].placement = actual
-            previous = placement
+        apply_chain_errors(
+            self.chain, self.nominal_pin_model, self.pin_model, self.errors.as_array()
+        )
 
     def placement_chain(
         self, model: pin.Model | None = None

@@ -1,0 +1,308 @@
+"""Any turntable from its URDF: a generic error model read off a serial chain of 1 to 3 revolute
+joints with free names, axes and nominal origins.
+
+The rule that places the errors (stated once, here):
+
+- every joint ``J`` carries, after its nominal ``<origin>``, rotations about its own axis ``a``
+  (``J.position``, the position error) and about two directions perpendicular to it, ``u`` then
+  ``v`` (``J.tilt_a``, ``J.tilt_b``: the axis' wobble or orthogonality error), then translations
+  along ``u`` and ``v`` (``J.offset_a``, ``J.offset_b``, metres: the axes missing each other);
+- ``u`` is the coordinate axis of the joint frame least aligned with ``a`` (the first of x, y, z
+  on a tie), made perpendicular to ``a``; ``v = a x u``;
+- the payload mount (the first fixed joint after the last revolute one, or the payload frame
+  itself when there is none) carries rotations about its x, y and z axes (``M.rot_x``,
+  ``M.rot_y``, ``M.rot_z``): how the payload sits on the table.
+
+Angles are radians, offsets metres. Which combinations orientation data determine is found
+numerically (:meth:`GenericTable.identifiable`: QR with column pivoting of the orientation
+regressor on generic positions); no combination is hard-coded. The paper's table is this model
+too, under other names (see ``tests/model/test_generic_table.py``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+
+from ..core.exceptions import InputError, ModelError
+from .angles import ANGLE_ENTRIES
+from .chain import (
+    ROTATION,
+    TRANSLATION,
+    ErrorChain,
+    apply_chain_errors,
+    compose_rotation,
+    skew,
+)
+
+__all__ = [
+    "MAX_JOINTS",
+    "GenericTable",
+    "Identifiable",
+    "perpendicular_directions",
+]
+
+MAX_JOINTS = 3
+"""Most revolute joints a table may have (one to three axes)."""
+
+_REVOLUTE = ("JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned",
+             "JointModelRUBX", "JointModelRUBY", "JointModelRUBZ",
+             "JointModelRevoluteUnboundedUnaligned")  # fmt: skip
+
+
+def perpendicular_directions(axis) -> tuple[np.ndarray, np.ndarray]:
+    """``(u, v)``: unit directions perpendicular to ``axis`` by the module's stated rule."""
+    a = np.asarray(axis, dtype=float).reshape(3)
+    a = a / np.linalg.norm(a)
+    k = int(np.argmin(np.abs(a)))  # argmin takes the first on a tie: x before y before z
+    e = np.zeros(3)
+    e[k] = 1.0
+    u = e - (e @ a) * a
+    u /= np.linalg.norm(u)
+    return u, np.cross(a, u)
+
+
+def _check_urdf_text(path: Path) -> None:
+    """Refuse what Pinocchio would silently accept: mimic joints, prismatic/floating/planar."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise ModelError(f"{path}: not a readable URDF (XML error: {exc})") from None
+    for joint in root.iter("joint"):
+        name, kind = joint.get("name"), joint.get("type")
+        if joint.find("mimic") is not None:
+            raise ModelError(f"{path}: joint '{name}' is a mimic joint; give every axis its own")
+        if kind in ("prismatic", "floating", "planar"):
+            raise ModelError(
+                f"{path}: joint '{name}' is {kind}; a turntable has revolute (or continuous) "
+                "joints and fixed ones only"
+            )
+
+
+def _payload_frame(model, path: Path, payload_frame: str | None) -> str:
+    """The payload frame: the one given, or the only leaf body of the kinematic tree."""
+    import pinocchio as pin
+
+    bodies = [f for f in model.frames if f.type == pin.FrameType.BODY]
+    if payload_frame is not None:
+        if not model.existFrame(payload_frame):
+            raise ModelError(
+                f"{path}: no frame '{payload_frame}'; bodies are {[f.name for f in bodies]}"
+            )
+        return payload_frame
+    parents = {model.frames[f.parentFrame].name for f in model.frames}
+    leaves = [f.name for f in bodies if f.name not in parents]
+    if len(leaves) != 1:
+        raise ModelError(
+            f"{path}: the payload frame is ambiguous ({len(leaves)} leaf bodies: "
+            f"{', '.join(leaves)}); name it with --payload-frame"
+        )
+    return leaves[0]
+
+
+@dataclass(frozen=True)
+class Identifiable:
+    """What orientation data determine, found on generic positions.
+
+    Attributes:
+        base: the parameters QR with column pivoting picks as identifiable (one per determined
+            combination), in pivot order.
+        combinations: the determined combinations in words (reduced row-echelon form).
+        undetermined: the flat directions in words.
+        no_effect: parameters that never change the orientation (offsets).
+    """
+
+    base: tuple[str, ...]
+    combinations: tuple[str, ...]
+    undetermined: tuple[str, ...]
+    no_effect: tuple[str, ...]
+
+
+class GenericTable:
+    """The generic error model of a URDF turntable (see the module docstring for the rule).
+
+    Args:
+        urdf_path: the nominal URDF.
+        payload_frame: the payload frame (default: the only leaf of the chain).
+
+    Attributes:
+        urdf_path, payload_frame, nominal_pin_model: the table as read.
+        chain: its :class:`ErrorChain` with the generic factors.
+        parameter_names: ``<joint>.position``, ``.tilt_a``, ``.tilt_b``, ``.offset_a``,
+            ``.offset_b`` per joint from the base, then ``<mount>.rot_x``, ``.rot_y``, ``.rot_z``.
+    """
+
+    def __init__(self, urdf_path: str | Path, payload_frame: str | None = None) -> None:
+        import pinocchio as pin
+
+        path = Path(urdf_path)
+        if not path.is_file():
+            raise InputError("no such URDF file", path=path)
+        _check_urdf_text(path)
+        try:
+            model = pin.buildModelFromUrdf(str(path))
+        except (RuntimeError, ValueError) as exc:
+            raise ModelError(f"{path}: Pinocchio cannot read this URDF: {exc}") from None
+        frame = _payload_frame(model, path, payload_frame)
+        chain_joints = []
+        jid = model.frames[model.getFrameId(frame)].parentJoint
+        while jid > 0:
+            chain_joints.append(jid)
+            jid = model.parents[jid]
+        off_chain = sorted(set(range(1, model.njoints)) - set(chain_joints))
+        if off_chain:
+            names = ", ".join(model.names[j] for j in off_chain)
+            raise ModelError(
+                f"{path}: not a serial chain to '{frame}': joint(s) {names} are not on the way "
+                "from the root to the payload"
+            )
+        for j in chain_joints:
+            if model.joints[j].shortname() not in _REVOLUTE:
+                raise ModelError(
+                    f"{path}: joint '{model.names[j]}' is {model.joints[j].shortname()}, not "
+                    "revolute"
+                )
+        if not 1 <= len(chain_joints) <= MAX_JOINTS:
+            raise ModelError(
+                f"{path}: {len(chain_joints)} revolute joints on the chain to '{frame}'; a "
+                f"turntable has 1 to {MAX_JOINTS}"
+            )
+        self.urdf_path = path
+        self.payload_frame = frame
+        self.nominal_pin_model = model
+        probe = ErrorChain.from_pinocchio(model, frame, {}, ())
+        factors: dict[str, list[tuple]] = {}
+        names: list[str] = []
+        descriptions: dict[str, str] = {}
+        for link in probe.joints:
+            a = link.axis / np.linalg.norm(link.axis)
+            u, v = perpendicular_directions(a)
+            j = link.name
+            entries = [
+                (ROTATION, a, "position", f"position error of {j} (about its axis)"),
+                (ROTATION, u, "tilt_a", f"tilt of {j}'s axis about u = {_vec(u)}"),
+                (ROTATION, v, "tilt_b", f"tilt of {j}'s axis about v = {_vec(v)}"),
+                (TRANSLATION, u, "offset_a", f"offset of {j}'s axis along u (m)"),
+                (TRANSLATION, v, "offset_b", f"offset of {j}'s axis along v (m)"),
+            ]
+            factors[j] = [(kind, tuple(axis), f"{j}.{short}") for kind, axis, short, _ in entries]
+            for _, _, short, text in entries:
+                names.append(f"{j}.{short}")
+                descriptions[f"{j}.{short}"] = text
+        mount = next((link.name for link in probe.links if not link.is_joint), frame)
+        factors[mount] = [(ROTATION, ax, f"{mount}.rot_{ax}") for ax in ("x", "y", "z")]
+        for ax in ("x", "y", "z"):
+            names.append(f"{mount}.rot_{ax}")
+            descriptions[f"{mount}.rot_{ax}"] = f"payload mount rotation about its {ax} axis"
+        self.mount = mount
+        self.parameter_names = tuple(names)
+        self.descriptions = descriptions
+        self.chain = ErrorChain.from_pinocchio(model, frame, factors, names)
+
+    # ---- values ---------------------------------------------------------------------------
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The revolute joints from the base (the order of the angles everywhere)."""
+        return self.chain.joint_names
+
+    def values(self, errors: Mapping[str, float] | None = None) -> np.ndarray:
+        """The error vector (rad, m) in :attr:`parameter_names` order from ``{name: value}``."""
+        out = np.zeros(len(self.parameter_names))
+        for name, value in (errors or {}).items():
+            if name not in self.chain.error_names:
+                raise InputError(
+                    f"unknown error '{name}' for this table; its errors: "
+                    f"{', '.join(self.parameter_names)}"
+                )
+            out[self.parameter_names.index(name)] = float(value)
+        return out
+
+    def _angles(self, angles_rad: Sequence) -> list[np.ndarray]:
+        if len(angles_rad) != len(self.joint_names):
+            raise InputError(
+                f"expected {len(self.joint_names)} joint angle(s) ({', '.join(self.joint_names)})"
+                f", got {len(angles_rad)}"
+            )
+        return [np.asarray(a, dtype=float) for a in angles_rad]
+
+    def rotation_error(self, error_values, angles_rad: Sequence) -> np.ndarray:
+        """``dR = Rd^T Rt`` at joint angles (chain order, broadcast), shape S + (3, 3)."""
+        q = self._angles(angles_rad)
+        rt = compose_rotation(self.chain.placements(np.asarray(error_values, float)), q)
+        rd = compose_rotation(self.chain.placements(), q)
+        return np.swapaxes(rd, -1, -2) @ rt
+
+    def pinocchio_model(self, error_values) -> object:
+        """A Pinocchio model of the table with these errors in its placements."""
+        model = self.nominal_pin_model.copy()
+        apply_chain_errors(self.chain, self.nominal_pin_model, model, error_values)
+        return model
+
+    def write_urdf(self, error_values, path: str | Path) -> Path:
+        """Write the URDF with these errors in its joint ``<origin>``s (for plain Pinocchio)."""
+        from .urdf_io import write_error_urdf
+
+        return write_error_urdf(self.urdf_path, self.chain, np.asarray(error_values, float), path)
+
+    # ---- what orientation data determine ---------------------------------------------------
+    def regressor(self, angles_rad: Sequence) -> np.ndarray:
+        """d(dpsi, dtheta, dgamma)/d(errors) at zero errors, (N, 3, P), exact (analytic)."""
+        q = [np.atleast_1d(a) for a in self._angles(angles_rad)]
+        n = np.broadcast_shapes(*(a.shape for a in q))[0]
+        rd = compose_rotation(self.chain.placements(), q)  # (N, 3, 3)
+        out = np.zeros((n, 3, len(self.parameter_names)))
+        prefix = np.broadcast_to(np.eye(3), (n, 3, 3))
+        qi = 0
+        for link in self.chain.links:
+            prefix = prefix @ link.nominal[:3, :3]
+            for factor in link.factors:  # at zero errors the factors are the identity
+                if factor.kind != ROTATION:
+                    continue
+                # Rt = P R_u(e) S with Rd = P S: d(Rd^T Rt)/de = Rd^T P [u]x P^T Rd.
+                d = np.swapaxes(rd, -1, -2) @ prefix @ skew(factor.unit) @ np.swapaxes(
+                    prefix, -1, -2
+                ) @ rd
+                col = self.parameter_names.index(factor.error)
+                out[:, :, col] = np.stack([d[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)
+            if link.is_joint:
+                from ..core.rotations import axis_rotation
+
+                prefix = prefix @ axis_rotation(link.axis, q[qi])
+                qi += 1
+        return out
+
+    @cached_property
+    def identifiable(self) -> Identifiable:
+        """What orientation data on generic positions determine (QR with column pivoting)."""
+        from scipy.linalg import qr
+
+        from ..stats.least_squares import RANK_RTOL, analyse_identifiability, combination_name
+
+        rng = np.random.default_rng(0)  # generic positions: any random draw is generic
+        angles = [rng.uniform(-np.pi, np.pi, 64) for _ in self.joint_names]
+        jac = self.regressor(angles).reshape(-1, len(self.parameter_names))
+        norms = np.linalg.norm(jac, axis=0)
+        no_effect = tuple(n for n, s in zip(self.parameter_names, norms, strict=True) if s < 1e-12)
+        live = np.flatnonzero(norms >= 1e-12)
+        _, r, pivots = qr(jac[:, live] / norms[live], mode="economic", pivoting=True)
+        diag = np.abs(np.diag(r))
+        rank = int(np.sum(diag > RANK_RTOL * diag[0]))
+        base = tuple(self.parameter_names[live[p]] for p in pivots[:rank])
+        names = tuple(self.parameter_names[i] for i in live)
+        ident = analyse_identifiability(jac[:, live], names)
+        return Identifiable(
+            base=base,
+            combinations=tuple(combination_name(c, names) for c in ident.determined),
+            undetermined=tuple(combination_name(c, names) for c in ident.undetermined),
+            no_effect=no_effect,
+        )
+
+
+def _vec(v: np.ndarray) -> str:
+    return "(" + ", ".join(f"{x:.3g}" for x in np.where(np.abs(v) < 1e-12, 0.0, v)) + ")"
