@@ -19,13 +19,13 @@ PACKAGE = Path(__file__).resolve().parents[1] / "src" / "turntable_pin"
 LAYER_RANK = {
     "core": 0,
     "stats": 1,
-    "model": 1,
-    "calibration": 2,
-    "measurement": 3,
-    "allocation": 3,
-    "report": 4,
-    "viewer": 4,
-    "cli": 5,
+    "model": 2,
+    "calibration": 3,
+    "measurement": 4,
+    "allocation": 4,
+    "report": 5,
+    "viewer": 5,
+    "cli": 6,
 }
 
 
