@@ -278,3 +278,27 @@ def test_a_single_axis_table_has_position_and_tilts(tmp_path):
     ident = table.identifiable
     assert "a.tilt_a" in ident.combinations and "a.tilt_b" in ident.combinations
     assert "a.position + m.rot_z" in ident.combinations
+
+
+def _single_axis(tmp_path):
+    fixed = '<joint name="m" type="fixed"><parent link="l1"/><child link="l2"/></joint>'
+    return GenericTable(_urdf(tmp_path, fixed))
+
+
+@pytest.mark.parametrize("table_name", ["single", "paper", "three"])
+def test_batch_field_equals_the_chain_for_one_two_and_three_axes(
+    table_name, three_axis, tmp_path, rng
+):
+    from turntable_pin import OrientationErrorField
+
+    table = {"single": lambda: _single_axis(tmp_path), "paper": lambda: GenericTable(PAPER_URDF),
+             "three": lambda: three_axis}[table_name]()  # fmt: skip
+    sets = rng.uniform(-2e-3, 2e-3, size=(3, len(table.parameter_names)))
+    field = OrientationErrorField.from_chain(table.chain, sets)
+    angles = [rng.uniform(-4, 4, 50) for _ in table.joint_names]
+    got = field.rotation(*angles)
+    for k in range(3):
+        np.testing.assert_allclose(got[k], table.rotation_error(sets[k], angles), atol=1e-12)
+    np.testing.assert_allclose(
+        field.angles(*angles)[:, :, 0], got[:, :, 0, 2], atol=0, rtol=0
+    )

@@ -57,30 +57,41 @@ def trig_basis(angle_rad) -> np.ndarray:
     return rows.T.reshape(a.shape + (N_BASIS,))
 
 
-def _outer_basis_blocks(phi1_rad: np.ndarray, phi2_rad: np.ndarray):
-    """Yield ``(slice, B)`` with ``B[5*m + n, p] = u_m(phi1[p]) u_n(phi2[p])`` per block."""
-    u1 = np.empty((N_BASIS, _CHUNK))
-    u2 = np.empty((N_BASIS, _CHUNK))
-    for start in range(0, phi1_rad.size, _CHUNK):
-        block = slice(start, min(start + _CHUNK, phi1_rad.size))
+def _outer_basis_blocks(*angles_rad: np.ndarray):
+    """Yield ``(slice, B)`` per block: ``B[5*m + n, p] = u_m(phi1[p]) u_n(phi2[p])`` for two
+    joints, the Kronecker product of the K bases (5^K rows) in general."""
+    buffers = [np.empty((N_BASIS, _CHUNK)) for _ in angles_rad]
+    for start in range(0, angles_rad[0].size, _CHUNK):
+        block = slice(start, min(start + _CHUNK, angles_rad[0].size))
         size = block.stop - block.start
-        a = _basis_rows(phi1_rad[block], u1[:, :size])
-        b = _basis_rows(phi2_rad[block], u2[:, :size])
-        yield block, (a[:, None, :] * b[None, :, :]).reshape(N_BASIS * N_BASIS, size)
+        pairs = zip(angles_rad, buffers, strict=True)
+        rows = [_basis_rows(a[block], u[:, :size]) for a, u in pairs]
+        basis = rows[0]
+        for b in rows[1:]:
+            basis = (basis[:, None, :] * b[None, :, :]).reshape(-1, size)
+        yield block, basis
 
 
 _BASIS_INV = np.linalg.inv(trig_basis(_GRID_RAD))  # rows: grid points, cols: basis functions
 
 
 def _coefficients(actual_chain, ideal_chain) -> np.ndarray:
-    """Coefficients C (K, 3, 3, 5, 5) of dR for chains whose placements have a leading dim K."""
-    g1, g2 = np.meshgrid(_GRID_RAD, _GRID_RAD, indexing="ij")  # (5, 5)
-    # Placements (K, 4, 4) broadcast against the (5, 5) grid of joint values.
-    rt = compose_rotation([(p[:, None, None], a) for p, a in actual_chain], (g1, g2))
-    rd = compose_rotation([(p[:, None, None], a) for p, a in ideal_chain], (g1, g2))
-    dR = np.swapaxes(rd, -1, -2) @ rt  # (K, 5, 5, 3, 3)
-    # dR[k, a, b] = sum_mn B[a, m] C[m, n] B[b, n]  ->  C = Binv dR Binv^T on the grid axes.
-    return np.einsum("ma,kabij,nb->kijmn", _BASIS_INV, dR, _BASIS_INV)
+    """Coefficients C (K, 3, 3, 5, ..., 5) of dR (one 5 per joint) for chains whose placements
+    have a leading dim K."""
+    n_joints = sum(axis is not None for _, axis in actual_chain)
+    grid = np.meshgrid(*([_GRID_RAD] * n_joints), indexing="ij")  # (5, ..., 5)
+    # Placements (K, 4, 4) broadcast against the grid of joint values.
+    lead = (slice(None),) + (None,) * n_joints
+    rt = compose_rotation([(p[lead], a) for p, a in actual_chain], grid)
+    rd = compose_rotation([(p[lead], a) for p, a in ideal_chain], grid)
+    dR = np.swapaxes(rd, -1, -2) @ rt  # (K, 5, ..., 5, 3, 3)
+    # dR[k, a, b] = sum_mn B[a, m] C[m, n] B[b, n]  ->  C = Binv dR Binv^T on the grid axes
+    # (two joints: "ma,kabij,nb->kijmn"; likewise one Binv per grid axis).
+    grid_in, grid_out = "abc"[:n_joints], "mno"[:n_joints]
+    inputs = [f"{grid_out[0]}{grid_in[0]}", f"k{grid_in}ij"]
+    inputs += [f"{o}{i}" for o, i in zip(grid_out[1:], grid_in[1:], strict=True)]
+    operands = [_BASIS_INV, dR] + [_BASIS_INV] * (n_joints - 1)
+    return np.einsum(f"{','.join(inputs)}->kij{grid_out}", *operands)
 
 
 class OrientationErrorField:
@@ -90,13 +101,14 @@ class OrientationErrorField:
     error sets on the same URDF). ``coefficients`` has shape (K, 3, 3, 5, 5).
     """
 
-    def __init__(self, coefficients: np.ndarray) -> None:
+    def __init__(self, coefficients: np.ndarray, n_joints: int = 2) -> None:
         coefficients = np.asarray(coefficients, dtype=float)
-        if coefficients.ndim == 4:
+        if coefficients.ndim == 2 + n_joints:
             coefficients = coefficients[None]
+        self.n_joints = int(n_joints)
         self.coefficients = coefficients
         self.coefficients.setflags(write=False)
-        # dpsi, dtheta, dgamma coefficient blocks, (K, 3, 5, 5).
+        # dpsi, dtheta, dgamma coefficient blocks, (K, 3, 5, ..., 5).
         self._angle_coefficients = np.stack(
             [coefficients[:, i, j] for i, j in ANGLE_ENTRIES], axis=1
         )
@@ -127,37 +139,50 @@ class OrientationErrorField:
         values = np.atleast_2d(np.asarray(error_values, dtype=float))
         if values.shape[-1] == len(ERROR_NAMES) - 1:
             values = np.concatenate([values, np.zeros((values.shape[0], 1))], axis=1)
-        actual = model.chain.placements(values)
-        ideal = [(p[None], a) for p, a in model.chain.placements()]
-        return cls(_coefficients(actual, ideal))
+        return cls.from_chain(model.chain, values)
+
+    @classmethod
+    def from_chain(cls, chain, error_values: np.ndarray) -> OrientationErrorField:
+        """The fields of K error sets on any :class:`ErrorChain` (1 to 3 joints).
+
+        ``error_values`` has shape (K, E) in ``chain.error_names`` order (rad, m).
+        """
+        values = np.atleast_2d(np.asarray(error_values, dtype=float))
+        actual = chain.placements(values)
+        ideal = [(p[None], a) for p, a in chain.placements()]
+        return cls(_coefficients(actual, ideal), n_joints=len(chain.joints))
 
     # ---- evaluation --------------------------------------------------------------------------
-    def _evaluate(self, coefficients: np.ndarray, phi1_rad, phi2_rad) -> np.ndarray:
-        """Contract (K, E, 5, 5) coefficients with the basis at N pairs: (K, E, N)."""
-        phi1, phi2 = np.broadcast_arrays(
-            np.asarray(phi1_rad, dtype=float).ravel(), np.asarray(phi2_rad, dtype=float).ravel()
-        )
+    def _evaluate(self, coefficients: np.ndarray, angles_rad) -> np.ndarray:
+        """Contract (K, E, 5, ..., 5) coefficients with the basis at N angle tuples: (K, E, N)."""
+        if len(angles_rad) != self.n_joints:
+            raise ValueError(f"expected {self.n_joints} joint angle arrays, got {len(angles_rad)}")
+        angles = np.broadcast_arrays(*(np.asarray(a, dtype=float).ravel() for a in angles_rad))
         k, e = coefficients.shape[:2]
-        flat = coefficients.reshape(k * e, N_BASIS * N_BASIS)
-        out = np.empty((k * e, phi1.size))
-        for block, basis in _outer_basis_blocks(phi1, phi2):
+        flat = coefficients.reshape(k * e, N_BASIS**self.n_joints)
+        out = np.empty((k * e, angles[0].size))
+        for block, basis in _outer_basis_blocks(*angles):
             out[:, block] = flat @ basis
-        return out.reshape(k, e, phi1.size)
+        return out.reshape(k, e, angles[0].size)
 
-    def rotation(self, phi1_rad, phi2_rad) -> np.ndarray:
-        """Full ``dR`` at N angle pairs (broadcast, flattened): shape (K, N, 3, 3)."""
+    def rotation(self, *angles_rad) -> np.ndarray:
+        """Full ``dR`` at N joint-angle tuples (chain order; broadcast, flattened): (K, N, 3, 3).
+
+        For the paper's table ``rotation(phi1_rad, phi2_rad)``.
+        """
         k = self.n_sets
         values = self._evaluate(
-            self.coefficients.reshape(k, 9, N_BASIS, N_BASIS), phi1_rad, phi2_rad
+            self.coefficients.reshape((k, 9) + (N_BASIS,) * self.n_joints), angles_rad
         )
         return values.transpose(0, 2, 1).reshape(k, -1, 3, 3)
 
-    def angles(self, phi1_rad, phi2_rad) -> np.ndarray:
-        """``(dpsi, dtheta, dgamma)`` in radians at N angle pairs, shape (K, N, 3).
+    def angles(self, *angles_rad) -> np.ndarray:
+        """``(dpsi, dtheta, dgamma)`` in radians at N joint-angle tuples, shape (K, N, 3).
 
-        One (3K, 25) x (25, P) product per block of P pairs; see the module docstring.
+        For two joints one (3K, 25) x (25, P) product per block of P pairs (5^K rows for K
+        joints); see the module docstring.
         """
-        return self._evaluate(self._angle_coefficients, phi1_rad, phi2_rad).transpose(0, 2, 1)
+        return self._evaluate(self._angle_coefficients, angles_rad).transpose(0, 2, 1)
 
     def angles_on_phi2_grid(self, phi1_rad: float, phi2_grid_rad) -> np.ndarray:
         """``(dpsi, dtheta, dgamma)`` of every error set on a grid of phi2 at one phi1.
