@@ -22,6 +22,9 @@ __all__ = [
     "bounded_float",
     "errors_from_args",
     "finite_float",
+    "generic_errors_from_args",
+    "generic_table_from_args",
+    "paper_table_requested",
     "latitude_deg",
     "model_from_args",
     "one_line_errors",
@@ -154,6 +157,56 @@ def add_error_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--urdf", type=Path, metavar="FILE.urdf", help="nominal turntable URDF (default: bundled)"
     )
+    parser.add_argument(
+        "--payload-frame",
+        metavar="NAME",
+        help="the payload frame of the URDF (default: the only leaf of its chain)",
+    )
+
+
+def paper_table_requested(args: argparse.Namespace) -> bool:
+    """Whether the paper's model (its nine named errors) applies: the bundled table, or a URDF
+    with the paper's joints and payload, and no ``--payload-frame`` naming another frame."""
+    from ..model.paper_table import INNER_JOINT, OUTER_JOINT, PAYLOAD_FRAME
+
+    frame = getattr(args, "payload_frame", None)
+    if frame not in (None, PAYLOAD_FRAME):
+        return False
+    if args.urdf is None:
+        return True
+    table = generic_table_from_args(args)
+    return table.joint_names == (OUTER_JOINT, INNER_JOINT) and table.payload_frame == PAYLOAD_FRAME
+
+
+def generic_table_from_args(args: argparse.Namespace):
+    """The :class:`~turntable_pin.model.generic_table.GenericTable` of ``--urdf`` and
+    ``--payload-frame``."""
+    from ..core.resources import default_urdf_path
+    from ..model.generic_table import GenericTable
+
+    return GenericTable(args.urdf or default_urdf_path(), getattr(args, "payload_frame", None))
+
+
+def generic_errors_from_args(table, args: argparse.Namespace) -> np.ndarray:
+    """The error vector of ``--errors`` overridden entry by entry by ``--error``, in the generic
+    names of ``table`` (``<joint>.position``, ``<joint>.tilt_a``, ...)."""
+    values = table.errors_from_yaml(args.errors) if args.errors else table.values()
+    given: dict[str, str] = {}
+    for item in args.error:
+        if "=" not in item:
+            raise InputError(f"--error '{item}': expected NAME=VALUE")
+        key, _, text = item.partition("=")
+        try:
+            name, value = parse_error_value(
+                key, text, names=table.parameter_names, length_names=table.length_names
+            )
+        except InputError as exc:
+            raise InputError(f"--error '{item}': {exc.detail}") from None
+        if name in given:
+            raise InputError(f"--error '{item}': {name} is given twice (also '{given[name]}')")
+        given[name] = item
+        values[table.parameter_names.index(name)] = value
+    return values
 
 
 def errors_from_args(args: argparse.Namespace) -> TurntableErrors:

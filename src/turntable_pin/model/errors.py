@@ -9,7 +9,7 @@ angles, millimetres (or ``_m``) for ``deta``. Readers refuse values beyond the s
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
@@ -21,6 +21,7 @@ from ..core.files import read_yaml, write_text_atomic
 from ..core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, M_PER_MM
 
 __all__ = [
+    "read_error_mapping",
     "ANGULAR_ERROR_NAMES",
     "DEFAULT_ANGLE_UNIT",
     "DEFAULT_LENGTH_UNIT",
@@ -97,11 +98,19 @@ def _to_float(value: object, what: str) -> float:
     return number
 
 
-def parse_error_value(key: str, value: object) -> tuple[str, float]:
+def parse_error_value(
+    key: str,
+    value: object,
+    *,
+    names: Sequence[str] = ERROR_NAMES,
+    length_names: Sequence[str] = ("deta",),
+) -> tuple[str, float]:
     """Turn one user entry into ``(name, value in rad or m)``.
 
     ``key`` is an error name, optionally with a unit suffix (``dphi_y1_arcmin``, ``deta_m``).
-    Without a suffix angles are arc seconds and ``deta`` is millimetres.
+    Without a suffix angles are arc seconds and lengths (``deta``) millimetres. ``names`` and
+    ``length_names`` are the table's error names and those of them that are lengths (default:
+    the paper's nine, of which ``deta``).
 
     Raises:
         InputError: unknown name or unit, a value that is not a finite number, an angle beyond
@@ -109,26 +118,27 @@ def parse_error_value(key: str, value: object) -> tuple[str, float]:
     """
     key = key.strip()
     name, unit = key, None
-    if key not in ERROR_NAMES:
+    if key not in names:
         base, _, suffix = key.rpartition("_")
-        if base in ERROR_NAMES:
+        if base in names:
             name, unit = base, suffix
         else:
             raise InputError(
-                f"unknown error name '{key}'; known names: {', '.join(ERROR_NAMES)} "
+                f"unknown error name '{key}'; known names: {', '.join(names)} "
                 "(optionally with a unit suffix such as _arcsec, _arcmin, _deg, _rad, _mm, _m)"
             )
-    units = _LENGTH_UNITS if name == "deta" else _ANGLE_UNITS
-    unit = unit or (DEFAULT_LENGTH_UNIT if name == "deta" else DEFAULT_ANGLE_UNIT)
+    is_length = name in length_names
+    units = _LENGTH_UNITS if is_length else _ANGLE_UNITS
+    unit = unit or (DEFAULT_LENGTH_UNIT if is_length else DEFAULT_ANGLE_UNIT)
     if unit not in units:
         raise InputError(f"'{key}': unit '{unit}' is not one of {', '.join(units)}")
     number = _to_float(value, f"error '{key}'")
     si_value = number * units[unit]
-    if name == "deta":
+    if is_length:
         if not abs(si_value) <= MAX_DETA_M:
             raise InputError(
                 f"error '{key}' = {number:g} {unit} is beyond the range of the model: "
-                f"|deta| must be at most {MAX_DETA_M / M_PER_MM:g} mm"
+                f"|{name}| must be at most {MAX_DETA_M / M_PER_MM:g} mm"
             )
     elif not abs(si_value) <= MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD:
         raise InputError(
@@ -136,6 +146,30 @@ def parse_error_value(key: str, value: object) -> tuple[str, float]:
             f"at most {MAX_ANGULAR_ERROR_DEG:g} deg ({MAX_ANGULAR_ERROR_DEG * 3600:g} arcsec)"
         )
     return name, si_value
+
+
+def read_error_mapping(path: str | Path) -> Mapping:
+    """The ``name[_unit]: value`` mapping of an errors YAML file (optionally under ``errors:``).
+
+    Raises:
+        InputError: unreadable YAML, a key beside ``errors:``, or not a mapping (naming the file).
+    """
+    path = Path(path)
+    data = read_yaml(path)
+    if isinstance(data, Mapping) and "errors" in data:
+        extra = [str(k) for k in data if k != "errors"]
+        if extra:
+            raise InputError(
+                f"unknown top-level key(s) {', '.join(repr(k) for k in extra)} beside "
+                "'errors:'; the file holds either 'errors:' alone or the error names",
+                path=path,
+            )
+        data = data["errors"]
+    if data is None:
+        data = {}
+    if not isinstance(data, Mapping):
+        raise InputError("expected a mapping of error names to values", path=path)
+    return data
 
 
 @dataclass(frozen=True)
@@ -204,20 +238,7 @@ class TurntableErrors:
               deta_mm: 0.2
         """
         path = Path(path)
-        data = read_yaml(path)
-        if isinstance(data, Mapping) and "errors" in data:
-            extra = [str(k) for k in data if k != "errors"]
-            if extra:
-                raise InputError(
-                    f"unknown top-level key(s) {', '.join(repr(k) for k in extra)} beside "
-                    "'errors:'; the file holds either 'errors:' alone or the error names",
-                    path=path,
-                )
-            data = data["errors"]
-        if data is None:
-            data = {}
-        if not isinstance(data, Mapping):
-            raise InputError("expected a mapping of error names to values", path=path)
+        data = read_error_mapping(path)
         try:
             return cls.from_user_units(data)
         except InputError as exc:

@@ -223,6 +223,63 @@ class GenericTable:
             out[self.parameter_names.index(name)] = float(value)
         return out
 
+    @property
+    def length_names(self) -> tuple[str, ...]:
+        """The parameters that are lengths (the offsets, metres)."""
+        return tuple(n for n in self.parameter_names if ".offset_" in n)
+
+    def errors_from_user_units(self, entries: Mapping[str, object]) -> np.ndarray:
+        """The error vector from ``{name[_unit]: value}`` in user units (arcsec and mm by
+        default; ``_arcmin``, ``_deg``, ``_rad``, ``_um``, ``_m`` suffixes), with the ranges of
+        :func:`~turntable_pin.model.errors.parse_error_value`."""
+        from .errors import parse_error_value
+
+        out = np.zeros(len(self.parameter_names))
+        given: set[str] = set()
+        for key, value in entries.items():
+            name, si_value = parse_error_value(
+                str(key), value, names=self.parameter_names, length_names=self.length_names
+            )
+            if name in given:
+                raise InputError(f"error '{name}' is given twice")
+            given.add(name)
+            out[self.parameter_names.index(name)] = si_value
+        return out
+
+    def errors_from_yaml(self, path: str | Path) -> np.ndarray:
+        """The error vector of a YAML file of ``name[_unit]: value`` (optionally under
+        ``errors:``), in this table's names."""
+        from .errors import read_error_mapping
+
+        try:
+            return self.errors_from_user_units(read_error_mapping(path))
+        except InputError as exc:
+            if exc.path is not None:
+                raise
+            raise InputError(exc.detail, path=Path(path)) from None
+
+    def to_user_units(self, error_values) -> dict[str, float]:
+        """``{name_arcsec: value, ..., <joint>.offset_a_mm: value}``: what
+        :meth:`errors_from_user_units` reads."""
+        from ..core.units import ARCSEC_PER_RAD, M_PER_MM
+
+        out = {}
+        for name, value in zip(self.parameter_names, np.asarray(error_values), strict=True):
+            if name in self.length_names:
+                out[f"{name}_mm"] = float(value) / M_PER_MM
+            else:
+                out[f"{name}_arcsec"] = float(value) * ARCSEC_PER_RAD
+        return out
+
+    def payload_origin_m(self, error_values, angles_rad: Sequence[float]) -> np.ndarray:
+        """The payload origin in the base frame with these errors (Pinocchio), metres."""
+        import pinocchio as pin
+
+        model = self.pinocchio_model(error_values)
+        data = model.createData()
+        pin.framesForwardKinematics(model, data, self.chain.joint_vector(*angles_rad))
+        return np.array(data.oMf[model.getFrameId(self.payload_frame)].translation)
+
     def _angles(self, angles_rad: Sequence) -> list[np.ndarray]:
         if len(angles_rad) != len(self.joint_names):
             raise InputError(
