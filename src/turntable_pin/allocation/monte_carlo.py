@@ -17,6 +17,7 @@ the whole process group, is left to the parent.
 from __future__ import annotations
 
 import os
+import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
@@ -94,18 +95,27 @@ def _run_chunk(args) -> tuple[np.ndarray, float]:
     return worst, dependence
 
 
-def _stop_workers(pools: list[ProcessPoolExecutor]) -> None:
-    """Kill the worker processes of ``pools`` (SIGKILL; no chunk is waited for) and shut the
-    pools down. Idempotent; a no-op for a pool already shut down normally."""
+def _stop_workers(pools: list[ProcessPoolExecutor], kill: bool = True) -> None:
+    """Stop the workers of ``pools``. Idempotent; a no-op for a pool already shut down normally.
+
+    ``kill`` (an interruption): SIGKILL the workers, wait for none of their chunks, and do not
+    join the pool's manager thread: a worker killed while it wrote a result leaves half a message
+    in the result pipe, which the manager thread then waits on for ever (the interrupted command
+    ends with ``os._exit``, so nothing joins it later). Otherwise (an error): cancel what has not
+    started and wait for the chunks that run.
+    """
     with deferred():
         for pool in pools:
+            if not kill:
+                pool.shutdown(wait=True, cancel_futures=True)
+                continue
             processes = list((getattr(pool, "_processes", None) or {}).values())
             for process in processes:
                 if process.exitcode is None:
                     process.kill()
             for process in processes:
                 process.join()
-            pool.shutdown(wait=True, cancel_futures=True)
+            pool.shutdown(wait=False, cancel_futures=True)
         pools.clear()
 
 
@@ -257,7 +267,8 @@ def run_monte_carlo(
                 pool.shutdown(cancel_futures=True)
             pools.clear()
     finally:
-        _stop_workers(pools)  # on error or interruption: kill them, do not wait for their chunk
+        # On an interruption kill them and wait for no chunk; on an error let running chunks end.
+        _stop_workers(pools, kill=isinstance(sys.exc_info()[1], KeyboardInterrupt))
         unregister()
     elapsed = time.perf_counter() - start
     phi1_used = (0.0,) if dependence <= PHI1_TOLERANCE else tuple(phi1_grid * DEG_PER_RAD)
