@@ -20,6 +20,7 @@ __all__ = [
     "accuracy_dph",
     "add_error_options",
     "bounded_float",
+    "error_overrides",
     "errors_from_args",
     "finite_float",
     "generic_errors_from_args",
@@ -187,24 +188,37 @@ def generic_table_from_args(args: argparse.Namespace):
     return GenericTable(args.urdf or default_urdf_path(), getattr(args, "payload_frame", None))
 
 
-def generic_errors_from_args(table, args: argparse.Namespace) -> np.ndarray:
-    """The error vector of ``--errors`` overridden entry by entry by ``--error``, in the generic
-    names of ``table`` (``<joint>.position``, ``<joint>.tilt_a``, ...)."""
-    values = table.errors_from_yaml(args.errors) if args.errors else table.values()
+def error_overrides(args: argparse.Namespace, **table_names) -> dict[str, float]:
+    """``{name: value in rad or m}`` of the ``--error NAME=VALUE`` options, each name once.
+
+    ``table_names`` (``names``, ``length_names``) are passed to
+    :func:`~turntable_pin.model.errors.parse_error_value` (default: the paper's nine errors).
+    """
+    values: dict[str, float] = {}
     given: dict[str, str] = {}
     for item in args.error:
         if "=" not in item:
             raise InputError(f"--error '{item}': expected NAME=VALUE")
         key, _, text = item.partition("=")
         try:
-            name, value = parse_error_value(
-                key, text, names=table.parameter_names, length_names=table.length_names
-            )
+            name, value = parse_error_value(key, text, **table_names)
         except InputError as exc:
             raise InputError(f"--error '{item}': {exc.detail}") from None
         if name in given:
             raise InputError(f"--error '{item}': {name} is given twice (also '{given[name]}')")
         given[name] = item
+        values[name] = value
+    return values
+
+
+def generic_errors_from_args(table, args: argparse.Namespace) -> np.ndarray:
+    """The error vector of ``--errors`` overridden entry by entry by ``--error``, in the generic
+    names of ``table`` (``<joint>.position``, ``<joint>.tilt_a``, ...)."""
+    values = table.errors_from_yaml(args.errors) if args.errors else table.values()
+    overrides = error_overrides(
+        args, names=table.parameter_names, length_names=table.length_names
+    )
+    for name, value in overrides.items():
         values[table.parameter_names.index(name)] = value
     return values
 
@@ -212,21 +226,7 @@ def generic_errors_from_args(table, args: argparse.Namespace) -> np.ndarray:
 def errors_from_args(args: argparse.Namespace) -> TurntableErrors:
     """The error set of ``--errors`` overridden entry by entry by ``--error``."""
     base = TurntableErrors.from_yaml(args.errors) if args.errors else TurntableErrors.zero()
-    values = base.as_dict()
-    given: dict[str, str] = {}
-    for item in args.error:
-        if "=" not in item:
-            raise InputError(f"--error '{item}': expected NAME=VALUE")
-        key, _, text = item.partition("=")
-        try:
-            name, value = parse_error_value(key, text)
-        except InputError as exc:
-            raise InputError(f"--error '{item}': {exc.detail}") from None
-        if name in given:
-            raise InputError(f"--error '{item}': {name} is given twice (also '{given[name]}')")
-        given[name] = item
-        values[name] = value
-    return TurntableErrors(**values)
+    return TurntableErrors(**{**base.as_dict(), **error_overrides(args)})
 
 
 def model_from_args(args: argparse.Namespace) -> TurntableModel:
