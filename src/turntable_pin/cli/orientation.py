@@ -124,26 +124,31 @@ def generic_orientation_report(table, error_values, angles_deg: list[float]) -> 
     return report
 
 
+def _print_report(report: dict, position: str, approx_key: str, approx_label: str) -> None:
+    """The text form of an ``orientation`` report: dR, the exact angles beside their
+    approximation (``<angle>_<approx_key>_arcsec``), the payload origin."""
+    print(f"position: {position}")
+    print("dR = Rd^T Rt:")
+    for row in report["dR"]:
+        print("  [" + "  ".join(f"{v: .12f}" for v in row) + "]")
+    label = f"{approx_label} (arcsec)"
+    print(f"{'':8s}{'exact (arcsec)':>16s}{label:>{len(label) + 3}s}")
+    for name in ANGLE_NAMES:
+        exact, approx = report[f"{name}_arcsec"], report[f"{name}_{approx_key}_arcsec"]
+        print(f"{name:8s}{exact:16.6f}{approx:{len(label) + 3}.6f}")
+    x, y, z = report["payload_origin_mm"]
+    print(f"payload origin (mm): x = {x:.6f}, y = {y:.6f}, z = {z:.6f}")
+
+
 def run_orientation(args: argparse.Namespace) -> int:
     if not paper_table_requested(args):
         return _run_generic_orientation(args)
     phi1, phi2 = _joint_angles_deg(args, 2)
-    args.phi1_deg, args.phi2_deg = phi1, phi2
-    report = orientation_report(model_from_args(args), args.phi1_deg, args.phi2_deg)
+    report = orientation_report(model_from_args(args), phi1, phi2)
     if args.json:
         print_json(report)
-        return 0
-    print(f"position: phi1 = {args.phi1_deg:g} deg, phi2 = {args.phi2_deg:g} deg")
-    print("dR = Rd^T Rt:")
-    for row in report["dR"]:
-        print("  [" + "  ".join(f"{v: .12f}" for v in row) + "]")
-    print(f"{'':8s}{'exact (arcsec)':>16s}{'eq. 26 (arcsec)':>18s}")
-    for name in ANGLE_NAMES:
-        exact = report[f"{name}_arcsec"]
-        small = report[f"{name}_small_angle_arcsec"]
-        print(f"{name:8s}{exact:16.6f}{small:18.6f}")
-    x, y, z = report["payload_origin_mm"]
-    print(f"payload origin (mm): x = {x:.6f}, y = {y:.6f}, z = {z:.6f}")
+    else:
+        _print_report(report, f"phi1 = {phi1:g} deg, phi2 = {phi2:g} deg", "small_angle", "eq. 26")
     return 0
 
 
@@ -155,16 +160,8 @@ def _run_generic_orientation(args: argparse.Namespace) -> int:
         print_json(report)
         return 0
     where = ", ".join(f"{j} = {a:g} deg" for j, a in report["angles_deg"].items())
-    print(f"position: {where} (payload frame {table.payload_frame})")
-    print("dR = Rd^T Rt:")
-    for row in report["dR"]:
-        print("  [" + "  ".join(f"{v: .12f}" for v in row) + "]")
-    print(f"{'':8s}{'exact (arcsec)':>16s}{'first order (arcsec)':>23s}")
-    for name in ANGLE_NAMES:
-        exact, first = report[f"{name}_arcsec"], report[f"{name}_first_order_arcsec"]
-        print(f"{name:8s}{exact:16.6f}{first:23.6f}")
-    x, y, z = report["payload_origin_mm"]
-    print(f"payload origin (mm): x = {x:.6f}, y = {y:.6f}, z = {z:.6f}")
+    position = f"{where} (payload frame {table.payload_frame})"
+    _print_report(report, position, "first_order", "first order")
     return 0
 
 
