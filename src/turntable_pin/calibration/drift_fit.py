@@ -312,12 +312,7 @@ def calibrate_run(path: str | Path, latitude_rad: float) -> CalibrationResult:
                 path=table.path, row=int(table.rows[bad[0]]), column="sigma_dph",
             )  # fmt: skip
     if table.has("time_s"):
-        bad = np.flatnonzero(table["time_s"] < 0)
-        if bad.size:
-            raise InputError(
-                f"time since the start of the run must be >= 0, found {table['time_s'][bad[0]]:g}",
-                path=table.path, row=int(table.rows[bad[0]]), column="time_s",
-            )  # fmt: skip
+        table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
     positions = PositionSet(
         deg_to_rad(table["phi1_deg"]), deg_to_rad(table["phi2_deg"]), name=str(path)
     )

@@ -42,6 +42,16 @@ class CsvTable:
         """Whether the optional column ``name`` is present."""
         return name in self.columns
 
+    def refuse(self, column: str, bad, rule: str) -> None:
+        """Raise :class:`InputError` at the first row where ``bad`` (a mask over the rows) holds:
+        ``"<rule>, found <value>"`` with file, row and column."""
+        rows = np.flatnonzero(bad)
+        if rows.size:
+            raise InputError(
+                f"{rule}, found {self[column][rows[0]]:g}",
+                path=self.path, row=int(self.rows[rows[0]]), column=column,
+            )  # fmt: skip
+
     def __getitem__(self, name: str) -> np.ndarray:
         return self.columns[name]
 

@@ -164,15 +164,7 @@ def _looks_like_radians(values_deg: np.ndarray) -> str | None:
 
 def _check_at_most(table, column: str, limit: float, rule: str) -> None:
     """Refuse the first ``|value| > limit`` of ``column``, naming file, row and column."""
-    values = table[column]
-    bad = np.flatnonzero(np.abs(values) > limit)
-    if bad.size:
-        raise InputError(
-            f"{rule}, found {values[bad[0]]:g}",
-            path=table.path,
-            row=int(table.rows[bad[0]]),
-            column=column,
-        )
+    table.refuse(column, np.abs(table[column]) > limit, rule)
 
 
 def read_measurements(path: str | Path) -> OrientationMeasurements:
@@ -222,14 +214,7 @@ def read_measurements(path: str | Path) -> OrientationMeasurements:
             f"sigma must be at most {limit:g} arcsec ({MAX_ANGULAR_ERROR_DEG:g} deg)",
         )  # fmt: skip
     if table.has("time_s"):
-        bad = np.flatnonzero(table["time_s"] < 0)
-        if bad.size:
-            raise InputError(
-                f"time since the start of the run must be >= 0, found {table['time_s'][bad[0]]:g}",
-                path=table.path,
-                row=int(rows[bad[0]]),
-                column="time_s",
-            )
+        table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
         _check_at_most(
             table, "time_s", MAX_TIME_S,
             f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
