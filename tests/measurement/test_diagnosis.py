@@ -88,10 +88,7 @@ def test_clean_data_false_alarm_rate(capsys):
 
 
 def _with_extra(data: OrientationMeasurements, extra_rad: np.ndarray) -> OrientationMeasurements:
-    return OrientationMeasurements(
-        data.phi1_rad, data.phi2_rad, data.angles_rad + extra_rad, data.sigma_rad, data.time_s,
-        data.dir1, data.dir2,
-    )  # fmt: skip
+    return data.replace(angles_rad=data.angles_rad + extra_rad)
 
 
 def test_an_effect_outside_the_catalogue_is_unexplained():
@@ -134,8 +131,7 @@ def test_until_explained_finds_two_effects():
 
 def test_untestable_effects_are_reported():
     sim = simulate_measurements(seed=1)
-    data = OrientationMeasurements(sim.data.phi1_rad, sim.data.phi2_rad, sim.data.angles_rad,
-                                   sim.data.sigma_rad)  # fmt: skip
+    data = sim.data.replace(time_s=None, dirs=())
     d = diagnose_measurements(data).to_dict()
     assert sorted(d["verdict"]["untestable"]) == ["backlash", "thermal_drift"]
     entry = next(c for c in d["candidates"] if c["effect"] == "thermal_drift")

@@ -11,9 +11,9 @@ from turntable_pin.measurement.effects import EFFECTS, PositionVariables
 
 def _grid_variables(seed=0, n=60):
     rng = np.random.default_rng(seed)
-    return PositionVariables(
-        rng.uniform(0, 2 * np.pi, n), rng.uniform(0, 2 * np.pi, n), rng.uniform(0, 9000, n),
-        rng.choice([-1.0, 1.0], n), rng.choice([-1.0, 1.0], n),
+    return PositionVariables.of(
+        rng.uniform(0, 2 * np.pi, n), rng.uniform(0, 2 * np.pi, n), time_s=rng.uniform(0, 9000, n),
+        dirs=(rng.choice([-1.0, 1.0], n), rng.choice([-1.0, 1.0], n)),
     )  # fmt: skip
 
 

@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 
 from turntable_pin.core.units import ARCSEC_PER_RAD
-from turntable_pin.measurement.data import OrientationMeasurements
 from turntable_pin.measurement.fit import fit_orientation
 from turntable_pin.measurement.residuals import (
     analyse_residuals,
@@ -28,9 +27,7 @@ def test_an_outlier_is_the_failing_position_and_harmonics_show_a_missing_term(tm
     angles = sim.data.angles_rad.copy()
     angles[17, 2] += 6.0 / ARCSEC_PER_RAD  # 12 sigma on dgamma
     angles[:, 1] += 2.0 / ARCSEC_PER_RAD * np.sin(2 * sim.data.phi1_rad)  # 2/rev in phi1 on dtheta
-    data = OrientationMeasurements(
-        sim.data.phi1_rad, sim.data.phi2_rad, angles, sim.data.sigma_rad, sim.data.time_s
-    )
+    data = sim.data.replace(angles_rad=angles, dirs=())
     analysis = analyse_residuals(orientation_residuals(fit_orientation(data)), k_sigma=3)
     worst = analysis.failing[0]
     assert worst["row"] == int(data.rows[17]) and worst["component"] == "dgamma"

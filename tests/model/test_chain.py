@@ -128,7 +128,7 @@ def test_every_consumer_of_the_chain_equals_an_independent_numpy_chain(
         OrientationErrorField.from_model(model).rotation(phi1, phi2)[0, 0], expected, atol=1e-12
     )
     fit_model = OrientationModel(
-        PositionVariables(np.array([phi1]), np.array([phi2])), (), TurntableModel(urdf_path=path)
+        PositionVariables.of(np.array([phi1]), np.array([phi2])), (), TurntableModel(urdf_path=path)
     )
     np.testing.assert_allclose(
         fit_model.rotation_error(errors.angular_array_rad())[0], expected, atol=1e-12

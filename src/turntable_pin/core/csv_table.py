@@ -9,7 +9,7 @@ from __future__ import annotations
 import csv
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -28,12 +28,16 @@ class CsvTable:
         columns: ``{name: float array}`` of the required and the present optional columns.
         header: every column name of the file, in file order (unknown ones are kept, unused).
         rows: the spreadsheet row number of each data row (2 for the first).
+        extra: with ``extra=True``, the other columns whose every cell is a finite number.
+        skipped: with ``extra=True``, the other columns that are not (kept out, named here).
     """
 
     path: Path
     columns: dict[str, np.ndarray]
     header: tuple[str, ...]
     rows: np.ndarray
+    extra: dict[str, np.ndarray] = field(default_factory=dict)
+    skipped: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return int(self.rows.size)
@@ -62,6 +66,8 @@ def read_csv_table(
     optional: Sequence[str] = (),
     *,
     min_rows: int = 1,
+    blank: Sequence[str] = (),
+    extra: bool = False,
 ) -> CsvTable:
     """Read ``path`` and check that every required column exists and every value is finite.
 
@@ -70,6 +76,9 @@ def read_csv_table(
         required: column names that must be present, exactly spelled.
         optional: column names that are read (and checked) when present.
         min_rows: fewest data rows accepted.
+        blank: columns whose empty cells are read as NaN ("not measured") instead of refused.
+        extra: also read every other column whose cells are all finite numbers (into
+            :attr:`CsvTable.extra`); the others are named in :attr:`CsvTable.skipped`.
 
     Raises:
         InputError: unreadable file, missing header, a missing column (with close matches named),
@@ -115,6 +124,9 @@ def read_csv_table(
     wanted = [name for name in (*required, *optional) if name in header]
     index = {name: header.index(name) for name in wanted}
     values = {name: [] for name in wanted}
+    blank_ok = set(blank)
+    others = [n for n in header if n not in index and n] if extra else []
+    other_cells: dict[str, list[str]] = {n: [] for n in others}
     row_numbers = []
     for (line_no, _), cells in zip(lines[1:], parsed[1:], strict=True):
         if len(cells) != len(header):
@@ -123,8 +135,13 @@ def read_csv_table(
                 path=path,
                 row=line_no,
             )
+        for name in others:
+            other_cells[name].append(cells[header.index(name)].strip())
         for name in wanted:
             text = cells[index[name]].strip()
+            if not text and name in blank_ok:
+                values[name].append(math.nan)
+                continue
             try:
                 number = float(text)
             except ValueError:
@@ -142,12 +159,30 @@ def read_csv_table(
         raise InputError(
             f"expected at least {min_rows} data row(s), found {len(row_numbers)}", path=path
         )
+    extra_columns, skipped = {}, []
+    for name, cells in other_cells.items():
+        column = _numeric_column(cells)
+        if column is None:
+            skipped.append(name)
+        else:
+            extra_columns[name] = column
     return CsvTable(
         path=path,
         columns={name: np.asarray(v, dtype=float) for name, v in values.items()},
         header=header,
         rows=np.asarray(row_numbers, dtype=int),
+        extra=extra_columns,
+        skipped=tuple(skipped),
     )
+
+
+def _numeric_column(cells: Sequence[str]) -> np.ndarray | None:
+    """The cells as floats when every one is a finite number, else ``None``."""
+    try:
+        values = np.array([float(c) for c in cells], dtype=float)
+    except ValueError:
+        return None
+    return values if values.size and np.all(np.isfinite(values)) else None
 
 
 def refuse_repeated_rows(table: CsvTable, key_columns: Sequence[str], advice: str) -> None:
@@ -187,4 +222,6 @@ def write_csv_table(
 def _format_cell(value) -> str:
     if isinstance(value, (int, np.integer)):
         return str(int(value))
+    if math.isnan(float(value)):
+        return ""  # an empty cell: not measured
     return repr(float(value))

@@ -22,7 +22,9 @@ reader's checks (missing columns, non-numbers, NaN), a file is refused, naming r
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import dataclasses
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -50,7 +52,10 @@ __all__ = [
 REQUIRED_COLUMNS = ("phi1_deg", "phi2_deg", "dpsi_arcsec", "dtheta_arcsec", "dgamma_arcsec")
 """Columns every measurement CSV must have (angles in degrees, errors in arcsec)."""
 OPTIONAL_COLUMNS = ("sigma_arcsec", "time_s", "dir1", "dir2")
-"""Columns read when present: 1-sigma noise (arcsec), time (s), approach directions (+1/-1)."""
+"""Columns read when present: 1-sigma noise (arcsec), time (s), approach directions (+1/-1);
+also ``sigma_dpsi_arcsec, sigma_dtheta_arcsec, sigma_dgamma_arcsec`` (a sigma per angle) and
+``dirK`` for joint K of a table with more axes."""
+_RESERVED = frozenset(("sigma_arcsec", "time_s"))
 
 MAX_MEASURED_ANGLE_ARCSEC = MAX_ANGULAR_ERROR_DEG * 3600.0
 """Largest ``|dpsi|, |dtheta|, |dgamma|`` and ``sigma_arcsec`` of a row, arc seconds (5 deg):
@@ -62,51 +67,112 @@ MAX_TIME_S = 366 * 86400.0
 """Largest ``time_s``, seconds (a year): a longer run is a unit mix-up (ms written as s)."""
 
 
+def _frozen(value, dtype=float) -> np.ndarray:
+    out = np.array(value, dtype=dtype)
+    out.setflags(write=False)
+    return out
+
+
 @dataclass(frozen=True)
 class OrientationMeasurements:
     """Measured orientation errors at N positions (radians and seconds inside).
 
     Attributes:
-        phi1_rad, phi2_rad: commanded angles (N,).
-        angles_rad: measured ``dpsi, dtheta, dgamma`` (N, 3).
-        sigma_rad: 1-sigma noise per row (N,), or ``None`` (to be estimated from the fit).
-        time_s, dir1, dir2: optional columns (N,) or ``None``.
+        joint_rad: commanded joint angles (N, J), chain order from the base (phi1 .. phiJ).
+        angles_rad: measured ``dpsi, dtheta, dgamma`` (N, 3); NaN where an angle was not measured.
+        sigma_rad: 1-sigma noise of each angle (N, 3), or ``None`` (to be estimated from the fit).
+        time_s: time of each row (N,) or ``None``.
+        dirs: per joint, the approach direction ``dirK`` (N,) or ``None``.
+        extra: other numeric columns of the file, ``{name: (N,)}`` (suspects for the diagnosis).
         rows: spreadsheet row of each position in the file (N,) (2 = first data row).
         source: the file read, or a description.
+        joint_names: the table's joint names (for column names and labels), or ``()``.
     """
 
-    phi1_rad: np.ndarray
-    phi2_rad: np.ndarray
+    joint_rad: np.ndarray
     angles_rad: np.ndarray
     sigma_rad: np.ndarray | None = None
     time_s: np.ndarray | None = None
-    dir1: np.ndarray | None = None
-    dir2: np.ndarray | None = None
+    dirs: tuple[np.ndarray | None, ...] = ()
+    extra: Mapping[str, np.ndarray] = field(default_factory=dict)
     rows: np.ndarray | None = None
     source: str = ""
+    joint_names: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
-        n = np.asarray(self.phi1_rad).size
-        for name in ("phi1_rad", "phi2_rad", "sigma_rad", "time_s", "dir1", "dir2", "rows"):
-            value = getattr(self, name)
-            if value is not None:
-                value = np.array(value, dtype=int if name == "rows" else float).reshape(-1)
-                if value.size != n:
-                    raise InputError(f"{name} has {value.size} values, expected {n}")
-                value.setflags(write=False)
-                object.__setattr__(self, name, value)
-        angles = np.array(self.angles_rad, dtype=float).reshape(n, 3)
-        angles.setflags(write=False)
-        object.__setattr__(self, "angles_rad", angles)
-        if self.rows is None:
-            rows = np.arange(2, n + 2)
-            rows.setflags(write=False)
-            object.__setattr__(self, "rows", rows)
+        joints = np.array(self.joint_rad, dtype=float)
+        if joints.ndim == 1:
+            joints = joints[:, None]
+        n, n_joints = joints.shape
+        object.__setattr__(self, "joint_rad", _frozen(joints))
+        object.__setattr__(self, "angles_rad", _frozen(np.reshape(self.angles_rad, (n, 3))))
+        if self.sigma_rad is not None:
+            sigma = np.asarray(self.sigma_rad, dtype=float)
+            sigma = np.repeat(sigma.reshape(n, 1), 3, axis=1) if sigma.size == n else sigma
+            object.__setattr__(self, "sigma_rad", _frozen(sigma.reshape(n, 3)))
+        dirs = (tuple(self.dirs) + (None,) * n_joints)[:n_joints]
+        checked = []
+        for name, value in (("time_s", self.time_s), ("rows", self.rows),
+                            *((f"dir{k + 1}", d) for k, d in enumerate(dirs)),
+                            *self.extra.items()):  # fmt: skip
+            if value is not None and np.asarray(value).size != n:
+                raise InputError(f"{name} has {np.asarray(value).size} values, expected {n}")
+            checked.append(value)
+        if self.time_s is not None:
+            object.__setattr__(self, "time_s", _frozen(np.reshape(self.time_s, -1)))
+        object.__setattr__(
+            self, "dirs", tuple(None if d is None else _frozen(np.reshape(d, -1)) for d in dirs)
+        )
+        object.__setattr__(
+            self, "extra", {k: _frozen(np.reshape(v, -1)) for k, v in self.extra.items()}
+        )
+        rows = np.arange(2, n + 2) if self.rows is None else np.reshape(self.rows, -1)
+        object.__setattr__(self, "rows", _frozen(rows, int))
+        object.__setattr__(self, "joint_names", tuple(self.joint_names))
+
+    @classmethod
+    def two_axis(
+        cls, phi1_rad, phi2_rad, angles_rad, sigma_rad=None, time_s=None, dir1=None, dir2=None,
+        rows=None, source: str = "",
+    ) -> OrientationMeasurements:  # fmt: skip
+        """Measurements of a two-axis table from its two angle arrays (the paper's layout)."""
+        joints = np.stack([np.reshape(phi1_rad, -1), np.reshape(phi2_rad, -1)], axis=1)
+        return cls(joints, angles_rad, sigma_rad, time_s, (dir1, dir2), {}, rows, source)
 
     @property
     def n_positions(self) -> int:
         """Number of positions N."""
-        return int(self.phi1_rad.size)
+        return int(self.joint_rad.shape[0])
+
+    @property
+    def n_joints(self) -> int:
+        """Number of joints J."""
+        return int(self.joint_rad.shape[1])
+
+    @property
+    def phi1_rad(self) -> np.ndarray:
+        """Commanded angle of joint 1, rad (N,)."""
+        return self.joint_rad[:, 0]
+
+    @property
+    def phi2_rad(self) -> np.ndarray:
+        """Commanded angle of joint 2, rad (N,)."""
+        return self.joint_rad[:, 1]
+
+    @property
+    def dir1(self) -> np.ndarray | None:
+        """Approach direction of joint 1, or ``None``."""
+        return self.dirs[0]
+
+    @property
+    def dir2(self) -> np.ndarray | None:
+        """Approach direction of joint 2, or ``None``."""
+        return self.dirs[1] if self.n_joints > 1 else None
+
+    @property
+    def measured(self) -> np.ndarray:
+        """Which angles were measured, (N, 3) bool (an empty cell is ``False``)."""
+        return np.isfinite(self.angles_rad)
 
     @property
     def has_sigma(self) -> bool:
@@ -115,32 +181,49 @@ class OrientationMeasurements:
 
     def variables(self) -> PositionVariables:
         """What effects may depend on at each position."""
-        return PositionVariables(self.phi1_rad, self.phi2_rad, self.time_s, self.dir1, self.dir2)
+        return PositionVariables(self.joint_rad, self.time_s, self.dirs, dict(self.extra))
 
     def columns(self) -> dict[str, np.ndarray]:
         """The CSV columns of ``docs/measurements.md`` in user units (degrees, arcsec, s)."""
+        # Rounded to 1e-9 deg so that a 30-degree grid is written as 30.0, not 29.999999...
         out = {
-            # Rounded to 1e-9 deg so that a 30-degree grid is written as 30.0, not 29.999999...
-            "phi1_deg": np.round(self.phi1_rad * DEG_PER_RAD, 9),
-            "phi2_deg": np.round(self.phi2_rad * DEG_PER_RAD, 9),
+            f"phi{k + 1}_deg": np.round(self.joint_rad[:, k] * DEG_PER_RAD, 9)
+            for k in range(self.n_joints)
         }
         for i, name in enumerate(ANGLE_NAMES):
             out[f"{name}_arcsec"] = self.angles_rad[:, i] * ARCSEC_PER_RAD
         if self.sigma_rad is not None:
-            out["sigma_arcsec"] = self.sigma_rad * ARCSEC_PER_RAD
+            sigma = self.sigma_rad * ARCSEC_PER_RAD
+            if np.all(sigma == sigma[:, :1]):
+                out["sigma_arcsec"] = sigma[:, 0]
+            else:
+                for i, name in enumerate(ANGLE_NAMES):
+                    out[f"sigma_{name}_arcsec"] = sigma[:, i]
         if self.time_s is not None:
             out["time_s"] = self.time_s
-        for name in ("dir1", "dir2"):
-            value = getattr(self, name)
+        for k, value in enumerate(self.dirs):
             if value is not None:
-                out[name] = value.astype(int)
+                out[f"dir{k + 1}"] = value.astype(int)
+        out.update(self.extra)
         return out
+
+    def replace(self, **changes) -> OrientationMeasurements:
+        """A copy with some attributes changed (``sigma_rad=None``, ``angles_rad=...``)."""
+        return dataclasses.replace(self, **changes)
 
     def without_sigma(self) -> OrientationMeasurements:
         """The same data with the noise level left to be estimated from the fit."""
-        return OrientationMeasurements(
-            self.phi1_rad, self.phi2_rad, self.angles_rad, None, self.time_s, self.dir1,
-            self.dir2, self.rows, self.source,
+        return self.replace(sigma_rad=None)
+
+    def select(self, keep) -> OrientationMeasurements:
+        """The rows where ``keep`` (a mask or index array over the rows) holds."""
+        keep = np.asarray(keep)
+        return self.replace(
+            joint_rad=self.joint_rad[keep], angles_rad=self.angles_rad[keep],
+            sigma_rad=None if self.sigma_rad is None else self.sigma_rad[keep],
+            time_s=None if self.time_s is None else self.time_s[keep],
+            dirs=tuple(None if d is None else d[keep] for d in self.dirs),
+            extra={k: v[keep] for k, v in self.extra.items()}, rows=self.rows[keep],
         )  # fmt: skip
 
 
@@ -167,23 +250,89 @@ def _check_at_most(table, column: str, limit: float, rule: str) -> None:
     table.refuse(column, np.abs(table[column]) > limit, rule)
 
 
-def read_measurements(path: str | Path) -> OrientationMeasurements:
+def angle_columns(header: Sequence[str], joint_names: Sequence[str] | None, path=None):
+    """The commanded-angle column of each joint: ``phiK_deg`` or ``<joint>_deg``.
+
+    Without ``joint_names`` the table is the paper's two-axis one (``phi1_deg, phi2_deg``).
+
+    Raises:
+        InputError: a joint without its column, or with both spellings.
+    """
+    names = tuple(joint_names) if joint_names else ("", "")
+    out = []
+    for k, joint in enumerate(names, start=1):
+        found = [c for c in (f"phi{k}_deg", f"{joint}_deg" if joint else None) if c in header]
+        if not found:
+            spelled = f"'phi{k}_deg'" + (f" or '{joint}_deg'" if joint else "")
+            raise InputError(
+                f"missing required column {spelled} (the commanded angle of joint {k}"
+                f"{' ' + joint if joint else ''}); the header has {', '.join(header)}",
+                path=path, row=1,
+            )  # fmt: skip
+        if len(found) > 1:
+            raise InputError(
+                f"joint {k} has two angle columns, {found[0]} and {found[1]}; keep one",
+                path=path, row=1,
+            )  # fmt: skip
+        out.append(found[0])
+    return tuple(out)
+
+
+def _header(path: Path) -> tuple[str, ...]:
+    """The header of a CSV file (the shared reader reports what is wrong with it)."""
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as handle:
+            for line in handle:
+                if line.strip() and not line.lstrip().startswith("#"):
+                    return tuple(c.strip() for c in line.split(","))
+    except (OSError, UnicodeDecodeError):
+        pass
+    return ()
+
+
+def read_measurements(
+    path: str | Path, joint_names: Sequence[str] | None = None
+) -> OrientationMeasurements:
     """Read and validate an orientation measurement CSV (see the module docstring).
+
+    Args:
+        path: the file.
+        joint_names: the table's revolute joints from the base (default: the paper's two axes,
+            columns ``phi1_deg, phi2_deg``); each joint's angle is ``phiK_deg`` or ``<joint>_deg``.
 
     Raises:
         InputError: naming file, row and column of the first problem found.
     """
-    table = read_csv_table(path, REQUIRED_COLUMNS, OPTIONAL_COLUMNS, min_rows=1)
+    path = Path(path)
+    header = _header(path)
+    joint_columns = angle_columns(header, joint_names, path) if header else ("phi1_deg",)
+    n_joints = len(joint_names) if joint_names else 2
+    value_columns = tuple(f"{n}_arcsec" for n in ANGLE_NAMES)
+    sigma_columns = tuple(f"sigma_{n}_arcsec" for n in ANGLE_NAMES)
+    dir_columns = tuple(f"dir{k}" for k in range(1, n_joints + 1))
+    table = read_csv_table(
+        path, (*joint_columns, *value_columns),
+        ("sigma_arcsec", *sigma_columns, "time_s", *dir_columns),
+        min_rows=1, blank=value_columns, extra=True,
+    )  # fmt: skip
     rows = table.rows
-    check_commanded_angles(table)
+    check_commanded_angles(table, joint_columns)
+    values = np.stack([table[c] for c in value_columns], axis=1)
+    none = np.flatnonzero(~np.isfinite(values).any(axis=1))
+    if none.size:
+        raise InputError(
+            "none of dpsi_arcsec, dtheta_arcsec, dgamma_arcsec is given: a row needs at least "
+            "one measured angle",
+            path=table.path, row=int(rows[none[0]]), column=value_columns[0],
+        )  # fmt: skip
     limit = MAX_MEASURED_ANGLE_ARCSEC
-    for column in (f"{n}_arcsec" for n in ANGLE_NAMES):
+    for column in value_columns:
         _check_at_most(
             table, column, limit,
             f"a measured orientation error must be within +-{limit:g} arcsec "
             f"({MAX_ANGULAR_ERROR_DEG:g} deg; more is not a small error)",
         )  # fmt: skip
-    for column in ("phi1_deg", "phi2_deg"):
+    for column in joint_columns:
         why = _looks_like_radians(table[column])
         if why:
             raise InputError(
@@ -193,56 +342,58 @@ def read_measurements(path: str | Path) -> OrientationMeasurements:
                 row=int(rows[0]),
                 column=column,
             )
-    if table.has("sigma_arcsec"):
-        bad = np.flatnonzero(table["sigma_arcsec"] <= 0)
-        if bad.size:
-            raise InputError(
-                f"sigma must be > 0, found {table['sigma_arcsec'][bad[0]]:g}",
-                path=table.path,
-                row=int(rows[bad[0]]),
-                column="sigma_arcsec",
-            )
-        bad = np.flatnonzero(table["sigma_arcsec"] < MIN_SIGMA_ARCSEC)
-        if bad.size:
-            raise InputError(
-                f"sigma must be at least {MIN_SIGMA_ARCSEC:g} arcsec, found "
-                f"{table['sigma_arcsec'][bad[0]]:g}",
-                path=table.path, row=int(rows[bad[0]]), column="sigma_arcsec",
-            )  # fmt: skip
+    if table.has("sigma_arcsec") and any(table.has(c) for c in sigma_columns):
+        raise InputError(
+            "give either sigma_arcsec or the per-angle sigma_<angle>_arcsec columns, not both",
+            path=table.path, row=1, column="sigma_arcsec",
+        )  # fmt: skip
+    for column in ("sigma_arcsec", *sigma_columns):
+        if not table.has(column):
+            continue
+        table.refuse(column, table[column] <= 0, "sigma must be > 0")
+        table.refuse(
+            column, table[column] < MIN_SIGMA_ARCSEC,
+            f"sigma must be at least {MIN_SIGMA_ARCSEC:g} arcsec",
+        )  # fmt: skip
         _check_at_most(
-            table, "sigma_arcsec", limit,
+            table, column, limit,
             f"sigma must be at most {limit:g} arcsec ({MAX_ANGULAR_ERROR_DEG:g} deg)",
         )  # fmt: skip
+    sigma = None
+    if table.has("sigma_arcsec"):
+        sigma = np.repeat(table["sigma_arcsec"][:, None], 3, axis=1)
+    elif any(table.has(c) for c in sigma_columns):
+        missing = [c for c in sigma_columns if not table.has(c)]
+        if missing:
+            raise InputError(
+                f"per-angle sigma needs all three columns; missing {', '.join(missing)}",
+                path=table.path, row=1,
+            )  # fmt: skip
+        sigma = np.stack([table[c] for c in sigma_columns], axis=1)
     if table.has("time_s"):
         table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
         _check_at_most(
             table, "time_s", MAX_TIME_S,
             f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
         )  # fmt: skip
-    for column in ("dir1", "dir2"):
+    for column in dir_columns:
         if table.has(column):
-            bad = np.flatnonzero(np.abs(table[column]) != 1)
-            if bad.size:
-                raise InputError(
-                    f"an approach direction must be +1 or -1, found {table[column][bad[0]]:g}",
-                    path=table.path,
-                    row=int(rows[bad[0]]),
-                    column=column,
-                )
+            table.refuse(
+                column, np.abs(table[column]) != 1, "an approach direction must be +1 or -1"
+            )
     refuse_repeated_rows(
         table,
-        ("phi1_deg", "phi2_deg", "dir1", "dir2", "time_s"),
+        (*joint_columns, *dir_columns, "time_s"),
         "repeats must differ in time_s or approach direction",
     )
-    angles = np.stack([table[f"{n}_arcsec"] for n in ANGLE_NAMES], axis=1) / ARCSEC_PER_RAD
     return OrientationMeasurements(
-        phi1_rad=table["phi1_deg"] / DEG_PER_RAD,
-        phi2_rad=table["phi2_deg"] / DEG_PER_RAD,
-        angles_rad=angles,
-        sigma_rad=table["sigma_arcsec"] / ARCSEC_PER_RAD if table.has("sigma_arcsec") else None,
+        joint_rad=np.stack([table[c] for c in joint_columns], axis=1) / DEG_PER_RAD,
+        angles_rad=values / ARCSEC_PER_RAD,
+        sigma_rad=None if sigma is None else sigma / ARCSEC_PER_RAD,
         time_s=table["time_s"] if table.has("time_s") else None,
-        dir1=table["dir1"] if table.has("dir1") else None,
-        dir2=table["dir2"] if table.has("dir2") else None,
+        dirs=tuple(table[c] if table.has(c) else None for c in dir_columns),
+        extra={k: v for k, v in table.extra.items() if k not in _RESERVED},
         rows=rows,
         source=str(table.path),
+        joint_names=tuple(joint_names or ()),
     )

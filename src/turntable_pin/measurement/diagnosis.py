@@ -19,16 +19,16 @@ import numpy as np
 
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD
-from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_DESCRIPTIONS
-from ..model.turntable import TurntableModel
 from ..stats.least_squares import RANK_RTOL
 from ..stats.model_selection import Diagnosis, diagnose
 from ..stats.structure_search import Probe
+from .catalogue import catalogue as table_catalogue
+from .catalogue import resolve_effect
 from .data import ANGLE_NAMES, OrientationMeasurements
 from .effect_model import OrientationModel
-from .effects import EFFECTS, get_effect
 from .effects.base import Effect, PositionVariables
 from .fit import OrientationFit, fit_orientation
+from .table import measured_table
 
 __all__ = ["MAX_HARMONIC", "SEPARATION_CHI2", "OrientationFamily", "diagnose_measurements"]
 
@@ -43,7 +43,14 @@ def _max_order(angle_rad: np.ndarray) -> int:
 
 
 class OrientationFamily:
-    """Orientation data, the base error model, and the effect catalogue (a ``ModelFamily``)."""
+    """Orientation data, the table's base error model and its effect catalogue (a
+    ``ModelFamily``).
+
+    Args:
+        data: the measurements.
+        catalogue: the candidate effects (default: the table's catalogue).
+        turntable: the table (see :func:`~turntable_pin.measurement.table.measured_table`).
+    """
 
     record_label = "positions"
     observation_unit = "arcsec"
@@ -52,24 +59,26 @@ class OrientationFamily:
         self,
         data: OrientationMeasurements,
         catalogue: Sequence[Effect] | None = None,
-        turntable: TurntableModel | None = None,
+        turntable=None,
     ) -> None:
         self.data = data
-        self.catalogue = tuple(catalogue if catalogue is not None else EFFECTS.values())
-        self.turntable = turntable or TurntableModel()
+        self.table = measured_table(turntable)
+        self.turntable = self.table
+        self.catalogue = tuple(catalogue if catalogue is not None else table_catalogue(self.table))
         self.n_records = data.n_positions
         self.sigma_scale = (
-            float(np.median(data.sigma_rad) * ARCSEC_PER_RAD)
+            float(np.nanmedian(np.where(data.measured, data.sigma_rad, np.nan)) * ARCSEC_PER_RAD)
             if data.sigma_rad is not None
             else ARCSEC_PER_RAD
         )
+        self._mask = data.measured.reshape(-1)
         self._cache: dict[tuple[str, ...], OrientationFit] = {}
 
     def fit(self, effects: Sequence[Effect], noise_variance: float | None = None) -> OrientationFit:
         """The fit of the base errors plus ``effects`` (cached per effect list)."""
         key = tuple(e.name for e in effects)
         if key not in self._cache:
-            self._cache[key] = fit_orientation(self.data, effects, turntable=self.turntable)
+            self._cache[key] = fit_orientation(self.data, effects, turntable=self.table)
         return self._cache[key]
 
     def untestable_reason(self, effect: Effect) -> str | None:
@@ -79,51 +88,65 @@ class OrientationFamily:
             return f"needs the column(s) {', '.join(missing)}, absent from the data"
         return None
 
+    def effect(self, name: str) -> Effect:
+        """The effect called ``name``: in this family's catalogue first, then the table's."""
+        return resolve_effect(name, self.table, self.catalogue)
+
     def describe(self, effect: Effect | str) -> dict:
         """The effect's story: title, definition, explanation, how to confirm it."""
-        return (get_effect(effect) if isinstance(effect, str) else effect).describe()
+        return (self.effect(effect) if isinstance(effect, str) else effect).describe()
 
     def design_warnings(self, base_fit: OrientationFit) -> list[str]:
         """Warn when the positions determine fewer error combinations than a full grid does.
 
-        The base model's rank on the data is compared with its rank on a 15-degree grid of both
-        axes; fewer means some turntable errors (and any effect that varies with phi1 or phi2)
-        cannot be told apart here, so a step with ``dir`` or a drift with ``time_s`` may stand for
-        whatever changed between the rows.
+        The base model's rank on the data is compared with its rank on a dense grid over every
+        axis; fewer means some turntable errors (and any effect that varies with a joint angle)
+        cannot be told apart here, so a step with ``dir`` or a drift with ``time_s`` may stand
+        for whatever changed between the rows.
         """
         data = self.data
         rank = base_fit.result.rank
-        dense = OrientationModel(self._dense_variables(), (), self.turntable)
+        dense = OrientationModel(self._dense_variables(), (), self.table)
         jac = dense.jacobian(np.zeros(dense.n_params)).reshape(-1, dense.n_params)
         singular = np.linalg.svd(jac / np.linalg.norm(jac, axis=0).clip(1e-300), compute_uv=False)
         full_rank = int(np.sum(singular > RANK_RTOL * singular[0]))
         if rank >= full_rank:
             return []
-        wrapped = np.round(np.mod(np.degrees([data.phi1_rad, data.phi2_rad]), 360.0), 6) % 360.0
-        distinct = np.unique(wrapped.T, axis=0)
+        wrapped = np.round(np.mod(np.degrees(data.joint_rad), 360.0), 6) % 360.0
+        distinct = np.unique(wrapped, axis=0)
+        labels = [self.table.angle_label(k) for k in range(1, data.n_joints + 1)]
+        axes = " or ".join(labels)
         where = (
-            f"all {data.n_positions} rows are at one position (phi1 {distinct[0, 0]:g}, phi2 "
-            f"{distinct[0, 1]:g} deg)"
+            f"all {data.n_positions} rows are at one position ("
+            + ", ".join(f"{lab} {v:g}" for lab, v in zip(labels, distinct[0], strict=True))
+            + " deg)"
             if len(distinct) == 1
             else f"the {data.n_positions} rows are at {len(distinct)} distinct positions"
         )
         return [
             f"{where}: they determine {rank} of the {full_rank} combinations of the turntable "
-            "errors that a grid over both axes determines, so effects that vary with phi1 or phi2 "
+            f"errors that a grid over every axis determines, so effects that vary with {axes} "
             "cannot be tested, and an effect named here (a step with dir, a drift in time) may "
             "stand for any error that changed between the rows; measure more positions over the "
-            "full turn of both axes"
+            "full turn of every axis"
         ]
 
+    def _observations(self, cols: np.ndarray) -> np.ndarray:
+        """(N, 3, g) per-angle columns as (m, g) rows of the measured observations."""
+        cols = cols.reshape(-1, cols.shape[-1])
+        return cols if self._mask.all() else cols[self._mask]
+
     def _measured_angle_probes(self, trig: np.ndarray, shape: str, w: np.ndarray) -> list[Probe]:
-        """One probe per measured angle: the harmonic pair ``trig`` (N, 2) added to that angle."""
+        """One probe per measured angle: the columns ``trig`` (N, g) added to that angle."""
         probes = []
         for a, angle in enumerate(ANGLE_NAMES):
+            if not self.data.measured[:, a].any():
+                continue
 
             def columns(a=a):
-                cols = np.zeros((self.data.n_positions, 3, 2))
+                cols = np.zeros((self.data.n_positions, 3, trig.shape[1]))
                 cols[:, a, :] = trig * w[:, a, None]
-                return cols.reshape(-1, 2)
+                return self._observations(cols)
 
             probes.append(
                 Probe(
@@ -136,105 +159,124 @@ class OrientationFamily:
             )
         return probes
 
+    def _error_probes(self, jac, w, trig, shape: str, what: str) -> list[Probe]:
+        """One probe per base error: its derivative times the columns ``trig`` (N, g)."""
+        probes = []
+        for e, name in enumerate(self.table.base_names):
+
+            def columns(e=e):
+                return self._observations(jac[:, :, e, None] * trig[:, None, :] * w[:, :, None])
+
+            probes.append(
+                Probe(
+                    f"{name} {shape}",
+                    f"a {what} of {name} ({self.table.descriptions.get(name, name)})",
+                    columns,
+                    ARCSEC_PER_RAD,
+                    "arcsec",
+                )
+            )
+        return probes
+
     def probes(self, fit: OrientationFit) -> list[Probe]:
         """The structure-search probes, weighted like the residuals of ``fit`` (see the module)."""
         data = self.data
-        w = fit.result.weights.reshape(-1, 3)
+        w = np.nan_to_num(fit.per_angle(fit.result.weights))  # (N, 3), 0 where not measured
         jac = fit.model.jacobian(fit.result.params)  # (N, 3, n)
         probes = []
-        angles = {"phi1": data.phi1_rad, "phi2": data.phi2_rad}
-        for var, phi in angles.items():
+        labels = [self.table.angle_label(k) for k in range(1, data.n_joints + 1)]
+        for var, phi in zip(labels, data.joint_rad.T, strict=True):
             for k in range(1, _max_order(phi) + 1):
                 trig = np.stack([np.cos(k * phi), np.sin(k * phi)], axis=-1)  # (N, 2)
-                for e, name in enumerate(ANGULAR_ERROR_NAMES):
-
-                    def columns(e=e, trig=trig):
-                        return (jac[:, :, e, None] * trig[:, None, :] * w[:, :, None]).reshape(
-                            -1, 2
-                        )
-
-                    probes.append(
-                        Probe(
-                            f"{name} {k}/rev in {var}",
-                            f"a {k}/rev term in {var} of {name} ({ERROR_DESCRIPTIONS[name]})",
-                            columns,
-                            ARCSEC_PER_RAD,
-                            "arcsec",
-                        )
-                    )
+                probes += self._error_probes(jac, w, trig, f"{k}/rev in {var}",
+                                             f"{k}/rev term in {var}")  # fmt: skip
                 probes += self._measured_angle_probes(trig, f"{k}/rev in {var}", w)
-        # Terms coupling the two angles (k/rev in phi1 + phi2 or phi1 - phi2) on each angle: the
-        # shapes above are separable in phi1 and phi2 and would miss them.
-        for label, combined in (("phi1+phi2", data.phi1_rad + data.phi2_rad),
-                                ("phi1-phi2", data.phi1_rad - data.phi2_rad)):  # fmt: skip
-            for k in range(1, min(2, _max_order(combined)) + 1):
-                trig = np.stack([np.cos(k * combined), np.sin(k * combined)], axis=-1)
-                probes += self._measured_angle_probes(trig, f"{k}/rev in {label}", w)
+        # Terms coupling two angles (k/rev in phiA + phiB or phiA - phiB) on each angle: the
+        # shapes above are separable in the angles and would miss them.
+        for i in range(data.n_joints):
+            for j in range(i + 1, data.n_joints):
+                a, b = data.joint_rad[:, i], data.joint_rad[:, j]
+                for sign, combined in (("+", a + b), ("-", a - b)):
+                    label = f"{labels[i]}{sign}{labels[j]}"
+                    for k in range(1, min(2, _max_order(combined)) + 1):
+                        trig = np.stack([np.cos(k * combined), np.sin(k * combined)], axis=-1)
+                        probes += self._measured_angle_probes(trig, f"{k}/rev in {label}", w)
         extra = []
         if data.time_s is not None and np.ptp(data.time_s) > 0:
             t = (data.time_s - data.time_s.min()) / np.ptp(data.time_s)
-            extra.append(("drift in time", "a drift with time (quadratic over the run)", [t, t**2]))
-        for column in ("dir1", "dir2"):
-            value = getattr(data, column)
+            extra.append(("drift in time", "a drift with time (quadratic over the run)",
+                          np.stack([t, t**2], axis=1)))  # fmt: skip
+        for k, value in enumerate(data.dirs, start=1):
             if value is not None:
-                extra.append((f"with {column}", f"a step with the approach direction {column}",
-                              [value]))  # fmt: skip
+                extra.append((f"with dir{k}", f"a step with the approach direction dir{k}",
+                              value[:, None]))  # fmt: skip
         for label, text, columns in extra:
             for a, angle in enumerate(ANGLE_NAMES):
+                if not data.measured[:, a].any():
+                    continue
 
                 def matrix(a=a, columns=columns):
-                    cols = np.zeros((data.n_positions, 3, len(columns)))
-                    for j, c in enumerate(columns):
-                        cols[:, a, j] = c * w[:, a]
-                    return cols.reshape(-1, len(columns))
+                    cols = np.zeros((data.n_positions, 3, columns.shape[1]))
+                    cols[:, a, :] = columns * w[:, a, None]
+                    return self._observations(cols)
 
-                probes.append(
-                    Probe(
-                        f"{angle} {label}",
-                        f"{text} in {angle}",
-                        matrix,
-                        ARCSEC_PER_RAD,
-                        "arcsec",
-                    )
-                )
+                probes.append(Probe(f"{angle} {label}", f"{text} in {angle}", matrix,
+                                    ARCSEC_PER_RAD, "arcsec"))  # fmt: skip
+        # Other numeric columns (temperature, load, ...) as suspects: each base error and each
+        # measured angle linear and quadratic in the column.
+        for column, values in data.extra.items():
+            span = np.ptp(values)
+            if not span > 0:
+                continue
+            c = (values - values.min()) / span
+            trig = np.stack([c, c**2], axis=1)
+            probes += self._error_probes(jac, w, trig, f"in {column}",
+                                         f"term linear and quadratic in {column}")  # fmt: skip
+            probes += self._measured_angle_probes(trig, f"in {column}", w)
         return probes
 
     def _dense_variables(self) -> PositionVariables:
-        g = np.radians(np.arange(0.0, 360.0, 15.0))
-        g1, g2 = np.meshgrid(g, g, indexing="ij")
-        n = g1.size
+        """A dense design over every axis (15-degree grid; 30 degrees for three axes), with a
+        random time order and random approach directions where the data have them."""
+        step = 30.0 if self.data.n_joints > 2 else 15.0
+        g = np.radians(np.arange(0.0, 360.0, step))
+        grids = np.meshgrid(*([g] * self.data.n_joints), indexing="ij")
+        joints = np.stack([x.ravel() for x in grids], axis=1)
+        n = joints.shape[0]
         rng = np.random.default_rng(0)
         data = self.data
         time = None
         if data.time_s is not None:
             time = rng.permutation(np.linspace(data.time_s.min(), data.time_s.max(), n))
-        dirs = [rng.choice([-1.0, 1.0], n) if getattr(data, c) is not None else None
-                for c in ("dir1", "dir2")]  # fmt: skip
-        return PositionVariables(g1.ravel(), g2.ravel(), time, dirs[0], dirs[1])
+        dirs = tuple(rng.choice([-1.0, 1.0], n) if d is not None else None for d in data.dirs)
+        extra = {k: rng.permutation(np.linspace(v.min(), v.max(), n))
+                 for k, v in data.extra.items()}  # fmt: skip
+        return PositionVariables(joints, time, dirs, extra)
 
     def separation(self, fit_a: OrientationFit, effect_b: Effect) -> str:
         """Whether more positions would separate effect A (fitted) from B, or only another test."""
         a_effects = fit_a.model.effects
         a = a_effects[-1]
         variables = self._dense_variables()
-        truth = OrientationModel(variables, a_effects, self.turntable).predict(fit_a.result.params)
+        truth = OrientationModel(variables, a_effects, self.table).predict(fit_a.result.params)
         sigma = float(np.median(fit_a.sigma_rad))
         dense = OrientationMeasurements(
-            variables.phi1_rad, variables.phi2_rad, truth, np.full(variables.n, sigma),
-            variables.time_s, variables.dir1, variables.dir2, source="dense design",
+            variables.joint_rad, truth, np.full(variables.n, sigma), variables.time_s,
+            variables.dirs, dict(variables.extra), source="dense design",
         )  # fmt: skip
         base_effects = [e for e in a_effects if e is not a]
-        misfit = fit_orientation(dense, [*base_effects, effect_b], turntable=self.turntable)
+        misfit = fit_orientation(dense, [*base_effects, effect_b], turntable=self.table)
         chi2 = misfit.result.rss
+        grid = "30-degree" if self.data.n_joints > 2 else "15-degree"
         if chi2 > SEPARATION_CHI2:
             return (
-                f"{effect_b.name} mimics {a.name} on these positions only: on a 15-degree grid "
+                f"{effect_b.name} mimics {a.name} on these positions only: on a {grid} grid "
                 f"({variables.n} positions, random time order) it would leave chi2 = {chi2:.0f} "
                 f"of misfit at the same noise, so measuring more angles separates them"
             )
         return (
             f"{effect_b.name} reproduces the fitted {a.name} at every turntable position "
-            f"(noise-free misfit chi2 = {chi2:.2g} on a 15-degree grid), so no set of positions "
+            f"(noise-free misfit chi2 = {chi2:.2g} on a {grid} grid), so no set of positions "
             f"separates them; an independent measurement does. For {a.name}: {a.confirm} "
             f"For {effect_b.name}: {effect_b.confirm}"
         )
@@ -245,7 +287,7 @@ def diagnose_measurements(
     *,
     until_explained: bool = False,
     catalogue: Sequence[Effect] | None = None,
-    turntable: TurntableModel | None = None,
+    turntable=None,
 ) -> Diagnosis:
     """Diagnose orientation measurements against the effect catalogue (see :mod:`diagnosis`).
 

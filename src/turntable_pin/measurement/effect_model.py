@@ -8,9 +8,10 @@ coordinate axis by an angle *linear* in the parameters, so the Jacobian is exact
 ``Rt = A R_a(theta) B``, ``dRt/dtheta = A R_a(theta) [e_a]x B``, composed from prefix and
 suffix products.
 
-Parameters (internal units): the eight angular errors (rad) in :data:`ANGULAR_ERROR_NAMES` order,
-then each effect's parameters as ``"<effect>.<name>"``. ``deta`` is left out: it moves the payload
-origin, never its orientation.
+Parameters (internal units): the table's base errors (rad; the paper's table: the eight angular
+errors in :data:`ANGULAR_ERROR_NAMES` order), then each effect's parameters as
+``"<effect>.<name>"``. Offsets (``deta``, ``<joint>.offset_a``...) are left out: they move the
+payload origin, never its orientation.
 """
 
 from __future__ import annotations
@@ -26,14 +27,19 @@ from ..core.units import ARCSEC_PER_RAD
 from ..model.angles import ANGLE_ENTRIES
 from ..model.chain import ROTATION, skew
 from ..model.errors import ANGULAR_ERROR_NAMES
-from ..model.turntable import TurntableModel
 from .effects.base import POST, PRE, Effect, ParameterSpec, PositionVariables
+from .table import MeasuredTable, measured_table
 
-__all__ = ["AXIS_INDEX", "BASE_PARAMETERS", "OrientationModel"]
+__all__ = ["AXIS_INDEX", "BASE_PARAMETERS", "OrientationModel", "base_parameters"]
 
-BASE_PARAMETERS: tuple[ParameterSpec, ...] = tuple(
-    ParameterSpec(name, "arcsec", 1.0 / ARCSEC_PER_RAD, name) for name in ANGULAR_ERROR_NAMES
-)
+
+def base_parameters(names) -> tuple[ParameterSpec, ...]:
+    """The base errors ``names`` as parameters in arcsec."""
+    return tuple(ParameterSpec(name, "arcsec", 1.0 / ARCSEC_PER_RAD, name) for name in names)
+
+
+BASE_PARAMETERS: tuple[ParameterSpec, ...] = base_parameters(ANGULAR_ERROR_NAMES)
+"""The paper's base errors as parameters."""
 
 _GENERATORS = {
     axis: np.array(m, dtype=float)
@@ -60,20 +66,27 @@ class OrientationModel:
     Args:
         variables: the commanded angles (and time, directions) of the positions.
         effects: catalogued effects to include (their required columns must be present).
-        turntable: the Pinocchio model whose nominal chain is used (default: bundled URDF).
+        turntable: the table (:func:`~turntable_pin.measurement.table.measured_table` reads a
+            ``TurntableModel``, a ``GenericTable`` or ``None``: the bundled paper table).
     """
 
     def __init__(
         self,
         variables: PositionVariables,
         effects: Sequence[Effect] = (),
-        turntable: TurntableModel | None = None,
+        turntable: MeasuredTable | object | None = None,
     ) -> None:
         self.variables = variables
         self.effects = tuple(effects)
-        turntable = turntable or TurntableModel()
-        specs: list[ParameterSpec] = list(BASE_PARAMETERS)
-        names = list(ANGULAR_ERROR_NAMES)
+        self.table = turntable = measured_table(turntable)
+        if variables.n_joints != turntable.n_joints:
+            raise InputError(
+                f"the data have {variables.n_joints} joint angle(s), the table has "
+                f"{turntable.n_joints} ({', '.join(turntable.joint_names)})"
+            )
+        self.base_names = turntable.base_names
+        specs: list[ParameterSpec] = list(base_parameters(self.base_names))
+        names = list(self.base_names)
         terms_by_effect = []
         for effect in self.effects:
             missing = effect.missing_columns(variables)
@@ -104,11 +117,11 @@ class OrientationModel:
             gain[:, self._index[f"{prefix}{name}"]] += np.asarray(w, dtype=float)
         return gain
 
-    def _build_chain(self, turntable: TurntableModel, terms_by_effect):
+    def _build_chain(self, turntable: MeasuredTable, terms_by_effect):
         n = self.variables.n
         pre, post = [], []
         error_gain = {}
-        for name in ANGULAR_ERROR_NAMES:
+        for name in self.base_names:
             gain = np.zeros((n, self.n_params))
             gain[:, self._index[name]] = 1.0
             error_gain[name] = gain
@@ -119,10 +132,15 @@ class OrientationModel:
                     pre.append(_Factor(axis=term.axis, gain=gain))
                 elif term.site == POST:
                     post.append(_Factor(axis=term.axis, gain=gain))
-                else:
+                elif term.site in error_gain:
                     error_gain[term.site] = error_gain[term.site] + gain
+                else:
+                    raise InputError(
+                        f"effect '{effect.name}' changes '{term.site}', which is not an error of "
+                        f"this table; its errors: {', '.join(self.base_names)}"
+                    )
 
-        joint_angles = iter((self.variables.phi1_rad, self.variables.phi2_rad))
+        joint_angles = iter(self.variables.joint_rad.T)
         chain: list[_Factor] = list(pre)
         ideal = np.broadcast_to(np.eye(3), (n, 3, 3))
         for link in turntable.chain.links:
@@ -200,5 +218,3 @@ class OrientationModel:
                 raise InputError(f"unknown parameter '{name}'; parameters: {self.parameter_names}")
             p[self._index[name]] = value
         return p
-
-

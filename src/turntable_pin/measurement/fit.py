@@ -2,7 +2,8 @@
 
 :class:`OrientationFitProblem` adapts :class:`OrientationModel` and :class:`OrientationMeasurements`
 to the generic :class:`FitProblem` of :mod:`turntable_pin.stats.least_squares` (observations
-flattened position by position as ``dpsi, dtheta, dgamma``); :func:`fit_orientation` fits and
+flattened position by position as ``dpsi, dtheta, dgamma``, the angles not measured left out);
+:func:`fit_orientation` fits and
 returns an :class:`OrientationFit` that knows its data, model, residuals and parameters.
 """
 
@@ -15,7 +16,6 @@ import numpy as np
 
 from ..core.sizes import FIT_ROW_BYTES, MAX_FITTED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD
-from ..model.turntable import TurntableModel
 from ..stats.least_squares import FitResult, fit_least_squares
 from .data import OrientationMeasurements
 from .effect_model import OrientationModel
@@ -36,16 +36,21 @@ class OrientationFitProblem:
         self.parameter_names = model.parameter_names
         self.parameter_units = model.parameter_units
         self.per_user_unit = model.per_user_unit
-        self.observed = data.angles_rad.reshape(-1)
-        self.sigma = None if data.sigma_rad is None else np.repeat(data.sigma_rad, 3)
+        self.mask = data.measured.reshape(-1)
+        self.all_measured = bool(self.mask.all())
+        self.observed = self._measured(data.angles_rad.reshape(-1))
+        self.sigma = None if data.sigma_rad is None else self._measured(data.sigma_rad.reshape(-1))
+
+    def _measured(self, values: np.ndarray) -> np.ndarray:
+        return values if self.all_measured else values[self.mask]
 
     def predict(self, params: np.ndarray) -> np.ndarray:
-        """Predicted ``dpsi, dtheta, dgamma`` flattened position by position, (3N,), rad."""
-        return self.model.predict(params).reshape(-1)
+        """Predicted ``dpsi, dtheta, dgamma`` of the measured angles, position by position, rad."""
+        return self._measured(self.model.predict(params).reshape(-1))
 
     def jacobian(self, params: np.ndarray) -> np.ndarray:
-        """Derivative of :meth:`predict` with respect to the parameters, (3N, n_params)."""
-        return self.model.jacobian(params).reshape(-1, self.model.n_params)
+        """Derivative of :meth:`predict` with respect to the parameters, (m, n_params)."""
+        return self._measured(self.model.jacobian(params).reshape(-1, self.model.n_params))
 
 
 @dataclass(frozen=True)
@@ -55,6 +60,13 @@ class OrientationFit:
     data: OrientationMeasurements
     model: OrientationModel
     result: FitResult
+
+    def per_angle(self, values: np.ndarray) -> np.ndarray:
+        """Per-observation values (m,) of the result as (N, 3), NaN where not measured."""
+        mask = self.data.measured.reshape(-1)
+        out = np.full(mask.size, np.nan)
+        out[mask] = values
+        return out.reshape(-1, 3)
 
     @property
     def effects(self) -> tuple[Effect, ...]:
@@ -68,20 +80,25 @@ class OrientationFit:
 
     @property
     def residuals_rad(self) -> np.ndarray:
-        """Measured minus fitted ``dpsi, dtheta, dgamma`` per position, (N, 3)."""
-        return self.result.residuals.reshape(-1, 3)
+        """Measured minus fitted ``dpsi, dtheta, dgamma`` per position, (N, 3) (NaN: not
+        measured)."""
+        return self.per_angle(self.result.residuals)
 
     @property
     def normalised_residuals(self) -> np.ndarray:
         """Residuals in units of the noise sigma (given or estimated), (N, 3)."""
-        w = self.result.weights.reshape(-1, 3)
-        return self.residuals_rad * w / np.sqrt(self.result.noise_variance)
+        r = self.result.residuals * self.result.weights / np.sqrt(self.result.noise_variance)
+        return self.per_angle(r)
+
+    @property
+    def sigma_angles_rad(self) -> np.ndarray:
+        """The noise sigma of each angle used to judge the fit (given or estimated), (N, 3)."""
+        return self.per_angle(np.sqrt(self.result.noise_variance) / self.result.weights)
 
     @property
     def sigma_rad(self) -> np.ndarray:
-        """The noise sigma of each position used to judge the fit (given or estimated), (N,)."""
-        w = self.result.weights.reshape(-1, 3)[:, 0]
-        return np.sqrt(self.result.noise_variance) / w
+        """The noise sigma of each position (the median over its measured angles), (N,)."""
+        return np.nanmedian(self.sigma_angles_rad, axis=1)
 
     def fitted_rad(self) -> np.ndarray:
         """The model's ``dpsi, dtheta, dgamma`` at the measured positions, (N, 3)."""
@@ -111,7 +128,7 @@ def fit_orientation(
     effects: Sequence[Effect] = (),
     *,
     noise_variance: float | None = None,
-    turntable: TurntableModel | None = None,
+    turntable=None,
 ) -> OrientationFit:
     """Fit the base error model plus ``effects`` to ``data``.
 
@@ -120,7 +137,8 @@ def fit_orientation(
         effects: catalogued effects to include.
         noise_variance: for data without sigmas, the unit-weight variance (rad^2) to judge the fit
             with (default: estimated from this fit).
-        turntable: the Pinocchio model whose chain is used (default: bundled URDF).
+        turntable: the table (a ``MeasuredTable``, ``TurntableModel`` or ``GenericTable``;
+            default: the bundled paper table).
 
     Raises:
         InputError: more rows than :data:`~turntable_pin.core.sizes.MAX_FITTED_ROWS`.

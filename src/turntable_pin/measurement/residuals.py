@@ -171,6 +171,3 @@ def analyse_residuals(rs: ResidualSet, k_sigma: float = 3.0) -> ResidualAnalysis
             amp = harmonic_amplitudes(rs.residuals, angle, order)
             harmonics[name] = {c: amp[:, i].tolist() for i, c in enumerate(rs.components)}
     return ResidualAnalysis(rs, k_sigma, failing_positions(rs, k_sigma), rms, by_angle, harmonics)
-
-
-

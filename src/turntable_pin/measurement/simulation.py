@@ -20,7 +20,7 @@ from ..core.exceptions import InputError, check_seed
 from ..core.sizes import MAX_SIMULATED_ROWS, check_count, turn_grid_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
-from ..model.turntable import TurntableModel
+from .catalogue import resolve_effect
 from .data import (
     MAX_MEASURED_ANGLE_ARCSEC,
     MAX_TIME_S,
@@ -28,8 +28,8 @@ from .data import (
     OrientationMeasurements,
 )
 from .effect_model import OrientationModel
-from .effects import get_effect
 from .effects.base import PositionVariables
+from .table import measured_table
 
 __all__ = [
     "ROW_BYTES",
@@ -59,9 +59,11 @@ class Schedule:
     """Which positions are measured, in which order, when, and from which side.
 
     Attributes:
-        phi1_step_deg, phi2_step_deg: grid steps; the grid covers [start, start + 360).
-        phi1_start_deg, phi2_start_deg: first grid angles.
-        order: ``grid`` (phi1 outer loop, phi2 inner loop) or ``random`` (shuffled).
+        phi1_step_deg, phi2_step_deg, phi3_step_deg: grid steps of each joint (a table with
+            fewer joints ignores the others); the grid covers [start, start + 360).
+        phi1_start_deg, phi2_start_deg, phi3_start_deg: first grid angles.
+        order: ``grid`` (phi1 outer loop, the last joint's angle inner loop) or ``random``
+            (shuffled).
         repeats: how many times each position is measured.
         dwell_s: time between consecutive measurements.
         approach: ``random`` (each axis from a random side), ``motion`` (the side the move from the
@@ -72,13 +74,15 @@ class Schedule:
     phi2_step_deg: float = 30.0
     phi1_start_deg: float = 0.0
     phi2_start_deg: float = 0.0
+    phi3_step_deg: float = 30.0
+    phi3_start_deg: float = 0.0
     order: str = "grid"
     repeats: int = 1
     dwell_s: float = 60.0
     approach: str = "random"
 
     def __post_init__(self) -> None:
-        for name in ("phi1_step_deg", "phi2_step_deg"):
+        for name in ("phi1_step_deg", "phi2_step_deg", "phi3_step_deg"):
             step = getattr(self, name)
             if not 0 < step <= 360:
                 raise InputError(f"{name} must be in (0, 360], got {step:g}")
@@ -99,22 +103,32 @@ class Schedule:
         if self.dwell_s <= 0:
             raise InputError(f"dwell_s must be > 0, got {self.dwell_s:g}")
 
-    def duration_s(self) -> float:
-        """Time from the first to the last measurement, seconds (``time_s`` of the last row)."""
-        count = turn_grid_count(self.phi1_step_deg) * turn_grid_count(self.phi2_step_deg)
-        return (count * self.repeats - 1) * float(self.dwell_s)
+    def _steps(self, n_joints: int) -> list[tuple[float, float]]:
+        return [
+            (getattr(self, f"phi{k}_start_deg"), getattr(self, f"phi{k}_step_deg"))
+            for k in range(1, n_joints + 1)
+        ]
 
-    def positions_deg(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-        """Commanded (phi1, phi2) in degrees, in measurement order."""
-        a1 = self.phi1_start_deg + np.arange(0.0, 360.0 - 1e-9, self.phi1_step_deg)
-        a2 = self.phi2_start_deg + np.arange(0.0, 360.0 - 1e-9, self.phi2_step_deg)
-        g1, g2 = np.meshgrid(a1, a2, indexing="ij")
-        phi1 = np.tile(g1.ravel(), self.repeats)
-        phi2 = np.tile(g2.ravel(), self.repeats)
+    def count(self, n_joints: int = 2) -> int:
+        """Number of measurements on a table with ``n_joints`` joints."""
+        out = self.repeats
+        for _, step in self._steps(n_joints):
+            out *= turn_grid_count(step)
+        return int(out)
+
+    def duration_s(self, n_joints: int = 2) -> float:
+        """Time from the first to the last measurement, seconds (``time_s`` of the last row)."""
+        return (self.count(n_joints) - 1) * float(self.dwell_s)
+
+    def positions_deg(self, rng: np.random.Generator, n_joints: int = 2) -> tuple[np.ndarray, ...]:
+        """Commanded joint angles (phi1, phi2, ...) in degrees, in measurement order."""
+        axes = [start + np.arange(0.0, 360.0 - 1e-9, step) for start, step in self._steps(n_joints)]
+        grids = np.meshgrid(*axes, indexing="ij")
+        out = [np.tile(g.ravel(), self.repeats) for g in grids]
         if self.order == "random":
-            perm = rng.permutation(phi1.size)
-            phi1, phi2 = phi1[perm], phi2[perm]
-        return phi1, phi2
+            perm = rng.permutation(out[0].size)
+            out = [a[perm] for a in out]
+        return tuple(out)
 
     def directions(self, phi_deg: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """Approach direction (+1 / -1) of one axis at each measurement."""
@@ -135,7 +149,8 @@ class SimulatedMeasurements:
 
     Attributes:
         data: the measurements (with sigma, time and directions).
-        errors: the turntable errors used.
+        errors: the turntable errors used (the paper's ``TurntableErrors``, or ``{name: value in
+            user units}`` of another table: ``<error>_arcsec``, ``<offset>_mm``).
         effects: ``{effect: {parameter: value in user units}}`` hidden in the data.
         noise_arcsec: the noise sigma.
         seed: the random seed.
@@ -144,7 +159,7 @@ class SimulatedMeasurements:
     """
 
     data: OrientationMeasurements
-    errors: TurntableErrors
+    errors: TurntableErrors | dict[str, float]
     effects: dict[str, dict[str, float]]
     noise_arcsec: float
     seed: int
@@ -157,9 +172,8 @@ class SimulatedMeasurements:
         With ``hide_truth`` only the seed, noise and schedule are written, not the errors and the
         hidden effects, so that the file can be used to rehearse a blind diagnosis.
         """
-        errors = ", ".join(
-            f"{k}={v:.6g}" for k, v in self.errors.to_user_units().items() if k != "deta_mm"
-        )
+        user = self.errors.to_user_units() if hasattr(self.errors, "to_user_units") else self.errors
+        errors = ", ".join(f"{k}={v:.6g}" for k, v in user.items() if not k.endswith("_mm"))
         effects = "; ".join(
             f"{name}: " + ", ".join(f"{p}={v:.6g}" for p, v in params.items())
             for name, params in self.effects.items()
@@ -169,8 +183,12 @@ class SimulatedMeasurements:
             "simulated by turntable-pin simulate",
             f"seed={self.seed}",
             f"noise_arcsec={self.noise_arcsec:g}",
-            f"schedule: phi1_step_deg={s.phi1_step_deg:g} phi2_step_deg={s.phi2_step_deg:g} "
-            f"order={s.order} repeats={s.repeats} dwell_s={s.dwell_s:g} "
+            "schedule: "
+            + " ".join(
+                f"phi{k}_step_deg={getattr(s, f'phi{k}_step_deg'):g}"
+                for k in range(1, self.data.n_joints + 1)
+            )
+            + f" order={s.order} repeats={s.repeats} dwell_s={s.dwell_s:g} "
             f"approach={s.approach}",
         ]
         if hide_truth:
@@ -190,18 +208,19 @@ class SimulatedMeasurements:
 
 
 def simulate_measurements(
-    errors: TurntableErrors | None = None,
+    errors: TurntableErrors | np.ndarray | None = None,
     effects: Mapping[str, Mapping[str, float]] | None = None,
     *,
     schedule: Schedule | None = None,
     noise_arcsec: float = 1.0,
     seed: int = 0,
-    turntable: TurntableModel | None = None,
+    turntable=None,
 ) -> SimulatedMeasurements:
     """Simulate a measurement run.
 
     Args:
-        errors: turntable errors (default none).
+        errors: turntable errors (default none): the paper's ``TurntableErrors``, or for another
+            table its error vector (rad, m) in ``GenericTable.parameter_names`` order.
         effects: ``{effect name: {parameter name: value in user units}}`` (parameters not given
             are zero; units are the effect's, e.g. arcsec, arcsec/g, arcsec/h).
         schedule: positions, order, time and approach directions (default: 30-degree grid).
@@ -213,7 +232,7 @@ def simulate_measurements(
     Every effect needs at least one parameter, each within ``+-MAX_MEASURED_ANGLE_ARCSEC`` in its
     user unit; the run may last at most ``MAX_TIME_S`` and the simulated angles must stay within
     what a measurement file may hold, or :class:`InputError` says which.
-        turntable: the Pinocchio model (default: bundled URDF).
+        turntable: the table (``GenericTable``, ``TurntableModel`` or ``None``: the paper's).
     """
     limit = MAX_MEASURED_ANGLE_ARCSEC
     if not noise_arcsec > 0:
@@ -224,8 +243,22 @@ def simulate_measurements(
             f"{noise_arcsec:g}"
         )
     seed = check_seed(seed)
-    errors = errors or TurntableErrors.zero()
+    table = measured_table(turntable)
+    n_joints = table.n_joints
+    if table.paper:
+        errors = errors or TurntableErrors.zero()
+        base_values = dict(zip(ANGULAR_ERROR_NAMES, errors.angular_array_rad(), strict=True))
+    else:
+        vector = np.zeros(len(turntable.parameter_names)) if errors is None else errors
+        vector = np.asarray(vector, dtype=float)
+        errors = turntable.to_user_units(vector)
+        base_values = {
+            n: v for n, v in zip(turntable.parameter_names, vector, strict=True)
+            if n in table.base_names
+        }  # fmt: skip
     schedule = schedule or Schedule()
+    check_count(schedule.count(n_joints), MAX_SIMULATED_ROWS, "rows of simulated measurements",
+                ROW_BYTES)  # fmt: skip
     effects = {name: dict(params) for name, params in (effects or {}).items()}
     for name, params in effects.items():
         if not params:
@@ -244,23 +277,22 @@ def simulate_measurements(
                     f"+-{limit:g} (in its user unit: arcsec, arcsec/g or arcsec/h)"
                 )
     rng = np.random.default_rng(seed)
-    phi1_deg, phi2_deg = schedule.positions_deg(rng)
-    n = phi1_deg.size
-    if schedule.duration_s() > MAX_TIME_S:
+    angles_deg = schedule.positions_deg(rng, n_joints)
+    n = angles_deg[0].size
+    if schedule.duration_s(n_joints) > MAX_TIME_S:
         raise InputError(
             f"dwell_s {schedule.dwell_s:g}: the run of {n} measurements would last "
-            f"{schedule.duration_s():.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
+            f"{schedule.duration_s(n_joints):.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
         )
     variables = PositionVariables(
-        phi1_rad=phi1_deg / DEG_PER_RAD,
-        phi2_rad=phi2_deg / DEG_PER_RAD,
+        np.stack(angles_deg, axis=1) / DEG_PER_RAD,
         time_s=np.arange(n) * schedule.dwell_s,
-        dir1=schedule.directions(phi1_deg, rng),
-        dir2=schedule.directions(phi2_deg, rng),
+        dirs=tuple(schedule.directions(a, rng) for a in angles_deg),
     )
-    effect_objects = [get_effect(name) for name in effects]
-    model = OrientationModel(variables, effect_objects, turntable)
-    values = dict(zip(ANGULAR_ERROR_NAMES, errors.angular_array_rad(), strict=True))
+    effect_objects = [resolve_effect(name, table) for name in effects]
+    effects = {e.name: effects[name] for e, name in zip(effect_objects, effects, strict=True)}
+    model = OrientationModel(variables, effect_objects, table)
+    values = dict(base_values)
     for effect in effect_objects:
         specs = {s.name: s for s in effect.parameters(variables)}
         for pname, value in effects[effect.name].items():
@@ -281,14 +313,13 @@ def simulate_measurements(
             "parameters or noise"
         )
     data = OrientationMeasurements(
-        phi1_rad=variables.phi1_rad,
-        phi2_rad=variables.phi2_rad,
+        joint_rad=variables.joint_rad,
         angles_rad=measured,
         sigma_rad=np.full(n, sigma_rad),
         time_s=variables.time_s,
-        dir1=variables.dir1,
-        dir2=variables.dir2,
+        dirs=variables.dirs,
         source=f"simulated (seed {seed})",
+        joint_names=() if table.paper else table.joint_names,
     )
     return SimulatedMeasurements(
         data=data,

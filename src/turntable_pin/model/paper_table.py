@@ -11,6 +11,7 @@ from __future__ import annotations
 
 __all__ = [
     "INNER_JOINT",
+    "JOINT_ERRORS",
     "OUTER_JOINT",
     "PAYLOAD_FRAME",
     "PAYLOAD_MOUNT",
@@ -42,3 +43,10 @@ PLACEMENT_ERROR_FACTORS: dict[str, tuple[tuple[str, str, str], ...]] = {
 
 PLACEMENT_ORDER: tuple[str, ...] = (OUTER_JOINT, INNER_JOINT, PAYLOAD_MOUNT)
 """The placements carrying errors, from the base."""
+
+JOINT_ERRORS: dict[str, tuple[str, str, str]] = {
+    OUTER_JOINT: ("dphi_y1", "dalpha_x1", "dalpha_z1"),
+    INNER_JOINT: ("dphi_z2", "dalpha_x2", "dalpha_y2"),
+}
+"""Each joint's position error and its two wobble (tilt) errors in the paper's names: what the
+generic ``<joint>.position``, ``.tilt_a``, ``.tilt_b`` are called on this table."""

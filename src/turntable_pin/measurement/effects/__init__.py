@@ -66,21 +66,23 @@ def parameter_names(effect: Effect) -> tuple[str, ...]:
 
 
 def _every_parameter(effect: Effect):
-    one = np.zeros(1)
-    return effect.parameters(PositionVariables(one, one, time_s=one, dir1=one + 1, dir2=one + 1))
+    one = np.zeros((1, 3))
+    dirs = (one[:, 0] + 1,) * 3
+    return effect.parameters(PositionVariables(one, one[:, 0], dirs))
 
 
-def parse_effect_spec(text: str) -> tuple[str, dict[str, float]]:
+def parse_effect_spec(text: str, resolve=None) -> tuple[str, dict[str, float]]:
     """``"NAME:P=V,P=V"`` -> ``(name, {P: V})`` with values in the effect's user units.
 
     Refused (:class:`InputError`): an unknown effect; no parameters (the effect would add
     nothing); a ``:`` with nothing after it; an item that is not ``P=V`` (empty items between
     commas are skipped); a parameter given twice; a value that is not a finite number. Whether
     each ``P`` is a parameter of the effect is checked where the data are known
-    (:func:`simulate_measurements`).
+    (:func:`simulate_measurements`). ``resolve`` finds an effect by name (default: the paper's
+    catalogue, :func:`get_effect`; a table's ``MeasuredTable.resolve`` for its own names).
     """
     name, colon, rest = str(text).partition(":")
-    effect = get_effect(name)
+    effect = (resolve or get_effect)(name)
     specs = _every_parameter(effect)
     units = "/".join(dict.fromkeys(spec.unit for spec in specs))
     names = f"{', '.join(spec.name for spec in specs)} in {units}"

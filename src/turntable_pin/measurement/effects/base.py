@@ -16,6 +16,7 @@ factors of the chain and differentiates them analytically.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -80,23 +81,81 @@ class ChainTerm:
 class PositionVariables:
     """What an effect may depend on at each of N positions (commanded values).
 
-    ``time_s``, ``dir1``, ``dir2`` are ``None`` when the data set has no such column.
+    Attributes:
+        joint_rad: commanded joint angles (N, J), one column per revolute joint in chain order
+            from the base (``phi1 .. phiJ``).
+        time_s: time of each measurement (N,), or ``None`` when the data have no ``time_s``.
+        dirs: per joint, the approach direction (N,) of ``dirK`` (+1/-1), or ``None``.
+        extra: other numeric columns of the data file (``temperature_c``, ...), ``{name: (N,)}``.
     """
 
-    phi1_rad: np.ndarray
-    phi2_rad: np.ndarray
+    joint_rad: np.ndarray
     time_s: np.ndarray | None = None
-    dir1: np.ndarray | None = None
-    dir2: np.ndarray | None = None
+    dirs: tuple[np.ndarray | None, ...] = ()
+    extra: Mapping[str, np.ndarray] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        joints = np.array(self.joint_rad, dtype=float)
+        if joints.ndim == 1:
+            joints = joints[:, None]
+        joints.setflags(write=False)
+        object.__setattr__(self, "joint_rad", joints)
+        dirs = tuple(self.dirs) + (None,) * (joints.shape[1] - len(self.dirs))
+        object.__setattr__(self, "dirs", dirs[: joints.shape[1]])
+
+    @classmethod
+    def of(cls, *angles_rad, time_s=None, dirs=(), extra=None) -> PositionVariables:
+        """The variables of joint angle arrays given one per joint (``phi1, phi2, ...``)."""
+        joints = np.stack([np.asarray(a, dtype=float).reshape(-1) for a in angles_rad], axis=1)
+        return cls(joints, time_s, tuple(dirs), dict(extra or {}))
 
     @property
     def n(self) -> int:
         """Number of positions N."""
-        return int(np.asarray(self.phi1_rad).size)
+        return int(self.joint_rad.shape[0])
+
+    @property
+    def n_joints(self) -> int:
+        """Number of joints J."""
+        return int(self.joint_rad.shape[1])
+
+    def angle(self, k: int) -> np.ndarray:
+        """The commanded angle of joint ``k`` (1 = the base-most joint), rad (N,)."""
+        return self.joint_rad[:, k - 1]
+
+    @property
+    def phi1_rad(self) -> np.ndarray:
+        """The first joint's commanded angle (the paper's outer axis), rad (N,)."""
+        return self.angle(1)
+
+    @property
+    def phi2_rad(self) -> np.ndarray:
+        """The second joint's commanded angle (the paper's inner axis), rad (N,)."""
+        return self.angle(2)
+
+    @property
+    def dir1(self) -> np.ndarray | None:
+        """Approach direction of joint 1, or ``None``."""
+        return self.dirs[0] if self.dirs else None
+
+    @property
+    def dir2(self) -> np.ndarray | None:
+        """Approach direction of joint 2, or ``None``."""
+        return self.dirs[1] if len(self.dirs) > 1 else None
+
+    def column(self, name: str) -> np.ndarray | None:
+        """The data column ``name``: ``time_s``, ``dirK``, ``phiK`` (rad) or an extra column."""
+        if name == "time_s":
+            return self.time_s
+        for prefix, values in (("dir", self.dirs), ("phi", tuple(self.joint_rad.T))):
+            if name.startswith(prefix) and name[len(prefix) :].isdigit():
+                k = int(name[len(prefix) :])
+                return values[k - 1] if 1 <= k <= len(values) else None
+        return self.extra.get(name)
 
     def has(self, column: str) -> bool:
-        """Whether the optional column ``column`` (``time_s``, ``dir1``, ``dir2``) is present."""
-        return getattr(self, column) is not None
+        """Whether the data column ``column`` (``time_s``, ``dirK``, an extra one) is present."""
+        return self.column(column) is not None
 
 
 def harmonic_weights(angle_rad: np.ndarray, prefix: str = "") -> dict[str, np.ndarray]:

@@ -1,0 +1,140 @@
+"""A table's catalogue of candidate effects, and effects found by name (``docs/measurements.md``).
+
+- Per joint: ``encoder_harmonics@<joint>``, ``wobble_harmonics@<joint>``, ``backlash@<joint>``.
+- Table-wide: ``gravity_sag`` (a compliance ``K`` with the entries orientation data determine
+  beyond the base errors), ``base_tilt`` (about the base axes the data tell apart from the base
+  errors), ``thermal_drift``, ``payload_mount``.
+
+Which entries of ``K`` and which base axes are kept is found like the base errors: QR with column
+pivoting of the effect's columns, after projecting out the base errors, on generic positions.
+
+On the paper's table the catalogue is the paper's nine effects, and the per-joint names are
+aliases of them (``encoder_harmonics@outer_axis`` is ``outer_encoder_harmonics``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..core.exceptions import InputError
+from .effect_model import OrientationModel
+from .effects.base import Effect, PositionVariables
+from .table import JointErrors, MeasuredTable, measured_table
+
+__all__ = ["PAPER_ALIASES", "PER_JOINT_EFFECTS", "catalogue", "joint_effect", "resolve_effect"]
+
+PER_JOINT_EFFECTS = ("encoder_harmonics", "wobble_harmonics", "backlash")
+"""The kinds of per-joint effects, named ``<kind>@<joint>``."""
+_PER_JOINT_TEXT = ", ".join(f"{k}@<joint>" for k in PER_JOINT_EFFECTS)
+
+PAPER_ALIASES = {
+    "encoder_harmonics@outer_axis": "outer_encoder_harmonics",
+    "encoder_harmonics@inner_axis": "inner_encoder_harmonics",
+    "wobble_harmonics@outer_axis": "outer_wobble_harmonics",
+    "wobble_harmonics@inner_axis": "inner_wobble_harmonics",
+}
+"""The paper's catalogue names of per-joint effects on its table."""
+
+_CATALOGUES: dict[int, tuple[MeasuredTable, tuple[Effect, ...]]] = {}
+
+
+def catalogue(turntable=None) -> tuple[Effect, ...]:
+    """The candidate effects of a table, in catalogue order (module docstring)."""
+    from .effects import EFFECTS
+    from .effects.base_rotation import BaseRotation
+    from .effects.gravity_compliance import GravityCompliance
+    from .effects.payload_mount import PayloadMount
+    from .effects.thermal_drift import ThermalDrift
+
+    table = measured_table(turntable)
+    if table.paper:
+        return tuple(EFFECTS.values())
+    cached = _CATALOGUES.get(id(table))
+    if cached is not None and cached[0] is table:
+        return cached[1]
+    sag = GravityCompliance(table.rotation)
+    sag = GravityCompliance(table.rotation, _determined(table, sag))
+    tilt = BaseRotation()
+    tilt = BaseRotation(tuple(name[1] for name in _determined(table, tilt)))
+    out = (
+        *(joint_effect("encoder_harmonics", j) for j in table.joints),
+        *(joint_effect("wobble_harmonics", j) for j in table.joints),
+        *((sag,) if sag.entries else ()),
+        *((tilt,) if tilt.axes else ()),
+        ThermalDrift(),
+        *(joint_effect("backlash", j) for j in table.joints),
+        PayloadMount(),
+    )
+    _CATALOGUES[id(table)] = (table, out)
+    return out
+
+
+def joint_effect(kind: str, joint: JointErrors) -> Effect:
+    """The per-joint effect ``kind`` of ``joint``, named ``<kind>@<joint>``."""
+    from .effects.encoder_harmonics import EncoderHarmonics
+    from .effects.joint_backlash import JointBacklash
+    from .effects.wobble_harmonics import WobbleHarmonics
+
+    if kind == "encoder_harmonics":
+        return EncoderHarmonics(joint.joint, joint.index, joint.position)
+    if kind == "wobble_harmonics":
+        return WobbleHarmonics(joint.joint, joint.index, joint.tilts)
+    if kind == "backlash":
+        return JointBacklash(joint.joint, joint.index, joint.position)
+    raise InputError(f"no per-joint effect '{kind}'; per-joint effects: {_PER_JOINT_TEXT}")
+
+
+def _determined(table: MeasuredTable, effect: Effect) -> tuple[str, ...]:
+    """The parameters of ``effect`` orientation data determine beyond the base errors."""
+    from scipy.linalg import qr
+
+    from ..stats.least_squares import RANK_RTOL
+
+    rng = np.random.default_rng(0)  # generic positions: any random draw is generic
+    variables = PositionVariables(rng.uniform(-np.pi, np.pi, (64, table.n_joints)))
+    model = OrientationModel(variables, [effect], table)
+    jac = model.jacobian(np.zeros(model.n_params)).reshape(-1, model.n_params)
+    n_base = len(table.base_names)
+    u, s, _ = np.linalg.svd(jac[:, :n_base], full_matrices=False)
+    u = u[:, s > RANK_RTOL * s[0]]
+    added = jac[:, n_base:]
+    extra = added - u @ (u.T @ added)
+    _, r, pivots = qr(extra / np.linalg.norm(added, axis=0), mode="economic", pivoting=True)
+    diag = np.abs(np.diag(r))
+    rank = int(np.sum(diag > RANK_RTOL * max(diag[0], 1e-300))) if diag.size else 0
+    names = [spec.name for spec in effect.parameters(variables)]
+    return tuple(sorted((names[p] for p in pivots[:rank]), key=names.index))
+
+
+def resolve_effect(name: str, turntable=None, extra: Sequence[Effect] = ()) -> Effect:
+    """The effect called ``name`` on a table: in ``extra`` (the caller's, first), the table's
+    catalogue, a paper alias, or a per-joint ``<kind>@<joint>``.
+
+    Raises:
+        InputError: an unknown name, listing the known ones.
+    """
+    table = measured_table(turntable)
+    name = name.strip()
+    known = (*extra, *catalogue(table))
+    for effect in known:
+        if effect.name == name:
+            return effect
+    kind, at, joint_name = name.partition("@")
+    if at:
+        joint = next((j for j in table.joints if j.joint == joint_name), None)
+        if joint is None:
+            raise InputError(
+                f"unknown joint '{joint_name}' in effect '{name}'; this table's joints: "
+                f"{', '.join(table.joint_names)}"
+            )
+        alias = PAPER_ALIASES.get(name) if table.paper else None
+        if alias:
+            return resolve_effect(alias, table)
+        if kind in PER_JOINT_EFFECTS:
+            return joint_effect(kind, joint)
+    raise InputError(
+        f"unknown effect '{name}'; effects of this table: {', '.join(e.name for e in known)} "
+        f"(and {_PER_JOINT_TEXT} for joints {', '.join(table.joint_names)})"
+    )

@@ -1,0 +1,136 @@
+"""The turntable as the measurement layer sees it: its error chain, base errors, joints, effects.
+
+One class, :class:`MeasuredTable`, serves the paper's table and any URDF table alike; the paper's
+table is the same model under the names of its Table 2 (a name map, ``model/paper_table.py``).
+
+- The *base errors* are the chain's rotation errors (offsets move the payload, never turn it).
+- Each joint has a *position error* and two *tilts* (generic: ``<joint>.position``,
+  ``.tilt_a``, ``.tilt_b``; the paper: ``dphi_y1, dalpha_x1, dalpha_z1`` for ``outer_axis`` and
+  ``dphi_z2, dalpha_x2, dalpha_y2`` for ``inner_axis``).
+
+Its candidate effects are in :mod:`turntable_pin.measurement.catalogue`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.chain import ROTATION, ErrorChain, compose_rotation
+
+__all__ = ["JointErrors", "MeasuredTable", "measured_table"]
+
+
+@dataclass(frozen=True)
+class JointErrors:
+    """One joint's errors in the table's names.
+
+    Attributes:
+        joint: the joint's name; index: its place from the base (1 = ``phi1``);
+        position: its position error; tilts: its two tilt (wobble) errors.
+    """
+
+    joint: str
+    index: int
+    position: str
+    tilts: tuple[str, str]
+
+
+class MeasuredTable:
+    """A turntable for fitting and diagnosing orientation data.
+
+    Args:
+        chain: the table's error chain (nominal placements, joint axes, error factors).
+        joints: each joint's errors, from the base.
+        descriptions: ``{base error: what it is}``.
+        label: how reports name the table (``paper`` or the URDF file).
+        paper: the paper's table (its catalogue and names).
+    """
+
+    def __init__(
+        self,
+        chain: ErrorChain,
+        joints: Sequence[JointErrors],
+        descriptions: dict[str, str],
+        *,
+        label: str,
+        paper: bool = False,
+    ) -> None:
+        self.chain = chain
+        self.joints = tuple(joints)
+        self.descriptions = dict(descriptions)
+        self.label = label
+        self.paper = paper
+        rotations = [f.error for link in chain.links for f in link.factors if f.kind == ROTATION]
+        self.base_names = tuple(n for n in chain.error_names if n in rotations)
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The revolute joints from the base."""
+        return tuple(j.joint for j in self.joints)
+
+    @property
+    def n_joints(self) -> int:
+        """Number of revolute joints."""
+        return len(self.joints)
+
+    def rotation(self, joint_rad: np.ndarray) -> np.ndarray:
+        """The nominal payload orientation ``Rd`` at joint angles (N, J), (N, 3, 3)."""
+        q = [np.asarray(joint_rad, dtype=float)[:, k] for k in range(self.n_joints)]
+        return compose_rotation(self.chain.placements(), q)
+
+    def angle_label(self, k: int) -> str:
+        """``phiK``, the name of joint K's angle in data files and reports."""
+        return f"phi{k}"
+
+
+def _paper(turntable) -> MeasuredTable:
+    from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_DESCRIPTIONS
+    from ..model.paper_table import JOINT_ERRORS
+
+    chain = turntable.chain
+    joints = [
+        JointErrors(name, k, JOINT_ERRORS[name][0], JOINT_ERRORS[name][1:])
+        for k, name in enumerate(chain.joint_names, start=1)
+    ]
+    table = MeasuredTable(
+        chain, joints, {n: ERROR_DESCRIPTIONS[n] for n in ANGULAR_ERROR_NAMES}, label="paper",
+        paper=True,
+    )  # fmt: skip
+    return table
+
+
+def _generic(table) -> MeasuredTable:
+    joints = [
+        JointErrors(name, k, f"{name}.position", (f"{name}.tilt_a", f"{name}.tilt_b"))
+        for k, name in enumerate(table.joint_names, start=1)
+    ]
+    return MeasuredTable(table.chain, joints, table.descriptions, label=str(table.urdf_path))
+
+
+def measured_table(turntable=None) -> MeasuredTable:
+    """The :class:`MeasuredTable` of ``turntable``: ``None`` (the bundled paper table), a
+    :class:`~turntable_pin.model.turntable.TurntableModel` (the paper's names), a
+    :class:`~turntable_pin.model.generic_table.GenericTable` (generic names), or a
+    :class:`MeasuredTable` (returned as it is)."""
+    if isinstance(turntable, MeasuredTable):
+        return turntable
+    if turntable is None:
+        return _default_paper()
+    if hasattr(turntable, "parameter_names") and hasattr(turntable, "identifiable"):
+        return _generic(turntable)
+    return _paper(turntable)
+
+
+_DEFAULT: list[MeasuredTable] = []
+
+
+def _default_paper() -> MeasuredTable:
+    """The bundled paper table (built once per process: reading the URDF costs ~10 ms)."""
+    if not _DEFAULT:
+        from ..model.turntable import TurntableModel
+
+        _DEFAULT.append(_paper(TurntableModel()))
+    return _DEFAULT[0]
