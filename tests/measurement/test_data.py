@@ -85,3 +85,51 @@ def test_small_angle_degree_data_are_not_mistaken_for_radians(tmp_path):
     assert data.n_positions == 20
     # A whole-degree grid is never flagged.
     assert read_measurements(write_file(tmp_path, HEAD + "\n" + grid_rows())).n_positions == 9
+
+
+# ---- tables other than the paper's, empty cells, per-angle sigma, extra columns ----------------
+def test_joint_angle_columns_by_position_or_joint_name(tmp_path):
+    joints = ("azimuth", "elevation")
+    by_k = "phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec\n10,20,1,2,3\n"
+    by_name = "elevation_deg,azimuth_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec\n20,10,1,2,3\n"
+    for text in (by_k, by_name):
+        data = read_measurements(write_file(tmp_path, text), joints)
+        np.testing.assert_allclose(np.degrees(data.joint_rad), [[10, 20]])
+    both = (
+        "phi1_deg,azimuth_deg,elevation_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec\n1,1,2,1,2,3\n"
+    )
+    with pytest.raises(InputError, match="joint 1 has two angle columns"):
+        read_measurements(write_file(tmp_path, both), joints)
+    with pytest.raises(InputError, match="'phi2_deg' or 'elevation_deg'"):
+        read_measurements(write_file(tmp_path, "phi1_deg,dpsi_arcsec,dtheta_arcsec,"
+                                               "dgamma_arcsec\n1,1,2,3\n"), joints)  # fmt: skip
+    one = read_measurements(
+        write_file(tmp_path, "phi1_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec,dir1\n5,1,2,3,-1\n"),
+        ("spindle",),
+    )
+    assert one.n_joints == 1 and one.dirs[0].tolist() == [-1.0]
+
+
+def test_an_empty_angle_cell_is_not_measured_and_a_row_needs_one_angle(tmp_path):
+    text = "phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec\n0,0,1,,3\n0,30,,,6\n"
+    data = read_measurements(write_file(tmp_path, text))
+    assert data.measured.tolist() == [[True, False, True], [False, False, True]]
+    bad = text + "0,60,,,\n"
+    with pytest.raises(InputError, match=r"row 4.*at least one measured angle"):
+        read_measurements(write_file(tmp_path, bad))
+    with pytest.raises(InputError, match="empty cell"):  # other columns stay strict
+        read_measurements(write_file(tmp_path, text.replace("0,30,", ",30,")))
+
+
+def test_sigma_per_angle_and_extra_numeric_columns(tmp_path):
+    text = (
+        "phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec,sigma_dpsi_arcsec,"
+        "sigma_dtheta_arcsec,sigma_dgamma_arcsec,temperature_c,operator\n"
+        "0,0,1,2,3,0.5,1,2,21.5,ann\n0,30,1,2,3,0.5,1,2,22.0,bob\n"
+    )
+    data = read_measurements(write_file(tmp_path, text))
+    np.testing.assert_allclose(data.sigma_rad[0] * 206264.80624709636, [0.5, 1, 2])
+    assert list(data.extra) == ["temperature_c"]  # text columns are not suspects
+    np.testing.assert_allclose(data.extra["temperature_c"], [21.5, 22.0])
+    with pytest.raises(InputError, match="not both"):
+        read_measurements(write_file(tmp_path, text.replace("sigma_dpsi_arcsec", "sigma_arcsec")))

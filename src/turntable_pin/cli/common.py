@@ -19,6 +19,7 @@ __all__ = [
     "OUTPUT_OPTIONS",
     "accuracy_dph",
     "add_error_options",
+    "add_table_options",
     "bounded_float",
     "error_overrides",
     "errors_from_args",
@@ -33,6 +34,7 @@ __all__ = [
     "positive_int",
     "print_json",
     "seed",
+    "table_from_args",
     "refuse_inputs_as_outputs",
 ]
 
@@ -155,6 +157,11 @@ def add_error_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--errors", type=Path, metavar="FILE.yaml", help="YAML file of turntable errors"
     )
+    add_table_options(parser)
+
+
+def add_table_options(parser: argparse.ArgumentParser) -> None:
+    """``--urdf FILE`` and ``--payload-frame NAME``: which turntable (default: the paper's)."""
     parser.add_argument(
         "--urdf", type=Path, metavar="FILE.urdf", help="nominal turntable URDF (default: bundled)"
     )
@@ -163,6 +170,15 @@ def add_error_options(parser: argparse.ArgumentParser) -> None:
         metavar="NAME",
         help="the payload frame of the URDF (default: the only leaf of its chain)",
     )
+
+
+def table_from_args(args: argparse.Namespace):
+    """The table of ``--urdf``/``--payload-frame`` for the measurement layer: ``None`` (the
+    bundled paper table), a ``TurntableModel`` (a URDF with the paper's joints: the paper's
+    names) or a ``GenericTable`` (any other table: generic names)."""
+    if paper_table_requested(args):
+        return TurntableModel(urdf_path=args.urdf) if args.urdf else None
+    return generic_table_from_args(args)
 
 
 def paper_table_requested(args: argparse.Namespace) -> bool:

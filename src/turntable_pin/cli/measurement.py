@@ -10,13 +10,16 @@ from ..measurement.data import MAX_TIME_S, MIN_SIGMA_ARCSEC, read_measurements
 from ..measurement.effects import EFFECT_NAMES, parse_effect_list, parse_effect_spec
 from .common import (
     add_error_options,
+    add_table_options,
     bounded_float,
     errors_from_args,
+    generic_errors_from_args,
     one_line_errors,
     positive_float,
     positive_int,
     print_json,
     seed,
+    table_from_args,
 )
 
 __all__ = ["register"]
@@ -51,6 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     s.add_argument("--seed", type=seed, default=0, help="random seed (recorded in the file)")
     s.add_argument("--phi1-step-deg", type=step, default=30.0)
     s.add_argument("--phi2-step-deg", type=step, default=30.0)
+    s.add_argument("--phi3-step-deg", type=step, default=30.0, help="third axis (3-axis tables)")
     s.add_argument("--order", choices=ORDERS, default="grid")
     s.add_argument("--repeats", type=positive_int, default=1)
     s.add_argument(
@@ -78,6 +82,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     one_line_errors(f)
     _add_data_options(f)
     f.add_argument("--effects", default="", metavar="A,B", help="effects to add to the base")
+    f.add_argument(
+        "--write-urdf",
+        type=Path,
+        metavar="OUT.urdf",
+        help="write the URDF with the fitted errors in its joint placements (combinations the "
+        "data cannot separate are split by the minimum-norm rule, stated in the output)",
+    )
     f.add_argument("--plots", type=Path, metavar="DIR", help="write residual plots (PNG) here")
     f.add_argument("--k-sigma", type=positive_float, default=3.0, help="failing threshold (> 0)")
     f.set_defaults(func=run_fit)
@@ -101,6 +112,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     one_line_errors(r)
     r.add_argument("data", type=Path, metavar="DATA.csv")
+    add_table_options(r)
     r.add_argument("--ignore-sigma", action="store_true")
     r.add_argument("--until-explained", action="store_true")
     r.add_argument("-o", "--output", type=Path, required=True, metavar="report.html")
@@ -116,6 +128,7 @@ def _noise_arcsec(text: str) -> float:
 
 def _add_data_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("data", type=Path, metavar="DATA.csv")
+    add_table_options(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument(
         "--ignore-sigma",
@@ -124,17 +137,22 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
     )
 
 
-def _read(args: argparse.Namespace):
-    data = read_measurements(args.data)
+def _read(args: argparse.Namespace, table=None):
+    """The measurements of ``args.data`` for ``table`` (angle columns ``phiK_deg`` or
+    ``<joint>_deg`` of its joints; the paper's ``phi1_deg, phi2_deg`` when ``None``)."""
+    joints = getattr(table, "joint_names", None) if hasattr(table, "identifiable") else None
+    data = read_measurements(args.data, joints)
     return data.without_sigma() if args.ignore_sigma else data
 
 
-def _parse_effect_options(texts: list[str]) -> dict[str, dict[str, float]]:
+def _parse_effect_options(texts: list[str], table=None) -> dict[str, dict[str, float]]:
     """The ``--effect`` options as ``{effect: {parameter: value}}``; each effect at most once."""
+    from ..measurement.catalogue import resolve_effect
+
     effects: dict[str, dict[str, float]] = {}
     for text in texts:
         try:
-            name, params = parse_effect_spec(text)
+            name, params = parse_effect_spec(text, lambda n: resolve_effect(n, table))
         except InputError as exc:
             raise InputError(f"--effect '{text}': {exc}") from None
         if name in effects:
@@ -146,29 +164,31 @@ def _parse_effect_options(texts: list[str]) -> dict[str, dict[str, float]]:
 def run_simulate(args: argparse.Namespace) -> int:
     from ..measurement.simulation import Schedule, simulate_measurements
 
-    effects = _parse_effect_options(args.effect)
+    table = table_from_args(args)
+    generic = hasattr(table, "identifiable")
+    effects = _parse_effect_options(args.effect, table)
     schedule = Schedule(
         phi1_step_deg=args.phi1_step_deg,
         phi2_step_deg=args.phi2_step_deg,
+        phi3_step_deg=args.phi3_step_deg,
         order=args.order,
         repeats=args.repeats,
         dwell_s=args.dwell_s,
         approach=args.approach,
     )
-    if schedule.duration_s() > MAX_TIME_S:
+    n_joints = len(table.joint_names) if generic else 2
+    if schedule.duration_s(n_joints) > MAX_TIME_S:
         raise InputError(
-            f"--dwell-s {args.dwell_s:g}: the run would last {schedule.duration_s():.7g} s, more "
-            f"than {MAX_TIME_S:.7g} s (a year)"
+            f"--dwell-s {args.dwell_s:g}: the run would last "
+            f"{schedule.duration_s(n_joints):.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
         )
-    from ..model.turntable import TurntableModel
-
     sim = simulate_measurements(
-        errors_from_args(args),
+        generic_errors_from_args(table, args) if generic else errors_from_args(args),
         effects,
         schedule=schedule,
         noise_arcsec=args.noise_arcsec,
         seed=args.seed,
-        turntable=TurntableModel(urdf_path=args.urdf) if args.urdf else None,
+        turntable=table,
     )
     path = sim.write_csv(args.output, with_sigma=not args.no_sigma, hide_truth=args.hide_truth)
     print(f"wrote {path}: {sim.data.n_positions} positions, seed {sim.seed}")
@@ -185,14 +205,16 @@ def _fit_line(label: str, summary: dict) -> str:
 
 
 def run_fit(args: argparse.Namespace) -> int:
+    from ..measurement.catalogue import resolve_effect
     from ..measurement.fit import fit_orientation
     from ..measurement.residuals import analyse_residuals, orientation_residuals
     from ..report.measurement_figures import write_residual_plots
 
-    data = _read(args)
-    effects = parse_effect_list(args.effects)
-    after = fit_orientation(data, effects)
-    before = fit_orientation(data) if effects else after
+    table = table_from_args(args)
+    data = _read(args, table)
+    effects = parse_effect_list(args.effects, lambda n: resolve_effect(n, table))
+    after = fit_orientation(data, effects, turntable=table)
+    before = fit_orientation(data, turntable=table) if effects else after
     # With sigma estimated, both fits are judged with the noise of the fuller model.
     before = before.with_noise_variance(after.result.noise_variance)
     analysis = analyse_residuals(orientation_residuals(after), args.k_sigma)
@@ -205,6 +227,10 @@ def run_fit(args: argparse.Namespace) -> int:
                                                      "rank", "n_params")}  # fmt: skip
     out["where_it_fails"] = analysis.to_dict(per_position=True)
     out["plots"] = plots
+    if args.write_urdf:
+        from ..measurement.identified import write_identified_urdf
+
+        out["identified_urdf"] = write_identified_urdf(after, args.write_urdf, args.urdf)
     if args.json:
         print_json(out)
         return 0
@@ -219,14 +245,21 @@ def run_fit(args: argparse.Namespace) -> int:
     und = after.result.undetermined_combinations()
     if und:
         print("not determined by these data: " + "; ".join(und))
+    if out["unobserved_combinations"]:
+        print("not observed because cells are empty (angles not measured): "
+              + "; ".join(out["unobserved_combinations"]))  # fmt: skip
     print(f"positions beyond {args.k_sigma:g} sigma: {len(analysis.failing)}")
     for f in analysis.failing[:10]:
+        where = " ".join(f"phi{k} {f[f'phi{k}_deg']:g}" for k in range(1, data.n_joints + 1))
         print(
-            f"  row {f['row']}: phi1 {f['phi1_deg']:g} phi2 {f['phi2_deg']:g} deg, "
+            f"  row {f['row']}: {where} deg, "
             f"{f['component']} {f['residual_arcsec']:+.2f} arcsec ({f['sigmas']:+.1f} sigma)"
         )
     for p in plots:
         print(f"wrote {p}")
+    if args.write_urdf:
+        written = out["identified_urdf"]
+        print(f"wrote {written['path']}: {written['rule']}")
     return 0
 
 
@@ -236,8 +269,9 @@ def run_diagnose(args: argparse.Namespace) -> int:
     from ..report.diagnosis_text import diagnosis_lines
     from ..report.measurement_figures import write_residual_plots
 
-    data = _read(args)
-    diagnosis = diagnose_measurements(data, until_explained=args.until_explained)
+    table = table_from_args(args)
+    data = _read(args, table)
+    diagnosis = diagnose_measurements(data, until_explained=args.until_explained, turntable=table)
     out = diagnosis.to_dict()
     if args.plots:
         base = diagnosis.base_fit.with_noise_variance(diagnosis.noise_variance)
@@ -258,10 +292,9 @@ def run_report(args: argparse.Namespace) -> int:
     from ..measurement.diagnosis import diagnose_measurements
     from ..report.html_report import write_report
 
-    data = read_measurements(args.data)
-    if args.ignore_sigma:
-        data = data.without_sigma()
-    diagnosis = diagnose_measurements(data, until_explained=args.until_explained)
+    table = table_from_args(args)
+    data = _read(args, table)
+    diagnosis = diagnose_measurements(data, until_explained=args.until_explained, turntable=table)
     path = write_report(diagnosis, args.output, title=f"Diagnosis of {args.data.name}")
     print(f"wrote {path}")
     return 0

@@ -54,15 +54,17 @@ def catalogue(turntable=None) -> tuple[Effect, ...]:
     cached = _CATALOGUES.get(id(table))
     if cached is not None and cached[0] is table:
         return cached[1]
+    # Keep the parameters the data determine; when none is, keep the whole effect, so that the
+    # diagnosis says it is absorbed by the base errors (a base tilt by the first joint's tilts).
     sag = GravityCompliance(table.rotation)
-    sag = GravityCompliance(table.rotation, _determined(table, sag))
+    sag = GravityCompliance(table.rotation, _determined(table, sag) or sag.entries)
     tilt = BaseRotation()
-    tilt = BaseRotation(tuple(name[1] for name in _determined(table, tilt)))
+    tilt = BaseRotation(tuple(name[1] for name in _determined(table, tilt)) or tilt.axes)
     out = (
         *(joint_effect("encoder_harmonics", j) for j in table.joints),
         *(joint_effect("wobble_harmonics", j) for j in table.joints),
-        *((sag,) if sag.entries else ()),
-        *((tilt,) if tilt.axes else ()),
+        sag,
+        tilt,
         ThermalDrift(),
         *(joint_effect("backlash", j) for j in table.joints),
         PayloadMount(),
@@ -100,10 +102,17 @@ def _determined(table: MeasuredTable, effect: Effect) -> tuple[str, ...]:
     u, s, _ = np.linalg.svd(jac[:, :n_base], full_matrices=False)
     u = u[:, s > RANK_RTOL * s[0]]
     added = jac[:, n_base:]
-    extra = added - u @ (u.T @ added)
-    _, r, pivots = qr(extra / np.linalg.norm(added, axis=0), mode="economic", pivoting=True)
-    diag = np.abs(np.diag(r))
-    rank = int(np.sum(diag > RANK_RTOL * max(diag[0], 1e-300))) if diag.size else 0
+    norms = np.linalg.norm(added, axis=0)
+    live = np.flatnonzero(norms > 1e-12 * max(norms.max(initial=0.0), 1e-300))
+    if not live.size:
+        return ()
+    extra = added[:, live] / norms[live]
+    extra = extra - u @ (u.T @ extra)
+    _, r, pivots = qr(extra, mode="economic", pivoting=True)
+    # Columns have unit norm before the projection, so the threshold is absolute: what is left
+    # of a column the base errors span is rounding (1e-16), not a new direction.
+    rank = int(np.sum(np.abs(np.diag(r)) > RANK_RTOL))
+    pivots = live[pivots]
     names = [spec.name for spec in effect.parameters(variables)]
     return tuple(sorted((names[p] for p in pivots[:rank]), key=names.index))
 

@@ -105,13 +105,27 @@ class OrientationFamily:
         for whatever changed between the rows.
         """
         data = self.data
+        warnings = []
+        lost = base_fit.unobserved_combinations()
+        if lost:
+            counts = ", ".join(
+                f"{name} at {int(np.sum(~data.measured[:, i]))}"
+                for i, name in enumerate(ANGLE_NAMES)
+                if not data.measured[:, i].all()
+            )
+            warnings.append(
+                f"angles not measured ({counts} of {data.n_positions} positions): "
+                f"{'; '.join(lost)} {'is' if len(lost) == 1 else 'are'} not observed, so no "
+                "effect that acts only there can be tested; measure those angles to see it"
+            )
         rank = base_fit.result.rank
         dense = OrientationModel(self._dense_variables(), (), self.table)
         jac = dense.jacobian(np.zeros(dense.n_params)).reshape(-1, dense.n_params)
         singular = np.linalg.svd(jac / np.linalg.norm(jac, axis=0).clip(1e-300), compute_uv=False)
         full_rank = int(np.sum(singular > RANK_RTOL * singular[0]))
+        full_rank -= len(lost)  # what the empty cells hide is said above
         if rank >= full_rank:
-            return []
+            return warnings
         wrapped = np.round(np.mod(np.degrees(data.joint_rad), 360.0), 6) % 360.0
         distinct = np.unique(wrapped, axis=0)
         labels = [self.table.angle_label(k) for k in range(1, data.n_joints + 1)]
@@ -123,7 +137,7 @@ class OrientationFamily:
             if len(distinct) == 1
             else f"the {data.n_positions} rows are at {len(distinct)} distinct positions"
         )
-        return [
+        return warnings + [
             f"{where}: they determine {rank} of the {full_rank} combinations of the turntable "
             f"errors that a grid over every axis determines, so effects that vary with {axes} "
             "cannot be tested, and an effect named here (a step with dir, a drift in time) may "

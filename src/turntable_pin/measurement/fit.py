@@ -17,7 +17,7 @@ import numpy as np
 from ..core.sizes import FIT_ROW_BYTES, MAX_FITTED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD
 from ..stats.least_squares import FitResult, fit_least_squares
-from .data import OrientationMeasurements
+from .data import ANGLE_NAMES, OrientationMeasurements
 from .effect_model import OrientationModel
 from .effects.base import Effect
 
@@ -100,6 +100,27 @@ class OrientationFit:
         """The noise sigma of each position (the median over its measured angles), (N,)."""
         return np.nanmedian(self.sigma_angles_rad, axis=1)
 
+    def unobserved_combinations(self) -> list[str]:
+        """The error combinations these positions would determine with every angle measured but
+        do not with the cells left empty (``[]`` when every angle was measured); e.g. without
+        ``dtheta`` on the paper's table, ``dphi_z2 + dalpha_z1``."""
+        from ..stats.least_squares import analyse_identifiability, combination_name
+
+        if self.data.measured.all():
+            return []
+        names = self.model.parameter_names
+        jac = self.model.jacobian(np.zeros(self.model.n_params)).reshape(-1, len(names))
+        full = analyse_identifiability(jac, names)
+        now = self.result.identifiability
+        q, _ = np.linalg.qr(now.determined.T) if now.rank else (np.zeros((len(names), 0)), None)
+        lost = full.determined.T - q @ (q.T @ full.determined.T)  # (n, rank_full)
+        u, s, _ = np.linalg.svd(lost, full_matrices=False)
+        keep = s > 1e-6 * max(1.0, float(np.abs(full.determined).max(initial=1.0)))
+        if not keep.any():
+            return []
+        rows = analyse_identifiability(u[:, keep].T, names).determined  # RREF of the lost space
+        return [combination_name(row, names) for row in rows]
+
     def fitted_rad(self) -> np.ndarray:
         """The model's ``dpsi, dtheta, dgamma`` at the measured positions, (N, 3)."""
         return self.model.predict(self.result.params)
@@ -118,6 +139,10 @@ class OrientationFit:
             "n_positions": self.data.n_positions,
             "effects": list(self.effect_names),
             "sigma_arcsec": float(np.median(self.sigma_rad) * ARCSEC_PER_RAD),
+            "not_measured": {
+                name: int(np.sum(~self.data.measured[:, i])) for i, name in enumerate(ANGLE_NAMES)
+            },
+            "unobserved_combinations": self.unobserved_combinations(),
         }
         out.update(self.result.to_dict())
         return out

@@ -34,8 +34,8 @@ class ResidualSet:
         label: e.g. ``"base"`` or ``"base + inner_encoder_harmonics"``.
         components: names of the residual components (columns).
         unit: unit of ``residuals``.
-        residuals: (N, C) measured - fitted.
-        normalised: (N, C) residuals / sigma (given or estimated).
+        residuals: (N, C) measured - fitted (NaN where a component was not measured).
+        normalised: (N, C) residuals / sigma (given or estimated; NaN where not measured).
         rows: (N,) file row of each position.
         angles_deg: ``{name: (N,)}`` angle variables (harmonic analysis, plots).
         others: ``{name: (N,)}`` further variables (time, approach direction).
@@ -54,11 +54,9 @@ class ResidualSet:
 def orientation_residuals(fit, label: str | None = None) -> ResidualSet:
     """The :class:`ResidualSet` of an :class:`OrientationFit`, in arc seconds."""
     data = fit.data
-    others = {}
-    for name in ("time_s", "dir1", "dir2"):
-        value = getattr(data, name)
-        if value is not None:
-            others[name] = np.asarray(value)
+    others = {} if data.time_s is None else {"time_s": np.asarray(data.time_s)}
+    others.update({f"dir{k}": np.asarray(d) for k, d in enumerate(data.dirs, 1) if d is not None})
+    others.update({name: np.asarray(v) for name, v in data.extra.items()})
     return ResidualSet(
         label=label or " + ".join(("base", *fit.effect_names)),
         components=ANGLE_NAMES,
@@ -67,8 +65,8 @@ def orientation_residuals(fit, label: str | None = None) -> ResidualSet:
         normalised=fit.normalised_residuals,
         rows=np.asarray(data.rows),
         angles_deg={
-            "phi1_deg": data.phi1_rad * DEG_PER_RAD,
-            "phi2_deg": data.phi2_rad * DEG_PER_RAD,
+            f"phi{k}_deg": data.joint_rad[:, k - 1] * DEG_PER_RAD
+            for k in range(1, data.n_joints + 1)
         },
         others=others,
     )
@@ -77,11 +75,12 @@ def orientation_residuals(fit, label: str | None = None) -> ResidualSet:
 def failing_positions(rs: ResidualSet, k_sigma: float = 3.0) -> list[dict]:
     """Positions with a component beyond ``k_sigma`` sigma, worst first."""
     out = []
-    worst = np.abs(rs.normalised).max(axis=1)
+    normalised = np.nan_to_num(np.abs(rs.normalised))  # not measured: never failing
+    worst = normalised.max(axis=1)
     for i in np.argsort(-worst):
         if worst[i] <= k_sigma:
             break
-        c = int(np.argmax(np.abs(rs.normalised[i])))
+        c = int(np.argmax(normalised[i]))
         entry = {"row": int(rs.rows[i])}
         entry.update({k: float(v[i]) for k, v in rs.angles_deg.items()})
         entry.update({k: float(v[i]) for k, v in rs.others.items()})
@@ -97,14 +96,21 @@ def failing_positions(rs: ResidualSet, k_sigma: float = 3.0) -> list[dict]:
 
 
 def harmonic_amplitudes(values: np.ndarray, angle_deg: np.ndarray, max_order: int) -> np.ndarray:
-    """Amplitudes of harmonics 1..max_order of ``values`` (N, C) in ``angle`` (joint LS fit)."""
+    """Amplitudes of harmonics 1..max_order of ``values`` (N, C) in ``angle`` (joint LS fit of
+    each component over the rows where it is not NaN; NaN when too few rows remain)."""
     a = np.radians(angle_deg)
     cols = [np.ones_like(a)]
     for k in range(1, max_order + 1):
         cols += [np.cos(k * a), np.sin(k * a)]
     design = np.stack(cols, axis=1)
-    coef = np.linalg.lstsq(design, values, rcond=None)[0]  # (1 + 2K, C)
-    return np.hypot(coef[1::2], coef[2::2])  # (K, C)
+    values = np.asarray(values, dtype=float)
+    out = np.full((max_order, values.shape[1]), np.nan)
+    for c in range(values.shape[1]):
+        ok = np.isfinite(values[:, c])
+        if ok.sum() >= design.shape[1]:
+            coef = np.linalg.lstsq(design[ok], values[ok, c], rcond=None)[0]  # (1 + 2K,)
+            out[:, c] = np.hypot(coef[1::2], coef[2::2])
+    return out  # (K, C)
 
 
 @dataclass(frozen=True)
@@ -125,9 +131,9 @@ class ResidualAnalysis:
         for i in range(rs.residuals.shape[0]):
             entry = {"row": int(rs.rows[i])}
             entry.update({k: float(v[i]) for k, v in rs.angles_deg.items()})
-            entry.update({f"{c}_{rs.unit}": float(rs.residuals[i, j])
+            entry.update({f"{c}_{rs.unit}": _finite(rs.residuals[i, j])
                           for j, c in enumerate(rs.components)})  # fmt: skip
-            entry["max_sigmas"] = float(np.abs(rs.normalised[i]).max())
+            entry["max_sigmas"] = float(np.nanmax(np.abs(rs.normalised[i])))
             out.append(entry)
         return out
 
@@ -148,6 +154,17 @@ class ResidualAnalysis:
         }
 
 
+def _finite(value) -> float | None:
+    """``value`` as a float, ``None`` when it is NaN (not measured)."""
+    return float(value) if np.isfinite(value) else None
+
+
+def _rms(values: np.ndarray) -> float | None:
+    """Root mean square over the measured (finite) values; ``None`` when there is none."""
+    values = values[np.isfinite(values)]
+    return float(np.sqrt(np.mean(values**2))) if values.size else None
+
+
 def analyse_residuals(rs: ResidualSet, k_sigma: float = 3.0) -> ResidualAnalysis:
     """Failing positions, rms per component and per angle value, harmonic content per axis.
 
@@ -155,19 +172,18 @@ def analyse_residuals(rs: ResidualSet, k_sigma: float = 3.0) -> ResidualAnalysis
     """
     if not (np.isfinite(k_sigma) and k_sigma > 0):
         raise InputError(f"k_sigma must be a number > 0, got {k_sigma!r}")
-    rms = {c: float(np.sqrt(np.mean(rs.residuals[:, i] ** 2))) for i, c in enumerate(rs.components)}
+    rms = {c: _rms(rs.residuals[:, i]) for i, c in enumerate(rs.components)}
     by_angle, harmonics = {}, {}
     for name, angle in rs.angles_deg.items():
         values = np.unique(np.round(angle, 9))
         table = {"value": values.tolist()}
         for i, c in enumerate(rs.components):
-            table[c] = [
-                float(np.sqrt(np.mean(rs.residuals[np.isclose(angle, v), i] ** 2))) for v in values
-            ]
+            table[c] = [_rms(rs.residuals[np.isclose(angle, v), i]) for v in values]
         by_angle[name] = table
         distinct = np.unique(np.round(np.mod(angle, 360.0), 9)).size
         order = int(min(6, max(0, (distinct - 1) // 2)))
         if order:
             amp = harmonic_amplitudes(rs.residuals, angle, order)
-            harmonics[name] = {c: amp[:, i].tolist() for i, c in enumerate(rs.components)}
+            harmonics[name] = {c: [_finite(a) for a in amp[:, i]]
+                               for i, c in enumerate(rs.components)}  # fmt: skip
     return ResidualAnalysis(rs, k_sigma, failing_positions(rs, k_sigma), rms, by_angle, harmonics)

@@ -47,6 +47,7 @@ class MeasuredTable:
         descriptions: ``{base error: what it is}``.
         label: how reports name the table (``paper`` or the URDF file).
         paper: the paper's table (its catalogue and names).
+        urdf_path: the nominal URDF the chain was read from.
     """
 
     def __init__(
@@ -57,8 +58,10 @@ class MeasuredTable:
         *,
         label: str,
         paper: bool = False,
+        urdf_path=None,
     ) -> None:
         self.chain = chain
+        self.urdf_path = urdf_path
         self.joints = tuple(joints)
         self.descriptions = dict(descriptions)
         self.label = label
@@ -97,7 +100,7 @@ def _paper(turntable) -> MeasuredTable:
     ]
     table = MeasuredTable(
         chain, joints, {n: ERROR_DESCRIPTIONS[n] for n in ANGULAR_ERROR_NAMES}, label="paper",
-        paper=True,
+        paper=True, urdf_path=turntable.urdf_path,
     )  # fmt: skip
     return table
 
@@ -107,7 +110,10 @@ def _generic(table) -> MeasuredTable:
         JointErrors(name, k, f"{name}.position", (f"{name}.tilt_a", f"{name}.tilt_b"))
         for k, name in enumerate(table.joint_names, start=1)
     ]
-    return MeasuredTable(table.chain, joints, table.descriptions, label=str(table.urdf_path))
+    return MeasuredTable(
+        table.chain, joints, table.descriptions, label=str(table.urdf_path),
+        urdf_path=table.urdf_path,
+    )  # fmt: skip
 
 
 def measured_table(turntable=None) -> MeasuredTable:

@@ -30,6 +30,7 @@ import numpy as np
 from ..core.exceptions import IdentifiabilityError
 
 __all__ = [
+    "DEAD_COLUMN_RTOL",
     "RANK_RTOL",
     "FitProblem",
     "FitResult",
@@ -38,6 +39,10 @@ __all__ = [
     "combination_name",
     "fit_least_squares",
 ]
+
+DEAD_COLUMN_RTOL = 1e-12
+"""A Jacobian column whose norm is below this fraction of the largest column's is zero: the
+parameter does not change the observations (what is left is rounding)."""
 
 RANK_RTOL = 1e-6
 """Singular values of the normalised Jacobian below this fraction of the largest are flat."""
@@ -126,7 +131,9 @@ class Identifiability:
 def analyse_identifiability(jacobian_weighted: np.ndarray, names) -> Identifiability:
     """Rank, determined combinations and flat directions of a weighted Jacobian (m, n)."""
     norms = np.linalg.norm(jacobian_weighted, axis=0)
-    dead = norms <= 1e-300
+    # A column many orders below the largest is rounding of a zero derivative (a parameter the
+    # data do not see), not a direction to normalise up to unit length and call determined.
+    dead = norms <= DEAD_COLUMN_RTOL * max(float(norms.max(initial=0.0)), 1e-300)
     scale = np.where(dead, 1.0, norms)
     m, n = jacobian_weighted.shape
     # vt must be square (n x n) to hold the null space; U need not be (m can be large).

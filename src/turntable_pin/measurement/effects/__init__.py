@@ -52,12 +52,13 @@ def get_effect(name: str) -> Effect:
         ) from None
 
 
-def parse_effect_list(text: str) -> tuple[Effect, ...]:
-    """``"a,b"`` -> the effects a and b (duplicates refused, empty items ignored)."""
+def parse_effect_list(text: str, resolve=None) -> tuple[Effect, ...]:
+    """``"a,b"`` -> the effects a and b (duplicates refused, empty items ignored); ``resolve``
+    finds an effect by name (default: the paper's catalogue, :func:`get_effect`)."""
     names = [item.strip() for item in text.split(",") if item.strip()]
     if len(set(names)) != len(names):
         raise InputError(f"an effect is listed twice in '{text}'")
-    return tuple(get_effect(n) for n in names)
+    return tuple((resolve or get_effect)(n) for n in names)
 
 
 def parameter_names(effect: Effect) -> tuple[str, ...]:
