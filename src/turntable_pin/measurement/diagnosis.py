@@ -18,12 +18,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
-from ..core.units import ARCSEC_PER_RAD
+from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_DESCRIPTIONS
 from ..model.turntable import TurntableModel
 from ..stats.least_squares import RANK_RTOL
 from ..stats.model_selection import Diagnosis, diagnose
-from ..stats.structure_search import Probe
+from ..stats.structure_search import Probe, ProbeFactors
 from .data import ANGLE_NAMES, OrientationMeasurements
 from .effect_model import OrientationModel
 from .effects import EFFECTS, get_effect
@@ -35,6 +35,22 @@ __all__ = ["MAX_HARMONIC", "SEPARATION_CHI2", "OrientationFamily", "diagnose_mea
 MAX_HARMONIC = 5
 SEPARATION_CHI2 = 25.0
 """Noise-free misfit chi2 above which a denser design is said to separate two effects."""
+
+
+def _harmonic(k: int):
+    """The basis functions ``cos(k x), sin(k x)`` of a k/rev probe, (p,) -> (p, 2)."""
+    return lambda x: np.stack([np.cos(k * x), np.sin(k * x)], axis=-1)
+
+
+def _one_angle(w: np.ndarray, a: int):
+    """The direction of a term added to measured angle ``a`` alone, weighted, (N, 3)."""
+
+    def direction():
+        d = np.zeros_like(w)
+        d[:, a] = w[:, a]
+        return d
+
+    return direction
 
 
 def _max_order(angle_rad: np.ndarray) -> int:
@@ -115,8 +131,18 @@ class OrientationFamily:
             "full turn of both axes"
         ]
 
-    def _measured_angle_probes(self, trig: np.ndarray, shape: str, w: np.ndarray) -> list[Probe]:
-        """One probe per measured angle: the harmonic pair ``trig`` (N, 2) added to that angle."""
+    def _measured_angle_probes(
+        self,
+        trig: np.ndarray,
+        shape: str,
+        w: np.ndarray,
+        plot: tuple[str, np.ndarray, int] | None = None,
+    ) -> list[Probe]:
+        """One probe per measured angle: the harmonic pair ``trig`` (N, 2) added to that angle.
+
+        ``plot`` (variable name, its values in rad, order k) describes ``trig`` as ``k/rev`` in
+        that variable, for the probes' :class:`ProbeFactors`.
+        """
         probes = []
         for a, angle in enumerate(ANGLE_NAMES):
 
@@ -125,6 +151,12 @@ class OrientationFamily:
                 cols[:, a, :] = trig * w[:, a, None]
                 return cols.reshape(-1, 2)
 
+            factors = None
+            if plot is not None:
+                var, values, k = plot
+                factors = ProbeFactors(
+                    var, values, _harmonic(k), _one_angle(w, a), DEG_PER_RAD, "deg"
+                )
             probes.append(
                 Probe(
                     f"{angle} {shape}",
@@ -132,6 +164,7 @@ class OrientationFamily:
                     columns,
                     ARCSEC_PER_RAD,
                     "arcsec",
+                    factors,
                 )
             )
         return probes
@@ -153,6 +186,9 @@ class OrientationFamily:
                             -1, 2
                         )
 
+                    def direction(e=e):
+                        return jac[:, :, e] * w
+
                     probes.append(
                         Probe(
                             f"{name} {k}/rev in {var}",
@@ -160,26 +196,39 @@ class OrientationFamily:
                             columns,
                             ARCSEC_PER_RAD,
                             "arcsec",
+                            ProbeFactors(var, phi, _harmonic(k), direction, DEG_PER_RAD, "deg"),
                         )
                     )
-                probes += self._measured_angle_probes(trig, f"{k}/rev in {var}", w)
+                probes += self._measured_angle_probes(
+                    trig, f"{k}/rev in {var}", w, (var, phi, k)
+                )
         # Terms coupling the two angles (k/rev in phi1 + phi2 or phi1 - phi2) on each angle: the
         # shapes above are separable in phi1 and phi2 and would miss them.
         for label, combined in (("phi1+phi2", data.phi1_rad + data.phi2_rad),
                                 ("phi1-phi2", data.phi1_rad - data.phi2_rad)):  # fmt: skip
             for k in range(1, min(2, _max_order(combined)) + 1):
                 trig = np.stack([np.cos(k * combined), np.sin(k * combined)], axis=-1)
-                probes += self._measured_angle_probes(trig, f"{k}/rev in {label}", w)
+                probes += self._measured_angle_probes(
+                    trig, f"{k}/rev in {label}", w, (label, combined, k)
+                )
         extra = []
         if data.time_s is not None and np.ptp(data.time_s) > 0:
             t = (data.time_s - data.time_s.min()) / np.ptp(data.time_s)
-            extra.append(("drift in time", "a drift with time (quadratic over the run)", [t, t**2]))
+            t0, span = float(data.time_s.min()), float(np.ptp(data.time_s))
+
+            def drift(x, t0=t0, span=span):
+                u = (np.asarray(x, dtype=float) - t0) / span
+                return np.stack([u, u**2], axis=-1)
+
+            extra.append(("drift in time", "a drift with time (quadratic over the run)", [t, t**2],
+                          ("time_s", data.time_s, drift, 1.0, "s")))  # fmt: skip
         for column in ("dir1", "dir2"):
             value = getattr(data, column)
             if value is not None:
+                step = (column, value, lambda x: np.asarray(x, dtype=float)[:, None], 1.0, "")
                 extra.append((f"with {column}", f"a step with the approach direction {column}",
-                              [value]))  # fmt: skip
-        for label, text, columns in extra:
+                              [value], step))  # fmt: skip
+        for label, text, columns, (var, values, functions, scale, unit) in extra:
             for a, angle in enumerate(ANGLE_NAMES):
 
                 def matrix(a=a, columns=columns):
@@ -188,6 +237,7 @@ class OrientationFamily:
                         cols[:, a, j] = c * w[:, a]
                     return cols.reshape(-1, len(columns))
 
+                factors = ProbeFactors(var, values, functions, _one_angle(w, a), scale, unit)
                 probes.append(
                     Probe(
                         f"{angle} {label}",
@@ -195,6 +245,7 @@ class OrientationFamily:
                         matrix,
                         ARCSEC_PER_RAD,
                         "arcsec",
+                        factors,
                     )
                 )
         return probes
