@@ -199,9 +199,7 @@ class OrientationFamily:
                             ProbeFactors(var, phi, _harmonic(k), direction, DEG_PER_RAD, "deg"),
                         )
                     )
-                probes += self._measured_angle_probes(
-                    trig, f"{k}/rev in {var}", w, (var, phi, k)
-                )
+                probes += self._measured_angle_probes(trig, f"{k}/rev in {var}", w, (var, phi, k))
         # Terms coupling the two angles (k/rev in phi1 + phi2 or phi1 - phi2) on each angle: the
         # shapes above are separable in phi1 and phi2 and would miss them.
         for label, combined in (("phi1+phi2", data.phi1_rad + data.phi2_rad),
