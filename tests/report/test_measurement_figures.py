@@ -18,6 +18,8 @@ from turntable_pin.report.measurement_figures import (
     residual_figure,
     residual_map_figure,
     structure_term_figure,
+    write_residual_plots,
+    write_structure_plots,
 )
 
 PLANTED_ARCSEC = 2.0
@@ -92,10 +94,10 @@ def test_term_figure_and_maps_are_valid_pngs(planted):
     width, height = _png_size(png)
     assert width > 400 and height > 200
     rs = orientation_residuals(diagnosis.base_fit)
-    a_map = residual_map_figure(rs, map_limit([rs]))
+    a_map = residual_map_figure([rs], map_limit([rs]))
     assert _png_size(a_map)[0] > 600
     single = dataclasses.replace(rs, angles_deg={"phi1_deg": rs.angles_deg["phi1_deg"]})
-    assert residual_map_figure(single) is None  # one angle: no map
+    assert residual_map_figure([single]) is None  # one angle: no map
 
 
 def test_the_map_shows_the_planted_phi2_structure_in_dtheta(planted):
@@ -122,3 +124,15 @@ def test_forward_and_backward_passes_are_told_apart():
     assert direction_of(rs, "time_s") is None
     assert direction_of(dataclasses.replace(rs, others={}), "phi1_deg") is None
     assert _png_size(residual_figure([rs]))[1] > 1000
+
+
+def test_plot_files_exist_and_are_pngs(planted, tmp_path):
+    _, diagnosis = planted
+    sets = [orientation_residuals(diagnosis.base_fit), orientation_residuals(diagnosis.best_fit)]
+    paths = write_residual_plots(sets, tmp_path)
+    assert [p.name for p in paths] == ["residuals.png", "harmonics.png", "residual_maps.png"]
+    paths += write_structure_plots(diagnosis.structure, tmp_path / "terms")
+    assert paths[-1].name == "structure_1.png" and len(paths) == 4
+    for path in paths:
+        assert path.is_file() and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        _png_size(path.read_bytes())

@@ -188,7 +188,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
             )  # fmt: skip
         )
     limit = map_limit([base_rs, best_rs])
-    base_map = residual_map_figure(base_rs, limit)
+    base_map = residual_map_figure([base_rs], limit)
     if base_map is not None:
         parts.append(
             "<p>The residuals over both angles (one square per position, repeats averaged): "
@@ -265,7 +265,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
             + _img(residual_figure([base_rs, best_rs]), "residuals before and after")
             + _img(harmonics_figure([base_an, best_an]), "harmonics before and after")
         )
-        best_map = residual_map_figure(best_rs, limit)
+        best_map = residual_map_figure([best_rs], limit)
         if best_map is not None:
             parts.append(
                 "<p>The residual map after, on the colour scale of the map in section 3:</p>"

@@ -24,6 +24,7 @@ __all__ = [
     "residual_map_figure",
     "structure_term_figure",
     "write_residual_plots",
+    "write_structure_plots",
 ]
 
 COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
@@ -143,38 +144,44 @@ def map_limit(sets: Sequence[ResidualSet]) -> float:
     return max(limits, default=0.0) or 1.0
 
 
-def residual_map_figure(rs: ResidualSet, limit: float | None = None) -> bytes | None:
-    """PNG: the residual of each component over the first two angles (a map), or None.
+def residual_map_figure(sets: Sequence[ResidualSet], limit: float | None = None) -> bytes | None:
+    """PNG: the residual of each component over the first two angles (maps), or None.
 
-    One panel per component (dpsi, dtheta, dgamma), the first angle across, the second up, one
-    square per measured position coloured by its residual (repeats averaged), on one symmetric
-    colour scale (``limit`` in the set's unit; default: the largest residual), so structure in
-    both angles at once shows. None when the set has fewer than two angles.
+    One row per residual set, one panel per component (dpsi, dtheta, dgamma), the first angle
+    across, the second up, one square per measured position coloured by its residual (repeats
+    averaged), on one symmetric colour scale (``limit`` in the sets' unit; default: the largest
+    residual, :func:`map_limit`), so structure in both angles at once shows. None when the sets
+    have fewer than two angles (only the first two are mapped: the others are averaged over).
     """
-    names = list(rs.angles_deg)
+    names = list(sets[0].angles_deg)
     if len(names) < 2:
         return None
     plt = pyplot()
 
-    x, y, mean = _positions_mean(rs.angles_deg[names[0]], rs.angles_deg[names[1]], rs.residuals)
-    limit = limit or map_limit([rs])
-    n_comp = len(rs.components)
-    fig, axes = plt.subplots(1, n_comp, figsize=(4.6 * n_comp, 4.0), squeeze=False)
-    size = max(8.0, 9000.0 / max(len(x), 1))
-    for i, comp in enumerate(rs.components):
-        ax = axes[0, i]
-        image = ax.scatter(x, y, c=mean[:, i], s=size, marker="s", cmap="RdBu_r",
-                           vmin=-limit, vmax=limit)  # fmt: skip
-        ax.set_xlim(-10, 370)
-        ax.set_ylim(-10, 370)
-        ax.set_xticks(range(0, 361, 90))
-        ax.set_yticks(range(0, 361, 90))
-        ax.set_aspect("equal")
-        ax.set_xlabel(names[0].replace("_deg", " (deg)"))
-        ax.set_ylabel(names[1].replace("_deg", " (deg)"))
-        ax.set_title(f"{comp} residual, {rs.label}", fontsize=9, color=COLOURS[i])
-    fig.subplots_adjust(wspace=0.35)
-    fig.colorbar(image, ax=axes[0].tolist(), label=f"residual ({rs.unit})", shrink=0.85)
+    limit = limit or map_limit(sets)
+    n_comp = len(sets[0].components)
+    fig, axes = plt.subplots(
+        len(sets), n_comp, figsize=(4.6 * n_comp, 4.0 * len(sets)), squeeze=False
+    )
+    for row, rs in enumerate(sets):
+        x, y, mean = _positions_mean(rs.angles_deg[names[0]], rs.angles_deg[names[1]],
+                                     rs.residuals)  # fmt: skip
+        size = max(8.0, 9000.0 / max(len(x), 1))
+        for i, comp in enumerate(rs.components):
+            ax = axes[row, i]
+            image = ax.scatter(x, y, c=mean[:, i], s=size, marker="s", cmap="RdBu_r",
+                               vmin=-limit, vmax=limit)  # fmt: skip
+            ax.set_xlim(-10, 370)
+            ax.set_ylim(-10, 370)
+            ax.set_xticks(range(0, 361, 90))
+            ax.set_yticks(range(0, 361, 90))
+            ax.set_aspect("equal")
+            ax.set_xlabel(names[0].replace("_deg", " (deg)"))
+            ax.set_ylabel(names[1].replace("_deg", " (deg)"))
+            ax.set_title(f"{comp} residual, {rs.label}", fontsize=9, color=COLOURS[i])
+    fig.subplots_adjust(wspace=0.35, hspace=0.3)
+    fig.colorbar(image, ax=axes.ravel().tolist(), label=f"residual ({sets[0].unit})",
+                 shrink=0.85 if len(sets) == 1 else 0.6)  # fmt: skip
     return save_png(fig)
 
 
@@ -229,11 +236,26 @@ def structure_term_figure(term: FoundTerm) -> bytes:
 
 
 def write_residual_plots(sets: Sequence[ResidualSet], directory: str | Path, k_sigma=3.0):
-    """Write ``residuals.png`` and ``harmonics.png`` into ``directory``; returns the paths."""
+    """Write ``residuals.png``, ``harmonics.png`` and ``residual_maps.png`` (when the sets have
+    two angles) into ``directory``; returns the paths."""
     directory = Path(directory)
     analyses = [analyse_residuals(s, k_sigma) for s in sets]
     paths = [
         write_bytes_atomic(directory / "residuals.png", residual_figure(sets, k_sigma)),
         write_bytes_atomic(directory / "harmonics.png", harmonics_figure(analyses)),
     ]
+    maps = residual_map_figure(sets)
+    if maps is not None:
+        paths.append(write_bytes_atomic(directory / "residual_maps.png", maps))
     return paths
+
+
+def write_structure_plots(terms: Sequence[FoundTerm], directory: str | Path) -> list[Path]:
+    """Write :func:`structure_term_figure` of each term that can be drawn as ``structure_<i>.png``
+    (i = 1, 2, ... in the order found) into ``directory``; returns the paths."""
+    directory = Path(directory)
+    return [
+        write_bytes_atomic(directory / f"structure_{i}.png", structure_term_figure(term))
+        for i, term in enumerate(terms, 1)
+        if term.factors is not None and term.residual_weighted is not None
+    ]
