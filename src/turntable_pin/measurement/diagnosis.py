@@ -9,6 +9,10 @@ Probes of the structure search (what "shape" the missing part has):
 - ``<angle> k/rev in phi1+phi2`` / ``phi1-phi2`` (k = 1, 2): shapes that couple the two angles;
 - ``<angle> drift in time`` (with ``time_s``): a quadratic in time;
 - ``<angle> with dir1`` / ``dir2``: a step with the approach direction.
+
+Every probe also says how its columns factor per position (a weighted direction in ``dpsi,
+dtheta, dgamma`` times functions of one variable: phi1, phi2, phi1+-phi2, time_s or dir), so the
+report can plot each found term against its variable.
 """
 
 from __future__ import annotations

@@ -10,6 +10,12 @@ G probes: searching G shapes at once is G chances of a false alarm, and ``2 ln G
 likelihood-scale form of a Bonferroni correction (on clean data of 432 observations with about
 130 probes, the chance of any false term falls from about 1.5 % to about 0.01 %, while a term of
 3 sigma amplitude lowers chi2 by several hundred).
+
+Each found term keeps, outside its JSON form, what a plot of it needs: its fitted contribution
+and its partial residual per observation and, when the probe says how its columns factor record
+by record (:class:`ProbeFactors`: a direction times functions of one variable), the residual
+projected record by record onto that direction, against that variable
+(:meth:`FoundTerm.projection`).
 """
 
 from __future__ import annotations
@@ -163,8 +169,9 @@ class FoundTerm:
         """
         if self.factors is None:
             raise ValueError(f"term '{self.name}' has no factors: it cannot be drawn as a curve")
-        basis = np.asarray(self.factors.functions(np.asarray(values, dtype=float)), dtype=float)
-        return basis.reshape(np.size(values), -1) @ np.asarray(self.coefficients)
+        values = np.atleast_1d(np.asarray(values, dtype=float))
+        basis = np.asarray(self.factors.functions(values), dtype=float)
+        return basis.reshape(values.size, -1) @ np.asarray(self.coefficients)
 
     def projection(self) -> TermProjection:
         """The term record by record: partial residual on its direction, noise, fitted value.
