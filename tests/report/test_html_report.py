@@ -1,12 +1,16 @@
-"""The HTML report: one self-contained page with every section and decodable embedded images."""
+"""The HTML report: one self-contained page with every section and decodable embedded images,
+the one-line verdict on top, each figure once, a plot of each structure term the search finds."""
 
 import base64
+import dataclasses
 import re
 
+import numpy as np
 import pytest
 
 from conftest import needs_chromium
 from turntable_pin import TurntableErrors
+from turntable_pin.core.units import ARCSEC_PER_RAD
 from turntable_pin.measurement.diagnosis import diagnose_measurements
 from turntable_pin.measurement.simulation import simulate_measurements
 from turntable_pin.report.html_report import diagnosis_html, write_report
@@ -25,7 +29,8 @@ def test_report_tells_the_whole_story(tmp_path):
     assert all(h in page for h in headings)
     assert "backlash" in page and "dphi_y1 + deps_y" in page
     images = re.findall(r'src="data:image/png;base64,([^"]+)"', page)
-    assert len(images) == 5  # data; base residuals, harmonics; the same before/after
+    # data; base residual map; residuals and harmonics before/after; residual map after
+    assert len(images) == 5
     assert all(base64.b64decode(i)[:4] == b"\x89PNG" for i in images)
     assert "http://" not in page and "https://" not in page
     path = write_report(diagnosis, tmp_path / "r.html", title="t")
@@ -35,6 +40,51 @@ def test_report_tells_the_whole_story(tmp_path):
 def test_clean_data_report_has_no_after_section():
     page = diagnosis_html(diagnose_measurements(simulate_measurements(seed=2).data))
     assert "5. Add it" not in page and "missing effect: none" in page
+    assert "The base model fits to the noise" in _top(page)
+    alts = re.findall(r'<img alt="([^"]+)"', page)
+    assert alts == ["measured angles", "base residual map", "base residuals", "base harmonics"]
+
+
+def _top(page: str, chars: int = 1500) -> str:
+    """The first part of the page's body (before any figure or section)."""
+    body = page[page.index("<body>") :]
+    head = body[:chars]
+    return head[: head.index("<h2>")] if "<h2>" in head else head
+
+
+def _images(page: str) -> list[str]:
+    return re.findall(r'src="data:image/png;base64,([^"]+)"', page)
+
+
+@pytest.fixture(scope="module")
+def partial_page():
+    """Gravity sag plus 2 arcsec of 3/rev in phi2 on dtheta, which no catalogued effect has."""
+    sim = simulate_measurements(
+        TurntableErrors.from_arcsec(deps_y=4, dalpha_x1=2), {"gravity_sag": {"k": 3.0}}, seed=3
+    )
+    angles = np.array(sim.data.angles_rad)
+    angles[:, 1] += 2.0 * np.cos(3 * sim.data.phi2_rad - 0.7) / ARCSEC_PER_RAD
+    diagnosis = diagnose_measurements(dataclasses.replace(sim.data, angles_rad=angles))
+    return diagnosis, diagnosis_html(diagnosis, title="t")
+
+
+def test_the_page_opens_with_the_verdict_and_shows_each_figure_once(partial_page):
+    diagnosis, page = partial_page
+    top = _top(page)
+    assert "<img" not in top and 'id="verdict"' in top
+    verdict = re.search(r'<p class="[^"]*headline[^"]*" id="verdict">([^<]+)</p>', top).group(1)
+    # the sag is found but the 3/rev stays: a partial explanation, not "the missing effect"
+    assert verdict.startswith("Partial explanation: gravity_sag")
+    assert "still unexplained: structure remains: " in verdict and "3/rev in phi2" in verdict
+    images = _images(page)
+    assert len(images) == len(set(images)) == 6
+    alts = re.findall(r'<img alt="([^"]+)"', page)
+    assert len(alts) == len(set(alts))
+    assert alts == ["measured angles", "base residual map",
+                    f"structure: {diagnosis.structure[0].name}", "residuals before and after",
+                    "harmonics before and after", "residual map after"]  # fmt: skip
+    assert all(base64.b64decode(i)[:8] == b"\x89PNG\r\n\x1a\n" for i in images)
+    assert "Structure left in the residuals of base + gravity_sag" in page
 
 
 @pytest.mark.slow
@@ -45,5 +95,6 @@ def test_report_opens_in_the_browser_and_every_image_loads(tmp_path):
     )
     path = write_report(diagnose_measurements(sim.data), tmp_path / "report.html")
     report = check_page_images(path)
-    assert report.n_images == len(re.findall(r"<img ", path.read_text())) == 5
+    page = path.read_text()
+    assert report.n_images == len(re.findall(r"<img ", page)) == len(set(_images(page)))
     assert report.all_loaded, report.failed

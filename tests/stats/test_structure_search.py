@@ -3,7 +3,12 @@
 import numpy as np
 import pytest
 
-from turntable_pin.stats.structure_search import Probe, delta_bic, search_structure
+from turntable_pin.stats.structure_search import (
+    Probe,
+    ProbeFactors,
+    delta_bic,
+    search_structure,
+)
 
 
 def _probes(x):
@@ -60,3 +65,64 @@ def test_a_shape_the_model_spans_to_first_order_is_not_new_structure():
     found = search_structure(r, model, [near_model, *_probes(x)], noise_variance=0.09)
     assert "near" not in [t.name for t in found]
     assert all(t.amplitude < 10 for t in found)
+
+
+def _factored_probes(x, direction):
+    """k/rev probes on records of two observations, entering along ``direction`` (n, 2)."""
+    probes = []
+    for k in range(1, 6):
+
+        def functions(v, k=k):
+            return np.stack([np.cos(k * v), np.sin(k * v)], axis=-1)
+
+        columns = (direction[:, :, None] * functions(x)[:, None, :]).reshape(-1, 2)
+        factors = ProbeFactors("x", x, functions, direction, value_scale=2.0, value_unit="half-x")
+        probes.append(Probe(f"{k}/rev", f"harmonic {k}", columns, 10.0, "u", factors))
+    return probes
+
+
+def test_a_found_term_keeps_what_its_plot_needs_and_projects_back_to_its_shape():
+    rng = np.random.default_rng(4)
+    n = 240
+    x = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    direction = np.stack([1.0 + 0.5 * np.cos(x), 0.8 * np.sin(2 * x)], axis=1)
+    direction[:3] = 0.0  # three records the shape does not reach
+    shape = 0.8 * np.cos(3 * x) - 0.5 * np.sin(3 * x)  # internal units: 10x in user units
+    noise = 0.3
+    r = (direction * shape[:, None]).reshape(-1) + rng.normal(0, noise, 2 * n)
+    model = np.ones((2 * n, 1))
+    r -= r.mean()  # a fit's residual is orthogonal to the model
+    for variance in (noise**2, None):
+        [term] = search_structure(r, model, _factored_probes(x, direction), noise_variance=variance)
+        assert term.name == "3/rev" and term.unit_scale == 10.0
+        assert term.coefficients == pytest.approx((8.0, -5.0), abs=0.5)
+        assert term.fitted_weighted.shape == term.residual_weighted.shape == (2 * n,)
+        assert term.explained_weighted.shape == (2 * n,)
+        estimated = variance is None
+        assert term.noise_std_weighted == pytest.approx(noise, rel=0.1 if estimated else 1e-12)
+        pr = term.projection()
+        assert pr.variable == "x" and pr.value_unit == "half-x" and pr.unit == "u"
+        assert np.allclose(pr.values, 2.0 * x)
+        assert np.isnan(pr.projected[:3]).all() and np.isnan(pr.noise[:3]).all()
+        ok = slice(3, None)
+        # the points scatter around the fitted term as the noise says they should
+        pulls = (pr.projected[ok] - pr.fitted[ok]) / pr.noise[ok]
+        assert abs(pulls.mean()) < 0.3 and np.std(pulls) == pytest.approx(1.0, abs=0.15)
+        assert np.allclose(pr.fitted, term.curve(x))
+        assert np.allclose(pr.fitted, 10.0 * (0.8 * np.cos(3 * x) - 0.5 * np.sin(3 * x)),
+                           atol=1.0)  # fmt: skip
+        assert set(term.to_dict()) == {
+            "term", "description", "delta_bic", "amplitude", "unit", "coefficients"
+        }  # fmt: skip
+
+
+def test_a_term_of_a_probe_without_factors_cannot_be_projected():
+    rng = np.random.default_rng(0)
+    x = np.linspace(0, 2 * np.pi, 240, endpoint=False)
+    r = 0.8 * np.cos(3 * x) + rng.normal(0, 0.3, x.size)
+    [term] = search_structure(r, np.ones((x.size, 1)), _probes(x), noise_variance=0.09)
+    assert term.fitted_weighted is not None and term.factors is None
+    with pytest.raises(ValueError, match="no data to project"):
+        term.projection()
+    with pytest.raises(ValueError, match="no factors"):
+        term.curve(x)

@@ -18,10 +18,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
-from ..core.units import ARCSEC_PER_RAD
+from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..stats.least_squares import RANK_RTOL
 from ..stats.model_selection import Diagnosis, diagnose
-from ..stats.structure_search import Probe
+from ..stats.structure_search import Probe, ProbeFactors
 from .catalogue import catalogue as table_catalogue
 from .catalogue import resolve_effect
 from .data import ANGLE_NAMES, OrientationMeasurements
@@ -35,6 +35,38 @@ __all__ = ["MAX_HARMONIC", "SEPARATION_CHI2", "OrientationFamily", "diagnose_mea
 MAX_HARMONIC = 5
 SEPARATION_CHI2 = 25.0
 """Noise-free misfit chi2 above which a denser design is said to separate two effects."""
+
+
+def _harmonic(k: int):
+    """The basis functions ``cos(k x), sin(k x)`` of a k/rev probe, (p,) -> (p, 2)."""
+    return lambda x: np.stack([np.cos(k * x), np.sin(k * x)], axis=-1)
+
+
+def _polynomial(values: np.ndarray):
+    """The basis ``u, u^2`` with ``u`` the column scaled to [0, 1] over the data, (p,) -> (p, 2)."""
+    low, span = float(np.min(values)), float(np.ptp(values))
+
+    def functions(x):
+        u = (np.asarray(x, dtype=float) - low) / span
+        return np.stack([u, u**2], axis=-1)
+
+    return functions
+
+
+def _step(x) -> np.ndarray:
+    """The basis of a step with the approach direction (+1/-1), (p,) -> (p, 1)."""
+    return np.asarray(x, dtype=float)[:, None]
+
+
+def _one_angle(w: np.ndarray, a: int):
+    """The direction of a term added to measured angle ``a`` alone, weighted, (N, 3)."""
+
+    def direction():
+        d = np.zeros_like(w)
+        d[:, a] = w[:, a]
+        return d
+
+    return direction
 
 
 def _max_order(angle_rad: np.ndarray) -> int:
@@ -71,6 +103,7 @@ class OrientationFamily:
             if data.sigma_rad is not None
             else ARCSEC_PER_RAD
         )
+        self._observed = data.measured
         self._mask = data.measured.reshape(-1)
         self._cache: dict[tuple[str, ...], OrientationFit] = {}
 
@@ -145,51 +178,48 @@ class OrientationFamily:
             "full turn of every axis"
         ]
 
-    def _observations(self, cols: np.ndarray) -> np.ndarray:
-        """(N, 3, g) per-angle columns as (m, g) rows of the measured observations."""
-        cols = cols.reshape(-1, cols.shape[-1])
-        return cols if self._mask.all() else cols[self._mask]
+    def _probe(self, name: str, description: str, factors: ProbeFactors) -> Probe:
+        """A probe whose columns are ``factors``' direction (N, 3) times its functions (N, g),
+        as rows of the measured observations."""
+        mask = self._mask
 
-    def _measured_angle_probes(self, trig: np.ndarray, shape: str, w: np.ndarray) -> list[Probe]:
-        """One probe per measured angle: the columns ``trig`` (N, g) added to that angle."""
+        def columns():
+            cols = (
+                factors.direction_matrix()[:, :, None]
+                * factors.functions(factors.values)[:, None, :]
+            )
+            cols = cols.reshape(-1, cols.shape[-1])
+            return cols if mask.all() else cols[mask]
+
+        return Probe(name, description, columns, ARCSEC_PER_RAD, "arcsec", factors)
+
+    def _measured_angle_probes(self, shape: str, text: str, plot: tuple, w) -> list[Probe]:
+        """One probe per measured angle: the shape ``plot`` (variable, values, functions, value
+        scale, unit) added to that angle itself; ``text`` describes it (``{angle}``: the angle)."""
         probes = []
+        var, values, functions, scale, unit = plot
         for a, angle in enumerate(ANGLE_NAMES):
             if not self.data.measured[:, a].any():
                 continue
-
-            def columns(a=a):
-                cols = np.zeros((self.data.n_positions, 3, trig.shape[1]))
-                cols[:, a, :] = trig * w[:, a, None]
-                return self._observations(cols)
-
-            probes.append(
-                Probe(
-                    f"{angle} {shape}",
-                    f"a {shape.replace('/rev', '/rev term', 1)} of {angle} itself",
-                    columns,
-                    ARCSEC_PER_RAD,
-                    "arcsec",
-                )
+            factors = ProbeFactors(
+                var, values, functions, _one_angle(w, a), scale, unit, self._observed
             )
+            probes.append(self._probe(f"{angle} {shape}", text.format(angle=angle), factors))
         return probes
 
-    def _error_probes(self, jac, w, trig, shape: str, what: str) -> list[Probe]:
-        """One probe per base error: its derivative times the columns ``trig`` (N, g)."""
+    def _error_probes(self, jac, w, shape: str, text: str, plot: tuple) -> list[Probe]:
+        """One probe per base error: its derivative (the direction it enters the angles) times
+        the shape ``plot`` (variable, values, functions, value scale, unit)."""
         probes = []
+        var, values, functions, scale, unit = plot
         for e, name in enumerate(self.table.base_names):
 
-            def columns(e=e):
-                return self._observations(jac[:, :, e, None] * trig[:, None, :] * w[:, :, None])
+            def direction(e=e):
+                return jac[:, :, e] * w
 
-            probes.append(
-                Probe(
-                    f"{name} {shape}",
-                    f"a {what} of {name} ({self.table.descriptions.get(name, name)})",
-                    columns,
-                    ARCSEC_PER_RAD,
-                    "arcsec",
-                )
-            )
+            factors = ProbeFactors(var, values, functions, direction, scale, unit, self._observed)
+            description = f"a {text} of {name} ({self.table.descriptions.get(name, name)})"
+            probes.append(self._probe(f"{name} {shape}", description, factors))
         return probes
 
     def probes(self, fit: OrientationFit) -> list[Probe]:
@@ -201,10 +231,12 @@ class OrientationFamily:
         labels = [self.table.angle_label(k) for k in range(1, data.n_joints + 1)]
         for var, phi in zip(labels, data.joint_rad.T, strict=True):
             for k in range(1, _max_order(phi) + 1):
-                trig = np.stack([np.cos(k * phi), np.sin(k * phi)], axis=-1)  # (N, 2)
-                probes += self._error_probes(jac, w, trig, f"{k}/rev in {var}",
-                                             f"{k}/rev term in {var}")  # fmt: skip
-                probes += self._measured_angle_probes(trig, f"{k}/rev in {var}", w)
+                plot = (var, phi, _harmonic(k), DEG_PER_RAD, "deg")
+                shape = f"{k}/rev in {var}"
+                probes += self._error_probes(jac, w, shape, f"{k}/rev term in {var}", plot)
+                probes += self._measured_angle_probes(
+                    shape, f"a {k}/rev term in {var} of {{angle}} itself", plot, w
+                )
         # Terms coupling two angles (k/rev in phiA + phiB or phiA - phiB) on each angle: the
         # shapes above are separable in the angles and would miss them.
         for i in range(data.n_joints):
@@ -213,40 +245,36 @@ class OrientationFamily:
                 for sign, combined in (("+", a + b), ("-", a - b)):
                     label = f"{labels[i]}{sign}{labels[j]}"
                     for k in range(1, min(2, _max_order(combined)) + 1):
-                        trig = np.stack([np.cos(k * combined), np.sin(k * combined)], axis=-1)
-                        probes += self._measured_angle_probes(trig, f"{k}/rev in {label}", w)
-        extra = []
+                        plot = (label, combined, _harmonic(k), DEG_PER_RAD, "deg")
+                        probes += self._measured_angle_probes(
+                            f"{k}/rev in {label}",
+                            f"a {k}/rev term in {label} of {{angle}} itself",
+                            plot,
+                            w,
+                        )
         if data.time_s is not None and np.ptp(data.time_s) > 0:
-            t = (data.time_s - data.time_s.min()) / np.ptp(data.time_s)
-            extra.append(("drift in time", "a drift with time (quadratic over the run)",
-                          np.stack([t, t**2], axis=1)))  # fmt: skip
+            plot = ("time_s", data.time_s, _polynomial(data.time_s), 1.0, "s")
+            probes += self._measured_angle_probes(
+                "drift in time", "a drift with time (quadratic over the run) in {angle}", plot, w
+            )
         for k, value in enumerate(data.dirs, start=1):
             if value is not None:
-                extra.append((f"with dir{k}", f"a step with the approach direction dir{k}",
-                              value[:, None]))  # fmt: skip
-        for label, text, columns in extra:
-            for a, angle in enumerate(ANGLE_NAMES):
-                if not data.measured[:, a].any():
-                    continue
-
-                def matrix(a=a, columns=columns):
-                    cols = np.zeros((data.n_positions, 3, columns.shape[1]))
-                    cols[:, a, :] = columns * w[:, a, None]
-                    return self._observations(cols)
-
-                probes.append(Probe(f"{angle} {label}", f"{text} in {angle}", matrix,
-                                    ARCSEC_PER_RAD, "arcsec"))  # fmt: skip
+                plot = (f"dir{k}", value, _step, 1.0, "")
+                probes += self._measured_angle_probes(
+                    f"with dir{k}",
+                    f"a step with the approach direction dir{k} in {{angle}}",
+                    plot,
+                    w,
+                )
         # Other numeric columns (temperature, load, ...) as suspects: each base error and each
         # measured angle linear and quadratic in the column.
         for column, values in data.extra.items():
-            span = np.ptp(values)
-            if not span > 0:
+            if not np.ptp(values) > 0:
                 continue
-            c = (values - values.min()) / span
-            trig = np.stack([c, c**2], axis=1)
-            probes += self._error_probes(jac, w, trig, f"in {column}",
-                                         f"term linear and quadratic in {column}")  # fmt: skip
-            probes += self._measured_angle_probes(trig, f"in {column}", w)
+            plot = (column, values, _polynomial(values), 1.0, "")
+            text = f"term linear and quadratic in {column}"
+            probes += self._error_probes(jac, w, f"in {column}", text, plot)
+            probes += self._measured_angle_probes(f"in {column}", f"a {text} of {{angle}}", plot, w)
         return probes
 
     def _dense_variables(self) -> PositionVariables:

@@ -2,12 +2,85 @@
 
 The text report, the JSON and the HTML page are three views of one structured result: this module
 reads only the dictionary, never another renderer's output. :func:`verdict_lines` is the verdict
-part, which the HTML report shows in its verdict box.
+part, which the HTML report shows in its verdict box; :func:`headline` the one-line verdict both
+reports open with.
+
+A headline effect is a *partial explanation*, not "the missing effect", when the model with
+every accepted effect is still unexplained (it fails the chi2 test, e.g. chi2_reduced 2.7 with
+sigma given, or the structure search still finds a term).
 """
 
 from __future__ import annotations
 
-__all__ = ["diagnosis_lines", "header_lines", "verdict_lines"]
+__all__ = ["diagnosis_lines", "header_lines", "headline", "verdict_lines"]
+
+
+def _number(value, fmt: str = "#.3g") -> str:
+    return "-" if value is None else format(value, fmt)
+
+
+def _rms_key(summary: dict) -> str:
+    return next(k for k in summary if k.startswith("rms_"))
+
+
+def _term_words(term: dict) -> str:
+    return f"{term['term']} ({term['amplitude']:.3g} {term['unit']})"
+
+
+def _still_unexplained(d: dict) -> str:
+    """Why the best model is still unexplained, in a few words (empty when it is not)."""
+    verdict = d["verdict"]
+    structure = verdict["remaining_structure"]
+    if structure:
+        more = f" and {len(structure) - 1} more" if len(structure) > 1 else ""
+        return f"structure remains: {_term_words(structure[0])}{more}"
+    if verdict["fails_fit_test"]:
+        return (
+            f"the best model still fails the chi2 test (chi2_reduced "
+            f"{_number(d['best']['chi2_reduced'], '.2f')})"
+        )
+    return ""
+
+
+def headline(d: dict) -> str:
+    """The verdict in one line, from ``Diagnosis.to_dict()``.
+
+    One of: ``Missing effect: E -- rms a -> b <unit>, chi2_reduced c -> d``; ``Partial
+    explanation: E -- ...; still unexplained: why``; ``Unexplained structure: term (no catalogued
+    effect) -- ...``; ``Unexplained misfit: ...``; ``The base model fits to the noise -- ...``.
+    """
+    verdict = d["verdict"]
+    base, best = d["base"], d["best"]
+    key = _rms_key(base)
+    unit = key[len("rms_") :]
+    if d["steps"]:
+        effects = verdict["missing_effects"]
+        also = verdict["also_significant"]
+        change = (
+            f"rms {_number(base[key])} -> {_number(best[key])} {unit}, chi2_reduced "
+            f"{_number(base['chi2_reduced'])} -> {_number(best['chi2_reduced'])}"
+        )
+        named = " + ".join(effects) + (f" (also significant: {', '.join(also)})" if also else "")
+        if verdict["unexplained"]:
+            return f"Partial explanation: {named} -- {change}; still unexplained: " + (
+                _still_unexplained(d)
+            )
+        label = "Missing effects" if len(effects) > 1 else "Missing effect"
+        return f"{label}: {named} -- {change}"
+    level = f"rms {_number(base[key])} {unit}, chi2_reduced {_number(base['chi2_reduced'])}"
+    structure = verdict["remaining_structure"]
+    if structure:
+        more = f" and {len(structure) - 1} more" if len(structure) > 1 else ""
+        return (
+            f"Unexplained structure: {_term_words(structure[0])}{more} (no catalogued effect) "
+            f"-- {level}"
+        )
+    if verdict["fails_fit_test"]:
+        return (
+            f"Unexplained misfit: no catalogued effect and no harmonic shape explains it -- "
+            f"{level} (is the stated sigma too small?)"
+        )
+    return f"The base model fits to the noise -- {level}"
 
 
 def header_lines(d: dict) -> list[str]:
@@ -55,7 +128,13 @@ def verdict_lines(d: dict) -> list[str]:
                 f"{s['rms_arcsec']:.3f} arcsec, chi2_reduced {s['chi2_reduced']:.3f}"
             )
         story = verdict["effect_story"]
-        lines.append(f"missing effect: {verdict['missing_effect']} ({story['title']})")
+        if verdict["unexplained"]:
+            lines.append(
+                f"partial explanation: {verdict['missing_effect']} ({story['title']}); "
+                f"still unexplained: {_still_unexplained(d)}"
+            )
+        else:
+            lines.append(f"missing effect: {verdict['missing_effect']} ({story['title']})")
         lines.append(f"  why: {story['explanation']}")
         lines.append(f"  confirm on the machine: {story['confirm']}")
     else:
@@ -99,5 +178,5 @@ def verdict_lines(d: dict) -> list[str]:
 
 
 def diagnosis_lines(d: dict) -> list[str]:
-    """The whole diagnosis in words: :func:`header_lines` then :func:`verdict_lines`."""
-    return header_lines(d) + verdict_lines(d)
+    """The whole diagnosis in words: the headline, the header lines, the verdict lines."""
+    return [headline(d), *header_lines(d), *verdict_lines(d)]

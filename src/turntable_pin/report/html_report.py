@@ -1,7 +1,9 @@
 """One self-contained HTML page telling the whole story of a measurement file.
 
-Data, base fit, where it fails, the diagnosis, the fit with the missing effect(s) and the
-parameters, with every plot embedded as a base64 PNG (the page needs no other file).
+The one-line verdict first, then data, base fit, where it fails (a residual map over both
+angles), the diagnosis (with a plot of each term the structure search finds against its
+variable), the fit with the missing effect(s) and the parameters, with every plot embedded once
+as a base64 PNG (the page needs no other file).
 """
 
 from __future__ import annotations
@@ -15,9 +17,16 @@ from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..measurement.data import ANGLE_NAMES
 from ..measurement.residuals import analyse_residuals, orientation_residuals
 from ..stats.model_selection import Diagnosis
-from .diagnosis_text import verdict_lines
+from .diagnosis_text import headline, verdict_lines
 from .figures import pyplot, save_png
-from .measurement_figures import COLOURS, harmonics_figure, residual_figure
+from .measurement_figures import (
+    COLOURS,
+    harmonics_figure,
+    map_limit,
+    residual_figure,
+    residual_map_figure,
+    structure_term_figure,
+)
 
 _STYLE = """
 body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
@@ -26,6 +35,7 @@ table{border-collapse:collapse;font-size:.9em;margin:.5em 0}
 td,th{border:1px solid #ddd;padding:.25em .6em;text-align:right}th{background:#f4f4f4}
 td.l,th.l{text-align:left}.verdict{background:#eef6ee;padding:.8em;border-left:4px solid #3a3}
 .warn{background:#fbf1e6;border-left-color:#d80}img{max-width:100%}code{background:#f4f4f4}
+.headline{font-size:1.1em;font-weight:600;margin:.4em 0 1em}
 """
 
 
@@ -74,6 +84,32 @@ def _fit_rows(diagnosis: Diagnosis, fits) -> list[list]:
     return rows
 
 
+def _structure_section(diagnosis: Diagnosis, best_fit) -> list[str]:
+    """HTML of the terms the structure search finds: words and one plot per term."""
+    terms = diagnosis.structure
+    if not terms:
+        return []
+    label = " + ".join(("base", *best_fit.effect_names))
+    parts = [
+        f"<h3>Structure left in the residuals of {html.escape(label)}</h3><p>The structure "
+        "search (harmonic shapes of each turntable error and of each measured angle, drifts, "
+        "steps with the approach direction) finds the term(s) below. Each plot shows the "
+        "residual, with this term's fitted part added back, projected at each position onto "
+        "the direction the term enters the measured angles along, against the variable of "
+        "the term, with the fitted term over it and the noise of one point as a grey "
+        "band.</p>"
+    ]
+    for term in terms:
+        words = (
+            f"<p><b>{html.escape(term.name)}</b>: {html.escape(term.description)}, amplitude "
+            f"{term.amplitude:.3g} {html.escape(term.unit)}, delta BIC {term.delta_bic:.0f}.</p>"
+        )
+        if term.factors is not None and term.residual_weighted is not None:
+            words += _img(structure_term_figure(term), f"structure: {term.name}")
+        parts.append(words)
+    return parts
+
+
 def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
     """The HTML page of a diagnosis (self-contained)."""
     data = diagnosis.family.data
@@ -84,7 +120,12 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
     base_rs = orientation_residuals(base_fit)
     best_rs = orientation_residuals(best_fit)
     base_an = analyse_residuals(base_rs)
+    explained = not verdict["unexplained"]
     parts = [f"<h1>{html.escape(title or 'Turntable measurement diagnosis')}</h1>"]
+    parts.append(
+        f'<p class="verdict headline{"" if explained else " warn"}" id="verdict">'
+        f"{html.escape(headline(d))}</p>"
+    )
     parts.append(
         f"<p>Source: <code>{html.escape(data.source)}</code> &mdash; {data.n_positions} "
         f"positions, {3 * data.n_positions} measured angles; noise sigma "
@@ -146,8 +187,17 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
                 ],
             )  # fmt: skip
         )
-    parts.append(_img(residual_figure([base_rs]), "base residuals"))
-    parts.append(_img(harmonics_figure([base_an]), "base harmonics"))
+    limit = map_limit([base_rs, best_rs])
+    base_map = residual_map_figure([base_rs], limit)
+    if base_map is not None:
+        parts.append(
+            "<p>The residuals over both angles (one square per position, repeats averaged): "
+            "structure in phi1 and phi2 at once shows here, while the plots against one angle "
+            "average over the other.</p>" + _img(base_map, "base residual map")
+        )
+    if not verdict["missing_effect"]:  # else shown before/after in section 5
+        parts.append(_img(residual_figure([base_rs]), "base residuals"))
+        parts.append(_img(harmonics_figure([base_an]), "base harmonics"))
     cls = "verdict" if not verdict["unexplained"] else "verdict warn"
     parts.append("<h2>4. Diagnosis: which physical effect is missing?</h2>")
     first = verdict["missing_effect"]
@@ -192,6 +242,8 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
             f"<p>{html.escape(story['explanation'])}</p>"
             f"<p><i>How to confirm it on the machine:</i> {html.escape(story['confirm'])}</p>"
         )
+    parts += _structure_section(diagnosis, best_fit)
+    if verdict["missing_effect"]:
         best_an = analyse_residuals(best_rs)
         parts.append(
             "<h2>5. Add it and watch the error fall</h2>"
@@ -213,6 +265,12 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
             + _img(residual_figure([base_rs, best_rs]), "residuals before and after")
             + _img(harmonics_figure([base_an, best_an]), "harmonics before and after")
         )
+        best_map = residual_map_figure([best_rs], limit)
+        if best_map is not None:
+            parts.append(
+                "<p>The residual map after, on the colour scale of the map in section 3:</p>"
+                + _img(best_map, "residual map after")
+            )
     res = best_fit.result
     parts.append(
         "<h2>6. Parameters of the final model</h2><p>Determined combinations (value &plusmn; "

@@ -1,4 +1,6 @@
-"""Figures of the measurement layer: residuals per position and variable, and their harmonics."""
+"""Figures of the measurement layer: residuals per position and variable, their harmonics, their
+map over two angles, and each term the structure search finds, against its variable.
+"""
 
 from __future__ import annotations
 
@@ -9,12 +11,38 @@ import numpy as np
 
 from ..core.files import write_bytes_atomic
 from ..measurement.residuals import ResidualAnalysis, ResidualSet, analyse_residuals
+from ..stats.structure_search import FoundTerm
 from .figures import pyplot, save_png
 
-__all__ = ["COLOURS", "harmonics_figure", "residual_figure", "write_residual_plots"]
+__all__ = [
+    "COLOURS",
+    "DIRECTION_MARKERS",
+    "direction_of",
+    "harmonics_figure",
+    "map_limit",
+    "residual_figure",
+    "residual_map_figure",
+    "structure_term_figure",
+    "write_residual_plots",
+    "write_structure_plots",
+]
 
 COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
 """Colour of each residual component (dpsi, dtheta, dgamma, ...) in every figure."""
+
+DIRECTION_MARKERS = {1.0: ("^", "forward"), -1.0: ("v", "backward")}
+"""Marker and label of the points approached forward (dir +1) and backward (dir -1)."""
+
+
+def direction_of(rs: ResidualSet, variable: str) -> np.ndarray | None:
+    """The approach direction (+1/-1 per position) that goes with an angle variable, or None.
+
+    The angle ``phi<k>_deg`` goes with the column ``dir<k>``; any other variable with none.
+    """
+    if not variable.startswith("phi") or not variable.endswith("_deg"):
+        return None
+    value = rs.others.get("dir" + variable[3:-4])
+    return None if value is None else np.asarray(value, dtype=float)
 
 
 def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
@@ -34,9 +62,22 @@ def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
             x = np.arange(rs.residuals.shape[0]) if name == "position" else (
                 rs.angles_deg.get(name, rs.others.get(name))
             )  # fmt: skip
+            direction = direction_of(rs, name)
             for i, comp in enumerate(rs.components):
                 jitter = 0.0 if name == "position" else (i - 1) * 0.01 * (np.ptp(x) or 1.0)
-                ax.plot(x + jitter, rs.residuals[:, i], ".", ms=3, color=COLOURS[i], label=comp)
+                if direction is None:
+                    ax.plot(x + jitter, rs.residuals[:, i], ".", ms=3, color=COLOURS[i],
+                            label=comp)  # fmt: skip
+                    continue
+                for sign, (marker, _) in DIRECTION_MARKERS.items():
+                    pick = direction == sign
+                    ax.plot(x[pick] + jitter, rs.residuals[pick, i], marker, ms=3.5,
+                            color=COLOURS[i], mfc=COLOURS[i] if sign > 0 else "none", mew=0.7,
+                            label=comp if sign > 0 else None)  # fmt: skip
+            if direction is not None:
+                ax.text(0.01, 0.02, "filled up-triangles: approached forward (dir +1); open "
+                        "down-triangles: backward (dir -1)", transform=ax.transAxes,
+                        fontsize=6.5, color="#555")  # fmt: skip
             if np.isfinite(sigma) and sigma > 0:
                 for s in (-k_sigma * sigma, k_sigma * sigma):
                     ax.axhline(s, color="grey", lw=0.7, ls="--")
@@ -81,12 +122,140 @@ def harmonics_figure(analyses: Sequence[ResidualAnalysis]) -> bytes:
     return save_png(fig)
 
 
+def _positions_mean(x: np.ndarray, y: np.ndarray, values: np.ndarray):
+    """The mean of ``values`` (N, C) at each distinct (x, y) position (repeats averaged)."""
+    keys = np.round(np.stack([np.mod(x, 360.0), np.mod(y, 360.0)], axis=1), 6)
+    unique, inverse = np.unique(keys, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    sums = np.zeros((unique.shape[0], values.shape[1]))
+    np.add.at(sums, inverse, values)
+    counts = np.bincount(inverse, minlength=unique.shape[0])[:, None]
+    return unique[:, 0], unique[:, 1], sums / counts
+
+
+def map_limit(sets: Sequence[ResidualSet]) -> float:
+    """A common colour limit for :func:`residual_map_figure` of several sets (largest |mean|)."""
+    limits = []
+    for rs in sets:
+        names = list(rs.angles_deg)
+        if len(names) >= 2:
+            x, y = rs.angles_deg[names[0]], rs.angles_deg[names[1]]
+            limits.append(float(np.abs(_positions_mean(x, y, rs.residuals)[2]).max()))
+    return max(limits, default=0.0) or 1.0
+
+
+def residual_map_figure(sets: Sequence[ResidualSet], limit: float | None = None) -> bytes | None:
+    """PNG: the residual of each component over the first two angles (maps), or None.
+
+    One row per residual set, one panel per component (dpsi, dtheta, dgamma), the first angle
+    across, the second up, one square per measured position coloured by its residual (repeats
+    averaged), on one symmetric colour scale (``limit`` in the sets' unit; default: the largest
+    residual, :func:`map_limit`), so structure in both angles at once shows. None when the sets
+    have fewer than two angles (only the first two are mapped: the others are averaged over).
+    """
+    names = list(sets[0].angles_deg)
+    if len(names) < 2:
+        return None
+    plt = pyplot()
+
+    limit = limit or map_limit(sets)
+    n_comp = len(sets[0].components)
+    fig, axes = plt.subplots(
+        len(sets), n_comp, figsize=(4.6 * n_comp, 4.0 * len(sets)), squeeze=False
+    )
+    for row, rs in enumerate(sets):
+        x, y, mean = _positions_mean(rs.angles_deg[names[0]], rs.angles_deg[names[1]],
+                                     rs.residuals)  # fmt: skip
+        size = max(8.0, 9000.0 / max(len(x), 1))
+        for i, comp in enumerate(rs.components):
+            ax = axes[row, i]
+            image = ax.scatter(x, y, c=mean[:, i], s=size, marker="s", cmap="RdBu_r",
+                               vmin=-limit, vmax=limit)  # fmt: skip
+            ax.set_xlim(-10, 370)
+            ax.set_ylim(-10, 370)
+            ax.set_xticks(range(0, 361, 90))
+            ax.set_yticks(range(0, 361, 90))
+            ax.set_aspect("equal")
+            ax.set_xlabel(names[0].replace("_deg", " (deg)"))
+            ax.set_ylabel(names[1].replace("_deg", " (deg)"))
+            ax.set_title(f"{comp} residual, {rs.label}", fontsize=9, color=COLOURS[i])
+    fig.subplots_adjust(wspace=0.35, hspace=0.3)
+    fig.colorbar(image, ax=axes.ravel().tolist(), label=f"residual ({sets[0].unit})",
+                 shrink=0.85 if len(sets) == 1 else 0.6)  # fmt: skip
+    return save_png(fig)
+
+
+def structure_term_figure(term: FoundTerm) -> bytes:
+    """PNG: one found term against its variable: the data that show it, the fit, the noise.
+
+    Points: the partial residual projected at each record onto the direction the term enters the
+    observations along (:meth:`FoundTerm.projection`); line: the fitted term; grey band: +-1 sigma
+    of one point (the noise floor).
+    """
+    plt = pyplot()
+
+    pr = term.projection()
+    f = term.factors
+    angle = pr.value_unit == "deg"
+    x = np.mod(pr.values, 360.0) if angle else pr.values
+    fig, ax = plt.subplots(figsize=(7.5, 3.4))
+    noise = float(np.nanmedian(pr.noise))
+    discrete = np.unique(x).size <= 3
+    if discrete:
+        levels = np.unique(x)
+        spread = 0.08 * (np.ptp(levels) or 1.0)
+        jitter = np.random.default_rng(0).uniform(-spread, spread, x.size)
+        ax.plot(x + jitter, pr.projected, ".", ms=4, color="tab:blue", label="projected residual")
+        for level in levels:
+            value = float(term.curve(np.array([level]))[0])
+            ax.hlines(value, level - 2 * spread, level + 2 * spread, color="tab:red", lw=2,
+                      label="fitted term" if level == levels[0] else None)  # fmt: skip
+        ax.set_xticks(levels)
+    else:
+        ax.plot(x, pr.projected, ".", ms=4, color="tab:blue", label="projected residual")
+        if angle:
+            grid = np.linspace(0.0, 360.0, 721)
+        else:
+            grid = np.linspace(float(x.min()), float(x.max()), 721)
+        ax.plot(grid, term.curve(grid / f.value_scale), color="tab:red", lw=1.6,
+                label="fitted term")  # fmt: skip
+        ax.set_xlim(grid[0], grid[-1])
+        if angle:
+            ax.set_xticks(range(0, 361, 45))
+    ax.axhspan(-noise, noise, color="grey", alpha=0.25, lw=0,
+               label=f"noise of one point (+-1 sigma, {noise:.2g} {pr.unit})")  # fmt: skip
+    ax.axhline(0.0, color="black", lw=0.5)
+    unit = f" ({pr.value_unit})" if pr.value_unit else ""
+    ax.set_xlabel(f"{pr.variable}{unit}")
+    ax.set_ylabel(f"size of the term ({pr.unit})")
+    ax.set_title(f"{term.name}: amplitude {term.amplitude:.3g} {term.unit}, delta BIC "
+                 f"{term.delta_bic:.0f}\n{term.description}", fontsize=9)  # fmt: skip
+    ax.legend(fontsize=7, loc="upper right", ncol=3)
+    fig.tight_layout()
+    return save_png(fig)
+
+
 def write_residual_plots(sets: Sequence[ResidualSet], directory: str | Path, k_sigma=3.0):
-    """Write ``residuals.png`` and ``harmonics.png`` into ``directory``; returns the paths."""
+    """Write ``residuals.png``, ``harmonics.png`` and ``residual_maps.png`` (when the sets have
+    two angles) into ``directory``; returns the paths."""
     directory = Path(directory)
     analyses = [analyse_residuals(s, k_sigma) for s in sets]
     paths = [
         write_bytes_atomic(directory / "residuals.png", residual_figure(sets, k_sigma)),
         write_bytes_atomic(directory / "harmonics.png", harmonics_figure(analyses)),
     ]
+    maps = residual_map_figure(sets)
+    if maps is not None:
+        paths.append(write_bytes_atomic(directory / "residual_maps.png", maps))
     return paths
+
+
+def write_structure_plots(terms: Sequence[FoundTerm], directory: str | Path) -> list[Path]:
+    """Write :func:`structure_term_figure` of each term that can be drawn as ``structure_<i>.png``
+    (i = 1, 2, ... in the order found) into ``directory``; returns the paths."""
+    directory = Path(directory)
+    return [
+        write_bytes_atomic(directory / f"structure_{i}.png", structure_term_figure(term))
+        for i, term in enumerate(terms, 1)
+        if term.factors is not None and term.residual_weighted is not None
+    ]

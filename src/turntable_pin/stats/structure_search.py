@@ -10,13 +10,19 @@ G probes: searching G shapes at once is G chances of a false alarm, and ``2 ln G
 likelihood-scale form of a Bonferroni correction (on clean data of 432 observations with about
 130 probes, the chance of any false term falls from about 1.5 % to about 0.01 %, while a term of
 3 sigma amplitude lowers chi2 by several hundred).
+
+Each found term keeps, outside its JSON form, what a plot of it needs: its fitted contribution
+and its partial residual per observation and, when the probe says how its columns factor record
+by record (:class:`ProbeFactors`: a direction times functions of one variable), the residual
+projected record by record onto that direction, against that variable
+(:meth:`FoundTerm.projection`).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -25,6 +31,8 @@ __all__ = [
     "NEW_FRACTION",
     "FoundTerm",
     "Probe",
+    "ProbeFactors",
+    "TermProjection",
     "delta_bic",
     "search_structure",
 ]
@@ -42,6 +50,42 @@ fitted parameters, 1e-5..1e-3); fitting one of those to the residuals gave absur
 
 
 @dataclass(frozen=True)
+class ProbeFactors:
+    """How a probe's columns factor record by record: a direction times functions of a variable.
+
+    For data of n records of k observations each (m = n k, record-major), the probe's columns are
+    ``columns[i k + c, j] = direction[i, c] * functions(values)[i, j]``: at record i the shape
+    enters the observations along ``direction[i]`` with the size ``functions(values[i]) @ coef``.
+    This lets a plot show one number per record against the variable (see
+    :meth:`FoundTerm.projection`).
+
+    Attributes:
+        variable: name of the variable the shape is a function of.
+        values: (n,) that variable per record, in internal units.
+        functions: maps values (p,) to the g basis functions (p, g) (any values, for a curve).
+        direction: (n, k) weighted like the residuals, or a function without arguments that
+            returns it.
+        value_scale: user units per internal unit of ``values`` (for the plot's axis).
+        value_unit: the user unit of ``values``.
+        observed: (n, k) which observations the data hold (``None``: all); the residuals and
+            columns list only these.
+    """
+
+    variable: str
+    values: np.ndarray
+    functions: Callable[[np.ndarray], np.ndarray]
+    direction: np.ndarray | Callable[[], np.ndarray]
+    value_scale: float = 1.0
+    value_unit: str = ""
+    observed: np.ndarray | None = None
+
+    def direction_matrix(self) -> np.ndarray:
+        """The (n, k) direction (computed now when it was given as a function)."""
+        d = self.direction() if callable(self.direction) else self.direction
+        return np.asarray(d, dtype=float)
+
+
+@dataclass(frozen=True)
 class Probe:
     """One candidate shape: weighted columns (m, g) and how to describe them.
 
@@ -53,6 +97,8 @@ class Probe:
             so its memory stays that of a few columns however many probes there are.
         unit_scale: user units per internal unit of the probe's coefficients (for amplitudes).
         unit: the user unit of the coefficients.
+        factors: how the columns factor per record (optional: lets the report plot a found
+            term against its variable).
     """
 
     name: str
@@ -60,6 +106,7 @@ class Probe:
     columns: np.ndarray | Callable[[], np.ndarray]
     unit_scale: float = 1.0
     unit: str = ""
+    factors: ProbeFactors | None = None
 
     def matrix(self) -> np.ndarray:
         """The (m, g) columns (computed now when they were given as a function)."""
@@ -67,8 +114,42 @@ class Probe:
 
 
 @dataclass(frozen=True)
+class TermProjection:
+    """A found term seen record by record, in the user units of its coefficients.
+
+    Attributes:
+        variable: name of the variable the term is a function of.
+        values: (n,) that variable per record, in user units (``value_unit``).
+        value_unit: the unit of ``values``.
+        projected: (n,) the partial residual (the residual left by the model with every found
+            term, plus this term's fitted contribution) projected at each record onto the
+            direction the term enters the observations along: a noisy sample of the term.
+        noise: (n,) 1-sigma noise of each ``projected`` value.
+        fitted: (n,) the fitted term at each record.
+        unit: the user unit of ``projected``, ``noise`` and ``fitted``.
+    """
+
+    variable: str
+    values: np.ndarray
+    value_unit: str
+    projected: np.ndarray
+    noise: np.ndarray
+    fitted: np.ndarray
+    unit: str
+
+
+@dataclass(frozen=True)
 class FoundTerm:
-    """A probe accepted by the search, with its fitted size."""
+    """A probe accepted by the search, with its fitted size.
+
+    The fields after ``coefficients`` are kept for plots and left out of :meth:`to_dict`:
+    ``fitted_weighted`` (m,) is the term's fitted contribution to the weighted observations (the
+    probe's columns times its coefficients); ``residual_weighted`` (m,) the weighted residual
+    left by the model with every found term, plus ``fitted_weighted`` (the partial residual of
+    this term); ``explained_weighted`` (m,) the part of the weighted residual explained by the
+    probe's columns after projecting out the model and the terms found before it;
+    ``noise_std_weighted`` the noise of one weighted observation (1 when sigmas are given).
+    """
 
     name: str
     description: str
@@ -76,6 +157,63 @@ class FoundTerm:
     amplitude: float
     unit: str
     coefficients: tuple[float, ...]
+    unit_scale: float = 1.0
+    factors: ProbeFactors | None = field(default=None, repr=False, compare=False)
+    fitted_weighted: np.ndarray | None = field(default=None, repr=False, compare=False)
+    residual_weighted: np.ndarray | None = field(default=None, repr=False, compare=False)
+    explained_weighted: np.ndarray | None = field(default=None, repr=False, compare=False)
+    noise_std_weighted: float = 1.0
+
+    def curve(self, values: np.ndarray) -> np.ndarray:
+        """The fitted term at ``values`` of its variable (internal units), in user units.
+
+        Raises:
+            ValueError: the probe did not say how its columns factor (no ``factors``).
+        """
+        if self.factors is None:
+            raise ValueError(f"term '{self.name}' has no factors: it cannot be drawn as a curve")
+        values = np.atleast_1d(np.asarray(values, dtype=float))
+        basis = np.asarray(self.factors.functions(values), dtype=float)
+        return basis.reshape(values.size, -1) @ np.asarray(self.coefficients)
+
+    def projection(self) -> TermProjection:
+        """The term record by record: partial residual on its direction, noise, fitted value.
+
+        At record i with direction d_i (weighted), the projected value is ``d_i . p_i / |d_i|^2``
+        of the partial residual p_i (scaled to user units): the least-squares size of the term
+        that record alone sees, whose noise is ``noise_std_weighted / |d_i|``. Records the term
+        does not reach (d_i = 0) give NaN.
+
+        Raises:
+            ValueError: the search kept no per-observation data or the probe had no factors.
+        """
+        f = self.factors
+        if f is None or self.residual_weighted is None:
+            raise ValueError(f"term '{self.name}' kept no data to project")
+        d = f.direction_matrix()
+        n, k = d.shape
+        p = np.asarray(self.residual_weighted, dtype=float)
+        if f.observed is not None:
+            full = np.zeros(n * k)
+            full[np.asarray(f.observed, bool).reshape(-1)] = p
+            p = full
+            d = np.where(f.observed, d, 0.0)
+        p = p.reshape(n, k)
+        norm2 = np.sum(d * d, axis=1)
+        reach = norm2 > 0
+        safe = np.where(reach, norm2, 1.0)
+        projected = np.where(reach, np.sum(d * p, axis=1) / safe, np.nan) * self.unit_scale
+        noise = np.where(reach, self.noise_std_weighted / np.sqrt(safe), np.nan) * self.unit_scale
+        values = np.asarray(f.values, dtype=float)
+        return TermProjection(
+            variable=f.variable,
+            values=values * f.value_scale,
+            value_unit=f.value_unit,
+            projected=projected,
+            noise=noise,
+            fitted=self.curve(values),
+            unit=self.unit,
+        )
 
     def to_dict(self) -> dict:
         """The term as a JSON-ready dictionary."""
@@ -130,7 +268,7 @@ def search_structure(
     r = np.asarray(weighted_residuals, dtype=float).copy()
     m = r.size
     q = _orthonormal_columns(model_jacobian_weighted)
-    found: list[FoundTerm] = []
+    found: list[tuple] = []
     remaining = list(probes)
     threshold = BIC_THRESHOLD - 2.0 * math.log(max(len(remaining), 1))
     for _ in range(max_terms):
@@ -154,18 +292,41 @@ def search_structure(
         dbic = delta_bic(rss - reduction, rss, basis.shape[1], m, noise_variance)
         if dbic > threshold:
             break
-        coef = pseudo_inverse @ (basis.T @ r) * probe.unit_scale
-        found.append(
-            FoundTerm(
-                name=probe.name,
-                description=probe.description,
-                delta_bic=float(dbic),
-                amplitude=float(np.linalg.norm(coef)),
-                unit=probe.unit,
-                coefficients=tuple(float(c) for c in coef),
-            )
+        coef_internal = pseudo_inverse @ (basis.T @ r)
+        coef = coef_internal * probe.unit_scale
+        explained = basis @ (basis.T @ r)
+        term = FoundTerm(
+            name=probe.name,
+            description=probe.description,
+            delta_bic=float(dbic),
+            amplitude=float(np.linalg.norm(coef)),
+            unit=probe.unit,
+            coefficients=tuple(float(c) for c in coef),
+            unit_scale=probe.unit_scale,
+            factors=probe.factors,
         )
-        r = r - basis @ (basis.T @ r)
+        found.append((term, probe.matrix() @ coef_internal, explained))
+        r = r - explained
         q = np.concatenate([q, basis], axis=1)
         remaining.remove(probe)
-    return found
+    return _with_plot_data(found, r, q.shape[1], noise_variance)
+
+
+def _with_plot_data(found: list[tuple], residual: np.ndarray, rank: int, noise_variance):
+    """The found terms with their per-observation data (see :class:`FoundTerm`)."""
+    if not found:
+        return []
+    m = residual.size
+    if noise_variance is None:
+        noise_variance = float(residual @ residual) / max(m - rank, 1)
+    std = math.sqrt(noise_variance)
+    return [
+        replace(
+            term,
+            fitted_weighted=fitted,
+            residual_weighted=residual + fitted,
+            explained_weighted=explained,
+            noise_std_weighted=std,
+        )
+        for term, fitted, explained in found
+    ]

@@ -1,0 +1,104 @@
+"""The diagnosis in words: the one-line verdict, and a partial explanation named as such."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from turntable_pin import TurntableErrors
+from turntable_pin.measurement.diagnosis import diagnose_measurements
+from turntable_pin.measurement.simulation import simulate_measurements
+from turntable_pin.report.diagnosis_text import diagnosis_lines, headline, verdict_lines
+
+TERM = {
+    "term": "dtheta 3/rev in phi2",
+    "description": "a 3/rev term in phi2 of dtheta itself",
+    "delta_bic": -250.0,
+    "amplitude": 1.9,
+    "unit": "arcsec",
+    "coefficients": [1.5, 1.2],
+}
+
+
+def _dict(*, steps=(), chi2_best=1.01, fails=False, structure=()):
+    """A minimal ``Diagnosis.to_dict()``: base rms 1.9 arcsec, chi2_reduced 3.64."""
+    steps = [{"added": name, "delta_bic": -1100.0, "rms_arcsec": 0.99, "chi2_reduced": chi2_best,
+              "n_params": 13, "rank": 10, "p_value": 0.4} for name in steps]  # fmt: skip
+    base = {"rms_arcsec": 1.9, "chi2_reduced": 3.64, "n_params": 8, "rank": 5, "p_value": 1e-100}
+    best = dict(base, rms_arcsec=0.99, chi2_reduced=chi2_best) if steps else dict(base)
+    story = {"title": "t", "explanation": "e", "confirm": "c"}
+    return {
+        "base": base,
+        "best": {"effects": [s["added"] for s in steps], **best},
+        "steps": steps,
+        "verdict": {
+            "missing_effect": steps[0]["added"] if steps else None,
+            "missing_effects": [s["added"] for s in steps[:1]],
+            "also_significant": [s["added"] for s in steps[1:]],
+            "unexplained": bool(fails or structure),
+            "fails_fit_test": fails,
+            "remaining_structure": list(structure),
+            "separations": {},
+            "indistinguishable_from_base": [],
+            **({"effect_story": story} if steps else {}),
+        },
+    }
+
+
+def _first_text_line(d):
+    """The first line of the text report of ``d`` (completed with the header's keys)."""
+    d = dict(d, n_positions=144, n_observations=432, sigma_source="column", sigma_arcsec=1.0,
+             candidates=[], warnings=[])  # fmt: skip
+    return diagnosis_lines(d)[0]
+
+
+def test_headline_names_the_missing_effect_with_the_fall():
+    line = headline(_dict(steps=["inner_encoder_harmonics"]))
+    assert line == ("Missing effect: inner_encoder_harmonics -- rms 1.90 -> 0.990 arcsec, "
+                    "chi2_reduced 3.64 -> 1.01")  # fmt: skip
+
+
+def test_an_effect_that_leaves_the_fit_failing_is_a_partial_explanation():
+    d = _dict(steps=["gravity_sag"], chi2_best=2.7, fails=True)
+    line = headline(d)
+    assert line.startswith("Partial explanation: gravity_sag")
+    assert "3.64 -> 2.70" in line and "fails the chi2 test" in line
+    assert "Missing effect" not in line
+    words = verdict_lines(d)
+    assert any(w.startswith("partial explanation: gravity_sag") for w in words)
+    assert not any(w.startswith("missing effect:") for w in words)
+    assert _first_text_line(d) == line
+
+
+def test_an_effect_with_structure_left_is_a_partial_explanation():
+    line = headline(_dict(steps=["gravity_sag"], structure=[TERM, TERM]))
+    assert line.startswith("Partial explanation: gravity_sag")
+    assert line.endswith("structure remains: dtheta 3/rev in phi2 (1.9 arcsec) and 1 more")
+
+
+def test_headline_without_an_effect():
+    assert headline(_dict(structure=[TERM])) == (
+        "Unexplained structure: dtheta 3/rev in phi2 (1.9 arcsec) (no catalogued effect) -- "
+        "rms 1.90 arcsec, chi2_reduced 3.64"
+    )
+    assert headline(_dict(fails=True)).startswith("Unexplained misfit:")
+    clean = _dict()
+    clean["base"]["chi2_reduced"] = 1.02
+    fits = "The base model fits to the noise -- rms 1.90 arcsec, chi2_reduced 1.02"
+    assert headline(clean) == fits
+
+
+@pytest.mark.slow
+def test_a_real_partial_explanation_is_announced_as_such():
+    # gravity sag plus a stated sigma 0.6 of the true noise: the sag is found, chi2_reduced stays
+    # near 1 / 0.6^2 = 2.8, so the best model fails the fit test
+    sim = simulate_measurements(
+        TurntableErrors.from_arcsec(deps_y=4), {"gravity_sag": {"k": 4.0}}, seed=7
+    )
+    data = dataclasses.replace(sim.data, sigma_rad=np.asarray(sim.data.sigma_rad) * 0.6)
+    d = diagnose_measurements(data).to_dict()
+    assert d["verdict"]["missing_effect"] == "gravity_sag" and d["verdict"]["fails_fit_test"]
+    assert d["best"]["chi2_reduced"] == pytest.approx(2.8, abs=0.5)
+    line = headline(d)
+    assert line.startswith("Partial explanation: gravity_sag") and "still unexplained" in line
+    assert diagnosis_lines(d)[0] == line

@@ -1,0 +1,138 @@
+"""Plots that show what the text finds: a planted 3/rev term, projected, fitted, drawn; the map
+over both angles; forward and backward passes told apart."""
+
+import dataclasses
+import io
+
+import numpy as np
+import pytest
+
+from turntable_pin import TurntableErrors
+from turntable_pin.core.units import ARCSEC_PER_RAD
+from turntable_pin.measurement.diagnosis import OrientationFamily, diagnose_measurements
+from turntable_pin.measurement.residuals import orientation_residuals
+from turntable_pin.measurement.simulation import simulate_measurements
+from turntable_pin.report.measurement_figures import (
+    direction_of,
+    map_limit,
+    residual_figure,
+    residual_map_figure,
+    structure_term_figure,
+    write_residual_plots,
+    write_structure_plots,
+)
+
+PLANTED_ARCSEC = 2.0
+PHASE_RAD = 0.7
+
+
+def _png_size(png: bytes) -> tuple[int, int]:
+    from PIL import Image
+
+    with Image.open(io.BytesIO(png)) as image:
+        image.verify()
+    with Image.open(io.BytesIO(png)) as image:
+        return image.size
+
+
+@pytest.fixture(scope="module")
+def planted():
+    """A 30-degree grid (144 positions, sigma 1 arcsec) with 2 arcsec of 3/rev in phi2 on dtheta."""
+    sim = simulate_measurements(TurntableErrors.from_arcsec(deps_y=4, dalpha_x1=2), seed=3)
+    data = sim.data
+    angles = np.array(data.angles_rad)
+    angles[:, 1] += PLANTED_ARCSEC * np.cos(3 * data.phi2_rad - PHASE_RAD) / ARCSEC_PER_RAD
+    data = dataclasses.replace(data, angles_rad=angles)
+    return data, diagnose_measurements(data)
+
+
+def test_every_probe_factors_into_its_direction_times_its_functions(planted):
+    data, _ = planted
+    family = OrientationFamily(data)
+    probes = family.probes(family.fit([]))
+    assert probes and all(p.factors is not None for p in probes)
+    for p in probes:
+        f = p.factors
+        basis = f.functions(f.values)
+        rebuilt = (f.direction_matrix()[:, :, None] * basis[:, None, :]).reshape(-1, basis.shape[1])
+        columns = p.matrix()
+        assert np.allclose(rebuilt, columns, rtol=0, atol=1e-12 * np.abs(columns).max()), p.name
+
+
+def test_the_planted_term_is_found_and_its_projection_shows_it(planted):
+    _, diagnosis = planted
+    assert diagnosis.steps == []  # no catalogued effect: the structure search must speak
+    [term] = diagnosis.structure
+    assert term.name.endswith("3/rev in phi2")
+    pr = term.projection()
+    assert pr.variable == "phi2" and pr.value_unit == "deg" and pr.unit == "arcsec"
+    assert pr.values.shape == pr.projected.shape == pr.fitted.shape == (144,)
+    # the data behind the plot carry the planted 3/rev: fit one to the points themselves
+    phi2 = np.radians(pr.values)
+    design = np.stack([np.cos(3 * phi2), np.sin(3 * phi2)], axis=1)
+    coef, *_ = np.linalg.lstsq(design, pr.projected, rcond=None)
+    noise = float(np.median(pr.noise))
+    assert noise == pytest.approx(1.0, rel=0.05)  # sigma 1 arcsec on dtheta, which it enters 1:1
+    amplitude_std = noise * np.sqrt(2 / pr.values.size)
+    assert np.hypot(*coef) == pytest.approx(PLANTED_ARCSEC, abs=4 * amplitude_std)
+    assert np.arctan2(coef[1], coef[0]) == pytest.approx(PHASE_RAD, abs=0.15)
+    # the fitted curve passes through the points: what is left of them is the noise, unbiased
+    left = pr.projected - pr.fitted
+    assert abs(left.mean()) < 4 * noise / np.sqrt(left.size)
+    assert np.sqrt(np.mean(left**2)) == pytest.approx(noise, rel=0.2)
+    assert np.allclose(term.curve(np.radians(pr.values)), pr.fitted)
+    assert np.hypot(*coef) == pytest.approx(term.amplitude, rel=1e-6)
+    # the per-observation data stay out of the JSON
+    assert set(term.to_dict()) == {
+        "term", "description", "delta_bic", "amplitude", "unit", "coefficients"
+    }  # fmt: skip
+
+
+def test_term_figure_and_maps_are_valid_pngs(planted):
+    _, diagnosis = planted
+    png = structure_term_figure(diagnosis.structure[0])
+    width, height = _png_size(png)
+    assert width > 400 and height > 200
+    rs = orientation_residuals(diagnosis.base_fit)
+    a_map = residual_map_figure([rs], map_limit([rs]))
+    assert _png_size(a_map)[0] > 600
+    single = dataclasses.replace(rs, angles_deg={"phi1_deg": rs.angles_deg["phi1_deg"]})
+    assert residual_map_figure([single]) is None  # one angle: no map
+
+
+def test_the_map_shows_the_planted_phi2_structure_in_dtheta(planted):
+    from turntable_pin.report.measurement_figures import _positions_mean
+
+    _, diagnosis = planted
+    rs = orientation_residuals(diagnosis.base_fit)
+    phi1, phi2, mean = _positions_mean(rs.angles_deg["phi1_deg"], rs.angles_deg["phi2_deg"],
+                                       rs.residuals)  # fmt: skip
+    assert mean.shape == (144, 3)
+    # averaged over phi1, the dtheta map keeps the 3/rev in phi2; dpsi keeps none of it
+    rows = np.unique(phi2)
+    profile = np.array([mean[phi2 == v].mean(axis=0) for v in rows])
+    trig = np.stack([np.cos(3 * np.radians(rows)), np.sin(3 * np.radians(rows))], axis=1)
+    amp = np.hypot(*np.linalg.lstsq(trig, profile, rcond=None)[0])
+    assert amp[1] > 1.5 and amp[0] < 0.5
+
+
+def test_forward_and_backward_passes_are_told_apart():
+    sim = simulate_measurements(seed=4)
+    rs = orientation_residuals(diagnose_measurements(sim.data).base_fit)
+    assert set(direction_of(rs, "phi1_deg")) == {-1.0, 1.0}
+    assert np.array_equal(direction_of(rs, "phi2_deg"), sim.data.dir2)
+    assert direction_of(rs, "time_s") is None
+    assert direction_of(dataclasses.replace(rs, others={}), "phi1_deg") is None
+    assert _png_size(residual_figure([rs]))[1] > 1000
+
+
+def test_plot_files_exist_and_are_pngs(planted, tmp_path):
+    _, diagnosis = planted
+    sets = [orientation_residuals(diagnosis.base_fit), orientation_residuals(diagnosis.best_fit)]
+    paths = write_residual_plots(sets, tmp_path)
+    assert [p.name for p in paths] == ["residuals.png", "harmonics.png", "residual_maps.png"]
+    paths += write_structure_plots(diagnosis.structure, tmp_path / "terms")
+    assert paths[-1].name == "structure_1.png" and len(paths) == 4
+    for path in paths:
+        assert path.is_file() and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        _png_size(path.read_bytes())
