@@ -6,6 +6,7 @@ import pytest
 
 from conftest import EXAMPLES_DIR, cli, run_cli
 from turntable_pin.cli import main
+from turntable_pin.core.files import read_yaml
 
 EXAMPLE = EXAMPLES_DIR / "measurements_example.csv"
 
@@ -27,8 +28,8 @@ def test_bundled_example_diagnosis_names_its_hidden_effect_and_the_error_falls()
     proc = run_cli("diagnose", str(EXAMPLE), "--json")
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
-    hidden = [ln for ln in EXAMPLE.read_text().splitlines() if ln.startswith("# hidden effects")]
-    assert out["verdict"]["missing_effect"] in hidden[0]
+    truth = read_yaml(EXAMPLES_DIR / "truth" / "measurements_example.yaml")
+    assert [out["verdict"]["missing_effect"]] == list(truth["hidden_effects"])
     assert out["steps"][0]["rms_arcsec"] < 0.6 * out["base"]["rms_arcsec"]
     assert 0.8 < out["steps"][0]["chi2_reduced"] < 1.25 < out["base"]["chi2_reduced"]
 

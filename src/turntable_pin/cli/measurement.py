@@ -267,7 +267,7 @@ def run_diagnose(args: argparse.Namespace) -> int:
     from ..measurement.diagnosis import diagnose_measurements
     from ..measurement.residuals import orientation_residuals
     from ..report.diagnosis_text import diagnosis_lines
-    from ..report.measurement_figures import write_residual_plots
+    from ..report.measurement_figures import write_residual_plots, write_structure_plots
 
     table = table_from_args(args)
     data = _read(args, table)
@@ -279,6 +279,7 @@ def run_diagnose(args: argparse.Namespace) -> int:
         if diagnosis.steps:
             sets.append(orientation_residuals(diagnosis.best_fit))
         out["plots"] = [str(p) for p in write_residual_plots(sets, args.plots)]
+        out["plots"] += [str(p) for p in write_structure_plots(diagnosis.structure, args.plots)]
     if args.json:
         print_json(out)
         return 0

@@ -58,15 +58,17 @@ def _table(header: list[str], rows: list[list], left: int = 1) -> str:
 
 
 def data_figure(data) -> bytes:
-    """PNG: the measured angles against phi2, one panel per angle, coloured by phi1."""
+    """PNG: the measured angles against the last joint's angle (phi2 on a two-axis table), one
+    panel per angle, coloured by the first joint's (phi1); one joint: against phi1."""
     plt = pyplot()
 
     fig, axes = plt.subplots(1, 3, figsize=(14, 3.4))
-    phi1 = data.phi1_rad * DEG_PER_RAD
-    phi2 = data.phi2_rad * DEG_PER_RAD
+    last = data.n_joints
+    x = data.joint_rad[:, last - 1] * DEG_PER_RAD
+    colour = data.joint_rad[:, 0] * DEG_PER_RAD
     for i, (ax, name) in enumerate(zip(axes, ANGLE_NAMES, strict=True)):
-        sc = ax.scatter(phi2, data.angles_rad[:, i] * ARCSEC_PER_RAD, c=phi1, s=10, cmap="viridis")
-        ax.set_xlabel("phi2 (deg)")
+        sc = ax.scatter(x, data.angles_rad[:, i] * ARCSEC_PER_RAD, c=colour, s=10, cmap="viridis")
+        ax.set_xlabel(f"phi{last} (deg)")
         ax.set_ylabel(f"{name} (arcsec)")
         ax.set_title(f"measured {name}", fontsize=10, color=COLOURS[i])
     fig.colorbar(sc, ax=axes, label="phi1 (deg)")
@@ -171,18 +173,14 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
         f"positions have a residual beyond {base_an.k_sigma:g} sigma.</p>"
     )
     if failing:
+        joints = range(1, data.n_joints + 1)
         parts.append(
             _table(
-                ["row", "phi1 (deg)", "phi2 (deg)", "angle", "residual (arcsec)", "sigmas"],
+                ["row", *(f"phi{k} (deg)" for k in joints), "angle", "residual (arcsec)",
+                 "sigmas"],
                 [
-                    [
-                        f["row"],
-                        f["phi1_deg"],
-                        f["phi2_deg"],
-                        f["component"],
-                        f["residual_arcsec"],
-                        f["sigmas"],
-                    ]
+                    [f["row"], *(f[f"phi{k}_deg"] for k in joints), f["component"],
+                     f["residual_arcsec"], f["sigmas"]]
                     for f in failing[:15]
                 ],
             )  # fmt: skip
