@@ -126,3 +126,30 @@ def test_bad_grid_and_weights_are_refused():
         grid_angles_rad(table, 0.0)
     with pytest.raises(InputError, match="choose one of model, equal"):
         allocate_table_tolerances(table, LIMITS, weights="paper")
+
+
+def test_the_paper_table_through_the_generic_sensitivities_equals_its_own(rng):
+    from turntable_pin.allocation.sensitivity import sensitivity_matrix
+    from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
+    from turntable_pin.model.turntable import TurntableModel
+
+    mapping = {  # the paper's errors on the generic parameters (tests/model/test_generic_table.py)
+        "dphi_y1": "outer_axis.position",
+        "dalpha_z1": "inner_axis.position",
+        "dalpha_x1": "inner_axis.tilt_a",
+        "deps_x": "inner_axis.tilt_a",
+        "deps_y": "inner_axis.tilt_b",
+        "dalpha_y2": "payload_mount.rot_y",
+        "dphi_z2": "payload_mount.rot_z",
+        "dalpha_x2": "payload_mount.rot_x",
+    }
+    table = GenericTable(MODELS / "turntable.urdf")
+    names = angular_names(table)
+    model = TurntableModel()
+    for phi1, phi2 in rng.uniform(-np.pi, np.pi, (4, 2)):
+        generic = table.regressor([np.array([phi1]), np.array([phi2])])[0]
+        paper = sensitivity_matrix(model, phi1, phi2)
+        for col, paper_name in enumerate(ANGULAR_ERROR_NAMES):
+            column = table.parameter_names.index(mapping[paper_name])
+            np.testing.assert_allclose(paper[:, col], generic[:, column], atol=1e-12)
+    assert set(mapping.values()) <= set(names)
