@@ -6,6 +6,10 @@ check.
 from ..core.lazy import lazy_exports
 
 _EXPORTS = {
+    "TableAllocation": "table_allocation",
+    "allocate_table_tolerances": "table_allocation",
+    "run_table_monte_carlo": "table_monte_carlo",
+    "table_sensitivities": "table_allocation",
     "Allocation": "solver",
     "AverageSensitivities": "sensitivity",
     "ManufacturingCapability": "capability",

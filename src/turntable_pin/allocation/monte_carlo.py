@@ -119,6 +119,45 @@ def _stop_workers(pools: list[ProcessPoolExecutor], kill: bool = True) -> None:
         pools.clear()
 
 
+def _chunk_results(worker, tasks, sizes, workers: int, progress: bool):
+    """Yield ``worker(task)`` of every task in order, in this process (``workers == 1``) or in
+    a pool of ``workers`` processes, reporting the turntables done (``sizes``) on stderr.
+
+    The workers never outlive the run (see the module docstring).
+    """
+    pools: list[ProcessPoolExecutor] = []
+    # Registered before the workers start: an interruption at any moment still stops them.
+    unregister = register_cleanup(lambda: _stop_workers(pools))
+    try:
+        with Progress(int(sum(sizes)), "Monte Carlo", enabled=progress) as bar:
+            if workers == 1:
+                results = map(worker, tasks)
+            else:
+                # Workers start with SIGINT/SIGTERM blocked and set up their own handling.
+                with deferred(), signals_blocked():
+                    pools.append(
+                        ProcessPoolExecutor(max_workers=workers, initializer=worker_initializer)
+                    )
+                    # Not pool.map: its generator cancels the futures when interrupted, and
+                    # Python 3.11's pool then fails (a traceback) marking them broken.
+                    futures = [pools[0].submit(worker, task) for task in tasks]
+                results = (future.result() for future in futures)
+            for result, size in zip(results, sizes, strict=True):
+                yield result
+                bar.update(size)
+        with deferred():
+            for pool in pools:  # every chunk is done: the workers are idle
+                pool.shutdown(cancel_futures=True)
+            pools.clear()
+    finally:
+        # On an interruption kill them and wait for no chunk; on an error let running chunks end.
+        # A generator closed before its end (GeneratorExit) was abandoned: kill as well.
+        _stop_workers(
+            pools, kill=isinstance(sys.exc_info()[1], (KeyboardInterrupt, GeneratorExit))
+        )
+        unregister()
+
+
 @dataclass(frozen=True)
 class MonteCarloResult:
     """The outcome of :func:`run_monte_carlo`.
@@ -239,37 +278,13 @@ def run_monte_carlo(
     start = time.perf_counter()
     worst = np.empty((n, 3))
     dependence = 0.0
-    pools: list[ProcessPoolExecutor] = []
-    # Registered before the workers start: an interruption at any moment still stops them.
-    unregister = register_cleanup(lambda: _stop_workers(pools))
-    try:
-        with Progress(n, "Monte Carlo", enabled=progress) as bar:
-            if workers == 1:
-                results = map(_run_chunk, tasks)
-            else:
-                # Workers start with SIGINT/SIGTERM blocked and set up their own handling.
-                with deferred(), signals_blocked():
-                    pools.append(
-                        ProcessPoolExecutor(max_workers=workers, initializer=worker_initializer)
-                    )
-                    # Not pool.map: its generator cancels the futures when interrupted, and
-                    # Python 3.11's pool then fails (a traceback) marking them broken.
-                    futures = [pools[0].submit(_run_chunk, task) for task in tasks]
-                results = (future.result() for future in futures)
-            offset = 0
-            for (chunk_worst, chunk_dependence), size in zip(results, sizes, strict=True):
-                worst[offset : offset + size] = chunk_worst
-                dependence = max(dependence, chunk_dependence)
-                offset += size
-                bar.update(size)
-        with deferred():
-            for pool in pools:  # every chunk is done: the workers are idle
-                pool.shutdown(cancel_futures=True)
-            pools.clear()
-    finally:
-        # On an interruption kill them and wait for no chunk; on an error let running chunks end.
-        _stop_workers(pools, kill=isinstance(sys.exc_info()[1], KeyboardInterrupt))
-        unregister()
+    offset = 0
+    for (chunk_worst, chunk_dependence), size in zip(
+        _chunk_results(_run_chunk, tasks, sizes, workers, progress), sizes, strict=True
+    ):
+        worst[offset : offset + size] = chunk_worst
+        dependence = max(dependence, chunk_dependence)
+        offset += size
     elapsed = time.perf_counter() - start
     phi1_used = (0.0,) if dependence <= PHI1_TOLERANCE else tuple(phi1_grid * DEG_PER_RAD)
     return MonteCarloResult(

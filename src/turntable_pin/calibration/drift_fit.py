@@ -47,6 +47,7 @@ __all__ = [
     "calibrate_run",
     "check_identifiable",
     "fit_axis",
+    "require_identifiable",
     "simulate_run",
     "write_simulated_run",
 ]
@@ -135,6 +136,28 @@ class CalibrationResult:
     def to_dict(self) -> dict:
         """Both fits and the residual per position as a JSON-ready dict (degrees, deg/h)."""
         positions = self.inputs.positions
+        if hasattr(positions, "column_names"):  # any table: the angles under <joint>_deg
+            return {
+                "positions": positions.name,
+                "n_positions": len(positions),
+                "joints": list(positions.joint_names),
+                "latitude_deg": float(rad_to_deg(self.inputs.latitude_rad)),
+                "x": self.x.to_dict(),
+                "y": self.y.to_dict(),
+                "residuals": [
+                    {
+                        **dict(zip(positions.column_names, map(float, angles), strict=True)),
+                        "residual_x_dph": float(rx),
+                        "residual_y_dph": float(ry),
+                    }
+                    for angles, rx, ry in zip(
+                        rad_to_deg(positions.angles_rad),
+                        self.x.residuals_dph,
+                        self.y.residuals_dph,
+                        strict=True,
+                    )
+                ],
+            }
         return {
             "positions": positions.name,
             "n_positions": len(positions),
@@ -174,11 +197,16 @@ class CalibrationResult:
                 fit.names, fit.coefficients_dph, fit.standard_errors_dph, strict=True
             ):
                 lines.append(f"  D{axis}{name:3s} = {value:12.6f} +- {error:.3g}")
-        lines.append(f"{'phi1_deg':>9s} {'phi2_deg':>9s} {'res_x_dph':>12s} {'res_y_dph':>12s}")
+        angle_keys = getattr(self.inputs.positions, "column_names", ("phi1_deg", "phi2_deg"))
+        width = max(9, *(len(k) for k in angle_keys))
+        lines.append(
+            " ".join(f"{k:>{width}s}" for k in angle_keys)
+            + f" {'res_x_dph':>12s} {'res_y_dph':>12s}"
+        )
         for row in d["residuals"]:
             lines.append(
-                f"{row['phi1_deg']:9.3f} {row['phi2_deg']:9.3f} "
-                f"{row['residual_x_dph']:12.3e} {row['residual_y_dph']:12.3e}"
+                " ".join(f"{row[k]:{width}.3f}" for k in angle_keys)
+                + f" {row['residual_x_dph']:12.3e} {row['residual_y_dph']:12.3e}"
             )
         return "\n".join(lines)
 
@@ -283,10 +311,51 @@ def calibrate(
     )
 
 
-def calibrate_run(path: str | Path, latitude_rad: float) -> CalibrationResult:
-    """Read a calibration run CSV and fit it (see the module docstring for the format)."""
+def require_identifiable(inputs: PositionInputs) -> None:
+    """Raise :class:`IdentifiabilityError` (naming the positions) unless the positions of
+    ``inputs`` determine the seven drift coefficients of both axes (see
+    :func:`check_identifiable`)."""
+    for axis in AXES:
+        design = regressor_matrix(axis, inputs.specific_force_g)
+        try:
+            check_identifiable(design, axis, inputs.positions)
+        except IdentifiabilityError as exc:
+            raise IdentifiabilityError(f"positions {inputs.positions.name}: {exc}") from None
+
+
+def calibrate_run(path: str | Path, latitude_rad: float, table=None) -> CalibrationResult:
+    """Read a calibration run CSV and fit it (see the module docstring for the format).
+
+    ``table``: a :class:`~turntable_pin.model.generic_table.GenericTable` whose run this is (its
+    angle columns ``phi1_deg .. phiN_deg`` in chain order or ``<joint>_deg``, see
+    :mod:`~turntable_pin.calibration.table_positions`); default the paper's table
+    (``phi1_deg, phi2_deg``).
+    """
+    if table is not None:
+        return _calibrate_table_run(Path(path), latitude_rad, table)
     table = read_csv_table(path, RUN_REQUIRED_COLUMNS, RUN_OPTIONAL_COLUMNS)
     check_commanded_angles(table)
+    _check_run_values(path, table)
+    positions = PositionSet(
+        deg_to_rad(table["phi1_deg"]), deg_to_rad(table["phi2_deg"]), name=str(path)
+    )
+    return _fit_run(path, table, position_inputs(positions, latitude_rad), ("phi1_deg", "phi2_deg"))
+
+
+def _calibrate_table_run(path: Path, latitude_rad: float, table) -> CalibrationResult:
+    """:func:`calibrate_run` on a run of any table (its angle columns, chain order)."""
+    from .table_positions import JointPositions
+
+    optional = JointPositions.candidate_columns(table) + RUN_OPTIONAL_COLUMNS
+    csv = read_csv_table(path, RUN_REQUIRED_COLUMNS[2:], optional)
+    columns = JointPositions.columns_of(table, csv)
+    positions = JointPositions.from_table(table, csv, columns, str(path))
+    _check_run_values(path, csv)
+    return _fit_run(path, csv, position_inputs(positions, latitude_rad), columns)
+
+
+def _check_run_values(path, table) -> None:
+    """Refuse outputs, sigmas or times out of range (naming file, row and column)."""
     for column in ("out_x_dph", "out_y_dph", "sigma_dph"):
         if not table.has(column):
             continue
@@ -313,10 +382,10 @@ def calibrate_run(path: str | Path, latitude_rad: float) -> CalibrationResult:
             )  # fmt: skip
     if table.has("time_s"):
         table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
-    positions = PositionSet(
-        deg_to_rad(table["phi1_deg"]), deg_to_rad(table["phi2_deg"]), name=str(path)
-    )
-    inputs = position_inputs(positions, latitude_rad)
+
+
+def _fit_run(path, table, inputs: PositionInputs, angle_columns) -> CalibrationResult:
+    """Fit the outputs of a read run at ``inputs``; refuse copied rows after the fit."""
     try:
         result = calibrate(
             inputs,
@@ -329,7 +398,7 @@ def calibrate_run(path: str | Path, latitude_rad: float) -> CalibrationResult:
     # After the fit: positions that cannot determine the coefficients are the first problem.
     refuse_repeated_rows(
         table,
-        ("phi1_deg", "phi2_deg", "time_s"),
+        (*angle_columns, "time_s"),
         "a copied row counts one measurement twice (repeats must differ in time_s)",
     )
     return result
@@ -354,9 +423,17 @@ def simulate_run(
     rng = np.random.default_rng(check_seed(seed))
     outputs = gyrowheel.outputs_dph(inputs.specific_force_g, inputs.earth_rate_dph)
     outputs = outputs + rng.normal(0.0, noise_dph, size=outputs.shape)
-    columns = {
-        "phi1_deg": rad_to_deg(inputs.positions.phi1_rad),
-        "phi2_deg": rad_to_deg(inputs.positions.phi2_rad),
+    positions = inputs.positions
+    if hasattr(positions, "angles_rad"):  # any table: phi1_deg .. phiN_deg in chain order
+        columns = {
+            f"phi{i + 1}_deg": rad_to_deg(a) for i, a in enumerate(positions.angles_rad.T)
+        }
+    else:
+        columns = {
+            "phi1_deg": rad_to_deg(positions.phi1_rad),
+            "phi2_deg": rad_to_deg(positions.phi2_rad),
+        }
+    columns |= {
         "out_x_dph": outputs[:, 0],
         "out_y_dph": outputs[:, 1],
     }

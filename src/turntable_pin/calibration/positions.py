@@ -214,7 +214,9 @@ def position_inputs(
     """Specific force and earth rate along the payload axes at each position (eq. 3).
 
     Args:
-        positions: the commanded angles.
+        positions: the commanded angles: a :class:`PositionSet` of the paper's table, or a
+            :class:`~turntable_pin.calibration.table_positions.JointPositions` of any table
+            (whose nominal chain then gives ``Rd``; ``model`` is not used).
         latitude_rad: latitude of the test site, radians (|lat| <= pi/2).
         model: the turntable whose *ideal* (nominal) payload orientation is used; default the
             bundled URDF. Orientation errors enter later (eq. 8), not here.
@@ -225,13 +227,16 @@ def position_inputs(
             f"latitude must be within +-{MAX_LATITUDE_DEG:g} degrees, got "
             f"{rad_to_deg(latitude_rad)!r}"
         )
-    model = model if model is not None else TurntableModel()
-    rotations = np.array(
-        [
-            model.ideal_pose(p1, p2).rotation
-            for p1, p2 in zip(positions.phi1_rad, positions.phi2_rad, strict=True)
-        ]
-    )
+    if hasattr(positions, "nominal_rotations"):  # any table's positions (table_positions)
+        rotations = positions.nominal_rotations()
+    else:
+        model = model if model is not None else TurntableModel()
+        rotations = np.array(
+            [
+                model.ideal_pose(p1, p2).rotation
+                for p1, p2 in zip(positions.phi1_rad, positions.phi2_rad, strict=True)
+            ]
+        )
     force, rate = base_frame_inputs(latitude_rad)
     # Rd maps payload to base coordinates, so payload components are Rd^T v (row vector v Rd).
     return PositionInputs(

@@ -24,10 +24,13 @@ from ..core.units import ARCMIN_PER_RAD, DEG_PER_RAD
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from .common import (
     accuracy_dph,
+    add_table_options,
     bounded_float,
     finite_float,
+    generic_table_from_args,
     latitude_deg,
     one_line_errors,
+    paper_table_requested,
     positive_float,
     positive_int,
     print_json,
@@ -106,14 +109,25 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
         choices=WEIGHT_SCHEMES,
         default="model",
         help="W = 1/sensitivity from the exact model (default), from the paper's Figure 8 "
-        "(0.6481 for sin/cos terms, 1 for constants), or equal weights (traditional method)",
+        "(0.6481 for sin/cos terms, 1 for constants; the paper's table only), or equal weights "
+        "(traditional method)",
     )
     p.add_argument(
         "--lower-bounds",
         type=Path,
         metavar="FILE.yaml",
         help="manufacturing lower bounds (default: the bundled "
-        "models/manufacturing_lower_bounds.yaml)",
+        "models/manufacturing_lower_bounds.yaml; a table given by --urdf: its error names, "
+        "default 0)",
+    )
+    add_table_options(p)
+    p.add_argument(
+        "--grid-step-deg",
+        type=bounded_float(0.0, 90.0, "deg", low_open=True),
+        default=None,
+        help="a table given by --urdf: step of the grid over every joint on which sensitivities, "
+        "worst cases and the Monte Carlo run are evaluated (default 1, 5, 15 deg for 1, 2, 3 "
+        "joints)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -143,8 +157,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     m.add_argument(
         "--phi2-step-deg",
         type=bounded_float(0.0, 90.0, "deg", low_open=True),
-        default=1.0,
-        help="phi2 grid step, degrees (1)",
+        default=None,
+        help="phi2 grid step, degrees (1; the paper's table: --grid-step-deg for any other)",
     )
     m.add_argument(
         "--scale-bounds",
@@ -159,17 +173,73 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     m.set_defaults(func=run_montecarlo)
 
 
+def _limits_from_args(args: argparse.Namespace, table=None) -> tuple[OrientationLimits, str]:
+    """The orientation limits of the options and how they were given; the default limits come
+    from the calibration layer's requirement on ``table``'s positions (the paper's: None)."""
+    if args.limits_arcmin is not None:
+        return parse_limits(args.limits_arcmin, "arcmin"), f"--limits-arcmin {args.limits_arcmin}"
+    if args.limits_deg is not None:
+        return parse_limits(args.limits_deg, "deg"), f"--limits-deg {args.limits_deg}"
+    given = f"the limits of --accuracy-dph {args.accuracy_dph:g}"
+    if table is None:
+        limits = default_orientation_limits(args.accuracy_dph, args.positions, args.latitude_deg)
+        return limits, given
+    from ..calibration.requirement import orientation_requirement
+    from ..calibration.table_positions import JointPositions
+    from ..core.exceptions import IdentifiabilityError
+    from ..core.units import deg_to_rad
+
+    try:
+        requirement = orientation_requirement(
+            args.accuracy_dph,
+            JointPositions.parse(table, args.positions),
+            deg_to_rad(args.latitude_deg),
+        )
+    except IdentifiabilityError as exc:
+        raise IdentifiabilityError(
+            f"no default limits for this table ({exc}); give --limits-arcmin or --limits-deg"
+        ) from None
+    return OrientationLimits(*requirement.limits_rad), given
+
+
+def _table_allocation_from_args(args: argparse.Namespace, table):
+    """The allocation of a table given by ``--urdf`` (:mod:`..allocation.table_allocation`)."""
+    from ..allocation.table_allocation import allocate_table_tolerances, table_lower_bounds
+
+    if args.weights == "paper":
+        raise InputError(
+            "--weights paper: the paper's Figure 8 values belong to its table; for a table given "
+            "by --urdf choose --weights model or --weights equal"
+        )
+    if args.plots:
+        raise InputError("--plots: the figures are drawn for the paper's table only")
+    limits, given = _limits_from_args(args, table)
+    lower = table_lower_bounds(table, args.lower_bounds)
+    try:
+        return allocate_table_tolerances(
+            table, limits, args.weights, lower, grid_step_deg=args.grid_step_deg
+        )
+    except InfeasibleError as exc:
+        source = args.lower_bounds or "no lower bounds"
+        raise InfeasibleError(f"{given} with the lower bounds of {source}: {exc}") from None
+
+
+def _table(args: argparse.Namespace):
+    """The :class:`GenericTable` of ``--urdf``, or None for the paper's table (whose options
+    ``--grid-step-deg`` does not take)."""
+    if not paper_table_requested(args):
+        return generic_table_from_args(args)
+    if args.grid_step_deg is not None:
+        raise InputError(
+            "--grid-step-deg is for a table given by --urdf; the paper's table averages over "
+            "phi2 (montecarlo: --phi2-step-deg)"
+        )
+    return None
+
+
 def _allocation_from_args(args: argparse.Namespace) -> tuple[Allocation, AverageSensitivities]:
     """The allocation the options ask for and the sensitivities behind Figure 8."""
-    if args.limits_arcmin is not None:
-        limits = parse_limits(args.limits_arcmin, "arcmin")
-        given = f"--limits-arcmin {args.limits_arcmin}"
-    elif args.limits_deg is not None:
-        limits = parse_limits(args.limits_deg, "deg")
-        given = f"--limits-deg {args.limits_deg}"
-    else:
-        limits = default_orientation_limits(args.accuracy_dph, args.positions, args.latitude_deg)
-        given = f"the limits of --accuracy-dph {args.accuracy_dph:g}"
+    limits, given = _limits_from_args(args)
     capability = (
         ManufacturingCapability.from_yaml(args.lower_bounds)
         if args.lower_bounds
@@ -186,6 +256,16 @@ def _allocation_from_args(args: argparse.Namespace) -> tuple[Allocation, Average
 
 
 def run_allocate(args: argparse.Namespace) -> int:
+    table = _table(args)
+    if table is not None:
+        allocation = _table_allocation_from_args(args, table)
+        if args.json:
+            report = allocation.to_dict()
+            report["sensitivities"] = allocation.sensitivities.to_dict()["sensitivities"]
+            print_json(report)
+        else:
+            print(allocation.report())
+        return 0
     allocation, sensitivities = _allocation_from_args(args)
     figure = None
     if args.plots:
@@ -205,9 +285,74 @@ def run_allocate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _scaled_bounds(args: argparse.Namespace, upper, lower):
+    """The box of ``--scale-bounds`` K: K times the upper bounds, the lower ones too if K < 1."""
+    upper = upper * args.scale_bounds
+    if float(upper.max()) > MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD:
+        raise InputError(
+            f"--scale-bounds {args.scale_bounds:g}: the scaled bounds reach "
+            f"{float(upper.max()) * DEG_PER_RAD:g} deg, beyond the {MAX_ANGULAR_ERROR_DEG:g} deg "
+            "of a small error"
+        )
+    if args.scale_bounds < 1.0:
+        lower = lower * args.scale_bounds
+    return upper, lower
+
+
+def _run_table_montecarlo(args: argparse.Namespace, table) -> int:
+    """``montecarlo`` on a table given by ``--urdf``."""
+    from ..allocation.table_monte_carlo import run_table_monte_carlo
+
+    if args.phi2_step_deg is not None:
+        raise InputError("--phi2-step-deg is the paper table's; for this table: --grid-step-deg")
+    allocation = _table_allocation_from_args(args, table)
+    upper, lower = _scaled_bounds(args, allocation.upper_bounds_rad, allocation.lower_bounds_rad)
+    result = run_table_monte_carlo(
+        table,
+        upper,
+        allocation.limits,
+        args.n,
+        args.seed,
+        lower_bounds_rad=lower,
+        grid_step_deg=allocation.sensitivities.grid_step_deg,
+        workers=args.workers,
+        progress=not (args.quiet or args.json),
+    )
+    report = result.to_dict()
+    report["weights"] = args.weights
+    report["scale_bounds"] = args.scale_bounds
+    if args.json:
+        print_json(report)
+    else:
+        _print_montecarlo(
+            result,
+            allocation.limits,
+            f"Monte Carlo on {table.urdf_path.name}: {result.n} tables (seed {result.seed}), "
+            f"grid {result.grid_step_deg:g} deg over {', '.join(table.joint_names)} "
+            f"({result.n_grid_points} positions), exact chain, {result.elapsed_s:.1f} s",
+        )
+    return 0 if result.all_within else 1
+
+
+def _print_montecarlo(result, limits: OrientationLimits, title: str) -> None:
+    """The text report of a Monte Carlo run: each angle's largest value against its limit."""
+    limits = limits.to_dict()
+    print(title)
+    for k, name in enumerate(ORIENTATION_ANGLES):
+        value = result.max_abs_rad[k] * ARCMIN_PER_RAD
+        flag = "ok" if value <= limits[name] else "EXCEEDED"
+        print(f"  max |d{name}| = {value:.4f}'  limit {limits[name]:.4f}'  {flag}")
+    print("all within the limits" if result.all_within else "a limit is exceeded")
+
+
 def run_montecarlo(args: argparse.Namespace) -> int:
     if args.scale_bounds <= 0.0:
         raise InputError(f"--scale-bounds must be positive, got {args.scale_bounds}")
+    table = _table(args)
+    if table is not None:
+        return _run_table_montecarlo(args, table)
+    if args.phi2_step_deg is None:
+        args.phi2_step_deg = 1.0
     allocation, _ = _allocation_from_args(args)
     upper = allocation.upper_bounds_rad * args.scale_bounds
     if float(upper.max()) > MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD:

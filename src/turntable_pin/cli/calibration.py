@@ -16,9 +16,12 @@ from ..model.angles import ANGLE_NAMES, ANGLE_SYMBOLS
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from .common import (
     accuracy_dph,
+    add_table_options,
     bounded_float,
+    generic_table_from_args,
     latitude_deg,
     one_line_errors,
+    paper_table_requested,
     print_json,
 )
 
@@ -29,9 +32,11 @@ def _add_setup_options(parser: argparse.ArgumentParser, *, positions: bool = Tru
     if positions:
         parser.add_argument(
             "--positions", default="grid:30", metavar="SCHEME|FILE.csv",
-            help="test positions: grid:STEP (phi1, phi2 in 0, STEP, ... < 360 deg, all pairs), "
-            "grid:STEP1xSTEP2, or a CSV with phi1_deg, phi2_deg (default grid:30)",
+            help="test positions: grid:STEP (every joint in 0, STEP, ... < 360 deg, every "
+            "combination), grid:STEP1xSTEP2[xSTEP3] (one step per joint), or a CSV with "
+            "phi1_deg, phi2_deg (any table: phi1_deg .. phiN_deg or <joint>_deg) (default grid:30)",
         )  # fmt: skip
+    add_table_options(parser)
     parser.add_argument(
         "--latitude-deg", type=latitude_deg, default=DEFAULT_LATITUDE_DEG,
         help=f"latitude of the test site, degrees (default {DEFAULT_LATITUDE_DEG}, Harbin)",
@@ -89,7 +94,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     c = subparsers.add_parser(
         "calibrate",
         description="Least-squares calibration of a run CSV (phi1_deg, phi2_deg, out_x_dph, "
-        "out_y_dph[, sigma_dph, time_s]): coefficients, standard errors, residuals per position.",
+        "out_y_dph[, sigma_dph, time_s]; with --urdf one angle column per joint: phi1_deg .. "
+        "phiN_deg in chain order or <joint>_deg): coefficients, standard errors, residuals per "
+        "position.",
     )
     one_line_errors(c)
     c.add_argument("run", type=Path, metavar="RUN.csv")
@@ -98,21 +105,53 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     c.set_defaults(func=run_calibrate)
 
 
+def _table(args: argparse.Namespace):
+    """The :class:`GenericTable` of ``--urdf``, or None for the paper's table."""
+    return None if paper_table_requested(args) else generic_table_from_args(args)
+
+
+def _positions(args: argparse.Namespace, table):
+    """The positions of ``--positions`` for the paper's table (``table`` None) or ``table``."""
+    if table is None:
+        return PositionSet.parse(args.positions)
+    from ..calibration.table_positions import JointPositions
+
+    return JointPositions.parse(table, args.positions)
+
+
+def _table_keys(table) -> dict:
+    """What a report of any table adds: the URDF, the payload frame and the joints."""
+    if table is None:
+        return {}
+    return {
+        "urdf": str(table.urdf_path),
+        "payload_frame": table.payload_frame,
+        "joints": list(table.joint_names),
+    }
+
+
 def _gyrowheel(args: argparse.Namespace) -> GyroWheelModel:
     return GyroWheelModel.from_yaml(args.gyrowheel) if args.gyrowheel else GyroWheelModel.nominal()
 
 
 def run_rate_error(args: argparse.Namespace) -> int:
-    inputs = position_inputs(PositionSet.parse(args.positions), deg_to_rad(args.latitude_deg))
+    table = _table(args)
+    inputs = position_inputs(_positions(args, table), deg_to_rad(args.latitude_deg))
+    if table is not None:  # positions of another table may not determine the coefficients
+        from ..calibration.drift_fit import require_identifiable
+
+        require_identifiable(inputs)
     result = rate_error(
         _gyrowheel(args), inputs,
         deg_to_rad(args.dpsi_deg), deg_to_rad(args.dtheta_deg), deg_to_rad(args.dgamma_deg),
         exact=args.exact, definition=args.definition,
     )  # fmt: skip
-    report = result.to_dict()
+    report = {**result.to_dict(), **_table_keys(table)}
     if args.json:
         print_json(report)
         return 0
+    if table is not None:
+        print(f"table {table.urdf_path.name}: joints {', '.join(table.joint_names)}")
     print(
         f"positions {report['positions']} ({report['n_positions']}), latitude "
         f"{report['latitude_deg']:g} deg, {'exact rotation' if args.exact else 'eq. 7 dR'}, "
@@ -124,11 +163,12 @@ def run_rate_error(args: argparse.Namespace) -> int:
 
 
 def run_requirement(args: argparse.Namespace) -> int:
+    table = _table(args)
     result = orientation_requirement(
-        args.accuracy_dph, PositionSet.parse(args.positions), deg_to_rad(args.latitude_deg),
+        args.accuracy_dph, _positions(args, table), deg_to_rad(args.latitude_deg),
         gyrowheel=_gyrowheel(args), exact=args.exact, definition=args.definition,
     )  # fmt: skip
-    report = result.to_dict()
+    report = {**result.to_dict(), **_table_keys(table)}
     if args.plots:
         from ..report.requirement_figures import write_requirement_figures
 
@@ -136,6 +176,8 @@ def run_requirement(args: argparse.Namespace) -> int:
     if args.json:
         print_json(report)
         return 0
+    if table is not None:
+        print(f"table {table.urdf_path.name}: joints {', '.join(table.joint_names)}")
     print(
         f"accuracy {args.accuracy_dph:g} deg/h, positions {report['positions']} "
         f"({report['n_positions']}), latitude {report['latitude_deg']:g} deg, "
@@ -162,9 +204,10 @@ def run_requirement(args: argparse.Namespace) -> int:
 
 
 def run_calibrate(args: argparse.Namespace) -> int:
-    result = calibrate_run(args.run, deg_to_rad(args.latitude_deg))
+    table = _table(args)
+    result = calibrate_run(args.run, deg_to_rad(args.latitude_deg), table)
     if args.json:
-        print_json(result.to_dict())
+        print_json({**result.to_dict(), **_table_keys(table)})
     else:
         print(result.report())
     return 0

@@ -144,6 +144,19 @@ def one_line_errors(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
     return parser
 
 
+def add_table_options(parser: argparse.ArgumentParser) -> None:
+    """``--urdf FILE`` and ``--payload-frame NAME``: the table (default: the paper's)."""
+    parser.add_argument(
+        "--urdf", type=Path, metavar="FILE.urdf",
+        help="the turntable's URDF: 1 to 3 revolute joints in a chain (default: the paper's)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--payload-frame",
+        metavar="NAME",
+        help="the payload frame of the URDF (default: the only leaf of its chain)",
+    )
+
+
 def add_error_options(parser: argparse.ArgumentParser) -> None:
     """``--error NAME=VALUE`` (repeatable), ``--errors FILE.yaml`` and ``--urdf FILE``."""
     parser.add_argument(

@@ -4,6 +4,8 @@
 from ..core.lazy import lazy_exports
 
 _EXPORTS = {
+    "TableScene": "table_scene",
+    "render_table_snapshot": "snapshot",
     "Exaggeration": "scene",
     "SetupScene": "scene",
     "render_snapshot": "snapshot",

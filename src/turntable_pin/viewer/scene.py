@@ -295,11 +295,14 @@ def default_positions_deg() -> np.ndarray:
 
 def animation_frames_rad(positions_deg, frames_per_move: int = 12) -> np.ndarray:
     """Frames (phi1, phi2) in radians moving linearly through ``positions_deg`` (N, 2) and back
-    to the first, ``frames_per_move`` frames per move: shape (N * frames_per_move, 2)."""
-    positions = np.radians(np.asarray(positions_deg, dtype=float).reshape(-1, 2))
+    to the first, ``frames_per_move`` frames per move: shape (N * frames_per_move, 2). Any table:
+    ``positions_deg`` (N, J) of J joint angles gives frames (N * frames_per_move, J)."""
+    positions = np.asarray(positions_deg, dtype=float)
+    width = positions.shape[1] if positions.ndim == 2 else 2
+    positions = np.radians(positions.reshape(-1, width))
     if frames_per_move < 1:
         raise InputError(f"frames per move must be >= 1, got {frames_per_move}")
     targets = np.roll(positions, -1, axis=0)
     t = np.arange(frames_per_move)[:, None] / frames_per_move
     frames = positions[:, None, :] + t[None] * (targets - positions)[:, None, :]
-    return frames.reshape(-1, 2)
+    return frames.reshape(-1, width)

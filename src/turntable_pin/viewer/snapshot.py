@@ -27,8 +27,10 @@ __all__ = [
     "MAX_SIZE_PX",
     "MIN_SIZE_PX",
     "SnapshotResult",
+    "TableSnapshotResult",
     "decorate_static_page",
     "render_snapshot",
+    "render_table_snapshot",
     "scene_page",
 ]
 
@@ -91,16 +93,18 @@ def decorate_static_page(page: str, legend: list[str] | None = None) -> str:
 
 
 def scene_page(
-    scene: SetupScene, phi1_rad: float, phi2_rad: float, legend: bool = True
+    scene: SetupScene, phi1_rad: float, *more_angles_rad: float, legend: bool = True
 ) -> tuple[str, int]:
-    """The decorated static HTML page of ``scene`` at (phi1, phi2), and the pid of the (now
-    stopped) meshcat server that made it."""
+    """The decorated static HTML page of ``scene`` at (phi1, phi2) (a
+    :class:`~turntable_pin.viewer.table_scene.TableScene`: at its joint angles, one per joint),
+    and the pid of the (now stopped) meshcat server that made it."""
+    angles = (phi1_rad, *more_angles_rad)
     with MeshcatServer() as server:
         scene.draw(server.visualizer)
-        scene.set_position(phi1_rad, phi2_rad)
+        scene.set_position(*angles)
         page = server.visualizer.static_html()
         pid = server.pid
-    return decorate_static_page(page, scene.legend(phi1_rad, phi2_rad) if legend else None), pid
+    return decorate_static_page(page, scene.legend(*angles) if legend else None), pid
 
 
 def _check_size(name: str, value: int) -> int:
@@ -109,6 +113,31 @@ def _check_size(name: str, value: int) -> int:
             f"{name} must be between {MIN_SIZE_PX} and {MAX_SIZE_PX} pixels, got {value}"
         )
     return int(value)
+
+
+def _render(scene, angles_rad, output, width, height, legend, timeout_s):
+    """Render ``scene`` at ``angles_rad`` to the PNG ``output``: (output, width, height, scene
+    seconds, server pid, browser run)."""
+    width, height = _check_size("width", width), _check_size("height", height)
+    output = Path(output)
+    if output.suffix.lower() != ".png":
+        raise InputError(
+            "the snapshot is a PNG image: give an output name ending in .png", path=output
+        )
+    # Fail on a missing browser or meshcat before starting anything.
+    chromium = find_chromium()
+    import_meshcat()
+    start = time.perf_counter()
+    page, server_pid = scene_page(scene, *angles_rad, legend=legend)
+    scene_seconds = time.perf_counter() - start
+    with temporary_folder("turntable-pin-scene-") as tmp:
+        page_path = tmp / "scene.html"
+        page_path.write_text(page, encoding="utf-8")
+        data, run = screenshot_html(
+            page_path, width=width, height=height, timeout_s=timeout_s, chromium=chromium
+        )
+    write_bytes_atomic(output, data)
+    return output, width, height, scene_seconds, server_pid, run
 
 
 def render_snapshot(
@@ -129,31 +158,75 @@ def render_snapshot(
         BrowserNotFoundError: no Chromium (names the Debian package ``chromium``).
         BrowserError: Chromium failed or timed out.
     """
-    width, height = _check_size("width", width), _check_size("height", height)
-    output = Path(output)
-    if output.suffix.lower() != ".png":
-        raise InputError(
-            "the snapshot is a PNG image: give an output name ending in .png", path=output
-        )
-    # Fail on a missing browser or meshcat before starting anything.
-    chromium = find_chromium()
-    import_meshcat()
-    start = time.perf_counter()
-    page, server_pid = scene_page(scene, phi1_rad, phi2_rad, legend=legend)
-    scene_seconds = time.perf_counter() - start
-    with temporary_folder("turntable-pin-scene-") as tmp:
-        page_path = tmp / "scene.html"
-        page_path.write_text(page, encoding="utf-8")
-        data, run = screenshot_html(
-            page_path, width=width, height=height, timeout_s=timeout_s, chromium=chromium
-        )
-    write_bytes_atomic(output, data)
+    output, width, height, scene_seconds, server_pid, run = _render(
+        scene, (phi1_rad, phi2_rad), output, width, height, legend, timeout_s
+    )
     return SnapshotResult(
         path=output,
         width=width,
         height=height,
         phi1_deg=round(float(phi1_rad) * DEG_PER_RAD, 9),
         phi2_deg=round(float(phi2_rad) * DEG_PER_RAD, 9),
+        exaggeration=scene.exaggeration.to_dict(),
+        scene_seconds=scene_seconds,
+        browser_seconds=run.seconds,
+        server_pid=server_pid,
+        browser_pid=run.pid,
+    )
+
+
+@dataclass(frozen=True)
+class TableSnapshotResult:
+    """A written snapshot of any table: path, size (px), joint angles (deg), magnification,
+    timings (s), pids."""
+
+    path: Path
+    width: int
+    height: int
+    angles_deg: dict
+    exaggeration: dict
+    scene_seconds: float
+    browser_seconds: float
+    server_pid: int
+    browser_pid: int
+
+    def to_dict(self) -> dict:
+        """The result as a JSON-ready dict (sizes in px, angles in deg, times in s; no pids)."""
+        return {
+            "path": str(self.path),
+            "width_px": self.width,
+            "height_px": self.height,
+            "angles_deg": dict(self.angles_deg),
+            "exaggeration": self.exaggeration,
+            "scene_seconds": self.scene_seconds,
+            "browser_seconds": self.browser_seconds,
+        }
+
+
+def render_table_snapshot(
+    scene,
+    angles_rad,
+    output: str | Path,
+    *,
+    width: int = 800,
+    height: int = 600,
+    legend: bool = True,
+    timeout_s: float = 60.0,
+) -> TableSnapshotResult:
+    """Render a :class:`~turntable_pin.viewer.table_scene.TableScene` at its joint angles
+    (radians, chain order) to the PNG file ``output``; raises as :func:`render_snapshot`."""
+    angles = tuple(float(a) for a in angles_rad)
+    output, width, height, scene_seconds, server_pid, run = _render(
+        scene, angles, output, width, height, legend, timeout_s
+    )
+    return TableSnapshotResult(
+        path=output,
+        width=width,
+        height=height,
+        angles_deg={
+            j: round(a * DEG_PER_RAD, 9)
+            for j, a in zip(scene.table.joint_names, angles, strict=True)
+        },
         exaggeration=scene.exaggeration.to_dict(),
         scene_seconds=scene_seconds,
         browser_seconds=run.seconds,
