@@ -173,18 +173,6 @@ def add_error_options(parser: argparse.ArgumentParser) -> None:
     add_table_options(parser)
 
 
-def add_table_options(parser: argparse.ArgumentParser) -> None:
-    """``--urdf FILE`` and ``--payload-frame NAME``: which turntable (default: the paper's)."""
-    parser.add_argument(
-        "--urdf", type=Path, metavar="FILE.urdf", help="nominal turntable URDF (default: bundled)"
-    )
-    parser.add_argument(
-        "--payload-frame",
-        metavar="NAME",
-        help="the payload frame of the URDF (default: the only leaf of its chain)",
-    )
-
-
 def table_from_args(args: argparse.Namespace):
     """The table of ``--urdf``/``--payload-frame`` for the measurement layer: ``None`` (the
     bundled paper table), a ``TurntableModel`` (a URDF with the paper's joints: the paper's
