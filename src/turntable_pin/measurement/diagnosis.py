@@ -8,7 +8,12 @@ Probes of the structure search (what "shape" the missing part has):
 - ``<angle> k/rev in <phi>``: a harmonic added directly to ``dpsi``, ``dtheta`` or ``dgamma``;
 - ``<angle> k/rev in phi1+phi2`` / ``phi1-phi2`` (k = 1, 2): shapes that couple the two angles;
 - ``<angle> drift in time`` (with ``time_s``): a quadratic in time;
-- ``<angle> with dir1`` / ``dir2``: a step with the approach direction.
+- ``<angle> with dir1`` / ``dir2``: a step with the approach direction;
+- ``<error> in <column>``, ``<angle> in <column>``: linear and quadratic in another numeric column.
+
+Each probe carries its ``effect_spec``: the inline term (:mod:`.effect_terms`) that adds exactly
+that shape to the model with ``fit --effects`` (``dphi_z2~h3(phi2)``, ``dpsi~h1(phi1+phi2)``,
+``dtheta~poly2(time_s)``, ``dgamma~sign(dir1)``, ``dphi_y1~poly2(temperature_c)``).
 """
 
 from __future__ import annotations
@@ -136,8 +141,11 @@ class OrientationFamily:
         cols = cols.reshape(-1, cols.shape[-1])
         return cols if self._mask.all() else cols[self._mask]
 
-    def _measured_angle_probes(self, trig: np.ndarray, shape: str, w: np.ndarray) -> list[Probe]:
-        """One probe per measured angle: the columns ``trig`` (N, g) added to that angle."""
+    def _measured_angle_probes(
+        self, trig: np.ndarray, shape: str, w: np.ndarray, spec: str = ""
+    ) -> list[Probe]:
+        """One probe per measured angle: the columns ``trig`` (N, g) added to that angle;
+        ``spec`` is the shape of its ``effect_spec`` (``h3(phi1)``)."""
         probes = []
         for a, angle in enumerate(ANGLE_NAMES):
             if not self.data.measured[:, a].any():
@@ -155,11 +163,12 @@ class OrientationFamily:
                     columns,
                     ARCSEC_PER_RAD,
                     "arcsec",
+                    effect_spec=f"{angle}~{spec}" if spec else None,
                 )
             )
         return probes
 
-    def _error_probes(self, jac, w, trig, shape: str, what: str) -> list[Probe]:
+    def _error_probes(self, jac, w, trig, shape: str, what: str, spec: str = "") -> list[Probe]:
         """One probe per base error: its derivative times the columns ``trig`` (N, g)."""
         probes = []
         for e, name in enumerate(self.table.base_names):
@@ -174,6 +183,7 @@ class OrientationFamily:
                     columns,
                     ARCSEC_PER_RAD,
                     "arcsec",
+                    effect_spec=f"{name}~{spec}" if spec else None,
                 )
             )
         return probes
@@ -189,8 +199,8 @@ class OrientationFamily:
             for k in range(1, _max_order(phi) + 1):
                 trig = np.stack([np.cos(k * phi), np.sin(k * phi)], axis=-1)  # (N, 2)
                 probes += self._error_probes(jac, w, trig, f"{k}/rev in {var}",
-                                             f"{k}/rev term in {var}")  # fmt: skip
-                probes += self._measured_angle_probes(trig, f"{k}/rev in {var}", w)
+                                             f"{k}/rev term in {var}", f"h{k}({var})")  # fmt: skip
+                probes += self._measured_angle_probes(trig, f"{k}/rev in {var}", w, f"h{k}({var})")
         # Terms coupling two angles (k/rev in phiA + phiB or phiA - phiB) on each angle: the
         # shapes above are separable in the angles and would miss them.
         for i in range(data.n_joints):
@@ -200,17 +210,19 @@ class OrientationFamily:
                     label = f"{labels[i]}{sign}{labels[j]}"
                     for k in range(1, min(2, _max_order(combined)) + 1):
                         trig = np.stack([np.cos(k * combined), np.sin(k * combined)], axis=-1)
-                        probes += self._measured_angle_probes(trig, f"{k}/rev in {label}", w)
+                        probes += self._measured_angle_probes(
+                            trig, f"{k}/rev in {label}", w, f"h{k}({label})"
+                        )
         extra = []
         if data.time_s is not None and np.ptp(data.time_s) > 0:
             t = (data.time_s - data.time_s.min()) / np.ptp(data.time_s)
             extra.append(("drift in time", "a drift with time (quadratic over the run)",
-                          np.stack([t, t**2], axis=1)))  # fmt: skip
+                          np.stack([t, t**2], axis=1), "poly2(time_s)"))  # fmt: skip
         for k, value in enumerate(data.dirs, start=1):
             if value is not None:
                 extra.append((f"with dir{k}", f"a step with the approach direction dir{k}",
-                              value[:, None]))  # fmt: skip
-        for label, text, columns in extra:
+                              value[:, None], f"sign(dir{k})"))  # fmt: skip
+        for label, text, columns, spec in extra:
             for a, angle in enumerate(ANGLE_NAMES):
                 if not data.measured[:, a].any():
                     continue
@@ -221,7 +233,7 @@ class OrientationFamily:
                     return self._observations(cols)
 
                 probes.append(Probe(f"{angle} {label}", f"{text} in {angle}", matrix,
-                                    ARCSEC_PER_RAD, "arcsec"))  # fmt: skip
+                                    ARCSEC_PER_RAD, "arcsec", f"{angle}~{spec}"))  # fmt: skip
         # Other numeric columns (temperature, load, ...) as suspects: each base error and each
         # measured angle linear and quadratic in the column.
         for column, values in data.extra.items():
@@ -231,8 +243,9 @@ class OrientationFamily:
             c = (values - values.min()) / span
             trig = np.stack([c, c**2], axis=1)
             probes += self._error_probes(jac, w, trig, f"in {column}",
-                                         f"term linear and quadratic in {column}")  # fmt: skip
-            probes += self._measured_angle_probes(trig, f"in {column}", w)
+                                         f"term linear and quadratic in {column}",
+                                         f"poly2({column})")  # fmt: skip
+            probes += self._measured_angle_probes(trig, f"in {column}", w, f"poly2({column})")
         return probes
 
     def _dense_variables(self) -> PositionVariables:

@@ -53,6 +53,8 @@ class Probe:
             so its memory stays that of a few columns however many probes there are.
         unit_scale: user units per internal unit of the probe's coefficients (for amplitudes).
         unit: the user unit of the coefficients.
+        effect_spec: how the model family's users add this shape to their model (a text the
+            family defines), or ``None``.
     """
 
     name: str
@@ -60,6 +62,7 @@ class Probe:
     columns: np.ndarray | Callable[[], np.ndarray]
     unit_scale: float = 1.0
     unit: str = ""
+    effect_spec: str | None = None
 
     def matrix(self) -> np.ndarray:
         """The (m, g) columns (computed now when they were given as a function)."""
@@ -76,6 +79,7 @@ class FoundTerm:
     amplitude: float
     unit: str
     coefficients: tuple[float, ...]
+    effect_spec: str | None = None
 
     def to_dict(self) -> dict:
         """The term as a JSON-ready dictionary."""
@@ -86,6 +90,7 @@ class FoundTerm:
             "amplitude": self.amplitude,
             "unit": self.unit,
             "coefficients": list(self.coefficients),
+            "effect_spec": self.effect_spec,
         }
 
 
@@ -163,6 +168,7 @@ def search_structure(
                 amplitude=float(np.linalg.norm(coef)),
                 unit=probe.unit,
                 coefficients=tuple(float(c) for c in coef),
+                effect_spec=probe.effect_spec,
             )
         )
         r = r - basis @ (basis.T @ r)
