@@ -90,7 +90,8 @@ class EffectTerm:
         p, v = self.prefix, self.variable
         what = self.site
         if self.shape == "sign":
-            return (ParameterSpec(f"{p}b", "arcsec", ARCSEC, f"{what}: step with {v}"),)
+            return (ParameterSpec(f"{p}b", "arcsec", ARCSEC, f"{what}: coefficient of {v} "
+                                  "(+1/-1)"),)  # fmt: skip
         if self.shape == "polynomial":
             return tuple(
                 ParameterSpec(f"{p}p{k}", f"arcsec/{v}" + (f"^{k}" if k > 1 else ""), ARCSEC,
@@ -100,8 +101,9 @@ class EffectTerm:
         out = []
         for k in self.orders:
             times = "" if k == 1 else f"{k} "
-            out.append(ParameterSpec(f"{p}c{k}", "arcsec", ARCSEC, f"{what}: cos({times}{v})"))
-            out.append(ParameterSpec(f"{p}s{k}", "arcsec", ARCSEC, f"{what}: sin({times}{v})"))
+            for name, fn in ((f"{p}c{k}", "cos"), (f"{p}s{k}", "sin")):
+                text = f"{what}: {fn}({times}{v}) coefficient"
+                out.append(ParameterSpec(name, "arcsec", ARCSEC, text))
         return tuple(out)
 
     def definition(self) -> str:

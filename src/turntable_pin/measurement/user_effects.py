@@ -28,6 +28,7 @@ __all__ = [
     "EFFECT_FILE_KEYS",
     "TERM_KEYS",
     "check_user_effects",
+    "describe_effects",
     "inline_effect",
     "installed_effects",
     "load_catalogue",
@@ -358,3 +359,29 @@ def resolve_effects(
                 raise InputError(f"effect '{effect.name}' is listed twice in --effects")
             out.append(effect)
     return tuple(out)
+
+
+def describe_effects(effects: Sequence[Effect], turntable=None) -> list[dict]:
+    """Each effect's story with its parameters (``name, unit, description``) on a data set that
+    has every column it needs, and where it comes from (``catalogue`` or its file)."""
+    import numpy as np
+
+    from .effects.base import PositionVariables
+    from .table import measured_table
+
+    table = measured_table(turntable)
+    j = table.n_joints
+    columns = {c for e in effects for c in e.required_columns}
+    extra = {c: np.zeros(1) for c in columns
+             if c != "time_s" and not re.match(r"^(dir|phi)\d+$", c)}  # fmt: skip
+    variables = PositionVariables(np.zeros((1, j)), np.zeros(1), (np.ones(1),) * j, extra)
+    out = []
+    for effect in effects:
+        entry = effect.describe()
+        entry["source"] = getattr(effect, "source", "") or "catalogue"
+        entry["parameters"] = [
+            {"name": p.name, "unit": p.unit, "description": p.description}
+            for p in effect.parameters(variables)
+        ]
+        out.append(entry)
+    return out

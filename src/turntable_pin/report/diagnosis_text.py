@@ -7,7 +7,7 @@ part, which the HTML report shows in its verdict box.
 
 from __future__ import annotations
 
-__all__ = ["diagnosis_lines", "header_lines", "verdict_lines"]
+__all__ = ["diagnosis_lines", "fit_command", "header_lines", "verdict_lines"]
 
 
 def header_lines(d: dict) -> list[str]:
@@ -44,8 +44,9 @@ def header_lines(d: dict) -> list[str]:
     return lines
 
 
-def verdict_lines(d: dict) -> list[str]:
-    """The steps of the forward selection, the missing effect and whether anything remains."""
+def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
+    """The steps of the forward selection, the missing effect and whether anything remains;
+    for each remaining term, the ``fit`` command (on the file ``data``) that adds it."""
     verdict = d["verdict"]
     lines = []
     if d["steps"]:
@@ -93,11 +94,21 @@ def verdict_lines(d: dict) -> list[str]:
                 "missing effect is not a harmonic one"
             )
         lines.append("unexplained: yes, " + "; ".join(why))
+        specs = [t["effect_spec"] for t in structure if t.get("effect_spec")]
+        if specs:
+            lines.append("  to add what remains: " + fit_command(data, specs))
     else:
         lines.append("unexplained: no (the residuals are consistent with the noise)")
     return lines
 
 
-def diagnosis_lines(d: dict) -> list[str]:
+def fit_command(data: str, specs: list[str]) -> str:
+    """The ``turntable-pin fit`` command that adds the inline terms ``specs`` to the model."""
+    import shlex
+
+    return f"turntable-pin fit {shlex.quote(data)} --effects {shlex.quote(','.join(specs))}"
+
+
+def diagnosis_lines(d: dict, data: str = "DATA.csv") -> list[str]:
     """The whole diagnosis in words: :func:`header_lines` then :func:`verdict_lines`."""
-    return header_lines(d) + verdict_lines(d)
+    return header_lines(d) + verdict_lines(d, data)
