@@ -96,7 +96,8 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
         lines.append("unexplained: yes, " + "; ".join(why))
         specs = [t["effect_spec"] for t in structure if t.get("effect_spec")]
         if specs:
-            lines.append("  to add what remains: " + fit_command(data, specs))
+            effects = [*d.get("best", {}).get("effects", []), *specs]
+            lines.append("  fit with what remains: " + fit_command(data, effects))
     else:
         lines.append("unexplained: no (the residuals are consistent with the noise)")
     return lines
