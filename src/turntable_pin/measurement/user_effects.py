@@ -348,12 +348,15 @@ def resolve_effects(
             else:
                 try:
                     effect = resolve_effect(item, turntable, extra)
-                except InputError:
+                except InputError as exc:
                     if installed is None:  # installed plug-ins are loaded only when needed
                         installed = installed_effects()
                     found = [e for e in installed if e.name == item]
                     if not found:
-                        raise
+                        raise InputError(
+                            f"{exc.detail}; or give an effect file (.yaml) or an inline term "
+                            "such as dphi_z2~h3(phi2)"
+                        ) from None
                     effect = found[0]
             if any(e.name == effect.name for e in out):
                 raise InputError(f"effect '{effect.name}' is listed twice in --effects")
