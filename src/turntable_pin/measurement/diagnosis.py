@@ -233,7 +233,8 @@ class OrientationFamily:
                     return self._observations(cols)
 
                 probes.append(Probe(f"{angle} {label}", f"{text} in {angle}", matrix,
-                                    ARCSEC_PER_RAD, "arcsec", f"{angle}~{spec}"))  # fmt: skip
+                                    ARCSEC_PER_RAD, "arcsec",
+                                    effect_spec=f"{angle}~{spec}"))  # fmt: skip
         # Other numeric columns (temperature, load, ...) as suspects: each base error and each
         # measured angle linear and quadratic in the column.
         for column, values in data.extra.items():

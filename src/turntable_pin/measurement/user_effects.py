@@ -284,6 +284,12 @@ def installed_effects() -> tuple[Effect, ...]:
         found = _effects_in(objects, where)
         if not found:
             raise InputError(f"{where}: holds no Effect subclass or instance")
+        for effect in found:
+            if not getattr(effect, "source", ""):
+                try:
+                    effect.source = f"entry point {ep.name}"
+                except AttributeError:  # a read-only object: listed without its source
+                    pass
         out += found
     return tuple(out)
 
