@@ -84,7 +84,7 @@ def test_the_planted_term_is_found_and_its_projection_shows_it(planted):
     assert np.hypot(*coef) == pytest.approx(term.amplitude, rel=1e-6)
     # the per-observation data stay out of the JSON
     assert set(term.to_dict()) == {
-        "term", "description", "delta_bic", "amplitude", "unit", "coefficients"
+        "term", "description", "delta_bic", "amplitude", "unit", "coefficients", "effect_spec"
     }  # fmt: skip
 
 

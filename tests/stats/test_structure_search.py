@@ -112,7 +112,7 @@ def test_a_found_term_keeps_what_its_plot_needs_and_projects_back_to_its_shape()
         assert np.allclose(pr.fitted, 10.0 * (0.8 * np.cos(3 * x) - 0.5 * np.sin(3 * x)),
                            atol=1.0)  # fmt: skip
         assert set(term.to_dict()) == {
-            "term", "description", "delta_bic", "amplitude", "unit", "coefficients"
+            "term", "description", "delta_bic", "amplitude", "unit", "coefficients", "effect_spec"
         }  # fmt: skip
 
 

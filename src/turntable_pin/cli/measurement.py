@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..core.exceptions import InputError
 from ..measurement.data import MAX_TIME_S, MIN_SIGMA_ARCSEC, read_measurements
-from ..measurement.effects import EFFECT_NAMES, parse_effect_list, parse_effect_spec
+from ..measurement.effects import EFFECT_NAMES, parse_effect_spec
 from .common import (
     add_error_options,
     add_table_options,
@@ -49,6 +49,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="a hidden effect and its parameters in user units (arcsec, arcsec/g, arcsec/h), "
         "e.g. inner_encoder_harmonics:c1=3,s2=-2; repeatable",
     )
+    _add_catalogue_option(s)
     step = bounded_float(0.0, 360.0, "deg", low_open=True)
     s.add_argument("--noise-arcsec", type=_noise_arcsec, default=1.0, help="1-sigma noise")
     s.add_argument("--seed", type=seed, default=0, help="random seed (recorded in the file)")
@@ -81,7 +82,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     one_line_errors(f)
     _add_data_options(f)
-    f.add_argument("--effects", default="", metavar="A,B", help="effects to add to the base")
+    f.add_argument("--effects", action="append", default=[], metavar="A,B",
+                   help="effects to add to the base: catalogue names, effect files (.yaml) and "
+                   "inline terms (dphi_z2~h3(phi2), dpsi~poly1(temperature_c), "
+                   "dphi_y1~sign(dir1)); comma-separated, repeatable")  # fmt: skip
+    f.add_argument("--effects-module", action="append", default=[], type=Path, metavar="FILE.py",
+                   help="a Python file defining Effect subclasses; their names join --effects")
     f.add_argument(
         "--write-urdf",
         type=Path,
@@ -103,6 +109,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     _add_data_options(d)
     d.add_argument("--until-explained", action="store_true", help="add effects while significant")
     d.add_argument("--plots", type=Path, metavar="DIR", help="write residual plots (PNG) here")
+    _add_catalogue_option(d)
     d.set_defaults(func=run_diagnose)
 
     r = subparsers.add_parser(
@@ -116,6 +123,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     r.add_argument("--ignore-sigma", action="store_true")
     r.add_argument("--until-explained", action="store_true")
     r.add_argument("-o", "--output", type=Path, required=True, metavar="report.html")
+    _add_catalogue_option(r)
     r.set_defaults(func=run_report)
 
 
@@ -124,6 +132,22 @@ def _noise_arcsec(text: str) -> float:
     from ..measurement.simulation import MAX_NOISE_ARCSEC
 
     return bounded_float(MIN_SIGMA_ARCSEC, MAX_NOISE_ARCSEC, "arcsec")(text)
+
+
+def _add_catalogue_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--catalogue", action="append", default=[], type=Path, metavar="FILE",
+                   help="your effects (a .yaml effect file or a .py module) join the candidates; "
+                   "repeatable")  # fmt: skip
+
+
+def _user_catalogue(args: argparse.Namespace, table=None):
+    """The table's catalogue plus the effects of ``--catalogue`` (and installed ones), or
+    ``None`` when there are none besides the catalogue."""
+    from ..measurement.catalogue import catalogue
+    from ..measurement.user_effects import load_catalogue
+
+    user = load_catalogue(args.catalogue, table)
+    return (*catalogue(table), *user) if user else None
 
 
 def _add_data_options(p: argparse.ArgumentParser) -> None:
@@ -145,14 +169,17 @@ def _read(args: argparse.Namespace, table=None):
     return data.without_sigma() if args.ignore_sigma else data
 
 
-def _parse_effect_options(texts: list[str], table=None) -> dict[str, dict[str, float]]:
-    """The ``--effect`` options as ``{effect: {parameter: value}}``; each effect at most once."""
-    from ..measurement.catalogue import resolve_effect
+def _parse_effect_options(texts: list[str], table=None, user=()) -> dict[str, dict[str, float]]:
+    """The ``--effect`` options as ``{effect: {parameter: value}}``; each effect at most once.
+    Names may be the table's catalogue's, of the effects ``user`` or inline terms."""
+    from ..measurement.user_effects import resolve_effects
 
     effects: dict[str, dict[str, float]] = {}
     for text in texts:
         try:
-            name, params = parse_effect_spec(text, lambda n: resolve_effect(n, table))
+            name, params = parse_effect_spec(
+                text, lambda n: resolve_effects([n], table, user)[0]
+            )
         except InputError as exc:
             raise InputError(f"--effect '{text}': {exc}") from None
         if name in effects:
@@ -163,10 +190,13 @@ def _parse_effect_options(texts: list[str], table=None) -> dict[str, dict[str, f
 
 def run_simulate(args: argparse.Namespace) -> int:
     from ..measurement.simulation import Schedule, simulate_measurements
+    from ..measurement.user_effects import inline_effect, load_catalogue
 
     table = table_from_args(args)
     generic = hasattr(table, "identifiable")
-    effects = _parse_effect_options(args.effect, table)
+    user = load_catalogue(args.catalogue, table)
+    effects = _parse_effect_options(args.effect, table, user)
+    user = (*user, *(inline_effect(name, table) for name in effects if "~" in name))
     schedule = Schedule(
         phi1_step_deg=args.phi1_step_deg,
         phi2_step_deg=args.phi2_step_deg,
@@ -189,6 +219,7 @@ def run_simulate(args: argparse.Namespace) -> int:
         noise_arcsec=args.noise_arcsec,
         seed=args.seed,
         turntable=table,
+        catalogue=user,
     )
     path = sim.write_csv(args.output, with_sigma=not args.no_sigma, hide_truth=args.hide_truth)
     print(f"wrote {path}: {sim.data.n_positions} positions, seed {sim.seed}")
@@ -205,14 +236,15 @@ def _fit_line(label: str, summary: dict) -> str:
 
 
 def run_fit(args: argparse.Namespace) -> int:
-    from ..measurement.catalogue import resolve_effect
     from ..measurement.fit import fit_orientation
     from ..measurement.residuals import analyse_residuals, orientation_residuals
+    from ..measurement.user_effects import load_effects_module, resolve_effects
     from ..report.measurement_figures import write_residual_plots
 
     table = table_from_args(args)
     data = _read(args, table)
-    effects = parse_effect_list(args.effects, lambda n: resolve_effect(n, table))
+    modules = [e for path in args.effects_module for e in load_effects_module(path)]
+    effects = resolve_effects(args.effects, table, modules)
     after = fit_orientation(data, effects, turntable=table)
     before = fit_orientation(data, turntable=table) if effects else after
     # With sigma estimated, both fits are judged with the noise of the fuller model.
@@ -271,7 +303,9 @@ def run_diagnose(args: argparse.Namespace) -> int:
 
     table = table_from_args(args)
     data = _read(args, table)
-    diagnosis = diagnose_measurements(data, until_explained=args.until_explained, turntable=table)
+    diagnosis = diagnose_measurements(data, until_explained=args.until_explained,
+                                      catalogue=_user_catalogue(args, table),
+                                      turntable=table)  # fmt: skip
     out = diagnosis.to_dict()
     if args.plots:
         base = diagnosis.base_fit.with_noise_variance(diagnosis.noise_variance)
@@ -283,7 +317,7 @@ def run_diagnose(args: argparse.Namespace) -> int:
     if args.json:
         print_json(out)
         return 0
-    print("\n".join(diagnosis_lines(out)))
+    print("\n".join(diagnosis_lines(out, data=str(args.data))))
     for p in out.get("plots", []):
         print(f"wrote {p}")
     return 0
@@ -295,7 +329,9 @@ def run_report(args: argparse.Namespace) -> int:
 
     table = table_from_args(args)
     data = _read(args, table)
-    diagnosis = diagnose_measurements(data, until_explained=args.until_explained, turntable=table)
+    diagnosis = diagnose_measurements(data, until_explained=args.until_explained,
+                                      catalogue=_user_catalogue(args, table),
+                                      turntable=table)  # fmt: skip
     path = write_report(diagnosis, args.output, title=f"Diagnosis of {args.data.name}")
     print(f"wrote {path}")
     return 0

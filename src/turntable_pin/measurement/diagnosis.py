@@ -178,9 +178,10 @@ class OrientationFamily:
             "full turn of every axis"
         ]
 
-    def _probe(self, name: str, description: str, factors: ProbeFactors) -> Probe:
+    def _probe(self, name: str, description: str, factors: ProbeFactors, spec: str) -> Probe:
         """A probe whose columns are ``factors``' direction (N, 3) times its functions (N, g),
-        as rows of the measured observations."""
+        as rows of the measured observations; ``spec``: its ``effect_spec`` (what ``fit
+        --effects`` takes to add it)."""
         mask = self._mask
 
         def columns():
@@ -191,11 +192,16 @@ class OrientationFamily:
             cols = cols.reshape(-1, cols.shape[-1])
             return cols if mask.all() else cols[mask]
 
-        return Probe(name, description, columns, ARCSEC_PER_RAD, "arcsec", factors)
+        return Probe(
+            name, description, columns, ARCSEC_PER_RAD, "arcsec", factors, effect_spec=spec
+        )
 
-    def _measured_angle_probes(self, shape: str, text: str, plot: tuple, w) -> list[Probe]:
+    def _measured_angle_probes(
+        self, shape: str, text: str, plot: tuple, w, spec: str
+    ) -> list[Probe]:
         """One probe per measured angle: the shape ``plot`` (variable, values, functions, value
-        scale, unit) added to that angle itself; ``text`` describes it (``{angle}``: the angle)."""
+        scale, unit) added to that angle itself; ``text`` describes it (``{angle}``: the angle),
+        ``spec`` is the shape part of its ``effect_spec`` (``h3(phi1)``)."""
         probes = []
         var, values, functions, scale, unit = plot
         for a, angle in enumerate(ANGLE_NAMES):
@@ -204,10 +210,14 @@ class OrientationFamily:
             factors = ProbeFactors(
                 var, values, functions, _one_angle(w, a), scale, unit, self._observed
             )
-            probes.append(self._probe(f"{angle} {shape}", text.format(angle=angle), factors))
+            probes.append(
+                self._probe(
+                    f"{angle} {shape}", text.format(angle=angle), factors, f"{angle}~{spec}"
+                )
+            )
         return probes
 
-    def _error_probes(self, jac, w, shape: str, text: str, plot: tuple) -> list[Probe]:
+    def _error_probes(self, jac, w, shape: str, text: str, plot: tuple, spec: str) -> list[Probe]:
         """One probe per base error: its derivative (the direction it enters the angles) times
         the shape ``plot`` (variable, values, functions, value scale, unit)."""
         probes = []
@@ -219,7 +229,7 @@ class OrientationFamily:
 
             factors = ProbeFactors(var, values, functions, direction, scale, unit, self._observed)
             description = f"a {text} of {name} ({self.table.descriptions.get(name, name)})"
-            probes.append(self._probe(f"{name} {shape}", description, factors))
+            probes.append(self._probe(f"{name} {shape}", description, factors, f"{name}~{spec}"))
         return probes
 
     def probes(self, fit: OrientationFit) -> list[Probe]:
@@ -233,9 +243,10 @@ class OrientationFamily:
             for k in range(1, _max_order(phi) + 1):
                 plot = (var, phi, _harmonic(k), DEG_PER_RAD, "deg")
                 shape = f"{k}/rev in {var}"
-                probes += self._error_probes(jac, w, shape, f"{k}/rev term in {var}", plot)
+                spec = f"h{k}({var})"
+                probes += self._error_probes(jac, w, shape, f"{k}/rev term in {var}", plot, spec)
                 probes += self._measured_angle_probes(
-                    shape, f"a {k}/rev term in {var} of {{angle}} itself", plot, w
+                    shape, f"a {k}/rev term in {var} of {{angle}} itself", plot, w, spec
                 )
         # Terms coupling two angles (k/rev in phiA + phiB or phiA - phiB) on each angle: the
         # shapes above are separable in the angles and would miss them.
@@ -251,11 +262,16 @@ class OrientationFamily:
                             f"a {k}/rev term in {label} of {{angle}} itself",
                             plot,
                             w,
+                            f"h{k}({label})",
                         )
         if data.time_s is not None and np.ptp(data.time_s) > 0:
             plot = ("time_s", data.time_s, _polynomial(data.time_s), 1.0, "s")
             probes += self._measured_angle_probes(
-                "drift in time", "a drift with time (quadratic over the run) in {angle}", plot, w
+                "drift in time",
+                "a drift with time (quadratic over the run) in {angle}",
+                plot,
+                w,
+                "poly2(time_s)",
             )
         for k, value in enumerate(data.dirs, start=1):
             if value is not None:
@@ -265,6 +281,7 @@ class OrientationFamily:
                     f"a step with the approach direction dir{k} in {{angle}}",
                     plot,
                     w,
+                    f"sign(dir{k})",
                 )
         # Other numeric columns (temperature, load, ...) as suspects: each base error and each
         # measured angle linear and quadratic in the column.
@@ -273,8 +290,11 @@ class OrientationFamily:
                 continue
             plot = (column, values, _polynomial(values), 1.0, "")
             text = f"term linear and quadratic in {column}"
-            probes += self._error_probes(jac, w, f"in {column}", text, plot)
-            probes += self._measured_angle_probes(f"in {column}", f"a {text} of {{angle}}", plot, w)
+            spec = f"poly2({column})"
+            probes += self._error_probes(jac, w, f"in {column}", text, plot, spec)
+            probes += self._measured_angle_probes(
+                f"in {column}", f"a {text} of {{angle}}", plot, w, spec
+            )
         return probes
 
     def _dense_variables(self) -> PositionVariables:

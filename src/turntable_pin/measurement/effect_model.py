@@ -2,11 +2,11 @@
 
 The chain is the turntable's :class:`~turntable_pin.model.chain.ErrorChain` (nominal placements,
 joint axes, error factors), the same object Pinocchio evaluation and :class:`OrientationErrorField`
-read. Effects (:mod:`turntable_pin.measurement.effects`) add to the error angles per position or
-insert rotations before or after ``Rt``. Every parametrised factor is a rotation about a
-coordinate axis by an angle *linear* in the parameters, so the Jacobian is exact and cheap: for
-``Rt = A R_a(theta) B``, ``dRt/dtheta = A R_a(theta) [e_a]x B``, composed from prefix and
-suffix products.
+read. Effects (:mod:`turntable_pin.measurement.effects`) add to the error angles per position,
+insert rotations before or after ``Rt``, or add to a measured angle itself. Every parametrised
+factor is a rotation about a coordinate axis by an angle *linear* in the parameters, so the
+Jacobian is exact and cheap: for ``Rt = A R_a(theta) B``, ``dRt/dtheta = A R_a(theta) [e_a]x B``,
+composed from prefix and suffix products.
 
 Parameters (internal units): the table's base errors (rad; the paper's table: the eight angular
 errors in :data:`ANGULAR_ERROR_NAMES` order), then each effect's parameters as
@@ -24,10 +24,10 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.rotations import AXIS_INDEX, axis_rotation
 from ..core.units import ARCSEC_PER_RAD
-from ..model.angles import ANGLE_ENTRIES
+from ..model.angles import ANGLE_ENTRIES, ANGLE_NAMES
 from ..model.chain import ROTATION, skew
 from ..model.errors import ANGULAR_ERROR_NAMES
-from .effects.base import POST, PRE, Effect, ParameterSpec, PositionVariables
+from .effects.base import MEASURED, POST, PRE, Effect, ParameterSpec, PositionVariables
 from .table import MeasuredTable, measured_table
 
 __all__ = ["AXIS_INDEX", "BASE_PARAMETERS", "OrientationModel", "base_parameters"]
@@ -104,6 +104,7 @@ class OrientationModel:
         self.parameter_units = tuple(s.unit for s in specs)
         self.per_user_unit = np.array([s.per_user_unit for s in specs])
         self._index = {name: i for i, name in enumerate(names)}
+        self._added = None  # (N, 3, n_params): terms added to a measured angle, if any
         self._factors, self._rd = self._build_chain(turntable, terms_by_effect)
 
     @property
@@ -132,6 +133,10 @@ class OrientationModel:
                     pre.append(_Factor(axis=term.axis, gain=gain))
                 elif term.site == POST:
                     post.append(_Factor(axis=term.axis, gain=gain))
+                elif term.site == MEASURED and term.axis in ANGLE_NAMES:
+                    if self._added is None:
+                        self._added = np.zeros((n, 3, self.n_params))
+                    self._added[:, ANGLE_NAMES.index(term.axis)] += gain
                 elif term.site in error_gain:
                     error_gain[term.site] = error_gain[term.site] + gain
                 else:
@@ -185,7 +190,8 @@ class OrientationModel:
     def predict(self, params) -> np.ndarray:
         """``[dpsi, dtheta, dgamma]`` (rad) at each position, (N, 3)."""
         dR = self.rotation_error(params)
-        return np.stack([dR[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)
+        angles = np.stack([dR[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)
+        return angles if self._added is None else angles + self._added @ params
 
     def jacobian(self, params) -> np.ndarray:
         """Exact derivative of :meth:`predict` with respect to the parameters, (N, 3, n)."""
@@ -198,7 +204,7 @@ class OrientationModel:
         for m in reversed(mats):
             suffix.append(m @ suffix[-1])
         suffix = suffix[::-1]  # suffix[f] = product of factors f..end
-        jac = np.zeros((n, 3, self.n_params))
+        jac = np.zeros((n, 3, self.n_params)) if self._added is None else self._added.copy()
         for f, factor in enumerate(self._factors):
             if factor.fixed is not None:
                 continue

@@ -9,7 +9,7 @@ The output is the CSV of ``docs/measurements.md`` with the seed and the truth in
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -28,7 +28,7 @@ from .data import (
     OrientationMeasurements,
 )
 from .effect_model import OrientationModel
-from .effects.base import PositionVariables
+from .effects.base import Effect, PositionVariables
 from .table import measured_table
 
 __all__ = [
@@ -215,6 +215,7 @@ def simulate_measurements(
     noise_arcsec: float = 1.0,
     seed: int = 0,
     turntable=None,
+    catalogue: Sequence[Effect] = (),
 ) -> SimulatedMeasurements:
     """Simulate a measurement run.
 
@@ -233,6 +234,7 @@ def simulate_measurements(
     user unit; the run may last at most ``MAX_TIME_S`` and the simulated angles must stay within
     what a measurement file may hold, or :class:`InputError` says which.
         turntable: the table (``GenericTable``, ``TurntableModel`` or ``None``: the paper's).
+        catalogue: effects besides the table's catalogue that ``effects`` may name (the user's).
     """
     limit = MAX_MEASURED_ANGLE_ARCSEC
     if not noise_arcsec > 0:
@@ -289,7 +291,7 @@ def simulate_measurements(
         time_s=np.arange(n) * schedule.dwell_s,
         dirs=tuple(schedule.directions(a, rng) for a in angles_deg),
     )
-    effect_objects = [resolve_effect(name, table) for name in effects]
+    effect_objects = [resolve_effect(name, table, catalogue) for name in effects]
     effects = {e.name: effects[name] for e, name in zip(effect_objects, effects, strict=True)}
     model = OrientationModel(variables, effect_objects, table)
     values = dict(base_values)

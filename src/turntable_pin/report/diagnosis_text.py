@@ -12,7 +12,7 @@ sigma given, or the structure search still finds a term).
 
 from __future__ import annotations
 
-__all__ = ["diagnosis_lines", "header_lines", "headline", "verdict_lines"]
+__all__ = ["diagnosis_lines", "fit_command", "header_lines", "headline", "verdict_lines"]
 
 
 def _number(value, fmt: str = "#.3g") -> str:
@@ -117,8 +117,9 @@ def header_lines(d: dict) -> list[str]:
     return lines
 
 
-def verdict_lines(d: dict) -> list[str]:
-    """The steps of the forward selection, the missing effect and whether anything remains."""
+def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
+    """The steps of the forward selection, the missing effect and whether anything remains;
+    for each remaining term, the ``fit`` command (on the file ``data``) that adds it."""
     verdict = d["verdict"]
     lines = []
     if d["steps"]:
@@ -172,11 +173,23 @@ def verdict_lines(d: dict) -> list[str]:
                 "missing effect is not a harmonic one"
             )
         lines.append("unexplained: yes, " + "; ".join(why))
+        specs = [t["effect_spec"] for t in structure if t.get("effect_spec")]
+        if specs:
+            effects = [*d.get("best", {}).get("effects", []), *specs]
+            lines.append("  fit with what remains: " + fit_command(data, effects))
     else:
         lines.append("unexplained: no (the residuals are consistent with the noise)")
     return lines
 
 
-def diagnosis_lines(d: dict) -> list[str]:
-    """The whole diagnosis in words: the headline, the header lines, the verdict lines."""
-    return [headline(d), *header_lines(d), *verdict_lines(d)]
+def fit_command(data: str, specs: list[str]) -> str:
+    """The ``turntable-pin fit`` command that adds the inline terms ``specs`` to the model."""
+    import shlex
+
+    return f"turntable-pin fit {shlex.quote(data)} --effects {shlex.quote(','.join(specs))}"
+
+
+def diagnosis_lines(d: dict, data: str = "DATA.csv") -> list[str]:
+    """The whole diagnosis in words: the headline, the header lines, the verdict lines (with the
+    fit command for ``data``)."""
+    return [headline(d), *header_lines(d), *verdict_lines(d, data)]

@@ -99,6 +99,8 @@ class Probe:
         unit: the user unit of the coefficients.
         factors: how the columns factor per record (optional: lets the report plot a found
             term against its variable).
+        effect_spec: how the model family's users add this shape to their model (a text the
+            family defines), or ``None``.
     """
 
     name: str
@@ -107,6 +109,7 @@ class Probe:
     unit_scale: float = 1.0
     unit: str = ""
     factors: ProbeFactors | None = None
+    effect_spec: str | None = None
 
     def matrix(self) -> np.ndarray:
         """The (m, g) columns (computed now when they were given as a function)."""
@@ -163,6 +166,7 @@ class FoundTerm:
     residual_weighted: np.ndarray | None = field(default=None, repr=False, compare=False)
     explained_weighted: np.ndarray | None = field(default=None, repr=False, compare=False)
     noise_std_weighted: float = 1.0
+    effect_spec: str | None = None
 
     def curve(self, values: np.ndarray) -> np.ndarray:
         """The fitted term at ``values`` of its variable (internal units), in user units.
@@ -224,6 +228,7 @@ class FoundTerm:
             "amplitude": self.amplitude,
             "unit": self.unit,
             "coefficients": list(self.coefficients),
+            "effect_spec": self.effect_spec,
         }
 
 
@@ -304,6 +309,7 @@ def search_structure(
             coefficients=tuple(float(c) for c in coef),
             unit_scale=probe.unit_scale,
             factors=probe.factors,
+            effect_spec=probe.effect_spec,
         )
         found.append((term, probe.matrix() @ coef_internal, explained))
         r = r - explained

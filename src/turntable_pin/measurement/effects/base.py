@@ -8,7 +8,9 @@ in its parameters* (the angles it adds are ``sum_k weight_k(position) * p_k``):
 - ``ChainTerm(site="pre", axis=...)``: an extra rotation multiplied *before* ``Rt`` (in the base
   frame: base tilt);
 - ``ChainTerm(site="post", axis=...)``: an extra rotation multiplied *after* ``Rt`` (in the payload
-  frame: gravity sag, thermal drift, payload mount).
+  frame: gravity sag, thermal drift, payload mount);
+- ``ChainTerm(site="measured", axis="dpsi"|"dtheta"|"dgamma")``: an angle added to that measured
+  angle itself, after the chain (a term of the instrument's reading, not of the table).
 
 Terms of one site are applied in the order listed. :class:`OrientationModel` turns these terms into
 factors of the chain and differentiates them analytically.
@@ -25,6 +27,7 @@ from ...core.units import ARCSEC_PER_RAD
 
 __all__ = [
     "ARCSEC",
+    "MEASURED",
     "POST",
     "PRE",
     "ChainTerm",
@@ -39,6 +42,8 @@ PRE = "pre"
 """Site of a :class:`ChainTerm` applied before ``Rt`` (in the base frame)."""
 POST = "post"
 """Site of a :class:`ChainTerm` applied after ``Rt`` (in the payload frame)."""
+MEASURED = "measured"
+"""Site of a :class:`ChainTerm` added to a measured angle itself (``axis``: ``dpsi``, ...)."""
 
 
 @dataclass(frozen=True)
@@ -67,8 +72,9 @@ class ChainTerm:
     """An angle added to the chain: ``sum_k weights[k] * p_k`` (radians) at each position.
 
     Attributes:
-        site: an error name of :data:`ANGULAR_ERROR_NAMES`, or ``"pre"`` / ``"post"``.
-        axis: ``"x"``, ``"y"`` or ``"z"`` for ``pre`` / ``post`` terms (unused otherwise).
+        site: a base error name of the table, ``"pre"`` / ``"post"`` or ``"measured"``.
+        axis: ``"x"``, ``"y"`` or ``"z"`` for ``pre`` / ``post`` terms, the measured angle
+            (``"dpsi"``, ``"dtheta"``, ``"dgamma"``) for ``measured`` ones (unused otherwise).
         weights: ``{parameter name: array (N,)}`` multiplying that parameter per position.
     """
 

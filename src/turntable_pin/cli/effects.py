@@ -1,0 +1,64 @@
+"""``effects``: the candidate effects of a table (its catalogue and the user's) with their
+parameters, required columns, definition and title."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .common import one_line_errors, print_json
+
+__all__ = ["register"]
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``effects`` to ``subparsers``."""
+    p = subparsers.add_parser(
+        "effects",
+        description="List the candidate effects of the table: the catalogue, the effects of "
+        "--catalogue files (.yaml effect files, .py modules) and installed ones (entry point "
+        "group turntable_pin.effects), with parameters (name, unit, description), required "
+        "columns, definition and title.",
+    )
+    one_line_errors(p)
+    p.add_argument("--urdf", type=Path, metavar="FILE.urdf", help="the table (default: bundled)")
+    p.add_argument("--payload-frame", metavar="NAME", help="the payload frame of the URDF")
+    p.add_argument("--catalogue", action="append", default=[], type=Path, metavar="FILE",
+                   help="your effects (.yaml effect file or .py module); repeatable")  # fmt: skip
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=run_effects)
+
+
+def run_effects(args: argparse.Namespace) -> int:
+    from ..measurement.catalogue import catalogue
+    from ..measurement.table import measured_table
+    from ..measurement.user_effects import describe_effects, load_catalogue
+
+    table = None
+    if args.urdf is not None or args.payload_frame is not None:
+        from .common import generic_table_from_args, paper_table_requested
+
+        if paper_table_requested(args):
+            from ..model.turntable import TurntableModel
+
+            table = measured_table(TurntableModel(urdf_path=args.urdf))
+        else:
+            table = measured_table(generic_table_from_args(args))
+    table = measured_table(table)
+    effects = (*catalogue(table), *load_catalogue(args.catalogue, table))
+    listing = describe_effects(effects, table)
+    if args.json:
+        print_json({"table": table.label, "base_errors": list(table.base_names),
+                    "joints": list(table.joint_names), "effects": listing})  # fmt: skip
+        return 0
+    print(f"table {table.label}: joints {', '.join(table.joint_names)}; base errors "
+          f"{', '.join(table.base_names)}")  # fmt: skip
+    for e in listing:
+        where = "" if e["source"] == "catalogue" else f"  [{e['source']}]"
+        print(f"\n{e['effect']}: {e['title']}{where}")
+        print(f"  definition: {e['definition']}")
+        if e["required_columns"]:
+            print(f"  needs: {', '.join(e['required_columns'])}")
+        for p in e["parameters"]:
+            print(f"  {p['name']:10s} {p['unit']:18s} {p['description']}")
+    return 0

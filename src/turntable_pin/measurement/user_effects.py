@@ -1,0 +1,396 @@
+"""Effects the user brings without editing the package: effect files, modules, plug-ins, terms.
+
+- An **effect file** (YAML, ``docs/measurements.md`` section 4b) declares one effect as a list of
+  terms (:mod:`~turntable_pin.measurement.effect_terms`) with its story: :func:`read_effect_file`.
+- A **Python module** (``FILE.py``) defines :class:`Effect` subclasses (built without arguments)
+  or instances: :func:`load_effects_module` loads it from its path.
+- An installed package may declare effects in the entry point group ``turntable_pin.effects``
+  (each entry an ``Effect`` subclass or instance, or a sequence of them): :func:`installed_effects`
+  loads them, only when called.
+- An **inline term** (``dphi_z2~h3(phi2)``) is an effect of one term named by its text.
+
+:func:`resolve_effects` turns the items of ``fit --effects`` (catalogue names, effect files and
+inline terms) into effects; :func:`load_catalogue` reads the files of ``--catalogue``. Every
+problem is an :class:`InputError` of one line naming the file, the line or key, and what is wrong.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+
+from ..core.exceptions import InputError
+from .effects.base import Effect
+
+__all__ = [
+    "ENTRY_POINT_GROUP",
+    "EFFECT_FILE_KEYS",
+    "TERM_KEYS",
+    "check_user_effects",
+    "describe_effects",
+    "inline_effect",
+    "installed_effects",
+    "load_catalogue",
+    "load_effects_module",
+    "read_effect_file",
+    "resolve_effects",
+]
+
+ENTRY_POINT_GROUP = "turntable_pin.effects"
+"""The entry point group where installed packages declare effects."""
+EFFECT_FILE_KEYS = ("format", "name", "title", "explanation", "confirm", "terms")
+"""The keys of an effect file (``name`` and ``terms`` required)."""
+TERM_KEYS = ("site", "harmonics", "polynomial", "sign", "of", "prefix")
+"""The keys of a term of an effect file (``site`` and one of harmonics/polynomial/sign)."""
+EFFECT_FILE_SUFFIXES = (".yaml", ".yml")
+_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_.@-]*$")
+
+
+def _key_lines(path: Path) -> dict[tuple, int]:
+    """``{key path: line}`` of every mapping key and list item of a YAML file (1-based)."""
+    import yaml
+
+    lines: dict[tuple, int] = {}
+
+    def walk(node, where):
+        if isinstance(node, yaml.MappingNode):
+            for key, value in node.value:
+                here = (*where, key.value)
+                lines[here] = key.start_mark.line + 1
+                walk(value, here)
+        elif isinstance(node, yaml.SequenceNode):
+            for i, item in enumerate(node.value):
+                lines[(*where, i)] = item.start_mark.line + 1
+                walk(item, (*where, i))
+
+    try:
+        walk(yaml.compose(path.read_text(encoding="utf-8"), Loader=yaml.SafeLoader), ())
+    except (yaml.YAMLError, OSError, UnicodeDecodeError):
+        pass
+    return lines
+
+
+def _key_text(where: tuple) -> str:
+    out = ""
+    for part in where:
+        out += f"[{part + 1}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out
+
+
+def read_effect_file(path: str | Path, turntable=None) -> Effect:
+    """The effect declared in the YAML file ``path`` for ``turntable`` (default: the paper's).
+
+    Raises:
+        InputError: unreadable or invalid YAML, a key given twice, an unknown or missing key, a
+            bad value; one line naming the file, the line and the key.
+    """
+    from ..core.files import read_yaml
+    from .effect_terms import EffectTerm, parse_term
+    from .effects.declared import DeclaredEffect
+    from .table import measured_table
+
+    path = Path(path)
+    table = measured_table(turntable)
+    doc = read_yaml(path)
+    lines = _key_lines(path)
+
+    def fail(where: tuple, message: str):
+        key = _key_text(where)
+        line = lines.get(where)
+        return InputError(f"{key}: {message}" if key else message, path=path, line=line)
+
+    if not isinstance(doc, dict):
+        raise fail((), "expected a mapping with the keys name, terms (and title, explanation, "
+                       "confirm)")  # fmt: skip
+    for key in doc:
+        if key not in EFFECT_FILE_KEYS:
+            raise fail((key,), f"unknown key; the keys of an effect file: "
+                               f"{', '.join(EFFECT_FILE_KEYS)}")  # fmt: skip
+    for key in ("name", "terms"):
+        if key not in doc:
+            raise fail((), f"the key '{key}' is missing")
+    if "format" in doc and doc["format"] != 1:
+        raise fail(("format",), f"format {doc['format']!r} is not known; this version reads 1")
+    story = {}
+    for key in ("name", "title", "explanation", "confirm"):
+        value = doc.get(key, "")
+        if not isinstance(value, str) or (key == "name" and not value.strip()):
+            raise fail((key,), "expected a text" + (" (not empty)" if key == "name" else ""))
+        story[key] = " ".join(value.split())
+    if not _NAME.match(story["name"]):
+        raise fail(("name",), f"'{story['name']}': use letters, digits and _ . @ - (no spaces, "
+                              "commas or '~'), starting with a letter")  # fmt: skip
+    items = doc["terms"]
+    if not isinstance(items, list) or not items:
+        raise fail(("terms",), "expected a list of at least one term")
+    terms = []
+    for i, item in enumerate(items):
+        where = ("terms", i)
+        if isinstance(item, str):
+            try:
+                terms.append(parse_term(item, table))
+            except InputError as exc:
+                raise fail(where, exc.detail) from None
+            continue
+        if not isinstance(item, dict):
+            raise fail(where, "expected a term: a mapping (site, harmonics|polynomial|sign, of) "
+                              "or an inline term such as dphi_z2~h3(phi2)")  # fmt: skip
+        for key in item:
+            if key not in TERM_KEYS:
+                raise fail((*where, key), f"unknown key; the keys of a term: "
+                                          f"{', '.join(TERM_KEYS)}")  # fmt: skip
+        shapes = [k for k in ("harmonics", "polynomial", "sign") if k in item]
+        if "site" not in item or len(shapes) != 1:
+            raise fail(where, "a term needs 'site' and exactly one of harmonics, polynomial, "
+                              "sign")  # fmt: skip
+        shape = shapes[0]
+        for key in ("site", "prefix", *(("sign",) if shape == "sign" else ("of",))):
+            if key in item and not isinstance(item[key], str):
+                raise fail((*where, key), "expected a text")
+        if shape == "sign":
+            if "of" in item:
+                raise fail((*where, "of"), "a sign term names its column in 'sign' (sign: dir1)")
+            variable, orders = item["sign"], ()
+        else:
+            if "of" not in item:
+                raise fail(where, f"a {shape} term needs 'of' (the variable: "
+                                  + ("phi1, phi2, phi1+phi2, ...)" if shape == "harmonics"
+                                     else "a column such as temperature_c)"))  # fmt: skip
+            variable = item["of"]
+            orders = _file_orders(item[shape], shape)
+            if isinstance(orders, str):
+                raise fail((*where, shape), orders)
+        term = EffectTerm(item["site"].strip(), shape, variable.strip(), orders,
+                          item.get("prefix", "").strip())  # fmt: skip
+        try:
+            terms.append(term.check(table))
+        except InputError as exc:
+            raise fail(where, exc.detail) from None
+    names = [s.name for t in terms for s in t.parameters()]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise fail(("terms",), f"parameter(s) {', '.join(twice)} would be defined twice; give "
+                               "the terms different 'prefix' values (e.g. x_, z_)")  # fmt: skip
+    return DeclaredEffect(story["name"], terms, title=story["title"],
+                          explanation=story["explanation"], confirm=story["confirm"],
+                          source=str(path))  # fmt: skip
+
+
+def _file_orders(value, shape: str) -> tuple[int, ...] | str:
+    """The orders of ``harmonics:`` (an order, a list, ``"A..B"``) or the powers of a
+    ``polynomial:`` degree; a message when ``value`` is not one."""
+    from .effect_terms import MAX_HARMONIC_ORDER, MAX_POLYNOMIAL_DEGREE, _orders
+
+    if shape == "polynomial":
+        if isinstance(value, bool) or not isinstance(value, int):
+            return f"expected the degree, a whole number 1..{MAX_POLYNOMIAL_DEGREE}"
+        return tuple(range(1, value + 1)) if value >= 1 else "the degree must be >= 1"
+    if isinstance(value, str):
+        try:
+            return _orders(value.strip(), "orders")
+        except InputError as exc:
+            return exc.detail
+    values = value if isinstance(value, list) else [value]
+    if not values or any(isinstance(v, bool) or not isinstance(v, int) for v in values):
+        return (f"expected an order, a list of orders or a range 'A..B' (whole numbers "
+                f"1..{MAX_HARMONIC_ORDER})")  # fmt: skip
+    return tuple(values)
+
+
+def inline_effect(text: str, turntable=None) -> Effect:
+    """The effect of one inline term (``dphi_z2~h3(phi2)``), named by its text."""
+    from .effect_terms import parse_term
+    from .effects.declared import DeclaredEffect
+    from .table import measured_table
+
+    term = parse_term(text, measured_table(turntable))
+    return DeclaredEffect(term.spec(), [term], source="inline term")
+
+
+def _effects_in(objects: Iterable, where: str) -> list[Effect]:
+    """The effects among ``objects``: instances, and subclasses built without arguments."""
+    out = []
+    for obj in objects:
+        if isinstance(obj, type) and issubclass(obj, Effect) and obj is not Effect:
+            try:
+                obj = obj()
+            except Exception as exc:  # the user's code: any failure is one line
+                raise InputError(f"{where}: {obj.__name__}() failed: {type(exc).__name__}: "
+                                 f"{exc}") from None  # fmt: skip
+        if isinstance(obj, Effect):
+            out.append(obj)
+    return out
+
+
+def load_effects_module(path: str | Path) -> tuple[Effect, ...]:
+    """The effects a Python file defines: instances of :class:`Effect`, and the subclasses
+    defined in the file (built without arguments), in the order they appear.
+
+    Raises:
+        InputError: the file cannot be read or imported, or defines no effect.
+    """
+    import importlib.util
+    import sys
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError("no such Python file", path=path)
+    module_name = f"turntable_pin_user_effects_{abs(hash(str(path.resolve())))}"
+    spec = importlib.util.spec_from_file_location(module_name, path)
+    if spec is None or spec.loader is None:
+        raise InputError("cannot be loaded as a Python module (expected FILE.py)", path=path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[module_name] = module
+    try:
+        spec.loader.exec_module(module)
+    except Exception as exc:  # the user's code: any failure is one line
+        sys.modules.pop(module_name, None)
+        line = getattr(exc, "lineno", None)
+        text = str(exc).splitlines()[0] if str(exc) else ""
+        raise InputError(f"cannot import it: {type(exc).__name__}: {text}", path=path,
+                         line=line if isinstance(exc, SyntaxError) else None) from None  # fmt: skip
+    objects = [
+        obj for obj in vars(module).values()
+        if not (isinstance(obj, type) and obj.__module__ != module_name)
+    ]  # fmt: skip
+    effects = _effects_in(objects, str(path))
+    if not effects:
+        raise InputError(
+            "defines no effect (expected subclasses of turntable_pin.measurement.effects.Effect "
+            "or instances of them)",
+            path=path,
+        )
+    return tuple(effects)
+
+
+def installed_effects() -> tuple[Effect, ...]:
+    """The effects installed packages declare in the entry point group ``turntable_pin.effects``
+    (loaded now; nothing is loaded before this is called).
+
+    Raises:
+        InputError: an entry point that fails to load or holds no effect.
+    """
+    from importlib.metadata import entry_points
+
+    out: list[Effect] = []
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        where = f"entry point '{ep.name}' ({ep.value}) of {ENTRY_POINT_GROUP}"
+        try:
+            obj = ep.load()
+        except Exception as exc:  # an installed package's code: any failure is one line
+            raise InputError(f"{where}: cannot load it: {type(exc).__name__}: {exc}") from None
+        objects = obj if isinstance(obj, list | tuple) else [obj]
+        found = _effects_in(objects, where)
+        if not found:
+            raise InputError(f"{where}: holds no Effect subclass or instance")
+        for effect in found:
+            if not getattr(effect, "source", ""):
+                try:
+                    effect.source = f"entry point {ep.name}"
+                except AttributeError:  # a read-only object: listed without its source
+                    pass
+        out += found
+    return tuple(out)
+
+
+def check_user_effects(effects: Sequence[Effect], turntable=None) -> tuple[Effect, ...]:
+    """``effects`` if each has a usable name, unique and not one of the table's catalogue.
+
+    Raises:
+        InputError: an effect without a name, a name used twice or taken by the catalogue.
+    """
+    from .catalogue import catalogue
+
+    taken = {e.name for e in catalogue(turntable)}
+    seen: dict[str, str] = {}
+    for effect in effects:
+        where = getattr(effect, "source", "") or type(effect).__name__
+        name = getattr(effect, "name", "")
+        if not isinstance(name, str) or not name.strip() or "," in name:
+            raise InputError(f"{where}: an effect needs a name without commas (its 'name')")
+        if name in taken:
+            raise InputError(f"{where}: effect '{name}' is already in the catalogue; give yours "
+                             "another name")  # fmt: skip
+        if name in seen:
+            raise InputError(f"{where}: effect '{name}' is also defined by {seen[name]}")
+        seen[name] = where
+    return tuple(effects)
+
+
+def load_catalogue(paths: Sequence[str | Path], turntable=None) -> tuple[Effect, ...]:
+    """The effects of ``--catalogue`` files (``.yaml``/``.yml`` effect files, ``.py`` modules)
+    followed by the installed ones (:func:`installed_effects`), checked by
+    :func:`check_user_effects`."""
+    effects: list[Effect] = []
+    for path in map(Path, paths):
+        if path.suffix.lower() in EFFECT_FILE_SUFFIXES:
+            effects.append(read_effect_file(path, turntable))
+        elif path.suffix.lower() == ".py":
+            effects += load_effects_module(path)
+        else:
+            raise InputError("an effect catalogue is a .yaml/.yml effect file or a .py module",
+                             path=path)  # fmt: skip
+    return check_user_effects([*effects, *installed_effects()], turntable)
+
+
+def resolve_effects(
+    items: Sequence[str], turntable=None, extra: Sequence[Effect] = ()
+) -> tuple[Effect, ...]:
+    """The effects of ``fit --effects``: each item a comma-separated list of catalogue names
+    (or names of ``extra`` or of installed effects), effect files (``.yaml``/``.yml``) and inline
+    terms (``SITE~SHAPE(VAR)``); duplicates refused, empty items ignored."""
+    from .catalogue import resolve_effect
+
+    out: list[Effect] = []
+    installed: tuple[Effect, ...] | None = None
+    for text in items:
+        for item in filter(None, (x.strip() for x in str(text).split(","))):
+            if "~" in item:
+                effect = inline_effect(item, turntable)
+            elif item.lower().endswith(EFFECT_FILE_SUFFIXES):
+                effect = read_effect_file(item, turntable)
+                check_user_effects([effect], turntable)
+            else:
+                try:
+                    effect = resolve_effect(item, turntable, extra)
+                except InputError as exc:
+                    if installed is None:  # installed plug-ins are loaded only when needed
+                        installed = installed_effects()
+                    found = [e for e in installed if e.name == item]
+                    if not found:
+                        raise InputError(
+                            f"{exc.detail}; or give an effect file (.yaml) or an inline term "
+                            "such as dphi_z2~h3(phi2)"
+                        ) from None
+                    effect = found[0]
+            if any(e.name == effect.name for e in out):
+                raise InputError(f"effect '{effect.name}' is listed twice in --effects")
+            out.append(effect)
+    return tuple(out)
+
+
+def describe_effects(effects: Sequence[Effect], turntable=None) -> list[dict]:
+    """Each effect's story with its parameters (``name, unit, description``) on a data set that
+    has every column it needs, and where it comes from (``catalogue`` or its file)."""
+    import numpy as np
+
+    from .effects.base import PositionVariables
+    from .table import measured_table
+
+    table = measured_table(turntable)
+    j = table.n_joints
+    columns = {c for e in effects for c in e.required_columns}
+    extra = {c: np.zeros(1) for c in columns
+             if c != "time_s" and not re.match(r"^(dir|phi)\d+$", c)}  # fmt: skip
+    variables = PositionVariables(np.zeros((1, j)), np.zeros(1), (np.ones(1),) * j, extra)
+    out = []
+    for effect in effects:
+        entry = effect.describe()
+        entry["source"] = getattr(effect, "source", "") or "catalogue"
+        entry["parameters"] = [
+            {"name": p.name, "unit": p.unit, "description": p.description}
+            for p in effect.parameters(variables)
+        ]
+        out.append(entry)
+    return out
