@@ -189,3 +189,106 @@ def test_a_spurious_first_round_candidate_is_shown_not_significant_on_top_of_the
     for c in spurious:  # soaked up part of the real effect against the bare base model
         assert c["delta_bic_after_first"] > -6
     assert d["verdict"]["also_significant"] == []
+
+
+# ---- real campaigns: outliers, effects outside the catalogue, extra columns -------------------
+def _diagnose_and_fit_spec(data):
+    """The diagnosis of ``data`` and the chi2_reduced of the fit with its first finding added."""
+    from turntable_pin.measurement.user_effects import resolve_effects
+
+    d = diagnose_measurements(data).to_dict()
+    structure = d["verdict"]["remaining_structure"]
+    if not structure:
+        return d, None
+    effects = resolve_effects([*d["best"]["effects"], structure[0]["effect_spec"]])
+    return d, fit_orientation(data, effects).result.chi2_reduced
+
+
+@pytest.mark.slow
+def test_a_handful_of_gross_outliers_is_listed_never_explained():
+    for seed in range(8):
+        rng = np.random.default_rng(seed)
+        sim = simulate_measurements(random_errors(rng), seed=seed)
+        rows = rng.choice(sim.data.n_positions, 3, replace=False)
+        angles = rng.integers(0, 3, 3)
+        bumped = sim.data.angles_rad.copy()
+        bumped[rows, angles] += np.array([25.0, -32.0, 40.0]) / ARCSEC_PER_RAD
+        data = sim.data.replace(angles_rad=bumped)
+        d = diagnose_measurements(data).to_dict()
+        assert d["verdict"]["missing_effect"] is None and not d["verdict"]["unexplained"], seed
+        found = {(o["row"], o["angle"]) for o in d["outliers"]}
+        names = ("dpsi", "dtheta", "dgamma")
+        assert found == {(int(sim.data.rows[r]), names[a]) for r, a in zip(rows, angles)}
+        assert all(abs(o["residual_sigma"]) > 20 for o in d["outliers"])
+        kept = diagnose_measurements(data, outliers=False).to_dict()
+        assert kept["outliers"] == [] and kept["outlier_rule"] is None
+
+
+def test_outliers_do_not_hide_a_real_effect():
+    sim = simulate_measurements(
+        random_errors(np.random.default_rng(3)),
+        {"inner_encoder_harmonics": {"c1": 3.0, "s2": -2.0}}, seed=3,
+    )  # fmt: skip
+    bumped = sim.data.angles_rad.copy()
+    bumped[[5, 70], [0, 2]] += np.array([30.0, -30.0]) / ARCSEC_PER_RAD
+    d = diagnose_measurements(sim.data.replace(angles_rad=bumped)).to_dict()
+    assert d["verdict"]["missing_effect"] == "inner_encoder_harmonics"
+    assert not d["verdict"]["unexplained"]
+    assert {(o["row"], o["angle"]) for o in d["outliers"]} == {(7, "dpsi"), (72, "dgamma")}
+
+
+@pytest.mark.slow
+def test_a_term_outside_the_catalogue_gets_no_catalogued_name_and_its_spec_fits():
+    from turntable_pin.measurement.user_effects import inline_effect
+
+    term = inline_effect("dphi_z2~h3(phi2)")
+    for seed in range(6):
+        sim = simulate_measurements(
+            random_errors(np.random.default_rng(seed)), {term.name: {"c3": 3.0, "s3": -2.0}},
+            seed=seed, catalogue=[term],
+        )  # fmt: skip
+        d, chi2 = _diagnose_and_fit_spec(sim.data)
+        assert d["verdict"]["missing_effect"] is None and d["verdict"]["unexplained"], seed
+        assert "3/rev in phi2" in d["verdict"]["remaining_structure"][0]["term"]
+        assert chi2 < 1.25
+
+
+@pytest.mark.slow
+def test_an_error_following_the_temperature_column_is_found_there_not_in_wobbles():
+    from turntable_pin.measurement.effect_model import OrientationModel
+    from turntable_pin.measurement.user_effects import inline_effect
+
+    term = inline_effect("deps_x~poly1(temperature_c)")
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        sim = simulate_measurements(random_errors(rng), seed=seed)
+        n = sim.data.n_positions
+        # A slow warm-up over the run, which the grid order ties to phi1.
+        temperature = 20 + 3 * np.sin(np.linspace(0, 2.5, n)) + rng.normal(0, 0.05, n)
+        data = sim.data.replace(extra={"temperature_c": temperature})
+        model = OrientationModel(data.variables(), [term])
+        extra = model.predict(model.parameter_vector({f"{term.name}.p1": 1.5 / ARCSEC_PER_RAD}))
+        d, chi2 = _diagnose_and_fit_spec(data.replace(angles_rad=data.angles_rad + extra))
+        verdict = d["verdict"]
+        assert verdict["missing_effect"] is None and verdict["unexplained"], seed
+        assert verdict["remaining_structure"][0]["term"].endswith("in temperature_c")
+        assert verdict["unneeded_given_structure"]  # the wobble that mimicked it, not named
+        assert chi2 < 1.25
+
+
+@pytest.mark.slow
+def test_clean_data_false_alarm_rate_is_zero_with_outliers_and_missing_angles():
+    alarms = []
+    for seed in range(50):
+        rng = np.random.default_rng(1000 + seed)
+        sim = simulate_measurements(random_errors(rng), seed=1000 + seed)
+        angles = sim.data.angles_rad.copy()
+        rows = rng.choice(sim.data.n_positions, 2, replace=False)
+        angles[rows, rng.integers(0, 3, 2)] += rng.choice([-1, 1], 2) * 30 / ARCSEC_PER_RAD
+        empty = rng.random(angles.shape) < 0.2
+        empty[empty.all(axis=1), 0] = False
+        angles[empty] = np.nan
+        d = diagnose_measurements(sim.data.replace(angles_rad=angles)).to_dict()
+        if d["verdict"]["missing_effect"] or d["verdict"]["unexplained"]:
+            alarms.append((seed, d["verdict"]["missing_effect"]))
+    assert alarms == []

@@ -33,16 +33,26 @@ __all__ = ["COMMANDS", "build_parser", "main"]
 COMMANDS: dict[str, tuple[str, str]] = {
     "orientation": ("orientation", "orientation error dR of the payload at one position"),
     "urdf": ("orientation", "write the URDF with the errors in its joint placements"),
-    "rate-error": ("calibration",
-        "GyroWheel rate-sensing errors caused by an orientation error (eqs. 7-14)"),
-    "requirement": ("calibration",
-        "orientation requirement I_psi, I_theta, I_gamma for an accuracy (eqs. 15-16)"),
-    "calibrate": ("calibration",
-        "fit the 2 x 7 drift coefficients to a calibration run (eqs. 5-6)"),
-    "allocate": ("allocation",
-        "allocate the eight angular turntable errors to meet orientation limits"),
-    "montecarlo": ("allocation",
-        "allocate, then check the bounds with random turntables on the exact chain"),
+    "rate-error": (
+        "calibration",
+        "GyroWheel rate-sensing errors caused by an orientation error (eqs. 7-14)",
+    ),
+    "requirement": (
+        "calibration",
+        "orientation requirement I_psi, I_theta, I_gamma for an accuracy (eqs. 15-16)",
+    ),
+    "calibrate": (
+        "calibration",
+        "fit the 2 x 7 drift coefficients to a calibration run (eqs. 5-6)",
+    ),
+    "allocate": (
+        "allocation",
+        "allocate the eight angular turntable errors to meet orientation limits",
+    ),
+    "montecarlo": (
+        "allocation",
+        "allocate, then check the bounds with random turntables on the exact chain",
+    ),
     "simulate": ("measurement", "simulate orientation measurements with hidden effects"),
     "fit": ("measurement", "fit the error model (plus effects) to measurements"),
     "diagnose": ("measurement", "which catalogued physical effect is missing"),

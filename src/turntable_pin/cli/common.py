@@ -232,9 +232,7 @@ def generic_errors_from_args(table, args: argparse.Namespace) -> np.ndarray:
     """The error vector of ``--errors`` overridden entry by entry by ``--error``, in the generic
     names of ``table`` (``<joint>.position``, ``<joint>.tilt_a``, ...)."""
     values = table.errors_from_yaml(args.errors) if args.errors else table.values()
-    overrides = error_overrides(
-        args, names=table.parameter_names, length_names=table.length_names
-    )
+    overrides = error_overrides(args, names=table.parameter_names, length_names=table.length_names)
     for name, value in overrides.items():
         values[table.parameter_names.index(name)] = value
     return values

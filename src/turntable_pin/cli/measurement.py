@@ -86,8 +86,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="effects to add to the base: catalogue names, effect files (.yaml) and "
                    "inline terms (dphi_z2~h3(phi2), dpsi~poly1(temperature_c), "
                    "dphi_y1~sign(dir1)); comma-separated, repeatable")  # fmt: skip
-    f.add_argument("--effects-module", action="append", default=[], type=Path, metavar="FILE.py",
-                   help="a Python file defining Effect subclasses; their names join --effects")
+    f.add_argument(
+        "--effects-module",
+        action="append",
+        default=[],
+        type=Path,
+        metavar="FILE.py",
+        help="a Python file defining Effect subclasses; their names join --effects",
+    )
     f.add_argument(
         "--write-urdf",
         type=Path,
@@ -108,6 +114,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     one_line_errors(d)
     _add_data_options(d)
     d.add_argument("--until-explained", action="store_true", help="add effects while significant")
+    _add_outlier_option(d)
     d.add_argument("--plots", type=Path, metavar="DIR", help="write residual plots (PNG) here")
     _add_catalogue_option(d)
     d.set_defaults(func=run_diagnose)
@@ -122,6 +129,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_table_options(r)
     r.add_argument("--ignore-sigma", action="store_true")
     r.add_argument("--until-explained", action="store_true")
+    _add_outlier_option(r)
     r.add_argument("-o", "--output", type=Path, required=True, metavar="report.html")
     _add_catalogue_option(r)
     r.set_defaults(func=run_report)
@@ -132,6 +140,15 @@ def _noise_arcsec(text: str) -> float:
     from ..measurement.simulation import MAX_NOISE_ARCSEC
 
     return bounded_float(MIN_SIGMA_ARCSEC, MAX_NOISE_ARCSEC, "arcsec")(text)
+
+
+def _add_outlier_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--keep-outliers",
+        action="store_true",
+        help="turn the outlier rule off: every measured angle enters the fits (by default gross "
+        "outliers are found by a stated robust rule, left out and listed)",
+    )
 
 
 def _add_catalogue_option(p: argparse.ArgumentParser) -> None:
@@ -177,9 +194,7 @@ def _parse_effect_options(texts: list[str], table=None, user=()) -> dict[str, di
     effects: dict[str, dict[str, float]] = {}
     for text in texts:
         try:
-            name, params = parse_effect_spec(
-                text, lambda n: resolve_effects([n], table, user)[0]
-            )
+            name, params = parse_effect_spec(text, lambda n: resolve_effects([n], table, user)[0])
         except InputError as exc:
             raise InputError(f"--effect '{text}': {exc}") from None
         if name in effects:
@@ -305,7 +320,8 @@ def run_diagnose(args: argparse.Namespace) -> int:
     data = _read(args, table)
     diagnosis = diagnose_measurements(data, until_explained=args.until_explained,
                                       catalogue=_user_catalogue(args, table),
-                                      turntable=table)  # fmt: skip
+                                      turntable=table,
+                                      outliers=not args.keep_outliers)  # fmt: skip
     out = diagnosis.to_dict()
     if args.plots:
         base = diagnosis.base_fit.with_noise_variance(diagnosis.noise_variance)
@@ -331,7 +347,8 @@ def run_report(args: argparse.Namespace) -> int:
     data = _read(args, table)
     diagnosis = diagnose_measurements(data, until_explained=args.until_explained,
                                       catalogue=_user_catalogue(args, table),
-                                      turntable=table)  # fmt: skip
+                                      turntable=table,
+                                      outliers=not args.keep_outliers)  # fmt: skip
     path = write_report(diagnosis, args.output, title=f"Diagnosis of {args.data.name}")
     print(f"wrote {path}")
     return 0

@@ -118,9 +118,7 @@ def generic_orientation_report(table, error_values, angles_deg: list[float]) -> 
         report[f"{name}_arcsec"] = rad_to_arcsec(float(dR[i, j]))
         report[f"{name}_first_order_arcsec"] = rad_to_arcsec(float(first[k]))
     report["payload_origin_mm"] = table.payload_origin_m(error_values, angles_rad) / M_PER_MM
-    report["errors"] = {
-        k: v for k, v in table.to_user_units(error_values).items() if v != 0.0
-    }
+    report["errors"] = {k: v for k, v in table.to_user_units(error_values).items() if v != 0.0}
     return report
 
 

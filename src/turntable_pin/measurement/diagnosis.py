@@ -17,6 +17,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..core.exceptions import IdentifiabilityError
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..stats.least_squares import RANK_RTOL
@@ -30,7 +31,13 @@ from .effects.base import Effect, PositionVariables
 from .fit import OrientationFit, fit_orientation
 from .table import measured_table
 
-__all__ = ["MAX_HARMONIC", "SEPARATION_CHI2", "OrientationFamily", "diagnose_measurements"]
+__all__ = [
+    "MAX_HARMONIC",
+    "OUTLIER_RULE",
+    "SEPARATION_CHI2",
+    "OrientationFamily",
+    "diagnose_measurements",
+]
 
 MAX_HARMONIC = 5
 SEPARATION_CHI2 = 25.0
@@ -344,17 +351,110 @@ class OrientationFamily:
         )
 
 
+OUTLIER_RULE = (
+    "studentized residual |t| = |r| / (s sqrt(1 - h)) above the two-sided normal quantile at "
+    "0.01 / m (m measured angles; s the robust scale 1.4826 median |r| / sqrt(1 - h), h the "
+    "leverage), iterated: left out, refitted, tested again; first on the base model, then on "
+    "the model with the accepted effects; at most 5 % of the angles"
+)
+"""The outlier rule of :func:`diagnose_measurements` in words (``turntable_pin.stats.outliers``)."""
+
+_MAX_SCREEN_ROUNDS = 10
+
+
+def _without(data: OrientationMeasurements, cells: np.ndarray) -> OrientationMeasurements:
+    """``data`` with the cells ``cells`` (N, 3) left out (as not measured)."""
+    if not cells.any():
+        return data
+    angles = data.angles_rad.copy()
+    angles[cells] = np.nan
+    return data.replace(angles_rad=angles)
+
+
+def _screen(data, effects, table) -> tuple[np.ndarray, str | None]:
+    """The outlier cells (N, 3) of ``data`` under base + ``effects`` by the iterated rule, and a
+    note when the rule would flag more than its share (then none is left out)."""
+    from ..stats.outliers import MAX_OUTLIER_FRACTION, screen_outliers
+
+    flagged = np.zeros(data.angles_rad.shape, bool)
+    total = int(data.measured.sum())
+    for _ in range(_MAX_SCREEN_ROUNDS):
+        clean = _without(data, flagged)
+        try:
+            fit = fit_orientation(clean, effects, turntable=table)
+        except IdentifiabilityError:
+            return np.zeros_like(flagged), None
+        result = fit.result
+        test = screen_outliers(result.residuals * result.weights, result.jacobian_weighted)
+        if not test.flagged.size:
+            break
+        cells = np.flatnonzero(clean.measured.reshape(-1))[test.flagged]
+        flagged.reshape(-1)[cells] = True
+        if flagged.sum() > MAX_OUTLIER_FRACTION * total:
+            return np.zeros_like(flagged), (
+                f"the outlier rule would leave out more than {MAX_OUTLIER_FRACTION:.0%} of the "
+                "measured angles: these are not a handful of bad points but a model or a noise "
+                "level that does not fit, so none is left out"
+            )
+    return flagged, None
+
+
+def _outlier_records(diagnosis: Diagnosis, data, cells: np.ndarray) -> list[dict]:
+    """``{"row", "angle", "residual_sigma"}`` of each outlier cell under the final model, worst
+    first (sigma: the noise the verdict uses, given or estimated)."""
+    fit = diagnosis.best_fit
+    fitted = fit.fitted_rad()
+    if data.sigma_rad is not None:
+        sigma = data.sigma_rad * np.sqrt(diagnosis.noise_variance)
+    else:
+        sigma = np.full(data.angles_rad.shape, np.sqrt(diagnosis.noise_variance))
+    out = []
+    for i, a in zip(*np.nonzero(cells), strict=True):
+        value = (data.angles_rad[i, a] - fitted[i, a]) / sigma[i, a]
+        out.append({"row": int(data.rows[i]), "angle": ANGLE_NAMES[a],
+                    "residual_sigma": float(value)})  # fmt: skip
+    return sorted(out, key=lambda o: -abs(o["residual_sigma"]))
+
+
 def diagnose_measurements(
     data: OrientationMeasurements,
     *,
     until_explained: bool = False,
     catalogue: Sequence[Effect] | None = None,
     turntable=None,
+    outliers: bool = True,
 ) -> Diagnosis:
     """Diagnose orientation measurements against the effect catalogue (see :mod:`diagnosis`).
+
+    With ``outliers`` (the default) gross outliers are found by :data:`OUTLIER_RULE`, left out of
+    every fit of the verdict and listed in ``Diagnosis.outliers``; ``outliers=False`` keeps every
+    measured angle.
 
     Raises:
         InputError: more rows than :data:`~turntable_pin.core.sizes.MAX_DIAGNOSED_ROWS`.
     """
     check_count(data.n_positions, MAX_DIAGNOSED_ROWS, "measurement rows", DIAGNOSIS_ROW_BYTES)
-    return diagnose(OrientationFamily(data, catalogue, turntable), until_explained=until_explained)
+    table = measured_table(turntable)
+
+    def run(cells):
+        family = OrientationFamily(_without(data, cells), catalogue, table)
+        return diagnose(family, until_explained=until_explained)
+
+    if not outliers:
+        return run(np.zeros(data.angles_rad.shape, bool))
+    cells, note = _screen(data, (), table)
+    diagnosis = run(cells)
+    # Again with the accepted effects: points of a real effect the base model could not follow
+    # are not outliers, and an outlier the effects' fit shows up is.
+    effects = list(diagnosis.best_fit.model.effects)
+    if effects:
+        again, note_again = _screen(data, effects, table)
+        note = note_again if note_again else note
+        if not np.array_equal(again, cells):
+            cells = again
+            diagnosis = run(cells)
+    diagnosis.outliers = _outlier_records(diagnosis, data, cells)
+    diagnosis.outlier_rule = OUTLIER_RULE
+    if note:
+        diagnosis.warnings.append(note)
+    return diagnosis

@@ -164,9 +164,7 @@ class EffectTerm:
         sites = (*table.base_names, *(f"{w}.{a}" for w in ("pre", "post") for a in "xyz"),
                  *ANGLE_NAMES)  # fmt: skip
         if self.site not in sites:
-            raise InputError(
-                f"unknown site '{self.site}'; sites of this table: {', '.join(sites)}"
-            )
+            raise InputError(f"unknown site '{self.site}'; sites of this table: {', '.join(sites)}")
         if self.shape not in SHAPES:
             raise InputError(f"unknown shape '{self.shape}'; shapes: {', '.join(SHAPES)}")
         v, n = self.variable, table.n_joints
@@ -194,18 +192,14 @@ class EffectTerm:
                 )
             d = max(self.orders, default=0)
             if not 1 <= d <= MAX_POLYNOMIAL_DEGREE:
-                raise InputError(
-                    f"polynomial degree {d}: expected 1..{MAX_POLYNOMIAL_DEGREE}"
-                )
+                raise InputError(f"polynomial degree {d}: expected 1..{MAX_POLYNOMIAL_DEGREE}")
         else:
             match = _DIR.match(v)
             if not match or int(match[1]) > n:
                 dirs = ", ".join(f"dir{k}" for k in range(1, n + 1))
                 raise InputError(f"sign of '{v}': expected an approach direction ({dirs})")
         if self.prefix and not _COLUMN.match(self.prefix):
-            raise InputError(
-                f"prefix '{self.prefix}': use letters, digits and '_' (e.g. x_)"
-            )
+            raise InputError(f"prefix '{self.prefix}': use letters, digits and '_' (e.g. x_)")
         return self
 
 

@@ -148,6 +148,12 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
         )
     for name, text in verdict["separations"].items():
         lines.append(f"  alternative {name}: {text}")
+    for entry in verdict.get("unneeded_given_structure", []):
+        lines.append(
+            f"not named: {entry['effect']} was significant on its own, but the best description "
+            f"of the data does not need it (removing it changes BIC by "
+            f"{entry['bic_cost_of_removing']:+.1f}; an effect must earn at least 6)"
+        )
     for name in verdict["indistinguishable_from_base"]:
         lines.append(
             f"note: {name} cannot be told apart from the base errors on these data (if "
@@ -179,6 +185,16 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
             lines.append("  fit with what remains: " + fit_command(data, effects))
     else:
         lines.append("unexplained: no (the residuals are consistent with the noise)")
+    outliers = d.get("outliers", [])
+    if outliers:
+        shown = ", ".join(
+            f"row {o['row']} {o['angle']} ({o['residual_sigma']:+.1f} sigma)" for o in outliers[:10]
+        )
+        more = f" and {len(outliers) - 10} more" if len(outliers) > 10 else ""
+        lines.append(
+            f"outliers left out of every fit ({len(outliers)}): {shown}{more}; the rule: "
+            f"{d.get('outlier_rule')}; --keep-outliers keeps them"
+        )
     return lines
 
 

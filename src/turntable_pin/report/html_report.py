@@ -130,7 +130,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
     )
     parts.append(
         f"<p>Source: <code>{html.escape(data.source)}</code> &mdash; {data.n_positions} "
-        f"positions, {3 * data.n_positions} measured angles; noise sigma "
+        f"positions, {int(data.measured.sum())} measured angles; noise sigma "
         + (
             f"from the file's <code>sigma_arcsec</code> column (median {d['sigma_arcsec']:.3g} "
             "arcsec)."
@@ -140,12 +140,28 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
         + "</p>"
     )
     parts += [f'<p class="verdict warn">warning: {html.escape(w)}</p>' for w in d["warnings"]]
+    if d.get("outliers"):
+        parts.append(
+            f"<p>{len(d['outliers'])} gross outlier(s) were left out of every fit (shown here, "
+            f"not silently dropped; rule: {html.escape(d['outlier_rule'])}):</p>"
+            + _table(
+                ["row", "angle", "residual (sigma, final model)"],
+                [[o["row"], o["angle"], o["residual_sigma"]] for o in d["outliers"][:50]],
+            )
+        )
     parts.append("<h2>1. The data</h2>" + _img(data_figure(data), "measured angles"))
     b = d["base"]
     parts.append(
-        "<h2>2. The base model</h2><p>The nine turntable errors of the paper (the intersection "
-        "error never changes the orientation, so eight angles are fitted). The data determine "
-        f"{b['rank']} combinations of them:</p>"
+        "<h2>2. The base model</h2><p>"
+        + (
+            "The nine turntable errors of the paper (the intersection error never changes the "
+            "orientation, so eight angles are fitted)."
+            if diagnosis.family.table.paper
+            else f"The {len(diagnosis.family.table.base_names)} rotation errors of the table "
+            f"{html.escape(diagnosis.family.table.label)} (its offsets never change the "
+            "orientation)."
+        )
+        + f" The data determine {b['rank']} combinations of them:</p>"
     )
     combos = base_fit.result.combinations()
     parts.append(
@@ -176,11 +192,15 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
         joints = range(1, data.n_joints + 1)
         parts.append(
             _table(
-                ["row", *(f"phi{k} (deg)" for k in joints), "angle", "residual (arcsec)",
-                 "sigmas"],
+                ["row", *(f"phi{k} (deg)" for k in joints), "angle", "residual (arcsec)", "sigmas"],
                 [
-                    [f["row"], *(f[f"phi{k}_deg"] for k in joints), f["component"],
-                     f["residual_arcsec"], f["sigmas"]]
+                    [
+                        f["row"],
+                        *(f[f"phi{k}_deg"] for k in joints),
+                        f["component"],
+                        f["residual_arcsec"],
+                        f["sigmas"],
+                    ]
                     for f in failing[:15]
                 ],
             )  # fmt: skip

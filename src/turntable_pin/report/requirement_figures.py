@@ -150,4 +150,3 @@ def write_requirement_figures(result: OrientationRequirement, directory: str | P
         plot_figure4(result, directory / "figure4_rate_errors.png"),
         plot_figure5(result, directory / "figure5_requirement.png"),
     ]
-

@@ -33,6 +33,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+import numpy as np
+
 from ..core.exceptions import IdentifiabilityError
 from .least_squares import FitResult
 from .structure_search import BIC_THRESHOLD, FoundTerm, Probe, delta_bic, search_structure
@@ -212,6 +214,12 @@ class Diagnosis:
             that only looked significant against a base that lacked the real effect (because
             it soaked up part of that effect's signal) is no longer significant there.
         warnings: what the data's design cannot tell (the family's ``design_warnings``).
+        outliers: the records left out as gross outliers (the caller's rule and words; each a
+            dict the caller defines), empty when none or when the rule was off.
+        outlier_rule: the rule in words, or ``None`` when no rule was applied.
+        unneeded_given_structure: effects the forward selection accepted that the best
+            description of the data does not need (:func:`_least_needed`), with what removing
+            each cost in BIC (below 6): they are not named.
     """
 
     family: Any = field(repr=False)
@@ -226,6 +234,9 @@ class Diagnosis:
     until_explained: bool
     after_first: dict[str, float | None] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
+    outliers: list[dict] = field(default_factory=list)
+    outlier_rule: str | None = None
+    unneeded_given_structure: dict[str, float] = field(default_factory=dict)
 
     @property
     def missing_effect(self) -> str | None:
@@ -307,6 +318,10 @@ class Diagnosis:
             "separations": dict(self.separations),
             "indistinguishable_from_base": self.indistinguishable_from_base,
             "untestable": self.untestable,
+            "unneeded_given_structure": [
+                {"effect": name, "bic_cost_of_removing": value}
+                for name, value in self.unneeded_given_structure.items()
+            ],
         }
         if self.missing_effect:
             verdict["effect_story"] = self.family.describe(self.missing_effect)
@@ -329,6 +344,8 @@ class Diagnosis:
             "best": {"effects": [s.added for s in self.steps], **_summary(best.result, nv)},
             "verdict": verdict,
             "warnings": list(self.warnings),
+            "outliers": [dict(o) for o in self.outliers],
+            "outlier_rule": self.outlier_rule,
             "decision_rule": {
                 "accept_effect": f"delta_bic <= {BIC_THRESHOLD:g}",
                 "alternative": f"|chi2 difference| within the {ALTERNATIVE_LEVEL:g} quantile "
@@ -361,16 +378,38 @@ def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis
         round_candidates = compare_effects(family, current, current_fit, rest)
         if len(steps) == 1:
             after_first = {c.effect: c.delta_bic for c in round_candidates}
+    known = 1.0 if current_fit.result.sigma_known else None
+    probes = family.probes(current_fit)
+    structure = search_structure(
+        current_fit.result.residuals * current_fit.result.weights,
+        current_fit.result.jacobian_weighted,
+        probes,
+        noise_variance=known,
+    )
+    # An accepted effect must explain its own share: judged against the best description of the
+    # data -- the other accepted effects *and* the structure found -- not against a model whose
+    # chi2 the unexplained structure inflates (a 3/rev term makes any 1/rev effect look good).
+    unneeded: dict[str, float] = {}
+    while current:
+        worst = _least_needed(family, current, current_fit, structure, probes, known)
+        if worst is None:
+            break
+        name, dbic = worst
+        unneeded[name] = dbic
+        current = [e for e in current if e.name != name]
+        current_fit = family.fit(current)
+        probes = family.probes(current_fit)
+        structure = search_structure(
+            current_fit.result.residuals * current_fit.result.weights,
+            current_fit.result.jacobian_weighted,
+            probes,
+            noise_variance=known,
+        )
+    if unneeded:
+        steps = _steps_of(family, current, base_fit)
     best = current_fit.result
     noise_variance = _noise_variance(best)
     _mark_alternatives(candidates, noise_variance)
-    known = 1.0 if best.sigma_known else None
-    structure = search_structure(
-        best.residuals * best.weights,
-        best.jacobian_weighted,
-        family.probes(current_fit),
-        noise_variance=known,
-    )
     fails = bool(best.sigma_known and best.dof > 0 and best.p_value < FIT_TEST_ALPHA)
     separations = {}
     if steps:
@@ -391,4 +430,88 @@ def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis
         until_explained=until_explained,
         after_first=after_first,
         warnings=list(family.design_warnings(base_fit)),
+        unneeded_given_structure=unneeded,
     )
+
+
+def _projected_rss(residuals: np.ndarray, columns: np.ndarray) -> tuple[float, int]:
+    """The rss of ``residuals`` left after projecting out ``columns``, and their rank."""
+    norms = np.linalg.norm(columns, axis=0)
+    columns = columns[:, norms > 0] / norms[norms > 0]
+    u, s, _ = np.linalg.svd(columns, full_matrices=False)
+    u = u[:, s > 1e-9 * (s[0] if s.size else 1.0)]
+    left = residuals - u @ (u.T @ residuals)
+    return float(left @ left), int(u.shape[1])
+
+
+def _least_needed(family, current, current_fit, structure, probes, known):
+    """The accepted effect least needed in the best description of the data, with what removing
+    it costs in BIC, or ``None`` when every accepted effect still earns its place.
+
+    The best description is the accepted effects plus the structure found on top of them. An
+    effect E earns its place when removing it costs at least ``-BIC_THRESHOLD`` (6), the
+    acceptance rule itself, judged two ways:
+
+    - with the same structure: an effect that only soaked up part of a structure it does not
+      explain (a backlash taking a little of a 3/rev term) costs little to remove;
+    - with the structure the search finds in the residuals of the model without E (what E was
+      standing for), when that structure fits the data at least as well as E does: then E is a
+      mimic of a shape it does not have (an 8-parameter wobble following a slow temperature
+      change through the measurement order), and the found shape describes the data better.
+      When E fits better, E is kept: it is the physical hypothesis, and its extra harmonics are
+      not held against it.
+
+    Each structure term pays the search's look-elsewhere penalty ``2 ln G`` besides its
+    parameters. Linearised at the fits: the structure's probe columns join each model's
+    Jacobian (the models are nearly linear).
+    """
+    m = current_fit.result.n_obs
+    penalty = 2.0 * math.log(max(len(probes), 1))
+
+    def score(fit, terms, term_probes) -> tuple[float, float]:
+        """(BIC, its fit part) of ``fit`` with the probe columns of ``terms`` added."""
+        result = fit.result
+        by_name = {p.name: p for p in term_probes}
+        columns = [result.jacobian_weighted] + [by_name[t.name].matrix() for t in terms]
+        rss, rank = _projected_rss(result.residuals * result.weights, np.concatenate(columns, 1))
+        fit_term = rss / known if known is not None else m * math.log(max(rss, 1e-300))
+        return fit_term + rank * math.log(m) + penalty * len(terms), fit_term
+
+    full, full_fit = score(current_fit, structure, probes)
+    worst = None
+    for effect in current:
+        try:
+            without = family.fit([e for e in current if e is not effect])
+        except IdentifiabilityError:
+            continue
+        costs = [score(without, structure, probes)[0] - full]
+        own_probes = family.probes(without)
+        own = search_structure(
+            without.result.residuals * without.result.weights,
+            without.result.jacobian_weighted,
+            own_probes,
+            noise_variance=known,
+        )
+        if own:
+            bic_own, fit_own = score(without, own, own_probes)
+            if fit_own <= full_fit:
+                costs.append(bic_own - full)
+        cost = float(min(costs))
+        if cost < -BIC_THRESHOLD and (worst is None or cost < worst[1]):
+            worst = (effect.name, cost)
+    return worst
+
+
+def _steps_of(family, effects, base_fit) -> list[Step]:
+    """The forward-selection steps of ``effects`` in their order (each fit cached by the
+    family), with the delta_bic of each against the previous model."""
+    steps = []
+    previous = base_fit
+    known = 1.0 if base_fit.result.sigma_known else None
+    for k in range(len(effects)):
+        fit = family.fit(effects[: k + 1])
+        added = fit.result.rank - previous.result.rank
+        dbic = delta_bic(fit.result.rss, previous.result.rss, added, fit.result.n_obs, known)
+        steps.append(Step(effects[k].name, float(dbic), fit, []))
+        previous = fit
+    return steps
