@@ -218,7 +218,8 @@ def test_a_handful_of_gross_outliers_is_listed_never_explained():
         assert d["verdict"]["missing_effect"] is None and not d["verdict"]["unexplained"], seed
         found = {(o["row"], o["angle"]) for o in d["outliers"]}
         names = ("dpsi", "dtheta", "dgamma")
-        assert found == {(int(sim.data.rows[r]), names[a]) for r, a in zip(rows, angles)}
+        planted = zip(rows, angles, strict=True)
+        assert found == {(int(sim.data.rows[r]), names[a]) for r, a in planted}
         assert all(abs(o["residual_sigma"]) > 20 for o in d["outliers"])
         kept = diagnose_measurements(data, outliers=False).to_dict()
         assert kept["outliers"] == [] and kept["outlier_rule"] is None
