@@ -133,3 +133,22 @@ def test_sigma_per_angle_and_extra_numeric_columns(tmp_path):
     np.testing.assert_allclose(data.extra["temperature_c"], [21.5, 22.0])
     with pytest.raises(InputError, match="not both"):
         read_measurements(write_file(tmp_path, text.replace("sigma_dpsi_arcsec", "sigma_arcsec")))
+
+
+def test_the_python_api_refuses_nan_where_the_reader_would():
+    from turntable_pin.measurement.data import OrientationMeasurements
+
+    joints = np.zeros((3, 2))
+    angles = np.zeros((3, 3))
+    angles[1, 2] = np.nan  # not measured: fine
+    OrientationMeasurements(joints, angles)
+    bad = joints.copy()
+    bad[2, 1] = np.nan
+    with pytest.raises(InputError, match=r"joint_rad: expected finite.*row 4"):
+        OrientationMeasurements(bad, angles)
+    with pytest.raises(InputError, match="sigma_rad"):
+        OrientationMeasurements(joints, angles, sigma_rad=np.array([1e-6, np.nan, 1e-6]))
+    with pytest.raises(InputError, match="time_s"):
+        OrientationMeasurements(joints, angles, time_s=np.array([0.0, np.inf, 1.0]))
+    with pytest.raises(InputError, match="dir2"):
+        OrientationMeasurements(joints, angles, dirs=(None, np.array([1.0, 0.0, -1.0])))

@@ -129,6 +129,38 @@ class OrientationMeasurements:
         rows = np.arange(2, n + 2) if self.rows is None else np.reshape(self.rows, -1)
         object.__setattr__(self, "rows", _frozen(rows, int))
         object.__setattr__(self, "joint_names", tuple(self.joint_names))
+        self._check_values()
+
+    def _check_values(self) -> None:
+        """Refuse what would reach the fit as a NaN or a nonsense weight (the reader refuses the
+        same in files, naming the row): an empty cell means "not measured" for the three angles
+        only."""
+        for name, value in (("joint_rad", self.joint_rad), ("time_s", self.time_s),
+                            *((f"dir{k}", d) for k, d in enumerate(self.dirs, 1)),
+                            *self.extra.items()):  # fmt: skip
+            if value is None:
+                continue
+            bad = ~np.isfinite(np.asarray(value, float).reshape(self.rows.size, -1)).all(axis=1)
+            self._refuse(bad, f"{name}: expected finite numbers, found NaN or inf")
+        self._refuse(
+            np.isinf(self.angles_rad).any(axis=1),
+            "angles_rad: an angle is infinite (NaN means not measured; inf is an error)",
+        )
+        if self.sigma_rad is not None:
+            good = np.isfinite(self.sigma_rad) & (self.sigma_rad > 0)
+            self._refuse(
+                (self.measured & ~good).any(axis=1),
+                "sigma_rad: must be finite and > 0 for every measured angle",
+            )
+        for k, d in enumerate(self.dirs, 1):
+            if d is not None:
+                self._refuse(np.abs(d) != 1, f"dir{k}: must be +1 or -1")
+
+    def _refuse(self, bad: np.ndarray, what: str) -> None:
+        """Raise :class:`InputError` naming the first row where ``bad`` holds."""
+        if np.any(bad):
+            row = int(self.rows[np.flatnonzero(bad)[0]])
+            raise InputError(f"{what} (row {row} of {self.source or 'the data'})")
 
     @classmethod
     def two_axis(
