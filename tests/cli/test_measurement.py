@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from conftest import EXAMPLES_DIR, cli, run_cli
+from conftest import EXAMPLES_DIR, REPO_DIR, cli, run_cli
 from turntable_pin.cli import main
 from turntable_pin.core.files import read_yaml
 
@@ -123,3 +123,28 @@ def test_bad_arguments(args, fragment, capsys, tmp_path, monkeypatch):
 def test_unknown_effect_in_fit(sim_file, capsys):
     assert main(["fit", str(sim_file), "--effects", "gravity_sag,wobble"]) == 2
     assert "unknown effect 'wobble'" in capsys.readouterr().err
+
+
+def test_the_measurement_loop_on_a_three_axis_table(tmp_path):
+    urdf = str(REPO_DIR / "models" / "three_axis_imu_table.urdf")
+    data = tmp_path / "imu.csv"
+    proc = cli("simulate", "--urdf", urdf, "--phi1-step-deg", "90", "--phi2-step-deg", "60",
+               "--phi3-step-deg", "60", "--effect", "encoder_harmonics@inner_gimbal:c1=4,s2=3",
+               "--error", "middle_gimbal.tilt_a=8", "--seed", "2", "-o", str(data))  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    header = [ln for ln in data.read_text().splitlines() if not ln.startswith("#")][0]
+    assert header.startswith("phi1_deg,phi2_deg,phi3_deg,") and header.endswith("dir1,dir2,dir3")
+    proc = cli("diagnose", str(data), "--urdf", urdf, "--json")
+    assert proc.returncode == 0, proc.stderr
+    verdict = json.loads(proc.stdout)["verdict"]
+    assert verdict["missing_effect"] == "encoder_harmonics@inner_gimbal"
+    out = tmp_path / "identified.urdf"
+    proc = cli("fit", str(data), "--urdf", urdf, "--effects", "encoder_harmonics@inner_gimbal",
+               "--write-urdf", str(out), "--json")  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    fit = json.loads(proc.stdout)
+    assert fit["chi2_reduced"] < 1.3 and fit["identified_urdf"]["path"] == str(out)
+    assert abs(fit["identified_urdf"]["errors_arcsec"]["middle_gimbal.tilt_a"] - 8) < 1
+    # The paper's names are no names of this table.
+    proc = cli("fit", str(data), "--urdf", urdf, "--effects", "inner_encoder_harmonics")
+    assert proc.returncode == 2 and "unknown effect 'inner_encoder_harmonics'" in proc.stderr

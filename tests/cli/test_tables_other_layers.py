@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from conftest import REPO_DIR, cli, needs_chromium, write_file
+from conftest import EXAMPLES_DIR, REPO_DIR, cli, needs_chromium, write_file
 from turntable_pin.allocation.solver import OrientationLimits
 from turntable_pin.allocation.table_allocation import allocate_table_tolerances, angular_names
 from turntable_pin.calibration.drift_fit import simulate_run
@@ -201,7 +201,22 @@ COMMANDS = {
     "montecarlo": ["--limits-arcmin", "1", "-n", "10"],
     "view": ["--duration", "0"],
     "snapshot": ["-o", "OUT"],
+    # the measurement layer (its own tests are in test_measurement*.py)
+    "simulate": ["-o", "OUT"],
+    "fit": ["DATA"],
+    "diagnose": ["DATA"],
+    "report": ["DATA", "-o", "OUT"],
+    "effects": [],
 }
+
+
+def _placeholder(arg: str, run, folder) -> str:
+    """A command's argument with RUN/DATA (an input file) and OUT (an output path) filled in."""
+    if arg == "RUN":
+        return str(run)
+    if arg == "DATA":
+        return str(EXAMPLES_DIR / "measurements_example.csv")
+    return str(folder / "out.png") if arg == "OUT" else arg
 
 
 @pytest.mark.parametrize("command", sorted(COMMANDS))
@@ -211,7 +226,7 @@ def test_a_bad_urdf_is_one_line_exit_2_in_every_command(command, case, tmp_path)
     urdf = write_file(tmp_path, text, "bad.urdf")
     run = write_file(tmp_path, "phi1_deg,out_x_dph,out_y_dph\n0,1,2\n", "run.csv")
     extra = [
-        str(run) if a == "RUN" else str(tmp_path / "out.png") if a == "OUT" else a
+        _placeholder(a, run, tmp_path)
         for a in COMMANDS[command]
     ]
     _one_line_exit_2(cli(command, *extra, "--urdf", str(urdf)), fragment)
@@ -221,7 +236,7 @@ def test_a_bad_urdf_is_one_line_exit_2_in_every_command(command, case, tmp_path)
 def test_a_missing_payload_frame_is_one_line_exit_2_in_every_command(command, tmp_path):
     run = write_file(tmp_path, "phi1_deg,out_x_dph,out_y_dph\n0,1,2\n", "run.csv")
     extra = [
-        str(run) if a == "RUN" else str(tmp_path / "out.png") if a == "OUT" else a
+        _placeholder(a, run, tmp_path)
         for a in COMMANDS[command]
     ]
     proc = cli(command, *extra, "--urdf", THREE, "--payload-frame", "nowhere")
