@@ -325,9 +325,10 @@ def run_diagnose(args: argparse.Namespace) -> int:
     out = diagnosis.to_dict()
     if args.plots:
         base = diagnosis.base_fit.with_noise_variance(diagnosis.noise_variance)
-        sets = [orientation_residuals(base)]
+        left_out = diagnosis.family.left_out_rad
+        sets = [orientation_residuals(base, left_out_rad=left_out)]
         if diagnosis.steps:
-            sets.append(orientation_residuals(diagnosis.best_fit))
+            sets.append(orientation_residuals(diagnosis.best_fit, left_out_rad=left_out))
         out["plots"] = [str(p) for p in write_residual_plots(sets, args.plots)]
         out["plots"] += [str(p) for p in write_structure_plots(diagnosis.structure, args.plots)]
     if args.json:

@@ -112,6 +112,7 @@ class OrientationFamily:
         )
         self._observed = data.measured
         self._mask = data.measured.reshape(-1)
+        self.left_out_rad: np.ndarray | None = None  # outliers' measured values (N, 3), NaN else
         self._cache: dict[tuple[str, ...], OrientationFit] = {}
 
     def fit(self, effects: Sequence[Effect], noise_variance: float | None = None) -> OrientationFit:
@@ -438,6 +439,7 @@ def diagnose_measurements(
 
     def run(cells):
         family = OrientationFamily(_without(data, cells), catalogue, table)
+        family.left_out_rad = np.where(cells, data.angles_rad, np.nan)
         return diagnose(family, until_explained=until_explained)
 
     if not outliers:

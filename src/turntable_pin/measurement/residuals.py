@@ -39,6 +39,8 @@ class ResidualSet:
         rows: (N,) file row of each position.
         angles_deg: ``{name: (N,)}`` angle variables (harmonic analysis, plots).
         others: ``{name: (N,)}`` further variables (time, approach direction).
+        outliers: (N, C) residuals of the observations left out as outliers (NaN elsewhere), or
+            ``None``: shown in the plots, never in the statistics.
     """
 
     label: str
@@ -49,10 +51,13 @@ class ResidualSet:
     rows: np.ndarray
     angles_deg: dict[str, np.ndarray]
     others: dict[str, np.ndarray] = field(default_factory=dict)
+    outliers: np.ndarray | None = None
 
 
-def orientation_residuals(fit, label: str | None = None) -> ResidualSet:
-    """The :class:`ResidualSet` of an :class:`OrientationFit`, in arc seconds."""
+def orientation_residuals(fit, label: str | None = None, left_out_rad=None) -> ResidualSet:
+    """The :class:`ResidualSet` of an :class:`OrientationFit`, in arc seconds; ``left_out_rad``
+    (N, 3): the measured values of the angles left out as outliers (NaN elsewhere), whose
+    residuals against this fit are kept apart for the plots."""
     data = fit.data
     others = {} if data.time_s is None else {"time_s": np.asarray(data.time_s)}
     others.update({f"dir{k}": np.asarray(d) for k, d in enumerate(data.dirs, 1) if d is not None})
@@ -69,6 +74,9 @@ def orientation_residuals(fit, label: str | None = None) -> ResidualSet:
             for k in range(1, data.n_joints + 1)
         },
         others=others,
+        outliers=None
+        if left_out_rad is None or not np.isfinite(left_out_rad).any()
+        else (np.asarray(left_out_rad) - fit.fitted_rad()) * ARCSEC_PER_RAD,
     )
 
 

@@ -119,8 +119,9 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
     verdict = d["verdict"]
     base_fit = diagnosis.base_fit.with_noise_variance(diagnosis.noise_variance)
     best_fit = diagnosis.best_fit.with_noise_variance(diagnosis.noise_variance)
-    base_rs = orientation_residuals(base_fit)
-    best_rs = orientation_residuals(best_fit)
+    left_out = diagnosis.family.left_out_rad
+    base_rs = orientation_residuals(base_fit, left_out_rad=left_out)
+    best_rs = orientation_residuals(best_fit, left_out_rad=left_out)
     base_an = analyse_residuals(base_rs)
     explained = not verdict["unexplained"]
     parts = [f"<h1>{html.escape(title or 'Turntable measurement diagnosis')}</h1>"]

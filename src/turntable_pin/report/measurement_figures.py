@@ -54,9 +54,9 @@ def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
     fig, axes = plt.subplots(
         len(variables), len(sets), figsize=(5.2 * len(sets), 2.4 * len(variables)), squeeze=False
     )
-    limit = max(float(np.abs(s.residuals).max()) for s in sets) * 1.1 or 1.0
+    limit = max(float(np.nanmax(np.abs(s.residuals), initial=0.0)) for s in sets) * 1.1 or 1.0
     for col, rs in enumerate(sets):
-        sigma = np.median(np.abs(rs.residuals / np.where(rs.normalised == 0, 1, rs.normalised)))
+        sigma = np.nanmedian(np.abs(rs.residuals / np.where(rs.normalised == 0, 1, rs.normalised)))
         for row, (name, _) in enumerate(variables):
             ax = axes[row, col]
             x = np.arange(rs.residuals.shape[0]) if name == "position" else (
@@ -74,6 +74,13 @@ def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
                     ax.plot(x[pick] + jitter, rs.residuals[pick, i], marker, ms=3.5,
                             color=COLOURS[i], mfc=COLOURS[i] if sign > 0 else "none", mew=0.7,
                             label=comp if sign > 0 else None)  # fmt: skip
+            if rs.outliers is not None:
+                # Left out of every fit: drawn at their value, or at the edge when beyond it.
+                shown = np.clip(rs.outliers, -0.97 * limit, 0.97 * limit)
+                for i in range(len(rs.components)):
+                    pick = np.isfinite(rs.outliers[:, i])
+                    ax.plot(x[pick], shown[pick, i], "x", ms=6, mew=1.4, color="black",
+                            label="outlier (left out)" if i == 0 else None)  # fmt: skip
             if direction is not None:
                 ax.text(0.01, 0.02, "filled up-triangles: approached forward (dir +1); open "
                         "down-triangles: backward (dir -1)", transform=ax.transAxes,
