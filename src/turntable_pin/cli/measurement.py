@@ -310,18 +310,26 @@ def run_fit(args: argparse.Namespace) -> int:
     return 0
 
 
-def run_diagnose(args: argparse.Namespace) -> int:
+def _diagnosis(args: argparse.Namespace):
+    """The diagnosis ``diagnose`` and ``report`` make of their arguments."""
     from ..measurement.diagnosis import diagnose_measurements
+
+    table = table_from_args(args)
+    return diagnose_measurements(
+        _read(args, table),
+        until_explained=args.until_explained,
+        catalogue=_user_catalogue(args, table),
+        turntable=table,
+        outliers=not args.keep_outliers,
+    )
+
+
+def run_diagnose(args: argparse.Namespace) -> int:
     from ..measurement.residuals import orientation_residuals
     from ..report.diagnosis_text import diagnosis_lines
     from ..report.measurement_figures import write_residual_plots, write_structure_plots
 
-    table = table_from_args(args)
-    data = _read(args, table)
-    diagnosis = diagnose_measurements(data, until_explained=args.until_explained,
-                                      catalogue=_user_catalogue(args, table),
-                                      turntable=table,
-                                      outliers=not args.keep_outliers)  # fmt: skip
+    diagnosis = _diagnosis(args)
     out = diagnosis.to_dict()
     if args.plots:
         base = diagnosis.base_fit.with_noise_variance(diagnosis.noise_variance)
@@ -341,15 +349,9 @@ def run_diagnose(args: argparse.Namespace) -> int:
 
 
 def run_report(args: argparse.Namespace) -> int:
-    from ..measurement.diagnosis import diagnose_measurements
     from ..report.html_report import write_report
 
-    table = table_from_args(args)
-    data = _read(args, table)
-    diagnosis = diagnose_measurements(data, until_explained=args.until_explained,
-                                      catalogue=_user_catalogue(args, table),
-                                      turntable=table,
-                                      outliers=not args.keep_outliers)  # fmt: skip
+    diagnosis = _diagnosis(args)
     path = write_report(diagnosis, args.output, title=f"Diagnosis of {args.data.name}")
     print(f"wrote {path}")
     return 0

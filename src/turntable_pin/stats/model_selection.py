@@ -379,13 +379,7 @@ def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis
         if len(steps) == 1:
             after_first = {c.effect: c.delta_bic for c in round_candidates}
     known = 1.0 if current_fit.result.sigma_known else None
-    probes = family.probes(current_fit)
-    structure = search_structure(
-        current_fit.result.residuals * current_fit.result.weights,
-        current_fit.result.jacobian_weighted,
-        probes,
-        noise_variance=known,
-    )
+    structure, probes = _search(family, current_fit, known)
     # An accepted effect must explain its own share: judged against the best description of the
     # data -- the other accepted effects *and* the structure found -- not against a model whose
     # chi2 the unexplained structure inflates (a 3/rev term makes any 1/rev effect look good).
@@ -398,13 +392,7 @@ def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis
         unneeded[name] = dbic
         current = [e for e in current if e.name != name]
         current_fit = family.fit(current)
-        probes = family.probes(current_fit)
-        structure = search_structure(
-            current_fit.result.residuals * current_fit.result.weights,
-            current_fit.result.jacobian_weighted,
-            probes,
-            noise_variance=known,
-        )
+        structure, probes = _search(family, current_fit, known)
     if unneeded:
         steps = _steps_of(family, current, base_fit)
     best = current_fit.result
@@ -432,6 +420,16 @@ def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis
         warnings=list(family.design_warnings(base_fit)),
         unneeded_given_structure=unneeded,
     )
+
+
+def _search(family, fit, known) -> tuple[list[FoundTerm], list[Probe]]:
+    """The structure search in the residuals of ``fit``, with the probes it used."""
+    probes = family.probes(fit)
+    result = fit.result
+    found = search_structure(
+        result.residuals * result.weights, result.jacobian_weighted, probes, noise_variance=known
+    )
+    return found, probes
 
 
 def _projected_rss(residuals: np.ndarray, columns: np.ndarray) -> tuple[float, int]:
@@ -485,13 +483,7 @@ def _least_needed(family, current, current_fit, structure, probes, known):
         except IdentifiabilityError:
             continue
         costs = [score(without, structure, probes)[0] - full]
-        own_probes = family.probes(without)
-        own = search_structure(
-            without.result.residuals * without.result.weights,
-            without.result.jacobian_weighted,
-            own_probes,
-            noise_variance=known,
-        )
+        own, own_probes = _search(family, without, known)
         if own:
             bic_own, fit_own = score(without, own, own_probes)
             if fit_own <= full_fit:
