@@ -191,7 +191,9 @@ def test_backlash_with_a_positive_only_approach_is_indistinguishable_and_said_so
     assert verdict["missing_effect"] is None
     assert "backlash" in verdict["indistinguishable_from_base"]
     [warning] = [w for w in d["warnings"] if "backlash" in w]
-    assert warning.startswith("dir1, dir2 are the same at every row (phi1 from below")
+    assert warning.startswith(
+        "dir1, dir2 are the same at every row (phi1 from below, phi2 from below)"
+    )
     assert "approach the positions from both sides" in warning
     # the same positions approached from both sides see it
     both = _diagnosis(Schedule(30, 30, approach="random"), {"backlash": {"b1": 3.0, "b2": -2.0}})

@@ -231,7 +231,7 @@ class OrientationFamily:
         ]  # fmt: skip
         if fixed:
             dirs = ", ".join(f"dir{k}" for k, _ in fixed)
-            sides = " and ".join(
+            sides = ", ".join(
                 f"{labels[k - 1]} from {'below' if v > 0 else 'above'}" for k, v in fixed
             )
             out.append(
