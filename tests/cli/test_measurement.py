@@ -248,3 +248,16 @@ def test_simulate_bad_positions_file_exit_2_naming_row_and_column(text, extra, f
     assert "positions.csv" in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
     assert not (tmp_path / "x.csv").exists()
     assert positions.read_text() == text
+
+
+def test_simulate_sweep_by_joint_name_on_another_table(tmp_path):
+    urdf = str(REPO_DIR / "models" / "two_axis_vertical_outer.urdf")
+    out = tmp_path / "sweep.csv"
+    proc = cli("simulate", "--urdf", urdf, "--sweep", "tilt_axis,azimuth_axis", "--phi1-step-deg",
+               "120", "--phi2-step-deg", "180", "-o", str(out))  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    pairs = [(float(r["phi1_deg"]), float(r["phi2_deg"])) for r in _rows(out)]
+    assert pairs == [(0, 0), (0, 180), (0, 0), (120, 0), (240, 0)]
+    assert "sweep=phi2,phi1" in out.read_text()
+    bad = cli("simulate", "--urdf", urdf, "--sweep", "elevation", "-o", str(tmp_path / "x.csv"))
+    assert bad.returncode == 2 and "phi1, phi2, azimuth_axis, tilt_axis" in bad.stderr
