@@ -148,3 +148,139 @@ def test_the_measurement_loop_on_a_three_axis_table(tmp_path):
     # The paper's names are no names of this table.
     proc = cli("fit", str(data), "--urdf", urdf, "--effects", "inner_encoder_harmonics")
     assert proc.returncode == 2 and "unknown effect 'inner_encoder_harmonics'" in proc.stderr
+# --- simulate: the designs engineers run ---------------------------------------------------------
+
+
+def _rows(path):
+    lines = [ln for ln in path.read_text().splitlines() if not ln.startswith("#")]
+    header = lines[0].split(",")
+    return [dict(zip(header, ln.split(","), strict=True)) for ln in lines[1:]]
+
+
+def test_simulate_positions_file_in_its_order(tmp_path):
+    positions = tmp_path / "positions.csv"
+    positions.write_text(
+        "# my plan\nphi2_deg,phi1_deg,dir1,note\n45,90,-1,a\n0,0,1,b\n10,180,1,c\n"
+    )
+    out = tmp_path / "out.csv"
+    proc = cli("simulate", "--positions", str(positions), "--seed", "2", "-o", str(out))
+    assert proc.returncode == 0, proc.stderr
+    rows = _rows(out)
+    assert [(r["phi1_deg"], r["phi2_deg"], r["dir1"]) for r in rows] == [
+        ("90.0", "45.0", "-1"), ("0.0", "0.0", "1"), ("180.0", "10.0", "1"),
+    ]  # fmt: skip
+    assert "# schedule: positions=positions.csv n_positions=3 given=dir1 repeats=1" in (
+        out.read_text()
+    )
+    back = cli("diagnose", str(out), "--json")
+    assert back.returncode == 0, back.stderr
+
+
+def test_simulate_positions_file_of_a_three_axis_table_by_joint_name(tmp_path):
+    urdf = str(REPO_DIR / "models" / "three_axis_imu_table.urdf")
+    from turntable_pin.model.generic_table import GenericTable
+
+    names = GenericTable(urdf).joint_names
+    positions = tmp_path / "positions.csv"
+    positions.write_text(f"{names[0]}_deg,phi2_deg,phi3_deg,time_s\n0,0,0,5\n90,10,20,50\n")
+    out = tmp_path / "out.csv"
+    assert cli("simulate", "--urdf", urdf, "--positions", str(positions), "-o",
+               str(out)).returncode == 0  # fmt: skip
+    rows = _rows(out)
+    assert [(r["phi1_deg"], r["phi3_deg"], r["time_s"]) for r in rows] == [
+        ("0.0", "0.0", "5.0"), ("90.0", "20.0", "50.0"),
+    ]  # fmt: skip
+
+
+def test_simulate_sweep_then_reverse_sweep_is_one_command(tmp_path):
+    out = tmp_path / "sweep.csv"
+    proc = cli("simulate", "--sweep", "phi1,phi2", "--phi1-step-deg", "90", "--phi2-step-deg",
+               "90", "--phi2-start-deg", "90", "--approach", "motion", "-o", str(out))  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    pairs = [(float(r["phi1_deg"]), float(r["phi2_deg"])) for r in _rows(out)]
+    assert pairs == [(0, 90), (90, 90), (180, 90), (270, 90), (0, 90), (0, 180), (0, 270), (0, 360)]
+    text = out.read_text()
+    assert "# schedule: sweep=phi1,phi2 phi1_step_deg=90 phi2_step_deg=90 held at " \
+        "phi1_start_deg=0 phi2_start_deg=90" in text  # fmt: skip
+
+
+def test_simulate_passes_random_positions_and_uneven_noise(tmp_path):
+    out = tmp_path / "passes.csv"
+    assert cli("simulate", "--passes", "2", "--phi1-step-deg", "180", "--phi2-step-deg", "180",
+               "-o", str(out)).returncode == 0  # fmt: skip
+    rows = _rows(out)
+    assert [r["dir1"] for r in rows] == (["1"] * 4 + ["-1"] * 4) * 2
+    assert [r["dir2"] for r in rows] == [r["dir1"] for r in rows]
+    assert "approach=motion passes=2" in out.read_text()
+    rnd = tmp_path / "random.csv"
+    args = ("simulate", "--random-positions", "30", "--noise-spread", "3", "--seed", "7")
+    assert cli(*args, "-o", str(rnd)).returncode == 0
+    again = tmp_path / "again.csv"
+    assert cli(*args, "-o", str(again)).returncode == 0
+    assert rnd.read_text() == again.read_text()
+    text = rnd.read_text()
+    assert "# seed=7" in text and "noise_spread=3" in text and "random_positions=30" in text
+    sigma = [float(r["sigma_arcsec"]) for r in _rows(rnd)]
+    assert 1 / 3 <= min(sigma) < max(sigma) <= 3
+    per_angle = tmp_path / "per_angle.csv"
+    assert cli("simulate", "--noise-arcsec", "0.5,2,1", "--no-sigma", "-o",
+               str(per_angle)).returncode == 0  # fmt: skip
+    assert "sigma" not in _rows(per_angle)[0]
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (("--sweep", "phi1", "--random-positions", "5"), "not allowed with argument"),
+        (("--sweep", "phi3"), "--sweep 'phi3': unknown axis 'phi3'"),
+        (("--sweep", "phi1,phi1"), "swept twice"),
+        (("--random-positions", "5", "--order", "random"), "--order random shuffles a grid"),
+        (("--random-positions", "0"), "--random-positions"),
+        (("--passes", "0"), "--passes"),
+        (("--noise-arcsec", "1,2"), "one value or three"),
+        (("--noise-spread", "0.5"), "--noise-spread"),
+        (("--noise-arcsec", "1000", "--noise-spread", "3"), "--noise-spread 3: with --noise"),
+        (("--random-positions", "600000", "--passes", "1"), "1,200,000 rows"),
+        (("--phi2-start-deg", "4000"), "--phi2-start-deg"),
+    ],
+)
+def test_simulate_bad_design_options_exit_2(args, fragment, tmp_path):
+    proc = cli("simulate", *args, "-o", str(tmp_path / "x.csv"))
+    assert proc.returncode == 2
+    assert fragment in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    assert not (tmp_path / "x.csv").exists()
+
+
+@pytest.mark.parametrize(
+    ("text", "extra", "fragment"),
+    [
+        ("phi1_deg,phi2_deg,dir1\n0,0,1\n90,45,2\n", (), "row 3, column 'dir1'"),
+        ("phi1_deg,phi2_deg\n0,0\n90,4000\n", (), "row 3, column 'phi2_deg'"),
+        ("phi1_deg\n0\n", (), "missing required column 'phi2_deg'"),
+        ("phi1_deg,phi2_deg,time_s\n0,0,-5\n", (), "row 2, column 'time_s'"),
+        ("phi1_deg,phi2_deg,time_s\n0,0,5\n0,0,5\n", (), "listed twice"),
+        ("phi1_deg,phi2_deg,time_s\n0,0,5\n", ("--repeats", "2"), "--repeats: "),
+        ("phi1_deg,phi2_deg,dir2\n0,0,1\n", ("--passes", "1"), "--passes: "),
+    ],
+)
+def test_simulate_bad_positions_file_exit_2_naming_row_and_column(text, extra, fragment, tmp_path):
+    positions = tmp_path / "positions.csv"
+    positions.write_text(text)
+    proc = cli("simulate", "--positions", str(positions), *extra, "-o", str(tmp_path / "x.csv"))
+    assert proc.returncode == 2 and fragment in proc.stderr, proc.stderr
+    assert "positions.csv" in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "x.csv").exists()
+    assert positions.read_text() == text
+
+
+def test_simulate_sweep_by_joint_name_on_another_table(tmp_path):
+    urdf = str(REPO_DIR / "models" / "two_axis_vertical_outer.urdf")
+    out = tmp_path / "sweep.csv"
+    proc = cli("simulate", "--urdf", urdf, "--sweep", "tilt_axis,azimuth_axis", "--phi1-step-deg",
+               "120", "--phi2-step-deg", "180", "-o", str(out))  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    pairs = [(float(r["phi1_deg"]), float(r["phi2_deg"])) for r in _rows(out)]
+    assert pairs == [(0, 0), (0, 180), (0, 0), (120, 0), (240, 0)]
+    assert "sweep=phi2,phi1" in out.read_text()
+    bad = cli("simulate", "--urdf", urdf, "--sweep", "elevation", "-o", str(tmp_path / "x.csv"))
+    assert bad.returncode == 2 and "phi1, phi2, azimuth_axis, tilt_axis" in bad.stderr

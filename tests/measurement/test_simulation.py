@@ -97,3 +97,133 @@ def test_cli_choices_match_the_library():
     from turntable_pin.measurement.simulation import APPROACHES, ORDERS
 
     assert measurement.ORDERS == ORDERS and measurement.APPROACHES == APPROACHES
+
+
+# --- the designs engineers run: positions, sweeps, passes, random positions, uneven noise --------
+
+
+def _deg(sim):
+    return np.degrees(sim.data.joint_rad).round(6)
+
+
+def test_explicit_positions_are_measured_in_their_order_with_their_dirs_and_times():
+    schedule = Schedule(
+        positions=((0, 0), (90, 45), (180, 10), (90, 45)),
+        positions_dirs=((1, -1, 1, 1), None),
+        positions_time_s=(0, 10, 30, 31),
+    )
+    sim = simulate_measurements(schedule=schedule, seed=3)
+    assert _deg(sim).tolist() == [[0, 0], [90, 45], [180, 10], [90, 45]]
+    assert sim.data.dir1.tolist() == [1, -1, 1, 1]
+    assert set(sim.data.dir2.tolist()) <= {-1, 1}  # the approach rule (random) for joint 2
+    assert sim.data.time_s.tolist() == [0, 10, 30, 31]
+    twice = simulate_measurements(schedule=Schedule(positions=((0, 0), (30, 60)), repeats=2))
+    assert _deg(twice).tolist() == [[0, 0], [30, 60], [0, 0], [30, 60]]
+    np.testing.assert_allclose(twice.data.time_s, [0, 60, 120, 180])
+
+
+def test_sweeps_move_one_axis_at_a_time_and_hold_the_others_at_their_start():
+    schedule = Schedule(90, 120, phi2_start_deg=90, sweep=("phi1", "phi2"), approach="motion")
+    sim = simulate_measurements(schedule=schedule)
+    assert _deg(sim).tolist() == [
+        [0, 90], [90, 90], [180, 90], [270, 90],  # phi1 swept at phi2 = 90
+        [0, 90], [0, 210], [0, 330],  # then phi2 swept at phi1 = 0
+    ]  # fmt: skip
+    assert sim.data.dir1.tolist() == [1, 1, 1, 1, -1, -1, -1]
+    assert sim.data.dir2.tolist() == [1, 1, 1, 1, 1, 1, 1]
+    assert Schedule(90, 120, sweep=("phi2",)).count() == 3
+    assert "sweep=phi1,phi2 phi1_step_deg=90 phi2_step_deg=120 held at phi1_start_deg=0 " \
+        "phi2_start_deg=90" in sim.comment()  # fmt: skip
+
+
+def test_passes_go_forward_then_backward_and_the_directions_follow_the_pass():
+    sim = simulate_measurements(schedule=Schedule(180, 120, passes=2), seed=1)
+    forward = [[0, 0], [0, 120], [0, 240], [180, 0], [180, 120], [180, 240]]
+    assert _deg(sim).tolist() == (forward + forward[::-1]) * 2
+    expected = ([1] * 6 + [-1] * 6) * 2
+    assert sim.data.dir1.tolist() == expected and sim.data.dir2.tolist() == expected
+    assert sim.schedule.approach == "motion" and "approach=motion passes=2" in sim.comment()
+    positive = simulate_measurements(schedule=Schedule(180, 120, passes=1, approach="positive"))
+    assert set(positive.data.dir1.tolist()) == {1}
+
+
+def test_random_positions_are_uniform_seeded_and_recorded():
+    a = simulate_measurements(schedule=Schedule(random_positions=500), seed=4)
+    b = simulate_measurements(schedule=Schedule(random_positions=500), seed=4)
+    c = simulate_measurements(schedule=Schedule(random_positions=500), seed=5)
+    np.testing.assert_array_equal(a.data.joint_rad, b.data.joint_rad)
+    assert not np.array_equal(a.data.joint_rad, c.data.joint_rad)
+    deg = _deg(a)
+    assert deg.min() >= 0 and deg.max() <= 360
+    assert np.all(np.histogram(deg[:, 0], bins=4, range=(0, 360))[0] > 90)  # spread over the turn
+    assert np.array_equal(deg, np.round(deg, 6))
+    assert "schedule: random_positions=500 uniform from phi1_start_deg=0" in a.comment()
+
+
+def test_uneven_noise_per_row_and_noise_per_angle(tmp_path):
+    sim = simulate_measurements(schedule=Schedule(15, 15), noise_arcsec=2.0, noise_spread=4.0,
+                                seed=8)  # fmt: skip
+    sigma = sim.data.sigma_rad[:, 0] * ARCSEC_PER_RAD
+    assert 0.5 <= sigma.min() < 0.7 and 5.7 < sigma.max() <= 8.0
+    assert abs(np.mean(np.log(sigma / 2.0))) < 0.1  # log-uniform about the stated sigma
+    pulls = (sim.data.angles_rad - sim.truth_rad) / sim.data.sigma_rad
+    assert pulls.std() == pytest.approx(1.0, rel=0.05)
+    assert "noise_arcsec=2 noise_spread=4" in sim.comment()
+    back = read_measurements(sim.write_csv(tmp_path / "spread.csv"))
+    np.testing.assert_allclose(back.sigma_rad, sim.data.sigma_rad, rtol=1e-12)
+    per_angle = simulate_measurements(noise_arcsec=(0.5, 2.0, 1.0), seed=8)
+    noise = (per_angle.data.angles_rad - per_angle.truth_rad) * ARCSEC_PER_RAD
+    np.testing.assert_allclose(noise.std(axis=0), [0.5, 2.0, 1.0], rtol=0.15)
+    path = per_angle.write_csv(tmp_path / "per_angle.csv")
+    header = [ln for ln in path.read_text().splitlines() if not ln.startswith("#")][0]
+    assert "sigma_dpsi_arcsec,sigma_dtheta_arcsec,sigma_dgamma_arcsec" in header
+    assert "# noise_arcsec=0.5,2,1 (dpsi,dtheta,dgamma)" in path.read_text()
+    bare = per_angle.write_csv(tmp_path / "bare.csv", with_sigma=False)
+    assert read_measurements(bare).sigma_rad is None
+
+
+def test_the_existing_options_draw_the_same_numbers():
+    # A schedule without the new options, and even noise, must keep every earlier file.
+    sim = simulate_measurements(schedule=Schedule(30, 30, order="random"), seed=9)
+    rng = np.random.default_rng(9)
+    perm = rng.permutation(144)
+    np.testing.assert_array_equal(np.degrees(sim.data.phi1_rad).round(6),
+                                  (np.repeat(np.arange(0, 360, 30), 12)[perm]))  # fmt: skip
+    assert sim.schedule.approach == "random"
+    assert "schedule: phi1_step_deg=30 phi2_step_deg=30 order=random repeats=1 dwell_s=60 " \
+        "approach=random\n" in sim.comment()  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "fragment"),
+    [
+        ({"positions": ((0, 0),), "sweep": ("phi1",)}, "give one design of positions"),
+        ({"random_positions": 5, "order": "random"}, "measured in their own order"),
+        ({"sweep": ("phi4",)}, "unknown axis 'phi4'"),
+        ({"sweep": ("phi1", "phi1")}, "swept twice"),
+        ({"positions": ((0, 0),), "positions_time_s": (0,), "repeats": 2}, "give their times"),
+        ({"positions": ((0, 0),), "positions_dirs": ((1,),), "passes": 1}, "passes set"),
+        ({"positions": ((0, 0),), "positions_dirs": ((2,),)}, "+1 or -1"),
+        ({"positions": ((0, 4000),)}, "within +-3600"),
+        ({"positions": ((0, 0), (1, 2)), "positions_time_s": (0, -1)}, "positions_time_s"),
+        ({"random_positions": 600_000, "passes": 1}, "1,200,000 rows"),
+        ({"phi1_start_deg": 5000.0}, "phi1_start_deg"),
+    ],
+)
+def test_bad_designs_are_refused(kwargs, fragment):
+    with pytest.raises(InputError, match=None) as info:
+        Schedule(**kwargs)
+    assert fragment in str(info.value)
+
+
+def test_bad_noise_and_positions_for_the_table():
+    with pytest.raises(InputError, match="noise_spread"):
+        simulate_measurements(noise_spread=0.5)
+    with pytest.raises(InputError, match="would leave"):
+        simulate_measurements(noise_arcsec=1000, noise_spread=2)
+    with pytest.raises(InputError, match="one number or three"):
+        simulate_measurements(noise_arcsec=(1, 2))
+    with pytest.raises(InputError, match="the table has 2 joints"):
+        simulate_measurements(schedule=Schedule(positions=((0, 0, 0),)))
+    with pytest.raises(InputError, match="no axis phi3"):
+        simulate_measurements(schedule=Schedule(sweep=("phi3",)))

@@ -51,20 +51,49 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     _add_catalogue_option(s)
     step = bounded_float(0.0, 360.0, "deg", low_open=True)
-    s.add_argument("--noise-arcsec", type=_noise_arcsec, default=1.0, help="1-sigma noise")
+    start = bounded_float(-3240.0, 3240.0, "deg")
+    s.add_argument(
+        "--noise-arcsec",
+        type=_noise_arcsec,
+        default=1.0,
+        help="1-sigma noise; three comma-separated values give dpsi,dtheta,dgamma their own",
+    )
+    s.add_argument(
+        "--noise-spread",
+        type=bounded_float(1.0, 100.0),
+        default=1.0,
+        metavar="F",
+        help="uneven noise: each row's sigma drawn log-uniform in [sigma/F, sigma*F] (seeded)",
+    )
     s.add_argument("--seed", type=seed, default=0, help="random seed (recorded in the file)")
     s.add_argument("--phi1-step-deg", type=step, default=30.0)
     s.add_argument("--phi2-step-deg", type=step, default=30.0)
     s.add_argument("--phi3-step-deg", type=step, default=30.0, help="third axis (3-axis tables)")
+    for k in (1, 2, 3):
+        s.add_argument(f"--phi{k}-start-deg", type=start, default=0.0,
+                       help=f"first grid angle of phi{k}; a sweep holds phi{k} here")  # fmt: skip
+    design = s.add_mutually_exclusive_group()
+    design.add_argument("--positions", type=Path, metavar="FILE.csv",
+                        help="measure these positions in the file's order (columns phi1_deg.. "
+                        "or <joint>_deg, optional dir1.. and time_s)")  # fmt: skip
+    design.add_argument("--sweep", metavar="AXES",
+                        help="single-axis sweeps, one after the other: phi1,phi2 sweeps phi1 "
+                        "over its grid with phi2 held, then phi2 with phi1 held")  # fmt: skip
+    design.add_argument("--random-positions", type=positive_int, metavar="N",
+                        help="N positions uniform over every joint's turn (seeded)")  # fmt: skip
     s.add_argument("--order", choices=ORDERS, default="grid")
     s.add_argument("--repeats", type=positive_int, default=1)
+    s.add_argument("--passes", type=positive_int, default=0, metavar="K",
+                   help="forward then backward over the positions, K times; approach "
+                   "directions follow the pass (+1 forward, -1 backward)")  # fmt: skip
     s.add_argument(
         "--dwell-s",
         type=bounded_float(0.0, MAX_TIME_S, "s", low_open=True),
         default=60.0,
         help="time per position",
     )
-    s.add_argument("--approach", choices=APPROACHES, default="random")
+    s.add_argument("--approach", choices=APPROACHES, default=None,
+                   help="random (default), motion (default with --passes) or positive")  # fmt: skip
     s.add_argument("--no-sigma", action="store_true", help="leave out the sigma_arcsec column")
     s.add_argument(
         "--hide-truth",
@@ -135,11 +164,40 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     r.set_defaults(func=run_report)
 
 
-def _noise_arcsec(text: str) -> float:
-    """argparse type of ``--noise-arcsec``: the simulator's noise range (imported when used)."""
+def _noise_arcsec(text: str) -> float | tuple[float, float, float]:
+    """argparse type of ``--noise-arcsec``: the simulator's noise range (imported when used); one
+    value, or three comma-separated ones (dpsi, dtheta, dgamma)."""
     from ..measurement.simulation import MAX_NOISE_ARCSEC
 
-    return bounded_float(MIN_SIGMA_ARCSEC, MAX_NOISE_ARCSEC, "arcsec")(text)
+    parse = bounded_float(MIN_SIGMA_ARCSEC, MAX_NOISE_ARCSEC, "arcsec")
+    parts = text.split(",")
+    if len(parts) == 1:
+        return parse(text)
+    if len(parts) != 3:
+        raise argparse.ArgumentTypeError(
+            f"expected one value or three (dpsi,dtheta,dgamma), got {len(parts)}: '{text}'"
+        )
+    return tuple(parse(p.strip()) for p in parts)
+
+
+def _sweep_axes(text: str, table) -> tuple[str, ...]:
+    """``--sweep``: comma-separated axes (``phiK`` or the table's joint names) as ``phiK``."""
+    names = tuple(getattr(table, "joint_names", ())) if hasattr(table, "identifiable") else ()
+    n_joints = len(names) if names else 2
+    known = {f"phi{k}": f"phi{k}" for k in range(1, n_joints + 1)}
+    known.update({name: f"phi{k}" for k, name in enumerate(names, start=1)})
+    out = []
+    for part in text.split(","):
+        axis = part.strip()
+        if axis not in known:
+            raise InputError(
+                f"--sweep '{text}': unknown axis '{axis}'; the table's axes are "
+                f"{', '.join(known)}"
+            )
+        if known[axis] in out:
+            raise InputError(f"--sweep '{text}': axis '{axis}' is swept twice")
+        out.append(known[axis])
+    return tuple(out)
 
 
 def _add_outlier_option(p: argparse.ArgumentParser) -> None:
@@ -204,7 +262,12 @@ def _parse_effect_options(texts: list[str], table=None, user=()) -> dict[str, di
 
 
 def run_simulate(args: argparse.Namespace) -> int:
-    from ..measurement.simulation import Schedule, simulate_measurements
+    from ..measurement.simulation import (
+        MAX_NOISE_ARCSEC,
+        Schedule,
+        read_positions,
+        simulate_measurements,
+    )
     from ..measurement.user_effects import inline_effect, load_catalogue
 
     table = table_from_args(args)
@@ -212,14 +275,52 @@ def run_simulate(args: argparse.Namespace) -> int:
     user = load_catalogue(args.catalogue, table)
     effects = _parse_effect_options(args.effect, table, user)
     user = (*user, *(inline_effect(name, table) for name in effects if "~" in name))
+    design = {}
+    if args.positions is not None:
+        design = read_positions(args.positions, table.joint_names if generic else None)
+        given = [f"dir{k}" for k, d in enumerate(design["positions_dirs"], start=1) if d]
+        for option, value in (("--repeats", args.repeats > 1), ("--passes", args.passes)):
+            if value and design["positions_time_s"] is not None:
+                raise InputError(
+                    f"{option}: {args.positions} gives time_s, so each of its rows is one "
+                    f"measurement; leave out {option} or the time_s column"
+                )
+        if args.passes and given:
+            raise InputError(
+                f"--passes: {args.positions} gives {given[0]}, but the passes set the approach "
+                f"directions (+1 forward, -1 backward); leave out --passes or the {given[0]} column"
+            )
+    elif args.sweep is not None:
+        design = {"sweep": _sweep_axes(args.sweep, table)}
+    elif args.random_positions:
+        design = {"random_positions": args.random_positions}
+    if design and args.order != "grid":
+        raise InputError(
+            "--order random shuffles a grid; --positions, --sweep and --random-positions are "
+            "measured in their own order"
+        )
+    if args.noise_spread != 1:
+        noise = args.noise_arcsec if isinstance(args.noise_arcsec, tuple) else (args.noise_arcsec,)
+        top = max(noise) * args.noise_spread
+        if top > MAX_NOISE_ARCSEC or min(noise) / args.noise_spread < MIN_SIGMA_ARCSEC:
+            raise InputError(
+                f"--noise-spread {args.noise_spread:g}: with --noise-arcsec "
+                f"{','.join(f'{v:g}' for v in noise)} the row sigmas would leave "
+                f"[{MIN_SIGMA_ARCSEC:g}, {MAX_NOISE_ARCSEC:g}] arcsec"
+            )
     schedule = Schedule(
         phi1_step_deg=args.phi1_step_deg,
         phi2_step_deg=args.phi2_step_deg,
         phi3_step_deg=args.phi3_step_deg,
+        phi1_start_deg=args.phi1_start_deg,
+        phi2_start_deg=args.phi2_start_deg,
+        phi3_start_deg=args.phi3_start_deg,
         order=args.order,
         repeats=args.repeats,
         dwell_s=args.dwell_s,
         approach=args.approach,
+        passes=args.passes,
+        **design,
     )
     n_joints = len(table.joint_names) if generic else 2
     if schedule.duration_s(n_joints) > MAX_TIME_S:
@@ -235,6 +336,7 @@ def run_simulate(args: argparse.Namespace) -> int:
         seed=args.seed,
         turntable=table,
         catalogue=user,
+        noise_spread=args.noise_spread,
     )
     path = sim.write_csv(args.output, with_sigma=not args.no_sigma, hide_truth=args.hide_truth)
     print(f"wrote {path}: {sim.data.n_positions} positions, seed {sim.seed}")

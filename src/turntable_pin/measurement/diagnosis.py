@@ -165,12 +165,14 @@ class OrientationFamily:
         singular = np.linalg.svd(jac / np.linalg.norm(jac, axis=0).clip(1e-300), compute_uv=False)
         full_rank = int(np.sum(singular > RANK_RTOL * singular[0]))
         full_rank -= len(lost)  # what the empty cells hide is said above
-        if rank >= full_rank:
-            return warnings
         wrapped = np.round(np.mod(np.degrees(data.joint_rad), 360.0), 6) % 360.0
         distinct = np.unique(wrapped, axis=0)
         labels = [self.table.angle_label(k) for k in range(1, data.n_joints + 1)]
-        axes = " or ".join(labels)
+        sampling = self._sampling_warnings(wrapped, labels) if len(distinct) > 1 else []
+        if rank >= full_rank:
+            return warnings + sampling
+        held = [lab for k, lab in enumerate(labels) if np.unique(wrapped[:, k]).size == 1]
+        axes = " or ".join(held if len(distinct) > 1 and held else labels)
         where = (
             f"all {data.n_positions} rows are at one position ("
             + ", ".join(f"{lab} {v:g}" for lab, v in zip(labels, distinct[0], strict=True))
@@ -184,7 +186,69 @@ class OrientationFamily:
             "cannot be tested, and an effect named here (a step with dir, a drift in time) may "
             "stand for any error that changed between the rows; measure more positions over the "
             "full turn of every axis"
-        ]
+        ] + sampling
+
+    def _sampling_warnings(self, wrapped_deg: np.ndarray, labels: list[str]) -> list[str]:
+        """What positions at more than one place still cannot tell: an axis held at one angle,
+        too few angles of an axis for the 2/rev terms, single-axis sweeps (no coupled terms), an
+        approach direction that never changes (no backlash)."""
+        data = self.data
+        out = []
+        counts = [np.unique(wrapped_deg[:, k]).size for k in range(data.n_joints)]
+        held = [k for k, c in enumerate(counts) if c == 1]
+        if held:
+            where = ", ".join(f"{labels[k]} at {wrapped_deg[0, k]:g} deg" for k in held)
+            names = " or ".join(labels[k] for k in held)
+            out.append(
+                f"the rows hold {where}: effects that vary with {names} cannot be tested here "
+                "(the diagnosis lists them as indistinguishable from the base); move "
+                f"{names} over its turn too (simulate --sweep {','.join(labels)}, or a grid)"
+            )
+        for k, count in enumerate(counts):
+            if 1 < count < 5:
+                top = (count - 1) // 2
+                out.append(
+                    f"{labels[k]} takes only {count} distinct angles: a k/rev term in "
+                    f"{labels[k]} needs at least 2k+1 angles over the turn, so terms of order "
+                    f"{top + 1} and above (the 2/rev terms of encoders and wobble) alias with "
+                    "lower orders or vanish at every row and cannot be tested; measure "
+                    f"{labels[k]} at 5 or more angles spread over the turn (a step of at most "
+                    "72 deg)"
+                )
+        moving = [k for k, c in enumerate(counts) if c > 1]
+        if len(moving) > 1:
+            base = [np.unique(wrapped_deg[:, k], return_counts=True) for k in range(data.n_joints)]
+            centre = np.array([v[np.argmax(c)] for v, c in base])
+            if np.all(np.sum(wrapped_deg != centre, axis=1) <= 1):
+                lines = ", ".join(
+                    f"{labels[k]} swept at " + ", ".join(
+                        f"{labels[j]} {centre[j]:g}" for j in range(data.n_joints) if j != k
+                    ) + " deg"
+                    for k in moving
+                )  # fmt: skip
+                out.append(
+                    f"the rows are single-axis sweeps ({lines}): an effect is seen only along "
+                    "these lines, so one that varies with several axes together (a term in "
+                    "phi1+phi2 or phi1-phi2, a product such as the gravity sag) cannot be told "
+                    "from terms in one axis each; measure positions where the axes move together "
+                    "(a grid or random positions) to see it"
+                )
+        fixed = [
+            (k, float(d[0])) for k, d in enumerate(data.dirs, start=1)
+            if d is not None and np.unique(d).size == 1
+        ]  # fmt: skip
+        if fixed:
+            dirs = ", ".join(f"dir{k}" for k, _ in fixed)
+            sides = ", ".join(
+                f"{labels[k - 1]} from {'below' if v > 0 else 'above'}" for k, v in fixed
+            )
+            out.append(
+                f"{dirs} {'is' if len(fixed) == 1 else 'are'} the same at every row ({sides}): a "
+                "step with the approach direction (backlash) cannot be told from a constant offset "
+                "of the axis, so it is indistinguishable from the base here; approach the "
+                "positions from both sides (simulate --approach random, or --passes) to see it"
+            )
+        return out
 
     def _probe(self, name: str, description: str, factors: ProbeFactors, spec: str) -> Probe:
         """A probe whose columns are ``factors``' direction (N, 3) times its functions (N, g),

@@ -15,17 +15,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.csv_table import write_csv_table
+from ..core.csv_table import read_csv_table, refuse_repeated_rows, write_csv_table
 from ..core.exceptions import InputError, check_seed
 from ..core.sizes import MAX_SIMULATED_ROWS, check_count, turn_grid_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
 from .catalogue import resolve_effect
 from .data import (
+    MAX_COMMANDED_ANGLE_DEG,
     MAX_MEASURED_ANGLE_ARCSEC,
     MAX_TIME_S,
     MIN_SIGMA_ARCSEC,
     OrientationMeasurements,
+    angle_columns,
 )
 from .effect_model import OrientationModel
 from .effects.base import Effect, PositionVariables
@@ -35,9 +37,11 @@ __all__ = [
     "ROW_BYTES",
     "APPROACHES",
     "MAX_NOISE_ARCSEC",
+    "MAX_NOISE_SPREAD",
     "ORDERS",
     "Schedule",
     "SimulatedMeasurements",
+    "read_positions",
     "simulate_measurements",
 ]
 
@@ -50,6 +54,9 @@ MAX_NOISE_ARCSEC = MAX_MEASURED_ANGLE_ARCSEC / 10.0
 """Largest simulated noise sigma, arc seconds (1800, half a degree): a tenth of the largest angle
 a measurement file may hold, so that noise alone never makes a file that cannot be read back."""
 
+MAX_NOISE_SPREAD = 100.0
+"""Largest ``noise_spread`` F: each row's sigma is drawn log-uniform in [sigma/F, sigma*F]."""
+
 ROW_BYTES = 1024
 """Memory a simulated row costs while it is built and written (rough upper bound), bytes."""
 
@@ -58,16 +65,37 @@ ROW_BYTES = 1024
 class Schedule:
     """Which positions are measured, in which order, when, and from which side.
 
+    The positions come from one of four designs: a grid over every joint (the default), an
+    explicit list (``positions``), single-axis sweeps (``sweep``) or random positions
+    (``random_positions``). The list is then measured ``repeats`` times over, and with ``passes``
+    K > 0 it is measured forward and then backward, K times.
+
     Attributes:
         phi1_step_deg, phi2_step_deg, phi3_step_deg: grid steps of each joint (a table with
             fewer joints ignores the others); the grid covers [start, start + 360).
-        phi1_start_deg, phi2_start_deg, phi3_start_deg: first grid angles.
+        phi1_start_deg, phi2_start_deg, phi3_start_deg: first grid angles; in a sweep, the angle
+            at which the joints not being swept are held.
         order: ``grid`` (phi1 outer loop, the last joint's angle inner loop) or ``random``
-            (shuffled).
+            (shuffled; grids only).
         repeats: how many times each position is measured.
         dwell_s: time between consecutive measurements.
         approach: ``random`` (each axis from a random side), ``motion`` (the side the move from the
-            previous position came from; unchanged when the axis did not move) or ``positive``.
+            previous position came from; unchanged when the axis did not move; on ``passes``, the
+            pass's direction: +1 forward, -1 backward for every joint) or ``positive``. ``None``
+            (the default): ``motion`` with ``passes``, else ``random``.
+        positions: an explicit list of positions, ``((phi1_deg, phi2_deg, ...), ...)``, measured
+            in its order (one angle per joint of the table).
+        positions_time_s: the time of each listed position (default: ``dwell_s`` apart); not
+            with ``repeats`` or ``passes``.
+        positions_dirs: per joint, the approach direction (+1/-1) of each listed position, or
+            ``None`` for a joint the list does not give (the ``approach`` rule then applies);
+            not with ``passes``.
+        positions_source: where the list came from (a file name), for the comment header.
+        sweep: joints swept one after the other, e.g. ``("phi1", "phi2")``: phi1 over its grid
+            with the others held at their start angle, then phi2 likewise.
+        random_positions: N > 0: N positions drawn uniformly over [start, start + 360) of every
+            joint (seeded; rounded to 1e-6 deg).
+        passes: K > 0: the positions forward then backward, K times (2K traversals).
     """
 
     phi1_step_deg: float = 30.0
@@ -79,23 +107,56 @@ class Schedule:
     order: str = "grid"
     repeats: int = 1
     dwell_s: float = 60.0
-    approach: str = "random"
+    approach: str | None = None
+    positions: tuple[tuple[float, ...], ...] | None = None
+    positions_time_s: tuple[float, ...] | None = None
+    positions_dirs: tuple[tuple[float, ...] | None, ...] = ()
+    positions_source: str = ""
+    sweep: tuple[str, ...] = ()
+    random_positions: int = 0
+    passes: int = 0
 
     def __post_init__(self) -> None:
         for name in ("phi1_step_deg", "phi2_step_deg", "phi3_step_deg"):
             step = getattr(self, name)
             if not 0 < step <= 360:
                 raise InputError(f"{name} must be in (0, 360], got {step:g}")
+        for name in ("phi1_start_deg", "phi2_start_deg", "phi3_start_deg"):
+            start = getattr(self, name)
+            if not abs(start) <= MAX_COMMANDED_ANGLE_DEG - 360.0:
+                raise InputError(
+                    f"{name} must be within +-{MAX_COMMANDED_ANGLE_DEG - 360.0:g} deg, got {start}"
+                )
         if self.order not in ORDERS:
             raise InputError(f"order must be one of {', '.join(ORDERS)}, got '{self.order}'")
+        if self.approach is None:
+            object.__setattr__(self, "approach", "motion" if self.passes else "random")
         if self.approach not in APPROACHES:
             raise InputError(f"approach must be one of {', '.join(APPROACHES)}")
         if self.repeats < 1:
             raise InputError(f"repeats must be >= 1, got {self.repeats}")
+        if self.passes < 0 or self.random_positions < 0:
+            raise InputError("passes and random_positions must be >= 0")
+        designs = [
+            name
+            for name, given in (
+                ("positions", self.positions is not None),
+                ("sweep", bool(self.sweep)),
+                ("random_positions", self.random_positions > 0),
+            )
+            if given
+        ]
+        if len(designs) > 1:
+            raise InputError(f"give one design of positions, not {' and '.join(designs)}")
+        if designs and self.order != "grid":
+            raise InputError(
+                f"order '{self.order}' shuffles a grid; {designs[0]} are measured in their own "
+                "order"
+            )
+        self._check_positions()
+        self._check_sweep()
         check_count(
-            float(turn_grid_count(self.phi1_step_deg))
-            * turn_grid_count(self.phi2_step_deg)
-            * self.repeats,
+            float(self._base_count(2)) * self.repeats * (2 * self.passes or 1),
             MAX_SIMULATED_ROWS,
             "rows of simulated measurements",
             ROW_BYTES,
@@ -103,44 +164,234 @@ class Schedule:
         if self.dwell_s <= 0:
             raise InputError(f"dwell_s must be > 0, got {self.dwell_s:g}")
 
+    def _check_positions(self) -> None:
+        if self.positions is None:
+            if self.positions_time_s is not None or any(d is not None for d in self.positions_dirs):
+                raise InputError("positions_time_s and positions_dirs need positions")
+            return
+        rows = np.asarray(self.positions, dtype=float)
+        if rows.ndim != 2 or rows.shape[0] < 1:
+            raise InputError("positions must be a non-empty list of (phi1_deg, phi2_deg, ...)")
+        if not np.all(np.abs(rows) <= MAX_COMMANDED_ANGLE_DEG):
+            raise InputError(
+                f"a listed position must be within +-{MAX_COMMANDED_ANGLE_DEG:g} deg (and finite)"
+            )
+        n = rows.shape[0]
+        if self.positions_time_s is not None:
+            time = np.asarray(self.positions_time_s, dtype=float)
+            if time.shape != (n,) or not np.all((time >= 0) & (time <= MAX_TIME_S)):
+                raise InputError(
+                    f"positions_time_s needs {n} times in [0, {MAX_TIME_S:g}] s, one per position"
+                )
+            if self.repeats > 1 or self.passes:
+                raise InputError(
+                    "the positions give their times; repeats and passes would need other times "
+                    "(leave out time_s, or list every measurement)"
+                )
+        for k, dirs in enumerate(self.positions_dirs, start=1):
+            if dirs is None:
+                continue
+            d = np.asarray(dirs, dtype=float)
+            if d.shape != (n,) or not np.all(np.abs(d) == 1):
+                raise InputError(f"positions_dirs of joint {k} needs {n} values, each +1 or -1")
+            if self.passes:
+                raise InputError(
+                    f"passes set the approach directions themselves; the positions give dir{k}"
+                )
+
+    def _check_sweep(self) -> None:
+        joints = [str(j) for j in self.sweep]
+        for j in joints:
+            if j not in ("phi1", "phi2", "phi3"):
+                raise InputError(f"sweep: unknown axis '{j}', expected phi1, phi2 or phi3")
+        if len(set(joints)) != len(joints):
+            raise InputError(f"sweep: an axis is swept twice in {','.join(joints)}")
+
     def _steps(self, n_joints: int) -> list[tuple[float, float]]:
         return [
             (getattr(self, f"phi{k}_start_deg"), getattr(self, f"phi{k}_step_deg"))
             for k in range(1, n_joints + 1)
         ]
 
-    def count(self, n_joints: int = 2) -> int:
-        """Number of measurements on a table with ``n_joints`` joints."""
-        out = self.repeats
-        for _, step in self._steps(n_joints):
+    def _base_count(self, n_joints: int) -> int:
+        """Positions of the design before ``repeats`` and ``passes``."""
+        if self.positions is not None:
+            return len(self.positions)
+        if self.random_positions:
+            return int(self.random_positions)
+        steps = self._steps(n_joints)
+        if self.sweep:
+            return sum(turn_grid_count(steps[int(j[3:]) - 1][1]) for j in self.sweep
+                       if int(j[3:]) <= n_joints)  # fmt: skip
+        out = 1
+        for _, step in steps:
             out *= turn_grid_count(step)
         return int(out)
 
+    def count(self, n_joints: int = 2) -> int:
+        """Number of measurements on a table with ``n_joints`` joints."""
+        return int(self._base_count(n_joints) * self.repeats * (2 * self.passes or 1))
+
     def duration_s(self, n_joints: int = 2) -> float:
         """Time from the first to the last measurement, seconds (``time_s`` of the last row)."""
+        if self.positions_time_s is not None:
+            return float(max(self.positions_time_s))
         return (self.count(n_joints) - 1) * float(self.dwell_s)
+
+    def _design_deg(self, rng: np.random.Generator, n_joints: int) -> list[np.ndarray]:
+        """The design's positions (before repeats and passes), one array per joint."""
+        steps = self._steps(n_joints)
+        if self.positions is not None:
+            rows = np.asarray(self.positions, dtype=float)
+            if rows.shape[1] != n_joints:
+                raise InputError(
+                    f"the positions give {rows.shape[1]} angles each; the table has {n_joints} "
+                    "joints"
+                )
+            return [rows[:, k] for k in range(n_joints)]
+        if self.random_positions:
+            starts = np.array([start for start, _ in steps])
+            draws = rng.uniform(0.0, 360.0, (self.random_positions, n_joints))
+            rows = np.round(starts + draws, 6)
+            return [rows[:, k] for k in range(n_joints)]
+        axes = [start + np.arange(0.0, 360.0 - 1e-9, step) for start, step in steps]
+        if self.sweep:
+            out: list[list[np.ndarray]] = [[] for _ in range(n_joints)]
+            for label in self.sweep:
+                swept = int(label[3:]) - 1
+                if swept >= n_joints:
+                    raise InputError(f"sweep: the table has no axis {label} ({n_joints} joints)")
+                for k in range(n_joints):
+                    size = axes[swept].size
+                    out[k].append(axes[k] if k == swept else np.full(size, steps[k][0]))
+            return [np.concatenate(parts) for parts in out]
+        grids = np.meshgrid(*axes, indexing="ij")
+        return [g.ravel() for g in grids]
+
+    def _pass_sign(self, size: int) -> np.ndarray | None:
+        """+1 on forward and -1 on backward rows of ``passes`` (``size`` rows per traversal)."""
+        if not self.passes:
+            return None
+        return np.tile(np.repeat([1.0, -1.0], size), self.passes)
 
     def positions_deg(self, rng: np.random.Generator, n_joints: int = 2) -> tuple[np.ndarray, ...]:
         """Commanded joint angles (phi1, phi2, ...) in degrees, in measurement order."""
-        axes = [start + np.arange(0.0, 360.0 - 1e-9, step) for start, step in self._steps(n_joints)]
-        grids = np.meshgrid(*axes, indexing="ij")
-        out = [np.tile(g.ravel(), self.repeats) for g in grids]
+        out = [np.tile(a, self.repeats) for a in self._design_deg(rng, n_joints)]
         if self.order == "random":
             perm = rng.permutation(out[0].size)
             out = [a[perm] for a in out]
+        if self.passes:
+            out = [np.tile(np.concatenate([a, a[::-1]]), self.passes) for a in out]
         return tuple(out)
 
-    def directions(self, phi_deg: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-        """Approach direction (+1 / -1) of one axis at each measurement."""
+    def directions(
+        self, phi_deg: np.ndarray, rng: np.random.Generator, joint: int | None = None
+    ) -> np.ndarray:
+        """Approach direction (+1 / -1) of one axis at each measurement (``joint``: which one,
+        1-based, for the directions a list of positions gives)."""
+        given = (
+            self.positions_dirs[joint - 1] if joint and joint <= len(self.positions_dirs) else None
+        )
+        if given is not None:
+            return np.tile(np.asarray(given, dtype=float), self.repeats)
         if self.approach == "positive":
             return np.ones(phi_deg.size)
         if self.approach == "random":
             return rng.choice([-1.0, 1.0], size=phi_deg.size)
+        if self.passes:
+            return self._pass_sign(phi_deg.size // (2 * self.passes))
         out = np.ones(phi_deg.size)
         for i in range(1, phi_deg.size):
             move = phi_deg[i] - phi_deg[i - 1]
             out[i] = out[i - 1] if move == 0 else np.sign(move)
         return out
+
+    def times_s(self, n: int) -> np.ndarray:
+        """Time of each of the ``n`` measurements, seconds."""
+        if self.positions_time_s is not None:
+            return np.asarray(self.positions_time_s, dtype=float)
+        return np.arange(n) * self.dwell_s
+
+    def describe(self, n_joints: int) -> str:
+        """The schedule in one line (the ``# schedule:`` comment of a simulated file)."""
+        steps = " ".join(
+            f"phi{k}_step_deg={getattr(self, f'phi{k}_step_deg'):g}" for k in range(1, n_joints + 1)
+        )
+        starts = " ".join(
+            f"phi{k}_start_deg={getattr(self, f'phi{k}_start_deg'):g}"
+            for k in range(1, n_joints + 1)
+        )
+        tail = f"repeats={self.repeats} dwell_s={self.dwell_s:g} approach={self.approach}"
+        if self.positions is not None:
+            given = [f"dir{k}" for k, d in enumerate(self.positions_dirs, start=1) if d is not None]
+            if self.positions_time_s is not None:
+                given.append("time_s")
+            head = (
+                f"positions={self.positions_source or 'list'} n_positions={len(self.positions)}"
+                + (f" given={','.join(given)}" if given else "")
+            )
+        elif self.random_positions:
+            head = f"random_positions={self.random_positions} uniform from {starts}"
+        elif self.sweep:
+            head = f"sweep={','.join(self.sweep)} {steps} held at {starts}"
+        else:
+            head = f"{steps} order={self.order}"
+            if any(getattr(self, f"phi{k}_start_deg") for k in range(1, n_joints + 1)):
+                head += f" {starts}"
+        return f"{head} {tail}" + (f" passes={self.passes}" if self.passes else "")
+
+
+def read_positions(path: str | Path, joint_names: Sequence[str] | None = None) -> dict:
+    """The ``positions`` of a :class:`Schedule` from a CSV file (``Schedule(**read_positions(p))``).
+
+    Columns: one commanded angle per joint (``phi1_deg .. phiN_deg`` or ``<joint>_deg``),
+    optionally ``dir1 .. dirN`` (+1/-1) and ``time_s``; other columns are ignored. The rows are
+    measured in the file's order.
+
+    Raises:
+        InputError: naming the file, row and column of the first problem.
+    """
+    from ..calibration.positions import check_commanded_angles
+
+    path = Path(path)
+    names = tuple(joint_names) if joint_names else ("", "")
+    header = ()
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as handle:
+            for line in handle:
+                if line.strip() and not line.lstrip().startswith("#"):
+                    header = tuple(c.strip() for c in line.split(","))
+                    break
+    except (OSError, UnicodeDecodeError):
+        pass
+    columns = angle_columns(header, joint_names, path) if header else ("phi1_deg",)
+    dir_columns = tuple(f"dir{k}" for k in range(1, len(names) + 1))
+    table = read_csv_table(path, columns, ("time_s", *dir_columns), min_rows=1)
+    check_commanded_angles(table, columns)
+    if table.has("time_s"):
+        table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
+        table.refuse(
+            "time_s", table["time_s"] > MAX_TIME_S,
+            f"time since the start of the run must be at most {MAX_TIME_S:g} s",
+        )  # fmt: skip
+        refuse_repeated_rows(
+            table, (*columns, *dir_columns, "time_s"),
+            "a measurement listed twice (same position, directions and time_s)",
+        )  # fmt: skip
+    for column in dir_columns:
+        if table.has(column):
+            table.refuse(
+                column, np.abs(table[column]) != 1, "an approach direction must be +1 or -1"
+            )
+    check_count(len(table[columns[0]]), MAX_SIMULATED_ROWS, "listed positions", ROW_BYTES)
+    return {
+        "positions": tuple(zip(*(table[c].tolist() for c in columns), strict=True)),
+        "positions_time_s": tuple(table["time_s"].tolist()) if table.has("time_s") else None,
+        "positions_dirs": tuple(
+            tuple(table[c].tolist()) if table.has(c) else None for c in dir_columns
+        ),
+        "positions_source": path.name,
+    }
 
 
 @dataclass(frozen=True)
@@ -152,19 +403,21 @@ class SimulatedMeasurements:
         errors: the turntable errors used (the paper's ``TurntableErrors``, or ``{name: value in
             user units}`` of another table: ``<error>_arcsec``, ``<offset>_mm``).
         effects: ``{effect: {parameter: value in user units}}`` hidden in the data.
-        noise_arcsec: the noise sigma.
+        noise_arcsec: the noise sigma (one number, or ``(dpsi, dtheta, dgamma)``).
         seed: the random seed.
         schedule: the :class:`Schedule` measured.
         truth_rad: noise-free ``dpsi, dtheta, dgamma`` (N, 3).
+        noise_spread: F: each row's sigma was drawn log-uniform in [sigma/F, sigma*F] (1: even).
     """
 
     data: OrientationMeasurements
     errors: TurntableErrors | dict[str, float]
     effects: dict[str, dict[str, float]]
-    noise_arcsec: float
+    noise_arcsec: float | tuple[float, float, float]
     seed: int
     schedule: Schedule
     truth_rad: np.ndarray = field(repr=False)
+    noise_spread: float = 1.0
 
     def comment(self, *, hide_truth: bool = False) -> str:
         """The comment lines written above the CSV header.
@@ -178,18 +431,20 @@ class SimulatedMeasurements:
             f"{name}: " + ", ".join(f"{p}={v:.6g}" for p, v in params.items())
             for name, params in self.effects.items()
         )
-        s = self.schedule
+        noise = np.atleast_1d(self.noise_arcsec)
+        noise_line = "noise_arcsec=" + ",".join(f"{v:g}" for v in noise)
+        if noise.size > 1:
+            noise_line += " (dpsi,dtheta,dgamma)"
+        if self.noise_spread != 1:
+            noise_line += (
+                f" noise_spread={self.noise_spread:g} (each row's sigma drawn log-uniform in "
+                "[sigma/spread, sigma*spread])"
+            )
         lines = [
             "simulated by turntable-pin simulate",
             f"seed={self.seed}",
-            f"noise_arcsec={self.noise_arcsec:g}",
-            "schedule: "
-            + " ".join(
-                f"phi{k}_step_deg={getattr(s, f'phi{k}_step_deg'):g}"
-                for k in range(1, self.data.n_joints + 1)
-            )
-            + f" order={s.order} repeats={s.repeats} dwell_s={s.dwell_s:g} "
-            f"approach={s.approach}",
+            noise_line,
+            "schedule: " + self.schedule.describe(self.data.n_joints),
         ]
         if hide_truth:
             return "\n".join([*lines, "errors and hidden effects: not recorded (--hide-truth)"])
@@ -203,7 +458,9 @@ class SimulatedMeasurements:
         """Write the CSV of ``docs/measurements.md`` atomically, seed (and truth) as comments."""
         columns = self.data.columns()
         if not with_sigma:
-            columns.pop("sigma_arcsec", None)
+            for name in ("sigma_arcsec", "sigma_dpsi_arcsec", "sigma_dtheta_arcsec",
+                         "sigma_dgamma_arcsec"):  # fmt: skip
+                columns.pop(name, None)
         return write_csv_table(path, columns, comment=self.comment(hide_truth=hide_truth))
 
 
@@ -212,10 +469,11 @@ def simulate_measurements(
     effects: Mapping[str, Mapping[str, float]] | None = None,
     *,
     schedule: Schedule | None = None,
-    noise_arcsec: float = 1.0,
+    noise_arcsec: float | Sequence[float] = 1.0,
     seed: int = 0,
     turntable=None,
     catalogue: Sequence[Effect] = (),
+    noise_spread: float = 1.0,
 ) -> SimulatedMeasurements:
     """Simulate a measurement run.
 
@@ -226,7 +484,11 @@ def simulate_measurements(
             are zero; units are the effect's, e.g. arcsec, arcsec/g, arcsec/h).
         schedule: positions, order, time and approach directions (default: 30-degree grid).
         noise_arcsec: 1-sigma Gaussian noise on each angle (in ``[MIN_SIGMA_ARCSEC,
-            MAX_NOISE_ARCSEC]``: the file must read back).
+            MAX_NOISE_ARCSEC]``: the file must read back); three numbers give the noise of
+            ``dpsi, dtheta, dgamma`` separately (written as ``sigma_<angle>_arcsec``).
+        noise_spread: F >= 1: each row's sigma is ``noise_arcsec`` times a factor drawn
+            log-uniform in [1/F, F] (seeded, after the noise), and the row's noise has that sigma;
+            every sigma stays within the noise range. 1 (the default): even noise.
         seed: seed of every random choice (order, directions, noise): a whole number
             0 <= seed < 2**63.
 
@@ -237,12 +499,26 @@ def simulate_measurements(
         catalogue: effects besides the table's catalogue that ``effects`` may name (the user's).
     """
     limit = MAX_MEASURED_ANGLE_ARCSEC
-    if not noise_arcsec > 0:
-        raise InputError(f"noise_arcsec must be > 0, got {noise_arcsec:g}")
-    if not MIN_SIGMA_ARCSEC <= noise_arcsec <= MAX_NOISE_ARCSEC:
+    noise = np.atleast_1d(np.asarray(noise_arcsec, dtype=float))
+    if noise.size not in (1, 3):
+        raise InputError(f"noise_arcsec takes one number or three, got {noise.size}")
+    for value in noise:
+        if not value > 0:
+            raise InputError(f"noise_arcsec must be > 0, got {value:g}")
+        if not MIN_SIGMA_ARCSEC <= value <= MAX_NOISE_ARCSEC:
+            raise InputError(
+                f"noise_arcsec must be in [{MIN_SIGMA_ARCSEC:g}, {MAX_NOISE_ARCSEC:g}], got "
+                f"{value:g}"
+            )
+    if not 1.0 <= noise_spread <= MAX_NOISE_SPREAD:
+        raise InputError(f"noise_spread must be in [1, {MAX_NOISE_SPREAD:g}], got {noise_spread:g}")
+    if (
+        noise.min() / noise_spread < MIN_SIGMA_ARCSEC
+        or noise.max() * noise_spread > MAX_NOISE_ARCSEC
+    ):
         raise InputError(
-            f"noise_arcsec must be in [{MIN_SIGMA_ARCSEC:g}, {MAX_NOISE_ARCSEC:g}], got "
-            f"{noise_arcsec:g}"
+            f"noise_spread {noise_spread:g}: the sigmas would leave [{MIN_SIGMA_ARCSEC:g}, "
+            f"{MAX_NOISE_ARCSEC:g}] arcsec (noise_arcsec / spread .. noise_arcsec * spread)"
         )
     seed = check_seed(seed)
     table = measured_table(turntable)
@@ -288,8 +564,8 @@ def simulate_measurements(
         )
     variables = PositionVariables(
         np.stack(angles_deg, axis=1) / DEG_PER_RAD,
-        time_s=np.arange(n) * schedule.dwell_s,
-        dirs=tuple(schedule.directions(a, rng) for a in angles_deg),
+        time_s=schedule.times_s(n),
+        dirs=tuple(schedule.directions(a, rng, k) for k, a in enumerate(angles_deg, start=1)),
     )
     effect_objects = [resolve_effect(name, table, catalogue) for name in effects]
     effects = {e.name: effects[name] for e, name in zip(effect_objects, effects, strict=True)}
@@ -305,8 +581,20 @@ def simulate_measurements(
                 )
             values[f"{effect.name}.{pname}"] = float(value) * specs[pname].per_user_unit
     truth = model.predict(model.parameter_vector(values))
-    sigma_rad = noise_arcsec / ARCSEC_PER_RAD
-    measured = truth + rng.normal(0.0, sigma_rad, truth.shape)
+    if noise.size == 1 and noise_spread == 1:
+        sigma_rad = float(noise[0]) / ARCSEC_PER_RAD
+        measured = truth + rng.normal(0.0, sigma_rad, truth.shape)
+        sigma_rad = np.full(n, sigma_rad)
+    else:
+        unit = rng.standard_normal(truth.shape)
+        factor = np.ones((n, 1))
+        if noise_spread != 1:
+            factor = np.exp(rng.uniform(-1.0, 1.0, (n, 1)) * math.log(noise_spread))
+        sigma_rad = factor * noise[None, :] / ARCSEC_PER_RAD  # (n, 1) or (n, 3)
+        measured = truth + unit * sigma_rad
+        sigma_rad = np.broadcast_to(sigma_rad, (n, noise.size)).copy()
+        if noise.size == 1:
+            sigma_rad = sigma_rad[:, 0]
     largest = float(np.max(np.abs(measured))) * ARCSEC_PER_RAD
     if not largest <= limit:
         raise InputError(
@@ -317,7 +605,7 @@ def simulate_measurements(
     data = OrientationMeasurements(
         joint_rad=variables.joint_rad,
         angles_rad=measured,
-        sigma_rad=np.full(n, sigma_rad),
+        sigma_rad=sigma_rad,
         time_s=variables.time_s,
         dirs=variables.dirs,
         source=f"simulated (seed {seed})",
@@ -327,8 +615,9 @@ def simulate_measurements(
         data=data,
         errors=errors,
         effects=effects,
-        noise_arcsec=float(noise_arcsec),
+        noise_arcsec=float(noise[0]) if noise.size == 1 else tuple(float(v) for v in noise),
         seed=int(seed),
         schedule=schedule,
         truth_rad=truth,
+        noise_spread=float(noise_spread),
     )
