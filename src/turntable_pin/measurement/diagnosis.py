@@ -180,13 +180,14 @@ class OrientationFamily:
             if len(distinct) == 1
             else f"the {data.n_positions} rows are at {len(distinct)} distinct positions"
         )
-        return warnings + [
+        rank_warning = (
             f"{where}: they determine {rank} of the {full_rank} combinations of the turntable "
             f"errors that a grid over every axis determines, so effects that vary with {axes} "
             "cannot be tested, and an effect named here (a step with dir, a drift in time) may "
             "stand for any error that changed between the rows; measure more positions over the "
             "full turn of every axis"
-        ] + sampling
+        )
+        return warnings + [rank_warning] + sampling
 
     def _sampling_warnings(self, wrapped_deg: np.ndarray, labels: list[str]) -> list[str]:
         """What positions at more than one place still cannot tell: an axis held at one angle,
@@ -289,12 +290,18 @@ class OrientationFamily:
             )
         return probes
 
-    def _error_probes(self, jac, w, shape: str, text: str, plot: tuple, spec: str) -> list[Probe]:
+    def _error_probes(
+        self, jac, w, shape: str, text: str, plot: tuple, spec: str, unseen=frozenset()
+    ) -> list[Probe]:
         """One probe per base error: its derivative (the direction it enters the angles) times
-        the shape ``plot`` (variable, values, functions, value scale, unit)."""
+        the shape ``plot`` (variable, values, functions, value scale, unit); none for the errors
+        ``unseen`` (those the measured angles do not see to first order: their derivative at the
+        fitted errors is a second-order remainder, and a shape along it is no finding)."""
         probes = []
         var, values, functions, scale, unit = plot
         for e, name in enumerate(self.table.base_names):
+            if name in unseen:
+                continue
 
             def direction(e=e):
                 return jac[:, :, e] * w
@@ -309,6 +316,7 @@ class OrientationFamily:
         data = self.data
         w = np.nan_to_num(fit.per_angle(fit.result.weights))  # (N, 3), 0 where not measured
         jac = fit.model.jacobian(fit.result.params)  # (N, 3, n)
+        unseen = set(fit.result.identifiability.unresponsive)
         probes = []
         labels = [self.table.angle_label(k) for k in range(1, data.n_joints + 1)]
         for var, phi in zip(labels, data.joint_rad.T, strict=True):
@@ -316,7 +324,9 @@ class OrientationFamily:
                 plot = (var, phi, _harmonic(k), DEG_PER_RAD, "deg")
                 shape = f"{k}/rev in {var}"
                 spec = f"h{k}({var})"
-                probes += self._error_probes(jac, w, shape, f"{k}/rev term in {var}", plot, spec)
+                probes += self._error_probes(
+                    jac, w, shape, f"{k}/rev term in {var}", plot, spec, unseen
+                )
                 probes += self._measured_angle_probes(
                     shape, f"a {k}/rev term in {var} of {{angle}} itself", plot, w, spec
                 )
@@ -363,7 +373,7 @@ class OrientationFamily:
             plot = (column, values, _polynomial(values), 1.0, "")
             text = f"term linear and quadratic in {column}"
             spec = f"poly2({column})"
-            probes += self._error_probes(jac, w, f"in {column}", text, plot, spec)
+            probes += self._error_probes(jac, w, f"in {column}", text, plot, spec, unseen)
             probes += self._measured_angle_probes(
                 f"in {column}", f"a {text} of {{angle}}", plot, w, spec
             )
@@ -418,9 +428,10 @@ class OrientationFamily:
 
 OUTLIER_RULE = (
     "studentized residual |t| = |r| / (s sqrt(1 - h)) above the two-sided normal quantile at "
-    "0.01 / m (m measured angles; s the robust scale 1.4826 median |r| / sqrt(1 - h), h the "
-    "leverage), iterated: left out, refitted, tested again; first on the base model, then on "
-    "the model with the accepted effects; at most 5 % of the angles"
+    "0.01 / m (m measured angles; h the leverage; s the robust scale 1.4826 median "
+    "|r| / sqrt(1 - h), the larger of that of the same angle, dpsi, dtheta or dgamma, and that "
+    "of all), iterated: left out, refitted, tested again; first on the base model, then on the "
+    "model with the accepted effects; at most 5 % of the angles"
 )
 """The outlier rule of :func:`diagnose_measurements` in words (``turntable_pin.stats.outliers``)."""
 
@@ -450,7 +461,10 @@ def _screen(data, effects, table) -> tuple[np.ndarray, str | None]:
         except IdentifiabilityError:
             return np.zeros_like(flagged), None
         result = fit.result
-        test = screen_outliers(result.residuals * result.weights, result.jacobian_weighted)
+        angle_of = np.broadcast_to(np.arange(3), clean.angles_rad.shape)[clean.measured]
+        test = screen_outliers(
+            result.residuals * result.weights, result.jacobian_weighted, groups=angle_of
+        )
         if not test.flagged.size:
             break
         cells = np.flatnonzero(clean.measured.reshape(-1))[test.flagged]

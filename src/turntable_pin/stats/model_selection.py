@@ -8,10 +8,13 @@ compared by the Bayesian information criterion, ``delta_bic = delta_chi2 + added
 (sigma given) or ``m ln(rss_new / rss_old) + added_rank ln m`` (sigma estimated: the variance
 profiled out), where ``added_rank`` is the number of *new* determined combinations (parameters the
 current model already absorbs do not count) and ``m`` the number of observations. An effect is
-accepted when ``delta_bic <= -6``. On clean data the improvement is chi2-distributed with
-``added_rank`` degrees of freedom, so for m = 432 observations the false-alarm probability of
-one candidate is P(chi2_k > k ln m + 6): 5e-4 (k=1), 1.2e-4 (k=2), 2e-6 (k=4); over the whole
-catalogue well under 1 %, while an effect of a few sigma lowers chi2 by hundreds. A plain
+accepted when ``delta_bic <= -6 - 2 ln K`` for the K candidates tested in that round (the
+look-elsewhere penalty the structure search pays for its probes: trying K effects is K chances of
+a false alarm). On clean data the improvement is chi2-distributed with ``added_rank`` degrees of
+freedom, so for m = 432 observations and K = 9 the false-alarm probability of one candidate is
+P(chi2_k > k ln m + 10.4): 5e-5 (k=1), 1.4e-5 (k=2); on small designs (m = 72..120, where
+``ln m`` is small) the penalty is what keeps the whole catalogue quiet, while an effect of a few
+sigma lowers chi2 by hundreds. A plain
 likelihood-ratio test at a fixed level would not penalise the 8-parameter
 wobble series more than a 1-parameter sag, and BIC does.
 
@@ -41,6 +44,7 @@ from .structure_search import BIC_THRESHOLD, FoundTerm, Probe, delta_bic, search
 
 __all__ = [
     "ALTERNATIVE_LEVEL",
+    "acceptance_threshold",
     "FIT_TEST_ALPHA",
     "Candidate",
     "Diagnosis",
@@ -104,11 +108,19 @@ class Candidate:
     added_rank: int = 0
     delta_bic: float | None = None
     alternatives: list[str] = field(default_factory=list)
+    threshold: float = BIC_THRESHOLD
 
     @property
     def significant(self) -> bool:
-        """Whether the effect lowers BIC by at least the threshold."""
-        return self.delta_bic is not None and self.delta_bic <= BIC_THRESHOLD
+        """Whether the effect lowers BIC by at least its round's threshold (:func:`threshold`)."""
+        return self.delta_bic is not None and self.delta_bic <= self.threshold
+
+
+def acceptance_threshold(n_testable: int) -> float:
+    """The delta_bic an effect must reach when ``n_testable`` candidates are tried at once:
+    ``-6 - 2 ln K``, the look-elsewhere penalty of the structure search applied to the catalogue
+    (K chances of a false alarm; -6 for a single candidate)."""
+    return BIC_THRESHOLD - 2.0 * math.log(max(n_testable, 1))
 
 
 def _chi2(result: FitResult, noise_variance: float) -> float:
@@ -159,6 +171,9 @@ def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, ca
             continue
         dbic = delta_bic(fit.result.rss, base.rss, added, m, known)
         out.append(Candidate(effect.name, True, None, fit, added, float(dbic)))
+    threshold = acceptance_threshold(sum(c.testable for c in out))
+    for c in out:
+        c.threshold = threshold
     out.sort(key=lambda c: (not c.testable, c.delta_bic if c.delta_bic is not None else 0.0))
     return out
 
@@ -282,6 +297,10 @@ class Diagnosis:
         """Whether the observations' sigmas were given (not estimated)."""
         return self.base_fit.result.sigma_known
 
+    def _first_threshold(self) -> float:
+        """The acceptance threshold of the first round (against the base model)."""
+        return next((c.threshold for c in self.candidates if c.testable), BIC_THRESHOLD)
+
     def summary(self, fit) -> dict:
         """rms, chi2_reduced, rank and p-value of ``fit`` judged with this noise variance."""
         return _summary(fit.result, self.noise_variance)
@@ -347,7 +366,8 @@ class Diagnosis:
             "outliers": [dict(o) for o in self.outliers],
             "outlier_rule": self.outlier_rule,
             "decision_rule": {
-                "accept_effect": f"delta_bic <= {BIC_THRESHOLD:g}",
+                "accept_effect": f"delta_bic <= {BIC_THRESHOLD:g} - 2 ln K (K testable candidates)",
+                "threshold": self._first_threshold(),
                 "alternative": f"|chi2 difference| within the {ALTERNATIVE_LEVEL:g} quantile "
                 "of chi2(larger added_rank)",
                 "fit_test_alpha": FIT_TEST_ALPHA if self.sigma_known else None,
@@ -385,7 +405,9 @@ def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis
     # chi2 the unexplained structure inflates (a 3/rev term makes any 1/rev effect look good).
     unneeded: dict[str, float] = {}
     while current:
-        worst = _least_needed(family, current, current_fit, structure, probes, known)
+        worst = _least_needed(
+            family, current, current_fit, structure, probes, known, candidates[0].threshold
+        )
         if worst is None:
             break
         name, dbic = worst
@@ -442,22 +464,23 @@ def _projected_rss(residuals: np.ndarray, columns: np.ndarray) -> tuple[float, i
     return float(left @ left), int(u.shape[1])
 
 
-def _least_needed(family, current, current_fit, structure, probes, known):
+def _least_needed(family, current, current_fit, structure, probes, known, threshold):
     """The accepted effect least needed in the best description of the data, with what removing
     it costs in BIC, or ``None`` when every accepted effect still earns its place.
 
     The best description is the accepted effects plus the structure found on top of them. An
-    effect E earns its place when removing it costs at least ``-BIC_THRESHOLD`` (6), the
-    acceptance rule itself, judged two ways:
+    effect E earns its place when removing it costs at least ``-threshold`` (the acceptance
+    rule itself, :func:`acceptance_threshold`), judged two ways:
 
     - with the same structure: an effect that only soaked up part of a structure it does not
       explain (a backlash taking a little of a 3/rev term) costs little to remove;
     - with the structure the search finds in the residuals of the model without E (what E was
-      standing for), when that structure fits the data at least as well as E does: then E is a
-      mimic of a shape it does not have (an 8-parameter wobble following a slow temperature
-      change through the measurement order), and the found shape describes the data better.
-      When E fits better, E is kept: it is the physical hypothesis, and its extra harmonics are
-      not held against it.
+      standing for), when that structure is not E's own shape (it lies outside the span of the
+      model with E) and fits the data at least as well as E does: then E is a mimic of a shape
+      it does not have (an 8-parameter wobble following a slow temperature change through the
+      measurement order), and the found shape describes the data better. When the found shape
+      is E's own (a step with dir where E is a backlash) or fits worse, E is kept: it is the
+      physical hypothesis, and its extra harmonics are not held against it.
 
     Each structure term pays the search's look-elsewhere penalty ``2 ln G`` besides its
     parameters. Linearised at the fits: the structure's probe columns join each model's
@@ -484,14 +507,31 @@ def _least_needed(family, current, current_fit, structure, probes, known):
             continue
         costs = [score(without, structure, probes)[0] - full]
         own, own_probes = _search(family, without, known)
-        if own:
+        if own and not _within(own, own_probes, current_fit.result.jacobian_weighted):
             bic_own, fit_own = score(without, own, own_probes)
             if fit_own <= full_fit:
                 costs.append(bic_own - full)
         cost = float(min(costs))
-        if cost < -BIC_THRESHOLD and (worst is None or cost < worst[1]):
+        if cost < -threshold and (worst is None or cost < worst[1]):
             worst = (effect.name, cost)
     return worst
+
+
+OWN_SHAPE_FRACTION = 0.05
+"""A found shape is an effect's own when less than this fraction of its columns (Frobenius norm)
+lies outside the span of the model with the effect."""
+
+
+def _within(terms, term_probes, jacobian_weighted: np.ndarray) -> bool:
+    """Whether the probe columns of ``terms`` lie (up to :data:`OWN_SHAPE_FRACTION`) in the span
+    of ``jacobian_weighted``."""
+    by_name = {p.name: p for p in term_probes}
+    columns = np.concatenate([by_name[t.name].matrix() for t in terms], axis=1)
+    norms = np.linalg.norm(jacobian_weighted, axis=0)
+    u, s, _ = np.linalg.svd(jacobian_weighted[:, norms > 0] / norms[norms > 0], full_matrices=False)
+    u = u[:, s > 1e-9 * (s[0] if s.size else 1.0)]
+    outside = columns - u @ (u.T @ columns)
+    return bool(np.linalg.norm(outside) <= OWN_SHAPE_FRACTION * np.linalg.norm(columns))
 
 
 def _steps_of(family, effects, base_fit) -> list[Step]:

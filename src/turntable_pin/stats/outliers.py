@@ -7,9 +7,11 @@ weighted Jacobian ``J``, the studentized residual of observation i is
 which a few gross errors cannot inflate, and which a real unmodelled effect does inflate, so that
 its points are not taken for outliers). Observation i is an outlier when ``|t_i| > z``, with
 ``z`` the two-sided normal quantile at ``alpha / m`` for m observations (Bonferroni: on clean data
-the chance of flagging any observation is about ``alpha``). The caller iterates: leaves the
-outliers out, refits, and applies the rule again until nothing new is flagged, and refuses to call
-more than ``MAX_OUTLIER_FRACTION`` of the data outliers (then the model or the noise is wrong).
+the chance of flagging any observation is about ``alpha``). With groups of observations (kinds of
+measurement), ``s`` of a group is the larger of its own and the pooled one. The caller iterates:
+leaves the outliers out, refits, and applies the rule again until nothing new is flagged, and
+refuses to call more than ``MAX_OUTLIER_FRACTION`` of the data outliers (then the model or the
+noise is wrong).
 """
 
 from __future__ import annotations
@@ -73,14 +75,30 @@ def leverages(jacobian_weighted: np.ndarray) -> np.ndarray:
 
 
 def screen_outliers(
-    weighted_residuals: np.ndarray, jacobian_weighted: np.ndarray, alpha: float = OUTLIER_ALPHA
+    weighted_residuals: np.ndarray,
+    jacobian_weighted: np.ndarray,
+    alpha: float = OUTLIER_ALPHA,
+    groups: np.ndarray | None = None,
 ) -> OutlierTest:
-    """One pass of the rule of the module docstring on the observations given."""
+    """One pass of the rule of the module docstring on the observations given.
+
+    ``groups`` (m,) labels observations that share a noise level (e.g. the same kind of
+    measurement): a group's scale is then the larger of its own and the pooled one, so that a
+    group whose residuals an unmodelled effect or a larger noise widens does not have its points
+    taken for outliers, while a quiet group is not made more sensitive than the pool.
+    ``OutlierTest.scale`` is then the median of the scales.
+    """
     r = np.asarray(weighted_residuals, dtype=float)
     h = leverages(jacobian_weighted)
     scaled = np.abs(r) / np.sqrt(np.clip(1.0 - h, 1e-12, None))
-    scale = _MAD_TO_SIGMA * float(np.median(scaled)) if r.size else 0.0
-    t = scaled / scale if scale > 0 else np.zeros_like(scaled)
+    labels = np.zeros(r.size, int) if groups is None else np.asarray(groups)
+    pooled = _MAD_TO_SIGMA * float(np.median(scaled)) if r.size else 0.0
+    scales = np.zeros(r.size)
+    for label in np.unique(labels):
+        pick = labels == label
+        scales[pick] = max(_MAD_TO_SIGMA * float(np.median(scaled[pick])), pooled)
+    t = np.divide(scaled, scales, out=np.zeros_like(scaled), where=scales > 0)
     z = outlier_threshold(r.size, alpha)
     flagged = np.flatnonzero(t > z)
+    scale = float(np.median(scales)) if r.size else 0.0
     return OutlierTest(t, scale, z, flagged[np.argsort(-t[flagged])])
