@@ -7,6 +7,7 @@ bounds that alone break a limit, and the text and dict forms of an allocation.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -17,12 +18,12 @@ from ..model.angles import ANGLE_SYMBOLS
 __all__ = [
     "ORIENTATION_ANGLES",
     "AllocationSummary",
+    "SubproblemOptimum",
     "combine_upper_bounds",
     "fixed_angle_solution",
     "lower_bounds_infeasible",
     "minimize_weighted",
     "render_allocation_report",
-    "subproblem_dict",
 ]
 
 ORIENTATION_ANGLES = ANGLE_SYMBOLS  # the limit names: psi_rad, theta_rad, gamma_rad
@@ -98,19 +99,44 @@ def combine_upper_bounds(subproblems, error_names: Sequence[str]) -> np.ndarray:
     return upper
 
 
-def subproblem_dict(sub, details: dict) -> dict:
-    """A sub-problem's optimum as a JSON-ready dict: its angle, solution, weights, J and limit,
-    then ``details`` (the solver's own), then its active constraints and method."""
-    return {
-        "angle": sub.angle,
-        "solution_arcmin": arcmin_by_name(sub.error_names, sub.solution_rad),
-        "weights": dict(zip(sub.error_names, map(float, sub.weights), strict=True)),
-        "J": sub.J,
-        "limit_arcmin": sub.limit_rad * ARCMIN_PER_RAD,
-        **details,
-        "active_constraints": list(sub.active),
-        "method": sub.method,
-    }
+@dataclass(frozen=True)
+class SubproblemOptimum:
+    """The optimum of one angle's problem, as every solver states it.
+
+    Attributes:
+        angle: psi, theta or gamma.  error_names: the errors that move it.
+        weights, lower_bounds_rad, solution_rad: per error of ``error_names``.
+        limit_rad: I_k.  J: objective at the optimum, errors in arc minutes (1/arcmin^2).
+        active: human-readable active constraints.  method: how it was solved.
+    """
+
+    angle: str
+    error_names: tuple[str, ...]
+    weights: np.ndarray
+    lower_bounds_rad: np.ndarray
+    solution_rad: np.ndarray
+    limit_rad: float
+    J: float
+    active: tuple[str, ...]
+    method: str
+
+    def details(self) -> dict:
+        """What a solver says beyond the common fields, JSON-ready (none here)."""
+        return {}
+
+    def to_dict(self) -> dict:
+        """The optimum as a JSON-ready dict: angle, solution (arcmin), weights, J, limit
+        (arcmin), the solver's :meth:`details`, active constraints and method."""
+        return {
+            "angle": self.angle,
+            "solution_arcmin": arcmin_by_name(self.error_names, self.solution_rad),
+            "weights": dict(zip(self.error_names, map(float, self.weights), strict=True)),
+            "J": self.J,
+            "limit_arcmin": self.limit_rad * ARCMIN_PER_RAD,
+            **self.details(),
+            "active_constraints": list(self.active),
+            "method": self.method,
+        }
 
 
 def render_allocation_report(

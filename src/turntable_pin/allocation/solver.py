@@ -42,12 +42,12 @@ from .capability import ManufacturingCapability
 from .common import (
     ORIENTATION_ANGLES,
     AllocationSummary,
+    SubproblemOptimum,
     combine_upper_bounds,
     fixed_angle_solution,
     lower_bounds_infeasible,
     minimize_weighted,
     render_allocation_report,
-    subproblem_dict,
 )
 from .sensitivity import PAPER_FIGURE8_TRIG, AverageSensitivities, average_sensitivities
 
@@ -275,50 +275,34 @@ def allocation_weights(
 
 # ---- one sub-problem -----------------------------------------------------------------------
 @dataclass(frozen=True)
-class SubproblemResult:
-    """Optimum of one of eqs. 31-33.
+class SubproblemResult(SubproblemOptimum):
+    """Optimum of one of eqs. 31-33 (the common fields: :class:`.common.SubproblemOptimum`;
+    ``error_names`` is the vector chi_k of this angle's model, ``method`` "exact" or "slsqp").
 
     Attributes:
-        angle: psi, theta or gamma.
-        error_names: the errors of this angle's model (the vector chi_k).
-        weights, lower_bounds_rad, solution_rad: per error of ``error_names``.
-        limit_rad: I_k.  interval_rad: the phi2 interval of the constraint.
-        J: objective at the optimum with the errors in arc minutes (unit 1/arcmin^2).
+        interval_rad: the phi2 interval of the constraint.
         constraint_rad: max of f_k over the interval at the optimum;  phi2_at_max_rad: where.
         multiplier: Lagrange multiplier of the semi-infinite constraint (x in arcmin).
         bound_multipliers: of the lower bounds (0 for free errors).
         kkt_residual: largest relative stationarity error over the free errors.
-        active: human-readable active constraints.  method: "exact" or "slsqp".
     """
 
-    angle: str
-    error_names: tuple[str, ...]
-    weights: np.ndarray
-    lower_bounds_rad: np.ndarray
-    solution_rad: np.ndarray
-    limit_rad: float
     interval_rad: tuple[float, float]
-    J: float
     constraint_rad: float
     phi2_at_max_rad: float
     multiplier: float
     bound_multipliers: np.ndarray
     kkt_residual: float
-    active: tuple[str, ...]
-    method: str
 
-    def to_dict(self) -> dict:
-        """The optimum as a JSON-ready dict (errors and limit in arcmin, phi2 in degrees)."""
-        return subproblem_dict(
-            self,
-            {
-                "phi2_interval_deg": [v * DEG_PER_RAD for v in self.interval_rad],
-                "constraint_arcmin": self.constraint_rad * ARCMIN_PER_RAD,
-                "phi2_at_max_deg": self.phi2_at_max_rad * DEG_PER_RAD,
-                "multiplier": self.multiplier,
-                "kkt_residual": self.kkt_residual,
-            },
-        )
+    def details(self) -> dict:
+        """phi2 interval and maximum (degrees), constraint (arcmin), multiplier, KKT residual."""
+        return {
+            "phi2_interval_deg": [v * DEG_PER_RAD for v in self.interval_rad],
+            "constraint_arcmin": self.constraint_rad * ARCMIN_PER_RAD,
+            "phi2_at_max_deg": self.phi2_at_max_rad * DEG_PER_RAD,
+            "multiplier": self.multiplier,
+            "kkt_residual": self.kkt_residual,
+        }
 
 
 def solve_subproblem(

@@ -40,12 +40,12 @@ from .capability import read_lower_bounds_file
 from .common import (
     ORIENTATION_ANGLES,
     AllocationSummary,
+    SubproblemOptimum,
     combine_upper_bounds,
     fixed_angle_solution,
     lower_bounds_infeasible,
     minimize_weighted,
     render_allocation_report,
-    subproblem_dict,
 )
 from .solver import OrientationLimits
 
@@ -176,39 +176,24 @@ def table_lower_bounds(table, path: str | Path | None = None) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class TableSubproblem:
-    """The optimum of one angle's problem.
+class TableSubproblem(SubproblemOptimum):
+    """The optimum of one angle's problem (the common fields: :class:`.common.SubproblemOptimum`;
+    ``method`` is ``exact`` or ``cutting planes``).
 
     Attributes:
-        angle: psi, theta or gamma.  error_names: the errors that move it.
-        weights, lower_bounds_rad, solution_rad: per error of ``error_names``.
-        limit_rad: I_k.  J: objective at the optimum, errors in arc minutes (1/arcmin^2).
         worst_rad: the first-order worst case at the solution (<= limit).
         at_angles_deg: the grid position where it is reached, degrees (chain order).
-        active: human-readable active constraints.  method: ``exact`` or ``cutting planes``.
     """
 
-    angle: str
-    error_names: tuple[str, ...]
-    weights: np.ndarray
-    lower_bounds_rad: np.ndarray
-    solution_rad: np.ndarray
-    limit_rad: float
-    J: float
     worst_rad: float
     at_angles_deg: tuple[float, ...]
-    active: tuple[str, ...]
-    method: str
 
-    def to_dict(self) -> dict:
-        """The optimum as a JSON-ready dict (errors and limit in arcmin)."""
-        return subproblem_dict(
-            self,
-            {
-                "worst_case_arcmin": self.worst_rad * ARCMIN_PER_RAD,
-                "at_angles_deg": list(self.at_angles_deg),
-            },
-        )
+    def details(self) -> dict:
+        """The first-order worst case (arcmin) and the grid position where it is reached."""
+        return {
+            "worst_case_arcmin": self.worst_rad * ARCMIN_PER_RAD,
+            "at_angles_deg": list(self.at_angles_deg),
+        }
 
 
 def _solve_rows(rows: np.ndarray, w: np.ndarray, lower: np.ndarray) -> tuple[np.ndarray, str]:
