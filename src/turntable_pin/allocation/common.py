@@ -106,8 +106,7 @@ class SubproblemOptimum:
     Attributes:
         angle: psi, theta or gamma.  error_names: the errors that move it.
         weights, lower_bounds_rad, solution_rad: per error of ``error_names``.
-        limit_rad: I_k.  J: objective at the optimum, errors in arc minutes (1/arcmin^2).
-        active: human-readable active constraints.  method: how it was solved.
+        limit_rad: I_k.  active: human-readable active constraints.  method: how it was solved.
     """
 
     angle: str
@@ -116,9 +115,13 @@ class SubproblemOptimum:
     lower_bounds_rad: np.ndarray
     solution_rad: np.ndarray
     limit_rad: float
-    J: float
     active: tuple[str, ...]
     method: str
+
+    @property
+    def J(self) -> float:
+        """The objective ``sum W^2 / x^2`` at the optimum, errors in arc minutes (1/arcmin^2)."""
+        return float(np.sum(self.weights**2 / (self.solution_rad * ARCMIN_PER_RAD) ** 2))
 
     def details(self) -> dict:
         """What a solver says beyond the common fields, JSON-ready (none here)."""

@@ -421,7 +421,6 @@ def _kkt_report(model, names, w, lower, x_rad, limit_rad, interval_rad, method):
         solution_rad=np.asarray(x_rad, dtype=float),
         limit_rad=limit_rad,
         interval_rad=(lo, hi),
-        J=float(np.sum(w**2 / x**2)),
         constraint_rad=value,
         phi2_at_max_rad=t_max,
         multiplier=multiplier,

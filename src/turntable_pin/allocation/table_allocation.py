@@ -253,7 +253,6 @@ def _subproblem(angle, k, sens: TableSensitivities, weights, lower, limit_rad) -
         lower_bounds_rad=lb,
         solution_rad=x,
         limit_rad=float(limit_rad),
-        J=float(np.sum(w**2 / (x * ARCMIN_PER_RAD) ** 2)),
         worst_rad=float(excess[at]),
         at_angles_deg=angles,
         active=tuple(active),
