@@ -7,7 +7,7 @@ bounds that alone break a limit, and the text and dict forms of an allocation.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -176,9 +176,24 @@ def render_allocation_report(
     return "\n".join(lines)
 
 
+@dataclass(frozen=True)
 class AllocationSummary:
-    """What every allocation result (fields ``subproblems``, ``worst_case_rad``, ``limits``,
-    ``weights_scheme``) says alike: its objectives and their JSON form."""
+    """What every allocation result holds and says alike: bounds, weights, sub-problems, worst
+    case, their objectives and their JSON form (the subclasses add their own fields, by keyword).
+
+    Attributes:
+        upper_bounds_rad: radians, in the allocation's error order.
+        limits: the :class:`~.solver.OrientationLimits`.  weights_scheme: the weights' name.
+        weights: (3, P).  subproblems: ``{psi|theta|gamma: SubproblemOptimum}``.
+        worst_case_rad: (3,) largest |dpsi|, |dtheta|, |dgamma| the box ``|chi| <= UB`` allows.
+    """
+
+    upper_bounds_rad: np.ndarray
+    limits: object
+    weights_scheme: str
+    weights: np.ndarray
+    subproblems: dict = field(default_factory=dict)
+    worst_case_rad: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     @property
     def J(self) -> dict[str, float]:

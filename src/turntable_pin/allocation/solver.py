@@ -434,24 +434,17 @@ def _kkt_report(model, names, w, lower, x_rad, limit_rad, interval_rad, method):
 # ---- the whole allocation ------------------------------------------------------------------
 @dataclass(frozen=True)
 class Allocation(AllocationSummary):
-    """Upper bounds UB of the eight angular errors (eq. 34) and how they were obtained.
+    """Upper bounds UB of the eight angular errors (eq. 34) and how they were obtained (the
+    fields of :class:`.common.AllocationSummary`: ``upper_bounds_rad`` (8,) in
+    :data:`ANGULAR_ERROR_NAMES` order; ``weights_scheme`` model, paper or equal; ``subproblems``
+    of :class:`SubproblemResult`; ``worst_case_rad`` over every angle and sign, Lemma 1 closed
+    form).
 
     Attributes:
-        upper_bounds_rad: (8,) in :data:`ANGULAR_ERROR_NAMES` order, radians.
-        limits: the orientation limits.  weights_scheme: model, paper or equal.
-        weights: (3, 8).  capability: the lower bounds used.
-        subproblems: ``{psi|theta|gamma: SubproblemResult}``.
-        worst_case_rad: (3,) largest |dpsi|, |dtheta|, |dgamma| the box ``|chi| <= UB`` allows
-            over every angle and sign (Lemma 1 closed form).
+        capability: the lower bounds used (by keyword).
     """
 
-    upper_bounds_rad: np.ndarray
-    limits: OrientationLimits
-    weights_scheme: str
-    weights: np.ndarray
-    capability: ManufacturingCapability
-    subproblems: dict[str, SubproblemResult] = field(default_factory=dict)
-    worst_case_rad: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    capability: ManufacturingCapability = field(kw_only=True)
 
     def errors(self) -> TurntableErrors:
         """The upper bounds as an error set (every error at its bound, positive sign)."""
@@ -512,4 +505,4 @@ def allocate_tolerances(
         )
     upper = combine_upper_bounds(subproblems, ANGULAR_ERROR_NAMES)
     worst = np.array([worst_case_full_circle(models[n], upper) for n in ORIENTATION_ANGLES])
-    return Allocation(upper, limits, weights, w, capability, subproblems, worst)
+    return Allocation(upper, limits, weights, w, subproblems, worst, capability=capability)

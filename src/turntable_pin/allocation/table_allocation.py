@@ -28,7 +28,7 @@ payload, never its orientation).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import KW_ONLY, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -262,28 +262,21 @@ def _subproblem(angle, k, sens: TableSensitivities, weights, lower, limit_rad) -
 
 @dataclass(frozen=True)
 class TableAllocation(AllocationSummary):
-    """Upper bounds of a table's angular errors (eq. 34 on the table's own model).
+    """Upper bounds of a table's angular errors (eq. 34 on the table's own model); the fields of
+    :class:`.common.AllocationSummary` (``upper_bounds_rad`` (P,), ``inf``: the error moves no
+    angle; ``weights_scheme`` ``model`` or ``equal``; ``subproblems`` of
+    :class:`TableSubproblem`; ``worst_case_rad`` first order, over the grid and every sign with
+    every error at its upper bound) and, by keyword:
 
     Attributes:
-        error_names: the table's angular errors.
-        upper_bounds_rad, lower_bounds_rad: (P,) radians (``inf``: the error moves no angle).
-        limits: the orientation limits.  weights_scheme: ``model`` or ``equal``.
-        weights: (3, P).  sensitivities: the :class:`TableSensitivities` used.
-        subproblems: ``{psi|theta|gamma: TableSubproblem}``.
-        worst_case_rad: (3,) first-order largest |dpsi|, |dtheta|, |dgamma| over the grid and
-            every sign with every error at its upper bound.
-        urdf, payload_frame: the table.
+        error_names: the table's angular errors.  lower_bounds_rad: (P,) radians.
+        sensitivities: the :class:`TableSensitivities` used.  urdf, payload_frame: the table.
     """
 
+    _: KW_ONLY
     error_names: tuple[str, ...]
-    upper_bounds_rad: np.ndarray
     lower_bounds_rad: np.ndarray
-    limits: OrientationLimits
-    weights_scheme: str
-    weights: np.ndarray
     sensitivities: TableSensitivities = field(repr=False)
-    subproblems: dict = field(default_factory=dict)
-    worst_case_rad: np.ndarray = field(default_factory=lambda: np.zeros(3))
     urdf: str = ""
     payload_frame: str = ""
 
