@@ -1,5 +1,6 @@
-"""Shared test helpers: seeded random error sets, the repository's paths, a file writer, the CLI
-runners (child process and in-process) and the skip of browser tests without Chromium.
+"""Shared test helpers: seeded random error sets, the paper's errors on the generic parameters,
+the repository's paths, a file writer, the CLI runners (child process and in-process), the
+transforms a meshcat scene sets, and the skip of browser tests without Chromium.
 
 The test folders mirror the package's subpackages (tests/core, tests/model, ...) and hold no
 ``__init__.py``: with pytest's default import mode every test module is imported by its basename,
@@ -10,9 +11,11 @@ folder.
 
 from __future__ import annotations
 
+import base64
 import contextlib
 import io
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -33,6 +36,19 @@ def random_errors(rng: np.random.Generator, scale_arcsec: float = 10.0) -> Turnt
 @pytest.fixture
 def rng() -> np.random.Generator:
     return np.random.default_rng(20261122)
+
+
+PAPER_TO_GENERIC: dict[str, str] = {
+    "dphi_y1": "outer_axis.position",
+    "dalpha_z1": "inner_axis.position",
+    "dalpha_x1": "inner_axis.tilt_a",
+    "deps_x": "inner_axis.tilt_a",
+    "deps_y": "inner_axis.tilt_b",
+    "dalpha_y2": "payload_mount.rot_y",
+    "dphi_z2": "payload_mount.rot_z",
+    "dalpha_x2": "payload_mount.rot_x",
+}
+"""The paper's eight angular errors as parameters of the generic model of its URDF."""
 
 
 # --- the repository's paths and a file writer ---------------------------------------------------
@@ -87,6 +103,41 @@ def cli(*args: str) -> subprocess.CompletedProcess:
     return subprocess.CompletedProcess(
         ["turntable-pin", *args], code, out.getvalue(), err.getvalue()
     )
+
+
+# --- meshcat --------------------------------------------------------------------------------------
+def meshcat_transforms(scene, *angles_rad: float) -> tuple[dict[str, np.ndarray], int]:
+    """Draw ``scene`` at ``angles_rad`` into a short-lived meshcat server: the 4x4 transforms its
+    static page sets, by path, and the (stopped) server's pid. Skips without meshcat/umsgpack."""
+    pytest.importorskip("meshcat")
+    from turntable_pin.viewer.meshcat_server import MeshcatServer
+
+    with MeshcatServer() as server:
+        scene.draw(server.visualizer)
+        scene.set_position(*angles_rad)
+        page = server.visualizer.static_html()
+        pid = server.pid
+    umsgpack = pytest.importorskip("umsgpack")
+    blobs = re.findall(r"base64,([A-Za-z0-9+/=]+)\"", page)
+    commands = [umsgpack.unpackb(base64.b64decode(blob)) for blob in blobs]
+    return {
+        c["path"]: np.array(c["matrix"], dtype=float).reshape(4, 4).T
+        for c in commands
+        if c["type"] == "set_transform"
+    }, pid
+
+
+def assert_triads_at(transforms: dict[str, np.ndarray], poses) -> str:
+    """The actual and ideal payload triads stand where ``poses`` puts them; returns the scene's
+    meshcat path prefix."""
+    from turntable_pin.viewer.scene import ROOT
+
+    prefix = f"/meshcat/{ROOT}"
+    np.testing.assert_allclose(
+        transforms[f"{prefix}/actual_triad"], poses.actual_payload, atol=1e-7
+    )
+    np.testing.assert_allclose(transforms[f"{prefix}/ideal_triad"], poses.ideal_payload, atol=1e-7)
+    return prefix
 
 
 def _chromium_available() -> bool:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from conftest import REPO_DIR, write_file
+from conftest import PAPER_TO_GENERIC, REPO_DIR, write_file
 from turntable_pin.allocation.solver import OrientationLimits
 from turntable_pin.allocation.table_allocation import (
     allocate_table_tolerances,
@@ -133,16 +133,7 @@ def test_the_paper_table_through_the_generic_sensitivities_equals_its_own(rng):
     from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
     from turntable_pin.model.turntable import TurntableModel
 
-    mapping = {  # the paper's errors on the generic parameters (tests/model/test_generic_table.py)
-        "dphi_y1": "outer_axis.position",
-        "dalpha_z1": "inner_axis.position",
-        "dalpha_x1": "inner_axis.tilt_a",
-        "deps_x": "inner_axis.tilt_a",
-        "deps_y": "inner_axis.tilt_b",
-        "dalpha_y2": "payload_mount.rot_y",
-        "dphi_z2": "payload_mount.rot_z",
-        "dalpha_x2": "payload_mount.rot_x",
-    }
+    mapping = PAPER_TO_GENERIC
     table = GenericTable(MODELS / "turntable.urdf")
     names = angular_names(table)
     model = TurntableModel()

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conftest import REPO_DIR, random_errors
+from conftest import PAPER_TO_GENERIC, REPO_DIR, random_errors
 from spec_reference import Rx, Ry, Rz
 from turntable_pin import TurntableModel
 from turntable_pin.core.exceptions import ModelError
@@ -152,16 +152,7 @@ def test_paper_errors_map_onto_the_generic_parameters(rng):
     """The paper's nine errors are the generic model under other names (to first order; exactly
     for the position errors, which sit where the generic ones do)."""
     generic = GenericTable(PAPER_URDF)
-    mapping = {
-        "dphi_y1": "outer_axis.position",
-        "dalpha_z1": "inner_axis.position",
-        "dalpha_x1": "inner_axis.tilt_a",
-        "deps_x": "inner_axis.tilt_a",
-        "deps_y": "inner_axis.tilt_b",
-        "dalpha_y2": "payload_mount.rot_y",
-        "dphi_z2": "payload_mount.rot_z",
-        "dalpha_x2": "payload_mount.rot_x",
-    }
+    mapping = PAPER_TO_GENERIC
     for paper_name in ("dphi_y1", "dalpha_z1"):
         errors = random_errors(rng).__class__.from_arcsec(**{paper_name: 30.0})
         values = generic.values({mapping[paper_name]: getattr(errors, paper_name)})

@@ -3,9 +3,7 @@ meshcat is actually sent (decoded from its static page)."""
 
 from __future__ import annotations
 
-import base64
 import math
-import re
 
 import numpy as np
 import pinocchio as pin
@@ -13,6 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from conftest import assert_triads_at, meshcat_transforms
 from turntable_pin import InputError, TurntableErrors
 from turntable_pin.core.rotations import rot_x, rot_y, rot_z
 from turntable_pin.core.units import arcsec_to_rad
@@ -20,7 +19,6 @@ from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
 from turntable_pin.viewer.scene import (
     DEFAULT_DISPLAY_ANGLE_RAD,
     DEFAULT_DISPLAY_OFFSET_M,
-    ROOT,
     Exaggeration,
     SetupScene,
     animation_frames_rad,
@@ -149,34 +147,12 @@ def test_animation_frames_visit_every_position_and_close_the_loop():
         animation_frames_rad(positions, frames_per_move=0)
 
 
-def _decoded_commands(page: str) -> list[dict]:
-    umsgpack = pytest.importorskip("umsgpack")
-    blobs = re.findall(r"base64,([A-Za-z0-9+/=]+)\"", page)
-    return [umsgpack.unpackb(base64.b64decode(blob)) for blob in blobs]
-
-
 def test_meshcat_receives_the_poses_of_the_model():
-    pytest.importorskip("meshcat")
-    from turntable_pin.viewer.meshcat_server import MeshcatServer
-
     scene = SetupScene(EXAMPLE)
     phi1, phi2 = 0.7, 2.1
-    with MeshcatServer() as server:
-        scene.draw(server.visualizer)
-        scene.set_position(phi1, phi2)
-        page = server.visualizer.static_html()
-        pid = server.pid
-    transforms = {
-        c["path"]: np.array(c["matrix"], dtype=float).reshape(4, 4).T
-        for c in _decoded_commands(page)
-        if c["type"] == "set_transform"
-    }
+    transforms, pid = meshcat_transforms(scene, phi1, phi2)
     poses = scene.poses(phi1, phi2)
-    prefix = f"/meshcat/{ROOT}"
-    np.testing.assert_allclose(
-        transforms[f"{prefix}/actual_triad"], poses.actual_payload, atol=1e-7
-    )
-    np.testing.assert_allclose(transforms[f"{prefix}/ideal_triad"], poses.ideal_payload, atol=1e-7)
+    prefix = assert_triads_at(transforms, poses)
     np.testing.assert_allclose(
         transforms[f"{prefix}/machine/visuals/gyrowheel_0"],
         poses.actual_payload @ _h(translation=(0.0, 0.0, 0.045)),

@@ -4,7 +4,6 @@ warning, and a snapshot is a real picture."""
 
 from __future__ import annotations
 
-import base64
 import math
 import re
 import xml.etree.ElementTree as ET
@@ -12,10 +11,9 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from conftest import REPO_DIR, needs_chromium
+from conftest import REPO_DIR, assert_triads_at, meshcat_transforms, needs_chromium
 from turntable_pin.core.units import arcsec_to_rad
 from turntable_pin.model.generic_table import GenericTable
-from turntable_pin.viewer.scene import ROOT
 from turntable_pin.viewer.table_scene import (
     FALLBACK_BOX_M,
     TableScene,
@@ -97,36 +95,14 @@ def test_exaggeration_of_offsets_and_of_a_perfect_table():
     assert k.length_factor == pytest.approx(min(k.angle_factor, 300.0))
 
 
-def _decoded_commands(page: str) -> list[dict]:
-    umsgpack = pytest.importorskip("umsgpack")
-    blobs = re.findall(r"base64,([A-Za-z0-9+/=]+)\"", page)
-    return [umsgpack.unpackb(base64.b64decode(blob)) for blob in blobs]
-
-
 def test_meshcat_receives_the_poses_of_a_three_axis_table():
-    pytest.importorskip("meshcat")
     from process_watch import alive
-    from turntable_pin.viewer.meshcat_server import MeshcatServer
 
     table = GenericTable(MODELS / "three_axis_imu_table.urdf")
     scene = TableScene(table, _errors(table))
     angles = (0.4, -0.8, 1.3)
-    with MeshcatServer() as server:
-        scene.draw(server.visualizer)
-        scene.set_position(*angles)
-        page = server.visualizer.static_html()
-        pid = server.pid
-    transforms = {
-        c["path"]: np.array(c["matrix"], dtype=float).reshape(4, 4).T
-        for c in _decoded_commands(page)
-        if c["type"] == "set_transform"
-    }
-    poses = scene.poses(*angles)
-    prefix = f"/meshcat/{ROOT}"
-    np.testing.assert_allclose(
-        transforms[f"{prefix}/actual_triad"], poses.actual_payload, atol=1e-7
-    )
-    np.testing.assert_allclose(transforms[f"{prefix}/ideal_triad"], poses.ideal_payload, atol=1e-7)
+    transforms, pid = meshcat_transforms(scene, *angles)
+    prefix = assert_triads_at(transforms, scene.poses(*angles))
     assert any(p.startswith(f"{prefix}/machine/visuals/") for p in transforms)
     assert not alive(pid)
 

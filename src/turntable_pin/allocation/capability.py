@@ -20,7 +20,27 @@ from ..core.resources import default_lower_bounds_path
 from ..core.units import ARCSEC_PER_RAD
 from ..model.errors import ANGULAR_ERROR_NAMES, parse_error_value
 
-__all__ = ["ManufacturingCapability"]
+__all__ = ["ManufacturingCapability", "read_lower_bounds_file"]
+
+
+def read_lower_bounds_file(path: Path) -> Mapping:
+    """The YAML file of lower bounds: a mapping ``lower_bounds: {name: value}`` and optionally
+    ``reasoning:``, nothing else (the names are the caller's to read).
+
+    Raises:
+        InputError: unreadable file, not YAML, not that mapping, an unknown top-level key.
+    """
+    data = read_yaml(path)
+    if not isinstance(data, Mapping) or not isinstance(data.get("lower_bounds"), Mapping):
+        raise InputError("expected a mapping 'lower_bounds: {name: value}'", path=path)
+    extra = [str(k) for k in data if k not in ("lower_bounds", "reasoning")]
+    if extra:
+        raise InputError(
+            f"unknown top-level key(s) {', '.join(repr(k) for k in extra)}; the file holds "
+            "'lower_bounds:' and optionally 'reasoning:'",
+            path=path,
+        )
+    return data
 
 
 @dataclass(frozen=True)
@@ -69,16 +89,7 @@ class ManufacturingCapability:
                 value, a value beyond the small-error range, reasoning that is not text.
         """
         path = Path(path)
-        data = read_yaml(path)
-        if not isinstance(data, Mapping) or not isinstance(data.get("lower_bounds"), Mapping):
-            raise InputError("expected a mapping 'lower_bounds: {name: value}'", path=path)
-        extra = [str(k) for k in data if k not in ("lower_bounds", "reasoning")]
-        if extra:
-            raise InputError(
-                f"unknown top-level key(s) {', '.join(repr(k) for k in extra)}; the file holds "
-                "'lower_bounds:' and optionally 'reasoning:'",
-                path=path,
-            )
+        data = read_lower_bounds_file(path)
         values = np.zeros(len(ANGULAR_ERROR_NAMES))
         given: dict[str, str] = {}
         for key, raw in data["lower_bounds"].items():

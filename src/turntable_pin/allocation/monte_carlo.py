@@ -12,6 +12,11 @@ Chunks draw their samples from ``SeedSequence(seed).spawn(...)``, so the result 
 only, not on the number of worker processes. Worker processes never outlive the run: on an error or
 an interruption (SIGINT, SIGTERM) they are killed at once, not waited for; Ctrl-C, which reaches
 the whole process group, is left to the parent.
+
+The run's machinery is shared with the Monte Carlo of any table (:mod:`.table_monte_carlo`):
+:func:`check_run` (the box, the count, the seed), :func:`signed_magnitudes` (the draw),
+:func:`chunk_plan` (chunks and their seeds), :func:`run_chunks` (the workers) and
+:class:`MonteCarloSummary` (the verdict and its JSON form).
 """
 
 from __future__ import annotations
@@ -40,9 +45,14 @@ __all__ = [
     "CHUNK_SIZE",
     "PHI1_TOLERANCE",
     "MonteCarloResult",
+    "MonteCarloSummary",
+    "check_run",
+    "chunk_plan",
     "phi1_dependence",
+    "run_chunks",
     "run_monte_carlo",
     "sample_errors",
+    "signed_magnitudes",
 ]
 
 CHUNK_SIZE = 2000  # turntables per block: the (chunk, 3, 360) intermediates stay small
@@ -55,17 +65,59 @@ TURNTABLE_BYTES = 64
 PHI1_TOLERANCE = 1e-12
 
 
+def signed_magnitudes(
+    rng: np.random.Generator, n: int, upper_bounds_rad, lower_bounds_rad
+) -> np.ndarray:
+    """(n, P) errors of magnitude uniform in [LB, UB] and random sign (magnitudes drawn first,
+    then signs)."""
+    upper = np.asarray(upper_bounds_rad, dtype=float)
+    lower = np.asarray(lower_bounds_rad, dtype=float)
+    magnitudes = rng.uniform(lower, upper, size=(n, upper.size))
+    signs = rng.choice(np.array([-1.0, 1.0]), size=(n, upper.size))
+    return magnitudes * signs
+
+
 def sample_errors(
     rng: np.random.Generator, n: int, upper_bounds_rad, lower_bounds_rad
 ) -> np.ndarray:
     """(n, 9) error sets: magnitudes uniform in [LB, UB], random signs, deta = 0."""
-    upper = np.asarray(upper_bounds_rad, dtype=float)
-    lower = np.asarray(lower_bounds_rad, dtype=float)
+    drawn = signed_magnitudes(rng, n, upper_bounds_rad, lower_bounds_rad)
     values = np.zeros((n, len(ERROR_NAMES)))
-    magnitudes = rng.uniform(lower, upper, size=(n, upper.size))
-    signs = rng.choice(np.array([-1.0, 1.0]), size=(n, upper.size))
-    values[:, : upper.size] = magnitudes * signs
+    values[:, : drawn.shape[1]] = drawn
     return values
+
+
+def check_run(
+    upper_bounds_rad, lower_bounds_rad, n: int, seed, size: int, size_message: str, *, finite=False
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """The box ``(upper, lower)`` (lower default 0) and the seed of a run, checked.
+
+    Raises:
+        InputError: not ``size`` bounds each (``size_message``), an upper bound not finite (when
+            ``finite``), a lower bound outside ``[0, upper]``, fewer than 1 or too many tables,
+            a bad seed.
+    """
+    upper = np.asarray(upper_bounds_rad, dtype=float).reshape(-1)
+    lower = (
+        np.zeros_like(upper) if lower_bounds_rad is None else np.asarray(lower_bounds_rad, float)
+    )
+    if upper.size != size or lower.shape != upper.shape:
+        raise InputError(size_message)
+    if finite and not np.all(np.isfinite(upper)):
+        raise InputError("every upper bound must be a finite number")
+    if np.any(lower > upper) or np.any(lower < 0.0):
+        raise InputError("every lower bound must be between 0 and its upper bound")
+    if n < 1:
+        raise InputError(f"the number of turntables must be at least 1, got {n}")
+    check_count(n, MAX_MONTE_CARLO_TURNTABLES, "random turntables", TURNTABLE_BYTES)
+    return upper, lower, check_seed(seed)
+
+
+def chunk_plan(n: int, chunk_size: int, seed: int) -> tuple[list[int], list]:
+    """The sizes of the chunks of ``n`` tables (``chunk_size`` each, the rest last) and each
+    chunk's ``SeedSequence`` (spawned from ``seed``: the result depends on the seed only)."""
+    sizes = [chunk_size] * (n // chunk_size) + ([n % chunk_size] if n % chunk_size else [])
+    return sizes, np.random.SeedSequence(seed).spawn(len(sizes))
 
 
 def phi1_dependence(field: OrientationErrorField) -> float:
@@ -158,8 +210,69 @@ def _chunk_results(worker, tasks, sizes, workers: int, progress: bool):
         unregister()
 
 
+def run_chunks(worker, tasks, sizes, workers: int, progress: bool):
+    """Run ``worker(task) -> (worst (size, 3), extra)`` on every task, in this process or in at
+    most ``workers`` processes (never more than the CPUs or the tasks; see the module docstring).
+
+    Returns ``(worst (N, 3) in task order, [extra of each task], workers used, elapsed s)``.
+    """
+    workers = max(1, min(int(workers), os.cpu_count() or 1, len(tasks)))
+    start = time.perf_counter()
+    worst = np.empty((int(sum(sizes)), 3))
+    extras = []
+    offset = 0
+    for (chunk_worst, extra), size in zip(
+        _chunk_results(worker, tasks, sizes, workers, progress), sizes, strict=True
+    ):
+        worst[offset : offset + size] = chunk_worst
+        extras.append(extra)
+        offset += size
+    return worst, extras, workers, time.perf_counter() - start
+
+
+class MonteCarloSummary:
+    """What every Monte Carlo result (fields ``worst_rad``, ``limits``, ``n``, ``seed``,
+    ``elapsed_s``, ``workers`` and an ``evaluations`` count) says alike."""
+
+    @property
+    def max_abs_rad(self) -> np.ndarray:
+        """(3,) largest |dpsi|, |dtheta|, |dgamma| over all tables and positions."""
+        return self.worst_rad.max(axis=0)
+
+    @property
+    def all_within(self) -> bool:
+        """Whether every table stays within the limits on every angle."""
+        return bool(np.all(self.max_abs_rad <= self.limits.as_array()))
+
+    def verdict_dict(self) -> dict:
+        """Largest angles and limits (arcmin), the verdict, tables over each limit, n and seed."""
+        limits = self.limits.as_array()
+        return {
+            "max_abs_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.max_abs_rad),
+            "limits_arcmin": self.limits.to_dict(),
+            "all_within": self.all_within,
+            "n_exceeding": dict(
+                zip(
+                    ORIENTATION_ANGLES,
+                    map(int, np.sum(self.worst_rad > limits, axis=0)),
+                    strict=True,
+                )
+            ),
+            "n": self.n,
+            "seed": self.seed,
+        }
+
+    def timing_dict(self) -> dict:
+        """Wall time (s), evaluations per second and workers, JSON-ready."""
+        return {
+            "elapsed_s": self.elapsed_s,
+            "evaluations_per_s": self.evaluations / max(self.elapsed_s, 1e-12),
+            "workers": self.workers,
+        }
+
+
 @dataclass(frozen=True)
-class MonteCarloResult:
+class MonteCarloResult(MonteCarloSummary):
     """The outcome of :func:`run_monte_carlo`.
 
     Attributes:
@@ -185,45 +298,21 @@ class MonteCarloResult:
     workers: int
 
     @property
-    def max_abs_rad(self) -> np.ndarray:
-        """(3,) largest |dpsi|, |dtheta|, |dgamma| over all turntables and angles."""
-        return self.worst_rad.max(axis=0)
-
-    @property
-    def all_within(self) -> bool:
-        """Whether every turntable stays within the limits on every angle."""
-        return bool(np.all(self.max_abs_rad <= self.limits.as_array()))
-
-    @property
     def evaluations(self) -> int:
         """Turntable x angle-pair evaluations done."""
         return self.n * int(round(360.0 / self.phi2_step_deg)) * len(self.phi1_evaluated_deg)
 
     def to_dict(self) -> dict:
         """The outcome as a JSON-ready dict (angles in arcmin, steps in degrees, time in s)."""
-        limits = self.limits.as_array()
         return {
-            "max_abs_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.max_abs_rad),
-            "limits_arcmin": self.limits.to_dict(),
-            "all_within": self.all_within,
-            "n_exceeding": dict(
-                zip(
-                    ORIENTATION_ANGLES,
-                    map(int, np.sum(self.worst_rad > limits, axis=0)),
-                    strict=True,
-                )
-            ),
-            "n": self.n,
-            "seed": self.seed,
+            **self.verdict_dict(),
             "sampling": "magnitude uniform in [lower, upper] bound, random sign; deta = 0",
             "upper_bounds_arcmin": arcmin_by_name(ANGULAR_ERROR_NAMES, self.upper_bounds_rad),
             "lower_bounds_arcmin": arcmin_by_name(ANGULAR_ERROR_NAMES, self.lower_bounds_rad),
             "phi2_step_deg": self.phi2_step_deg,
             "phi1_evaluated_deg": list(self.phi1_evaluated_deg),
             "max_phi1_dependence": self.max_phi1_dependence,
-            "elapsed_s": self.elapsed_s,
-            "evaluations_per_s": self.evaluations / max(self.elapsed_s, 1e-12),
-            "workers": self.workers,
+            **self.timing_dict(),
         }
 
 
@@ -250,42 +339,22 @@ def run_monte_carlo(
         workers: processes (the result does not depend on it).  progress: report on stderr.
         urdf_path: nominal URDF (default bundled).
     """
-    upper = np.asarray(upper_bounds_rad, dtype=float).reshape(-1)
-    lower = (
-        np.zeros_like(upper) if lower_bounds_rad is None else np.asarray(lower_bounds_rad, float)
-    )
-    if upper.size != len(ANGULAR_ERROR_NAMES) or lower.shape != upper.shape:
-        raise InputError(f"expected {len(ANGULAR_ERROR_NAMES)} upper and lower bounds")
-    if np.any(lower > upper) or np.any(lower < 0.0):
-        raise InputError("every lower bound must be between 0 and its upper bound")
-    if n < 1:
-        raise InputError(f"the number of turntables must be at least 1, got {n}")
-    check_count(n, MAX_MONTE_CARLO_TURNTABLES, "random turntables", TURNTABLE_BYTES)
-    seed = check_seed(seed)
+    count = len(ANGULAR_ERROR_NAMES)
+    message = f"expected {count} upper and lower bounds"
+    upper, lower, seed = check_run(upper_bounds_rad, lower_bounds_rad, n, seed, count, message)
     for name, step in (("phi2", phi2_step_deg), ("phi1", phi1_step_deg)):
         if not 0.0 < step <= 90.0:
             raise InputError(f"{name} grid step must be in (0, 90] degrees, got {step}")
     phi2_grid = np.arange(0.0, 360.0, phi2_step_deg) / DEG_PER_RAD
     phi1_grid = np.arange(0.0, 360.0, phi1_step_deg) / DEG_PER_RAD
     urdf = None if urdf_path is None else str(urdf_path)
-    sizes = [CHUNK_SIZE] * (n // CHUNK_SIZE) + ([n % CHUNK_SIZE] if n % CHUNK_SIZE else [])
-    seeds = np.random.SeedSequence(seed).spawn(len(sizes))
+    sizes, seeds = chunk_plan(n, CHUNK_SIZE, seed)
     tasks = [
         (s, size, upper, lower, phi2_grid, phi1_grid, urdf)
         for s, size in zip(seeds, sizes, strict=True)
     ]
-    workers = max(1, min(int(workers), os.cpu_count() or 1, len(tasks)))
-    start = time.perf_counter()
-    worst = np.empty((n, 3))
-    dependence = 0.0
-    offset = 0
-    for (chunk_worst, chunk_dependence), size in zip(
-        _chunk_results(_run_chunk, tasks, sizes, workers, progress), sizes, strict=True
-    ):
-        worst[offset : offset + size] = chunk_worst
-        dependence = max(dependence, chunk_dependence)
-        offset += size
-    elapsed = time.perf_counter() - start
+    worst, dependences, workers, elapsed = run_chunks(_run_chunk, tasks, sizes, workers, progress)
+    dependence = max([0.0, *dependences])
     phi1_used = (0.0,) if dependence <= PHI1_TOLERANCE else tuple(phi1_grid * DEG_PER_RAD)
     return MonteCarloResult(
         worst_rad=worst,

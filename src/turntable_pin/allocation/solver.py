@@ -31,15 +31,24 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
-from scipy.optimize import minimize, minimize_scalar
+from scipy.optimize import minimize_scalar
 
 from ..calibration.site import DEFAULT_LATITUDE_DEG
-from ..core.exceptions import InfeasibleError, InputError
+from ..core.exceptions import InputError
 from ..core.units import ARCMIN_PER_RAD, DEG_PER_RAD, arcmin_by_name
-from ..model.angles import ANGLE_SYMBOLS
 from ..model.errors import ANGULAR_ERROR_NAMES, MAX_ANGULAR_ERROR_DEG, TurntableErrors
 from ..model.small_angle import small_angle_matrix
 from .capability import ManufacturingCapability
+from .common import (
+    ORIENTATION_ANGLES,
+    AllocationSummary,
+    SubproblemOptimum,
+    combine_upper_bounds,
+    fixed_angle_solution,
+    lower_bounds_infeasible,
+    minimize_weighted,
+    render_allocation_report,
+)
 from .sensitivity import PAPER_FIGURE8_TRIG, AverageSensitivities, average_sensitivities
 
 __all__ = [
@@ -61,9 +70,6 @@ __all__ = [
     "solve_subproblem",
     "worst_case_full_circle",
 ]
-
-ORIENTATION_ANGLES = ANGLE_SYMBOLS  # the limit names: psi_rad, theta_rad, gamma_rad
-"""Names of the three orientation angles dpsi, dtheta, dgamma as used in keys and options."""
 
 PHI2_INTERVALS_RAD: dict[str, tuple[float, float]] = {
     "gamma": (0.0, 0.5 * math.pi),  # eq. 31
@@ -269,82 +275,34 @@ def allocation_weights(
 
 # ---- one sub-problem -----------------------------------------------------------------------
 @dataclass(frozen=True)
-class SubproblemResult:
-    """Optimum of one of eqs. 31-33.
+class SubproblemResult(SubproblemOptimum):
+    """Optimum of one of eqs. 31-33 (the common fields: :class:`.common.SubproblemOptimum`;
+    ``error_names`` is the vector chi_k of this angle's model, ``method`` "exact" or "slsqp").
 
     Attributes:
-        angle: psi, theta or gamma.
-        error_names: the errors of this angle's model (the vector chi_k).
-        weights, lower_bounds_rad, solution_rad: per error of ``error_names``.
-        limit_rad: I_k.  interval_rad: the phi2 interval of the constraint.
-        J: objective at the optimum with the errors in arc minutes (unit 1/arcmin^2).
+        interval_rad: the phi2 interval of the constraint.
         constraint_rad: max of f_k over the interval at the optimum;  phi2_at_max_rad: where.
         multiplier: Lagrange multiplier of the semi-infinite constraint (x in arcmin).
         bound_multipliers: of the lower bounds (0 for free errors).
         kkt_residual: largest relative stationarity error over the free errors.
-        active: human-readable active constraints.  method: "exact" or "slsqp".
     """
 
-    angle: str
-    error_names: tuple[str, ...]
-    weights: np.ndarray
-    lower_bounds_rad: np.ndarray
-    solution_rad: np.ndarray
-    limit_rad: float
     interval_rad: tuple[float, float]
-    J: float
     constraint_rad: float
     phi2_at_max_rad: float
     multiplier: float
     bound_multipliers: np.ndarray
     kkt_residual: float
-    active: tuple[str, ...]
-    method: str
 
-    def to_dict(self) -> dict:
-        """The optimum as a JSON-ready dict (errors and limit in arcmin, phi2 in degrees)."""
+    def details(self) -> dict:
+        """phi2 interval and maximum (degrees), constraint (arcmin), multiplier, KKT residual."""
         return {
-            "angle": self.angle,
-            "solution_arcmin": arcmin_by_name(self.error_names, self.solution_rad),
-            "weights": dict(zip(self.error_names, map(float, self.weights), strict=True)),
-            "J": self.J,
-            "limit_arcmin": self.limit_rad * ARCMIN_PER_RAD,
             "phi2_interval_deg": [v * DEG_PER_RAD for v in self.interval_rad],
             "constraint_arcmin": self.constraint_rad * ARCMIN_PER_RAD,
             "phi2_at_max_deg": self.phi2_at_max_rad * DEG_PER_RAD,
             "multiplier": self.multiplier,
             "kkt_residual": self.kkt_residual,
-            "active_constraints": list(self.active),
-            "method": self.method,
         }
-
-
-def _fixed_angle_solution(g, weights, lower, limit):
-    """Closed-form optimum of ``min sum W^2/x^2 s.t. g.x <= limit, x >= lower`` (g may be <= 0).
-
-    Errors with ``g_i <= 0`` are unconstrained by this relaxation (x_i = inf, no cost).
-    Returns ``(x, V)``.
-    """
-    x = np.full(g.shape, np.inf)
-    positive = g > 0.0
-    if not np.any(positive):
-        return x, 0.0
-    gp, wp, lp = g[positive], weights[positive], lower[positive]
-    k = np.cbrt(2.0 * wp**2 / gp)  # free optimum: x_i = k_i u with u = lambda^(-1/3)
-    breaks = np.sort(lp / k)  # x_i = max(lower_i, k_i u): error i is free once u > lower_i / k_i
-    order = np.argsort(lp / k)
-    # h(u) = sum g_i max(lower_i, k_i u) rises piecewise linearly from sum g lower; solve
-    # h(u) = limit on the piece where the errors with the j smallest breakpoints are free.
-    xp = lp.copy()
-    if gp @ lp < limit:
-        for j in range(1, order.size + 1):
-            free, at_lb = order[:j], order[j:]
-            u = (limit - gp[at_lb] @ lp[at_lb]) / float(np.sum(gp[free] * k[free]))
-            if j == order.size or u <= breaks[j]:
-                xp = np.maximum(lp, k * u)
-                break
-    x[positive] = xp
-    return x, float(np.sum(wp**2 / xp**2))
 
 
 def solve_subproblem(
@@ -377,15 +335,10 @@ def solve_subproblem(
 
     at_lower, _ = constraint(lower_z)
     if at_lower > 1.0 + 1e-12:
-        raise InfeasibleError(
-            f"the manufacturing lower bounds alone give d{model.angle} up to "
-            f"{at_lower * limit_rad * ARCMIN_PER_RAD:.4f} arcmin, above the limit "
-            f"{limit_rad * ARCMIN_PER_RAD:.4f} arcmin: no allocation exists (lower the bounds of "
-            f"{', '.join(names)} or relax the limit)"
-        )
+        raise lower_bounds_infeasible(model.angle, at_lower * limit_rad, limit_rad, names)
 
     def dual(t):
-        return _fixed_angle_solution(basis(t), w, lower_z, 1.0)
+        return fixed_angle_solution(basis(t), w, lower_z, 1.0)
 
     grid = np.linspace(lo, hi, 181)
     values = np.array([dual(t)[1] for t in grid])
@@ -423,22 +376,13 @@ def _slsqp(constraint, basis, w, lower_z):
     ones_value, _ = constraint(np.ones(lower_z.size))
     at_lower, _ = constraint(lower_z)
     start = lower_z + (1.0 - at_lower) / (2.0 * ones_value)
-    res = minimize(
-        lambda z: float(np.sum(w**2 / z**2)),
+    return minimize_weighted(
+        w,
         start,
-        jac=lambda z: -2.0 * w**2 / z**3,
-        bounds=[(max(lb, 1e-12), None) for lb in lower_z],
-        constraints=[
-            {
-                "type": "ineq",
-                "fun": lambda z: 1.0 - constraint(z)[0],
-                "jac": lambda z: -basis(constraint(z)[1]),
-            }
-        ],
-        method="SLSQP",
-        options={"ftol": 1e-15, "maxiter": 1000},
+        lower_z,
+        lambda z: 1.0 - constraint(z)[0],
+        lambda z: -basis(constraint(z)[1]),
     )
-    return np.asarray(res.x, dtype=float)
 
 
 def _kkt_report(model, names, w, lower, x_rad, limit_rad, interval_rad, method):
@@ -477,7 +421,6 @@ def _kkt_report(model, names, w, lower, x_rad, limit_rad, interval_rad, method):
         solution_rad=np.asarray(x_rad, dtype=float),
         limit_rad=limit_rad,
         interval_rad=(lo, hi),
-        J=float(np.sum(w**2 / x**2)),
         constraint_rad=value,
         phi2_at_max_rad=t_max,
         multiplier=multiplier,
@@ -490,32 +433,18 @@ def _kkt_report(model, names, w, lower, x_rad, limit_rad, interval_rad, method):
 
 # ---- the whole allocation ------------------------------------------------------------------
 @dataclass(frozen=True)
-class Allocation:
-    """Upper bounds UB of the eight angular errors (eq. 34) and how they were obtained.
+class Allocation(AllocationSummary):
+    """Upper bounds UB of the eight angular errors (eq. 34) and how they were obtained (the
+    fields of :class:`.common.AllocationSummary`: ``upper_bounds_rad`` (8,) in
+    :data:`ANGULAR_ERROR_NAMES` order; ``weights_scheme`` model, paper or equal; ``subproblems``
+    of :class:`SubproblemResult`; ``worst_case_rad`` over every angle and sign, Lemma 1 closed
+    form).
 
     Attributes:
-        upper_bounds_rad: (8,) in :data:`ANGULAR_ERROR_NAMES` order, radians.
-        limits: the orientation limits.  weights_scheme: model, paper or equal.
-        weights: (3, 8).  capability: the lower bounds used.
-        subproblems: ``{psi|theta|gamma: SubproblemResult}``.
-        worst_case_rad: (3,) largest |dpsi|, |dtheta|, |dgamma| the box ``|chi| <= UB`` allows
-            over every angle and sign (Lemma 1 closed form).
+        capability: the lower bounds used (by keyword).
     """
 
-    upper_bounds_rad: np.ndarray
-    limits: OrientationLimits
-    weights_scheme: str
-    weights: np.ndarray
-    capability: ManufacturingCapability
-    subproblems: dict[str, SubproblemResult] = field(default_factory=dict)
-    worst_case_rad: np.ndarray = field(default_factory=lambda: np.zeros(3))
-
-    @property
-    def J(self) -> dict[str, float]:
-        """Objective of each problem at its optimum (1/arcmin^2) and their sum."""
-        out = {name: self.subproblems[name].J for name in ORIENTATION_ANGLES}
-        out["total"] = float(sum(out.values()))
-        return out
+    capability: ManufacturingCapability = field(kw_only=True)
 
     def errors(self) -> TurntableErrors:
         """The upper bounds as an error set (every error at its bound, positive sign)."""
@@ -525,42 +454,23 @@ class Allocation:
         """Bounds, objectives, worst case and every sub-problem as a JSON-ready dict (arcmin)."""
         return {
             "upper_bounds_arcmin": arcmin_by_name(ANGULAR_ERROR_NAMES, self.upper_bounds_rad),
-            "J": self.J,
-            "J_unit": "1/arcmin^2 (errors in arc minutes)",
-            "worst_case_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.worst_case_rad),
-            "limits_arcmin": self.limits.to_dict(),
-            "weights": self.weights_scheme,
+            **self.summary_dict(),
             "lower_bounds": self.capability.to_dict(),
-            "active_constraints": {n: list(self.subproblems[n].active) for n in ORIENTATION_ANGLES},
-            "subproblems": {n: self.subproblems[n].to_dict() for n in ORIENTATION_ANGLES},
+            **self.subproblems_dict(),
         }
 
     def report(self) -> str:
         """The table of upper bounds with J, worst case and active constraints, as text."""
-        lines = [f"Error allocation (weights: {self.weights_scheme})", ""]
-        lines.append(f"{'error':12s}{'upper bound':>24s}{'lower bound':>14s}")
-        for n, ub, lb in zip(
+        return render_allocation_report(
+            f"Error allocation (weights: {self.weights_scheme})",
             ANGULAR_ERROR_NAMES,
             self.upper_bounds_rad,
             self.capability.lower_bounds_rad,
-            strict=True,
-        ):
-            lines.append(
-                f"{n:12s}{ub * ARCMIN_PER_RAD:11.4f}' = {ub * ARCMIN_PER_RAD * 60:7.2f}\""
-                f'{lb * ARCMIN_PER_RAD * 60:12.2f}"'
-            )
-        lines.append("")
-        limits = self.limits.to_dict()
-        for k, name in enumerate(ORIENTATION_ANGLES):
-            sub = self.subproblems[name]
-            lines.append(
-                f"d{name:6s} limit {limits[name]:.4f}'  worst case "
-                f"{self.worst_case_rad[k] * ARCMIN_PER_RAD:.4f}'"
-                f"  J = {sub.J:.6g} /arcmin^2  [{sub.method}, KKT residual {sub.kkt_residual:.1e}]"
-            )
-            for item in sub.active:
-                lines.append(f"         active: {item}")
-        return "\n".join(lines)
+            self.limits,
+            self.worst_case_rad,
+            self.subproblems,
+            lambda sub: f"{sub.method}, KKT residual {sub.kkt_residual:.1e}",
+        )
 
 
 def allocate_tolerances(
@@ -593,10 +503,6 @@ def allocate_tolerances(
             capability.lower_bounds_rad,
             PHI2_INTERVALS_RAD[name],
         )
-    upper = np.full(len(ANGULAR_ERROR_NAMES), np.inf)
-    for sub in subproblems.values():
-        for n, v in zip(sub.error_names, sub.solution_rad, strict=True):
-            i = ANGULAR_ERROR_NAMES.index(n)
-            upper[i] = min(upper[i], v)  # eq. 34
+    upper = combine_upper_bounds(subproblems, ANGULAR_ERROR_NAMES)
     worst = np.array([worst_case_full_circle(models[n], upper) for n in ORIENTATION_ANGLES])
-    return Allocation(upper, limits, weights, w, capability, subproblems, worst)
+    return Allocation(upper, limits, weights, w, subproblems, worst, capability=capability)

@@ -17,7 +17,7 @@ payload, never its orientation).
   the left side being the largest first-order ``|d angle_k|`` that errors of those magnitudes
   reach at ``q`` over every sign. Weights ``W = 1 / sensitivity`` (``model``) or 1 (``equal``).
   Solved exactly: each single row ``q`` has the closed-form optimum of
-  :func:`.solver._fixed_angle_solution`, a lower bound of the true optimum; the best row's
+  :func:`.common.fixed_angle_solution`, a lower bound of the true optimum; the best row's
   optimum is the answer when it satisfies every row, otherwise rows are added one at a time
   (the most violated first) and SLSQP solves the problem on the rows so far, until none is
   violated (a cutting-plane method; the last point is scaled onto the constraint).
@@ -28,15 +28,26 @@ payload, never its orientation).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import KW_ONLY, dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..core.exceptions import InfeasibleError, InputError
+from ..core.exceptions import InputError
 from ..core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, arcmin_by_name
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
-from .solver import ORIENTATION_ANGLES, OrientationLimits, _fixed_angle_solution
+from .capability import read_lower_bounds_file
+from .common import (
+    ORIENTATION_ANGLES,
+    AllocationSummary,
+    SubproblemOptimum,
+    combine_upper_bounds,
+    fixed_angle_solution,
+    lower_bounds_infeasible,
+    minimize_weighted,
+    render_allocation_report,
+)
+from .solver import OrientationLimits
 
 __all__ = [
     "DEFAULT_GRID_STEPS_DEG",
@@ -148,19 +159,8 @@ def table_lower_bounds(table, path: str | Path | None = None) -> np.ndarray:
     names = angular_names(table)
     if path is None:
         return np.zeros(len(names))
-    from ..core.files import read_yaml
-
     path = Path(path)
-    data = read_yaml(path)
-    if not isinstance(data, dict) or not isinstance(data.get("lower_bounds"), dict):
-        raise InputError("expected a mapping 'lower_bounds: {name: value}'", path=path)
-    extra = [str(k) for k in data if k not in ("lower_bounds", "reasoning")]
-    if extra:
-        raise InputError(
-            f"unknown top-level key(s) {', '.join(repr(k) for k in extra)}; the file holds "
-            "'lower_bounds:' and optionally 'reasoning:'",
-            path=path,
-        )
+    data = read_lower_bounds_file(path)
     try:
         values = table.errors_from_user_units(data["lower_bounds"])
     except InputError as exc:
@@ -176,42 +176,23 @@ def table_lower_bounds(table, path: str | Path | None = None) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class TableSubproblem:
-    """The optimum of one angle's problem.
+class TableSubproblem(SubproblemOptimum):
+    """The optimum of one angle's problem (the common fields: :class:`.common.SubproblemOptimum`;
+    ``method`` is ``exact`` or ``cutting planes``).
 
     Attributes:
-        angle: psi, theta or gamma.  error_names: the errors that move it.
-        weights, lower_bounds_rad, solution_rad: per error of ``error_names``.
-        limit_rad: I_k.  J: objective at the optimum, errors in arc minutes (1/arcmin^2).
         worst_rad: the first-order worst case at the solution (<= limit).
         at_angles_deg: the grid position where it is reached, degrees (chain order).
-        active: human-readable active constraints.  method: ``exact`` or ``cutting planes``.
     """
 
-    angle: str
-    error_names: tuple[str, ...]
-    weights: np.ndarray
-    lower_bounds_rad: np.ndarray
-    solution_rad: np.ndarray
-    limit_rad: float
-    J: float
     worst_rad: float
     at_angles_deg: tuple[float, ...]
-    active: tuple[str, ...]
-    method: str
 
-    def to_dict(self) -> dict:
-        """The optimum as a JSON-ready dict (errors and limit in arcmin)."""
+    def details(self) -> dict:
+        """The first-order worst case (arcmin) and the grid position where it is reached."""
         return {
-            "angle": self.angle,
-            "solution_arcmin": arcmin_by_name(self.error_names, self.solution_rad),
-            "weights": dict(zip(self.error_names, map(float, self.weights), strict=True)),
-            "J": self.J,
-            "limit_arcmin": self.limit_rad * ARCMIN_PER_RAD,
             "worst_case_arcmin": self.worst_rad * ARCMIN_PER_RAD,
             "at_angles_deg": list(self.at_angles_deg),
-            "active_constraints": list(self.active),
-            "method": self.method,
         }
 
 
@@ -220,30 +201,17 @@ def _solve_rows(rows: np.ndarray, w: np.ndarray, lower: np.ndarray) -> tuple[np.
     cutting planes (see the module docstring)."""
     values = np.empty(rows.shape[0])
     for r, g in enumerate(rows):
-        values[r] = _fixed_angle_solution(g, w, lower, 1.0)[1]
+        values[r] = fixed_angle_solution(g, w, lower, 1.0)[1]
     best = int(np.argmax(values))
-    z = _fixed_angle_solution(rows[best], w, lower, 1.0)[0]
+    z = fixed_angle_solution(rows[best], w, lower, 1.0)[0]
     if np.all(np.isfinite(z)) and float(np.max(rows @ z)) <= 1.0 + 1e-12:
         return z, "exact"
-    from scipy.optimize import minimize
-
     chosen = [best]
     for _ in range(200):
         sub = rows[chosen]
         start = np.where(np.isfinite(z), z, 1.0 / max(float(sub.sum(axis=1).max()), 1e-300))
         start = np.maximum(start / max(float(np.max(sub @ start)), 1e-300), lower)
-        res = minimize(
-            lambda v: float(np.sum(w**2 / v**2)),
-            start,
-            jac=lambda v: -2.0 * w**2 / v**3,
-            bounds=[(max(lb, 1e-12), None) for lb in lower],
-            constraints=[
-                {"type": "ineq", "fun": lambda v, a=sub: 1.0 - a @ v, "jac": lambda v, a=sub: -a}
-            ],
-            method="SLSQP",
-            options={"ftol": 1e-15, "maxiter": 1000},
-        )
-        z = np.asarray(res.x, dtype=float)
+        z = minimize_weighted(w, start, lower, lambda v, a=sub: 1.0 - a @ v, lambda v, a=sub: -a)
         excess = rows @ z
         worst = int(np.argmax(excess))
         if excess[worst] <= 1.0 + 1e-9 or worst in chosen:
@@ -262,12 +230,7 @@ def _subproblem(angle, k, sens: TableSensitivities, weights, lower, limit_rad) -
     w, lb = np.asarray(weights, float)[members], np.asarray(lower, float)[members]
     lower_z = lb / limit_rad
     if float(np.max(rows @ lower_z)) > 1.0 + 1e-12:
-        raise InfeasibleError(
-            f"the manufacturing lower bounds alone give d{angle} up to "
-            f"{float(np.max(rows @ lb)) * ARCMIN_PER_RAD:.4f} arcmin, above the limit "
-            f"{limit_rad * ARCMIN_PER_RAD:.4f} arcmin: no allocation exists (lower the bounds of "
-            f"{', '.join(names)} or relax the limit)"
-        )
+        raise lower_bounds_infeasible(angle, float(np.max(rows @ lb)), limit_rad, names)
     z, method = _solve_rows(rows, w, lower_z)
     peak_value = float(np.max(rows @ z))
     if peak_value > 0.0:  # onto the constraint: admissible, and no cheaper by shrinking
@@ -290,7 +253,6 @@ def _subproblem(angle, k, sens: TableSensitivities, weights, lower, limit_rad) -
         lower_bounds_rad=lb,
         solution_rad=x,
         limit_rad=float(limit_rad),
-        J=float(np.sum(w**2 / (x * ARCMIN_PER_RAD) ** 2)),
         worst_rad=float(excess[at]),
         at_angles_deg=angles,
         active=tuple(active),
@@ -299,38 +261,24 @@ def _subproblem(angle, k, sens: TableSensitivities, weights, lower, limit_rad) -
 
 
 @dataclass(frozen=True)
-class TableAllocation:
-    """Upper bounds of a table's angular errors (eq. 34 on the table's own model).
+class TableAllocation(AllocationSummary):
+    """Upper bounds of a table's angular errors (eq. 34 on the table's own model); the fields of
+    :class:`.common.AllocationSummary` (``upper_bounds_rad`` (P,), ``inf``: the error moves no
+    angle; ``weights_scheme`` ``model`` or ``equal``; ``subproblems`` of
+    :class:`TableSubproblem`; ``worst_case_rad`` first order, over the grid and every sign with
+    every error at its upper bound) and, by keyword:
 
     Attributes:
-        error_names: the table's angular errors.
-        upper_bounds_rad, lower_bounds_rad: (P,) radians (``inf``: the error moves no angle).
-        limits: the orientation limits.  weights_scheme: ``model`` or ``equal``.
-        weights: (3, P).  sensitivities: the :class:`TableSensitivities` used.
-        subproblems: ``{psi|theta|gamma: TableSubproblem}``.
-        worst_case_rad: (3,) first-order largest |dpsi|, |dtheta|, |dgamma| over the grid and
-            every sign with every error at its upper bound.
-        urdf, payload_frame: the table.
+        error_names: the table's angular errors.  lower_bounds_rad: (P,) radians.
+        sensitivities: the :class:`TableSensitivities` used.  urdf, payload_frame: the table.
     """
 
+    _: KW_ONLY
     error_names: tuple[str, ...]
-    upper_bounds_rad: np.ndarray
     lower_bounds_rad: np.ndarray
-    limits: OrientationLimits
-    weights_scheme: str
-    weights: np.ndarray
     sensitivities: TableSensitivities = field(repr=False)
-    subproblems: dict = field(default_factory=dict)
-    worst_case_rad: np.ndarray = field(default_factory=lambda: np.zeros(3))
     urdf: str = ""
     payload_frame: str = ""
-
-    @property
-    def J(self) -> dict[str, float]:
-        """Objective of each problem at its optimum (1/arcmin^2) and their sum."""
-        out = {name: self.subproblems[name].J for name in ORIENTATION_ANGLES}
-        out["total"] = float(sum(out.values()))
-        return out
 
     def to_dict(self) -> dict:
         """Bounds (arcmin, by the table's error names), objectives, worst case, sub-problems."""
@@ -343,45 +291,24 @@ class TableAllocation:
                 n: float(v * ARCSEC_PER_RAD)
                 for n, v in zip(self.error_names, self.lower_bounds_rad, strict=True)
             },
-            "J": self.J,
-            "J_unit": "1/arcmin^2 (errors in arc minutes)",
-            "worst_case_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.worst_case_rad),
-            "limits_arcmin": self.limits.to_dict(),
-            "weights": self.weights_scheme,
+            **self.summary_dict(),
             "grid_step_deg": self.sensitivities.grid_step_deg,
-            "active_constraints": {n: list(self.subproblems[n].active) for n in ORIENTATION_ANGLES},
-            "subproblems": {n: self.subproblems[n].to_dict() for n in ORIENTATION_ANGLES},
+            **self.subproblems_dict(),
         }
 
     def report(self) -> str:
         """The table of upper bounds with J, worst case and active constraints, as text."""
-        width = max(12, *(len(n) + 2 for n in self.error_names))
-        lines = [
+        return render_allocation_report(
             f"Error allocation of {Path(self.urdf).name} (joints "
             f"{', '.join(self.sensitivities.joint_names)}; weights: {self.weights_scheme}; "
             f"grid {self.sensitivities.grid_step_deg:g} deg)",
-            "",
-            f"{'error':{width}s}{'upper bound':>24s}{'lower bound':>14s}",
-        ]
-        for n, ub, lb in zip(
-            self.error_names, self.upper_bounds_rad, self.lower_bounds_rad, strict=True
-        ):
-            lines.append(
-                f"{n:{width}s}{ub * ARCMIN_PER_RAD:11.4f}' = {ub * ARCMIN_PER_RAD * 60:7.2f}\""
-                f'{lb * ARCMIN_PER_RAD * 60:12.2f}"'
-            )
-        lines.append("")
-        limits = self.limits.to_dict()
-        for k, name in enumerate(ORIENTATION_ANGLES):
-            sub = self.subproblems[name]
-            lines.append(
-                f"d{name:6s} limit {limits[name]:.4f}'  worst case "
-                f"{self.worst_case_rad[k] * ARCMIN_PER_RAD:.4f}'  J = {sub.J:.6g} /arcmin^2  "
-                f"[{sub.method}]"
-            )
-            for item in sub.active:
-                lines.append(f"         active: {item}")
-        return "\n".join(lines)
+            self.error_names,
+            self.upper_bounds_rad,
+            self.lower_bounds_rad,
+            self.limits,
+            self.worst_case_rad,
+            self.subproblems,
+        )
 
 
 def allocate_table_tolerances(
@@ -424,11 +351,7 @@ def allocate_table_tolerances(
     subproblems = {}
     for k, name in enumerate(ORIENTATION_ANGLES):
         subproblems[name] = _subproblem(name, k, sens, w[k], lower, limits.as_array()[k])
-    upper = np.full(p, np.inf)
-    for sub in subproblems.values():
-        for n, v in zip(sub.error_names, sub.solution_rad, strict=True):
-            i = sens.error_names.index(n)
-            upper[i] = min(upper[i], v)  # eq. 34
+    upper = combine_upper_bounds(subproblems, sens.error_names)
     finite = np.where(np.isfinite(upper), upper, 0.0)
     worst = (np.abs(sens.matrices) @ finite).max(axis=0)  # (3,)
     return TableAllocation(

@@ -8,25 +8,21 @@ grid over every joint of the allocation (:func:`.table_allocation.grid_angles_ra
 keeps each table's largest ``|dpsi|, |dtheta|, |dgamma|`` over the grid.
 
 Chunks draw their samples from ``SeedSequence(seed).spawn(...)``, so the result depends on the seed
-only, not on the number of worker processes; the workers are run and stopped as in
-:mod:`.monte_carlo`.
+only, not on the number of worker processes; the checks, the draw, the chunks, the
+workers and the verdict are :mod:`.monte_carlo`'s.
 """
 
 from __future__ import annotations
 
-import os
-import time
 from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
-from ..core.exceptions import InputError, check_seed
-from ..core.sizes import MAX_MONTE_CARLO_TURNTABLES, check_count
 from ..core.units import arcmin_by_name
 from ..model.batch_field import OrientationErrorField
-from .monte_carlo import TURNTABLE_BYTES, _chunk_results
-from .solver import ORIENTATION_ANGLES, OrientationLimits
+from .monte_carlo import MonteCarloSummary, check_run, chunk_plan, run_chunks, signed_magnitudes
+from .solver import OrientationLimits
 from .table_allocation import angular_names, default_grid_step_deg, grid_angles_rad
 
 __all__ = [
@@ -44,14 +40,9 @@ _POSITION_BLOCK = 1024  # grid positions evaluated at once
 def sample_table_errors(table, rng: np.random.Generator, n: int, upper_rad, lower_rad):
     """(n, E) error vectors in ``table.chain.error_names`` order: each angular error uniform in
     magnitude in [lower, upper] (radians) with a random sign, offsets 0."""
-    names = angular_names(table)
-    upper = np.asarray(upper_rad, dtype=float)
-    lower = np.asarray(lower_rad, dtype=float)
-    magnitudes = rng.uniform(lower, upper, size=(n, upper.size))
-    signs = rng.choice(np.array([-1.0, 1.0]), size=(n, upper.size))
     values = np.zeros((n, len(table.chain.error_names)))
-    columns = [table.chain.error_names.index(name) for name in names]
-    values[:, columns] = magnitudes * signs
+    columns = [table.chain.error_names.index(name) for name in angular_names(table)]
+    values[:, columns] = signed_magnitudes(rng, n, upper_rad, lower_rad)
     return values
 
 
@@ -63,8 +54,9 @@ def _table(urdf: str, payload_frame: str):
     return GenericTable(urdf, payload_frame)
 
 
-def _run_table_chunk(args) -> np.ndarray:
-    """Worker: sample one chunk of tables, return each one's max |angle| over the grid (n, 3)."""
+def _run_table_chunk(args) -> tuple[np.ndarray, None]:
+    """Worker: sample one chunk of tables, return each one's max |angle| over the grid (n, 3)
+    (and nothing else)."""
     seed_seq, n, upper, lower, urdf, frame, step = args
     table = _table(urdf, frame)
     rng = np.random.default_rng(seed_seq)
@@ -77,11 +69,11 @@ def _run_table_chunk(args) -> np.ndarray:
         block = [g[start : start + _POSITION_BLOCK] for g in grid]
         angles = np.abs(field.angles(*block))  # (n, B, 3)
         np.maximum(worst, angles.max(axis=1), out=worst)
-    return worst
+    return worst, None
 
 
 @dataclass(frozen=True)
-class TableMonteCarloResult:
+class TableMonteCarloResult(MonteCarloSummary):
     """The outcome of :func:`run_table_monte_carlo`.
 
     Attributes:
@@ -108,41 +100,22 @@ class TableMonteCarloResult:
     payload_frame: str = ""
 
     @property
-    def max_abs_rad(self) -> np.ndarray:
-        """(3,) largest |dpsi|, |dtheta|, |dgamma| over all tables and positions."""
-        return self.worst_rad.max(axis=0)
-
-    @property
-    def all_within(self) -> bool:
-        """Whether every table stays within the limits on every angle."""
-        return bool(np.all(self.max_abs_rad <= self.limits.as_array()))
+    def evaluations(self) -> int:
+        """Table x grid-position evaluations done."""
+        return self.n * self.n_grid_points
 
     def to_dict(self) -> dict:
         """The outcome as a JSON-ready dict (angles in arcmin, steps in degrees, time in s)."""
-        limits = self.limits.as_array()
         return {
             "urdf": self.urdf,
             "payload_frame": self.payload_frame,
-            "max_abs_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.max_abs_rad),
-            "limits_arcmin": self.limits.to_dict(),
-            "all_within": self.all_within,
-            "n_exceeding": dict(
-                zip(
-                    ORIENTATION_ANGLES,
-                    map(int, np.sum(self.worst_rad > limits, axis=0)),
-                    strict=True,
-                )
-            ),
-            "n": self.n,
-            "seed": self.seed,
+            **self.verdict_dict(),
             "sampling": "magnitude uniform in [lower, upper] bound, random sign; offsets 0",
             "upper_bounds_arcmin": arcmin_by_name(self.error_names, self.upper_bounds_rad),
             "lower_bounds_arcmin": arcmin_by_name(self.error_names, self.lower_bounds_rad),
             "grid_step_deg": self.grid_step_deg,
             "n_grid_points": self.n_grid_points,
-            "elapsed_s": self.elapsed_s,
-            "evaluations_per_s": self.n * self.n_grid_points / max(self.elapsed_s, 1e-12),
-            "workers": self.workers,
+            **self.timing_dict(),
         }
 
 
@@ -169,38 +142,23 @@ def run_table_monte_carlo(
         workers: processes (the result does not depend on it).  progress: report on stderr.
     """
     names = angular_names(table)
-    upper = np.asarray(upper_bounds_rad, dtype=float).reshape(-1)
-    lower = (
-        np.zeros_like(upper) if lower_bounds_rad is None else np.asarray(lower_bounds_rad, float)
+    upper, lower, seed = check_run(
+        upper_bounds_rad,
+        lower_bounds_rad,
+        n,
+        seed,
+        len(names),
+        f"expected {len(names)} upper and lower bounds ({', '.join(names)})",
+        finite=True,
     )
-    if upper.size != len(names) or lower.shape != upper.shape:
-        raise InputError(f"expected {len(names)} upper and lower bounds ({', '.join(names)})")
-    if not np.all(np.isfinite(upper)):
-        raise InputError("every upper bound must be a finite number")
-    if np.any(lower > upper) or np.any(lower < 0.0):
-        raise InputError("every lower bound must be between 0 and its upper bound")
-    if n < 1:
-        raise InputError(f"the number of turntables must be at least 1, got {n}")
-    check_count(n, MAX_MONTE_CARLO_TURNTABLES, "random turntables", TURNTABLE_BYTES)
-    seed = check_seed(seed)
     step = default_grid_step_deg(table) if grid_step_deg is None else float(grid_step_deg)
     n_grid = grid_angles_rad(table, step)[0].size  # checks the step
-    sizes = [TABLE_CHUNK_SIZE] * (n // TABLE_CHUNK_SIZE)
-    sizes += [n % TABLE_CHUNK_SIZE] if n % TABLE_CHUNK_SIZE else []
-    seeds = np.random.SeedSequence(seed).spawn(len(sizes))
+    sizes, seeds = chunk_plan(n, TABLE_CHUNK_SIZE, seed)
     urdf, frame = str(table.urdf_path), table.payload_frame
     tasks = [
         (s, size, upper, lower, urdf, frame, step) for s, size in zip(seeds, sizes, strict=True)
     ]
-    workers = max(1, min(int(workers), os.cpu_count() or 1, len(tasks)))
-    start = time.perf_counter()
-    worst = np.empty((n, 3))
-    offset = 0
-    for chunk_worst, size in zip(
-        _chunk_results(_run_table_chunk, tasks, sizes, workers, progress), sizes, strict=True
-    ):
-        worst[offset : offset + size] = chunk_worst
-        offset += size
+    worst, _, workers, elapsed = run_chunks(_run_table_chunk, tasks, sizes, workers, progress)
     return TableMonteCarloResult(
         worst_rad=worst,
         error_names=names,
@@ -211,7 +169,7 @@ def run_table_monte_carlo(
         seed=seed,
         grid_step_deg=step,
         n_grid_points=int(n_grid),
-        elapsed_s=time.perf_counter() - start,
+        elapsed_s=elapsed,
         workers=workers,
         urdf=urdf,
         payload_frame=frame,

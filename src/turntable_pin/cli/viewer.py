@@ -215,6 +215,21 @@ def _paper_angles_deg(args: argparse.Namespace) -> tuple[float, float]:
     return phi1, phi2
 
 
+def _print_snapshot(args: argparse.Namespace, scene, result, where: str, lengths: str) -> int:
+    """Say what ``snapshot`` wrote: one JSON object (``--json``) or one line; ``where`` is the
+    position's text ("" or ending "; "), ``lengths`` the name of the magnified lengths."""
+    if args.json:
+        print_json({**result.to_dict(), **scene.to_dict()})
+    else:
+        k = scene.exaggeration
+        print(
+            f"wrote {result.path} ({result.width}x{result.height} px; {where}errors magnified "
+            f"x{k.angle_factor:.4g}, {lengths} x{k.length_factor:.4g}; "
+            f"{result.scene_seconds + result.browser_seconds:.1f} s)"
+        )
+    return 0
+
+
 def _run_table_snapshot(args: argparse.Namespace, table) -> int:
     """``snapshot`` of a table given by ``--urdf`` (or ``--angles-deg``)."""
     from ..viewer.snapshot import render_table_snapshot
@@ -229,17 +244,8 @@ def _run_table_snapshot(args: argparse.Namespace, table) -> int:
         height=args.height,
         legend=not args.no_legend,
     )
-    if args.json:
-        print_json({**result.to_dict(), **scene.to_dict()})
-    else:
-        k = scene.exaggeration
-        print(
-            f"wrote {result.path} ({result.width}x{result.height} px; "
-            f"{', '.join(f'{j} = {a:g} deg' for j, a in result.angles_deg.items())}; errors "
-            f"magnified x{k.angle_factor:.4g}, offsets x{k.length_factor:.4g}; "
-            f"{result.scene_seconds + result.browser_seconds:.1f} s)"
-        )
-    return 0
+    where = ", ".join(f"{j} = {a:g} deg" for j, a in result.angles_deg.items())
+    return _print_snapshot(args, scene, result, f"{where}; ", "offsets")
 
 
 def run_snapshot(args: argparse.Namespace) -> int:
@@ -259,13 +265,4 @@ def run_snapshot(args: argparse.Namespace) -> int:
         height=args.height,
         legend=not args.no_legend,
     )
-    if args.json:
-        print_json({**result.to_dict(), **scene.to_dict()})
-    else:
-        k = scene.exaggeration
-        print(
-            f"wrote {result.path} ({result.width}x{result.height} px; errors magnified "
-            f"x{k.angle_factor:.4g}, deta x{k.length_factor:.4g}; "
-            f"{result.scene_seconds + result.browser_seconds:.1f} s)"
-        )
-    return 0
+    return _print_snapshot(args, scene, result, "", "deta")

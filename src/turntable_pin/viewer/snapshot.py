@@ -26,6 +26,7 @@ from .scene import SetupScene
 __all__ = [
     "MAX_SIZE_PX",
     "MIN_SIZE_PX",
+    "RenderedSnapshot",
     "SnapshotResult",
     "TableSnapshotResult",
     "decorate_static_page",
@@ -52,19 +53,22 @@ _PAGE_STYLE = """
 
 
 @dataclass(frozen=True)
-class SnapshotResult:
-    """A written snapshot: path, size (px), position (deg), magnification, timings (s), pids."""
+class RenderedSnapshot:
+    """What every written snapshot says: path, size (px), magnification, timings (s), pids;
+    the position is the subclass's (:meth:`position_dict`)."""
 
     path: Path
     width: int
     height: int
-    phi1_deg: float
-    phi2_deg: float
     exaggeration: dict
     scene_seconds: float
     browser_seconds: float
     server_pid: int
     browser_pid: int
+
+    def position_dict(self) -> dict:
+        """Where the table stood, degrees, JSON-ready (none here)."""
+        return {}
 
     def to_dict(self) -> dict:
         """The result as a JSON-ready dict (sizes in px, angles in deg, times in s; no pids)."""
@@ -72,12 +76,23 @@ class SnapshotResult:
             "path": str(self.path),
             "width_px": self.width,
             "height_px": self.height,
-            "phi1_deg": self.phi1_deg,
-            "phi2_deg": self.phi2_deg,
+            **self.position_dict(),
             "exaggeration": self.exaggeration,
             "scene_seconds": self.scene_seconds,
             "browser_seconds": self.browser_seconds,
         }
+
+
+@dataclass(frozen=True)
+class SnapshotResult(RenderedSnapshot):
+    """A written snapshot of the paper's table: :class:`RenderedSnapshot` at (phi1, phi2), deg."""
+
+    phi1_deg: float
+    phi2_deg: float
+
+    def position_dict(self) -> dict:
+        """``phi1_deg`` and ``phi2_deg``."""
+        return {"phi1_deg": self.phi1_deg, "phi2_deg": self.phi2_deg}
 
 
 def decorate_static_page(page: str, legend: list[str] | None = None) -> str:
@@ -115,9 +130,9 @@ def _check_size(name: str, value: int) -> int:
     return int(value)
 
 
-def _render(scene, angles_rad, output, width, height, legend, timeout_s):
-    """Render ``scene`` at ``angles_rad`` to the PNG ``output``: (output, width, height, scene
-    seconds, server pid, browser run)."""
+def _render(scene, angles_rad, output, width, height, legend, timeout_s) -> dict:
+    """Render ``scene`` at ``angles_rad`` to the PNG ``output``: the fields of
+    :class:`RenderedSnapshot`, by name."""
     width, height = _check_size("width", width), _check_size("height", height)
     output = Path(output)
     if output.suffix.lower() != ".png":
@@ -137,7 +152,16 @@ def _render(scene, angles_rad, output, width, height, legend, timeout_s):
             page_path, width=width, height=height, timeout_s=timeout_s, chromium=chromium
         )
     write_bytes_atomic(output, data)
-    return output, width, height, scene_seconds, server_pid, run
+    return {
+        "path": output,
+        "width": width,
+        "height": height,
+        "exaggeration": scene.exaggeration.to_dict(),
+        "scene_seconds": scene_seconds,
+        "browser_seconds": run.seconds,
+        "server_pid": server_pid,
+        "browser_pid": run.pid,
+    }
 
 
 def render_snapshot(
@@ -158,49 +182,23 @@ def render_snapshot(
         BrowserNotFoundError: no Chromium (names the Debian package ``chromium``).
         BrowserError: Chromium failed or timed out.
     """
-    output, width, height, scene_seconds, server_pid, run = _render(
-        scene, (phi1_rad, phi2_rad), output, width, height, legend, timeout_s
-    )
+    rendered = _render(scene, (phi1_rad, phi2_rad), output, width, height, legend, timeout_s)
     return SnapshotResult(
-        path=output,
-        width=width,
-        height=height,
+        **rendered,
         phi1_deg=round(float(phi1_rad) * DEG_PER_RAD, 9),
         phi2_deg=round(float(phi2_rad) * DEG_PER_RAD, 9),
-        exaggeration=scene.exaggeration.to_dict(),
-        scene_seconds=scene_seconds,
-        browser_seconds=run.seconds,
-        server_pid=server_pid,
-        browser_pid=run.pid,
     )
 
 
 @dataclass(frozen=True)
-class TableSnapshotResult:
-    """A written snapshot of any table: path, size (px), joint angles (deg), magnification,
-    timings (s), pids."""
+class TableSnapshotResult(RenderedSnapshot):
+    """A written snapshot of any table: :class:`RenderedSnapshot` at its joint angles (deg)."""
 
-    path: Path
-    width: int
-    height: int
     angles_deg: dict
-    exaggeration: dict
-    scene_seconds: float
-    browser_seconds: float
-    server_pid: int
-    browser_pid: int
 
-    def to_dict(self) -> dict:
-        """The result as a JSON-ready dict (sizes in px, angles in deg, times in s; no pids)."""
-        return {
-            "path": str(self.path),
-            "width_px": self.width,
-            "height_px": self.height,
-            "angles_deg": dict(self.angles_deg),
-            "exaggeration": self.exaggeration,
-            "scene_seconds": self.scene_seconds,
-            "browser_seconds": self.browser_seconds,
-        }
+    def position_dict(self) -> dict:
+        """``angles_deg``: ``{joint: degrees}``."""
+        return {"angles_deg": dict(self.angles_deg)}
 
 
 def render_table_snapshot(
@@ -216,20 +214,11 @@ def render_table_snapshot(
     """Render a :class:`~turntable_pin.viewer.table_scene.TableScene` at its joint angles
     (radians, chain order) to the PNG file ``output``; raises as :func:`render_snapshot`."""
     angles = tuple(float(a) for a in angles_rad)
-    output, width, height, scene_seconds, server_pid, run = _render(
-        scene, angles, output, width, height, legend, timeout_s
-    )
+    rendered = _render(scene, angles, output, width, height, legend, timeout_s)
     return TableSnapshotResult(
-        path=output,
-        width=width,
-        height=height,
+        **rendered,
         angles_deg={
             j: round(a * DEG_PER_RAD, 9)
             for j, a in zip(scene.table.joint_names, angles, strict=True)
         },
-        exaggeration=scene.exaggeration.to_dict(),
-        scene_seconds=scene_seconds,
-        browser_seconds=run.seconds,
-        server_pid=server_pid,
-        browser_pid=run.pid,
     )
