@@ -25,7 +25,7 @@ from ..core.exceptions import InputError
 from ..core.rotations import AXIS_INDEX, axis_rotation
 from ..core.units import ARCSEC_PER_RAD
 from ..model.angles import ANGLE_ENTRIES
-from ..model.chain import ROTATION, skew
+from ..model.chain import ROTATION
 from ..model.errors import ANGULAR_ERROR_NAMES
 from .effects.base import POST, PRE, Effect, ParameterSpec, PositionVariables
 from .table import MeasuredTable, measured_table
@@ -41,23 +41,60 @@ def base_parameters(names) -> tuple[ParameterSpec, ...]:
 BASE_PARAMETERS: tuple[ParameterSpec, ...] = base_parameters(ANGULAR_ERROR_NAMES)
 """The paper's base errors as parameters."""
 
-_GENERATORS = {
-    axis: np.array(m, dtype=float)
-    for axis, m in {
-        "x": [[0, 0, 0], [0, 0, -1], [0, 1, 0]],
-        "y": [[0, 0, 1], [0, 0, 0], [-1, 0, 0]],
-        "z": [[0, -1, 0], [1, 0, 0], [0, 0, 0]],
-    }.items()
-}
-
 
 @dataclass(frozen=True)
 class _Factor:
-    """One rotation of the chain: fixed matrices (N or 1, 3, 3) or ``R_axis(G @ p)``."""
+    """One rotation of the chain: fixed matrices (N or 1, 3, 3) or ``R_axis(angle)``.
+
+    A parametrised factor's angle is ``weights @ p[columns]`` (rad): ``columns`` are the indices
+    of the few parameters that turn it, ``weights`` their gains per position, (N or 1, k). The
+    gains are kept sparse: a dense (N, n_params) gain per factor cost most of the memory and
+    time of the Jacobian on long logs.
+    """
 
     fixed: np.ndarray | None = None
-    axis: str | None = None
-    gain: np.ndarray | None = None  # (N, n_params): angle = gain @ p
+    axis: str | np.ndarray | None = None
+    columns: np.ndarray | None = None
+    weights: np.ndarray | None = None
+
+    def angle(self, params: np.ndarray, n: int) -> np.ndarray:
+        """The factor's angle at each of the ``n`` positions (rad), (n,)."""
+        angle = self.weights @ params[self.columns]
+        return angle if angle.shape[0] == n else np.full(n, angle[0])
+
+
+def _sparse_gain(gain: dict[int, np.ndarray], n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``{parameter index: gain (N,) or scalar}`` as (columns, weights (N or 1, k))."""
+    columns = np.array(sorted(gain), dtype=int)
+    rows = [np.asarray(gain[c], dtype=float) for c in columns]
+    if all(r.ndim == 0 for r in rows):
+        return columns, np.array([[float(r) for r in rows]])
+    return columns, np.stack([np.broadcast_to(r, (n,)) for r in rows], axis=1)
+
+
+def _merge_fixed(chain: list[_Factor]) -> list[_Factor]:
+    """The chain with runs of fixed factors multiplied into one (identities dropped)."""
+    out: list[_Factor] = []
+    for factor in chain:
+        if factor.fixed is not None:
+            fixed = factor.fixed
+            if fixed.shape[0] == 1 and np.array_equal(fixed[0], np.eye(3)):
+                continue
+            if out and out[-1].fixed is not None:
+                out[-1] = _Factor(fixed=out[-1].fixed @ fixed)
+                continue
+        out.append(factor)
+    return out
+
+
+def _rotate_columns(m: np.ndarray, axis: str, angle: np.ndarray) -> None:
+    """``m <- m @ R_axis(angle)`` in place for stacked (N, 3, 3) ``m``: only two columns mix."""
+    i = AXIS_INDEX[axis]
+    j, k = (i + 1) % 3, (i + 2) % 3
+    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    mj, mk = m[:, :, j].copy(), m[:, :, k]
+    m[:, :, j] = mj * c + mk * s
+    m[:, :, k] = mk * c - mj * s
 
 
 class OrientationModel:
@@ -111,29 +148,34 @@ class OrientationModel:
         """Number of parameters: the base errors plus every effect's parameters."""
         return len(self.parameter_names)
 
-    def _gain(self, weights: dict[str, np.ndarray], prefix: str) -> np.ndarray:
-        gain = np.zeros((self.variables.n, self.n_params))
+    def _gain(self, weights: dict[str, np.ndarray], prefix: str) -> dict[int, np.ndarray]:
+        gain: dict[int, np.ndarray] = {}
         for name, w in weights.items():
-            gain[:, self._index[f"{prefix}{name}"]] += np.asarray(w, dtype=float)
+            i = self._index[f"{prefix}{name}"]
+            gain[i] = gain.get(i, 0.0) + np.asarray(w, dtype=float)
         return gain
 
     def _build_chain(self, turntable: MeasuredTable, terms_by_effect):
         n = self.variables.n
         pre, post = [], []
-        error_gain = {}
-        for name in self.base_names:
-            gain = np.zeros((n, self.n_params))
-            gain[:, self._index[name]] = 1.0
-            error_gain[name] = gain
+        error_gain = {name: {self._index[name]: np.asarray(1.0)} for name in self.base_names}
+
+        def factor(axis, gain):
+            columns, weights = _sparse_gain(gain, n)
+            return _Factor(axis=axis, columns=columns, weights=weights)
+
         for effect, terms in terms_by_effect:
             for term in terms:
                 gain = self._gain(term.weights, f"{effect.name}.")
                 if term.site == PRE:
-                    pre.append(_Factor(axis=term.axis, gain=gain))
+                    pre.append(factor(term.axis, gain))
                 elif term.site == POST:
-                    post.append(_Factor(axis=term.axis, gain=gain))
+                    post.append(factor(term.axis, gain))
                 elif term.site in error_gain:
-                    error_gain[term.site] = error_gain[term.site] + gain
+                    merged = dict(error_gain[term.site])
+                    for i, w in gain.items():
+                        merged[i] = merged.get(i, 0.0) + w
+                    error_gain[term.site] = merged
                 else:
                     raise InputError(
                         f"effect '{effect.name}' changes '{term.site}', which is not an error of "
@@ -147,9 +189,7 @@ class OrientationModel:
             placement = link.nominal[None, :3, :3]
             chain.append(_Factor(fixed=placement))
             chain.extend(
-                _Factor(axis=f.axis, gain=error_gain[f.error])
-                for f in link.factors
-                if f.kind == ROTATION
+                factor(f.axis, error_gain[f.error]) for f in link.factors if f.kind == ROTATION
             )
             ideal = ideal @ placement
             if link.is_joint:
@@ -157,17 +197,7 @@ class OrientationModel:
                 chain.append(_Factor(fixed=rotation))
                 ideal = ideal @ rotation
         chain.extend(post)
-        return chain, np.swapaxes(ideal, -1, -2).copy()
-
-    def _matrices(self, params: np.ndarray) -> list[np.ndarray]:
-        n = self.variables.n
-        out = []
-        for f in self._factors:
-            if f.fixed is not None:
-                out.append(np.broadcast_to(f.fixed, (n, 3, 3)))
-            else:
-                out.append(axis_rotation(f.axis, f.gain @ params))
-        return out
+        return _merge_fixed(chain), np.swapaxes(ideal, -1, -2).copy()
 
     def _check(self, params) -> np.ndarray:
         params = np.asarray(params, dtype=float).reshape(-1)
@@ -175,12 +205,38 @@ class OrientationModel:
             raise InputError(f"expected {self.n_params} parameters, got {params.size}")
         return params
 
+    def _forward(self, params: np.ndarray, axes: bool):
+        """``dR = Rd^T * factors`` (N, 3, 3) by one pass along the chain, and with ``axes`` the
+        rotation axis of every parametrised factor in the frame of ``Rd^T``'s rows, (N, 3) each.
+
+        The matrices are all rotations, so the suffix after factor f is ``P_f^T dR`` (``P_f``
+        the prefix up to f): ``d dR / d angle_f = P_f [a_f]x P_f^T dR = [P_f a_f]x dR``, and the
+        Jacobian needs no suffix products (see :meth:`jacobian`).
+        """
+        n = self.variables.n
+        m = self._rd.copy()
+        found = []
+        for f in self._factors:
+            if f.fixed is not None:
+                if f.fixed.shape[0] == 1:
+                    m = (m.reshape(-1, 3) @ f.fixed[0]).reshape(n, 3, 3)
+                else:
+                    m = m @ f.fixed
+                continue
+            angle = f.angle(params, n)
+            if isinstance(f.axis, str):
+                _rotate_columns(m, f.axis, angle)
+                if axes:
+                    found.append(m[:, :, AXIS_INDEX[f.axis]].copy())
+            else:
+                m = m @ axis_rotation(f.axis, angle)
+                if axes:
+                    found.append(m @ np.asarray(f.axis, dtype=float))
+        return m, found
+
     def rotation_error(self, params) -> np.ndarray:
         """``dR = Rd^T Rt`` at each position, (N, 3, 3)."""
-        total = None
-        for m in self._matrices(self._check(params)):
-            total = m if total is None else total @ m
-        return self._rd @ total
+        return self._forward(self._check(params), False)[0]
 
     def predict(self, params) -> np.ndarray:
         """``[dpsi, dtheta, dgamma]`` (rad) at each position, (N, 3)."""
@@ -189,26 +245,29 @@ class OrientationModel:
 
     def jacobian(self, params) -> np.ndarray:
         """Exact derivative of :meth:`predict` with respect to the parameters, (N, 3, n)."""
-        mats = self._matrices(self._check(params))
+        return self.predict_and_jacobian(params)[1]
+
+    def predict_and_jacobian(self, params) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`predict` (N, 3) and :meth:`jacobian` (N, 3, n) from one pass along the chain.
+
+        For a factor ``R_a(angle)`` whose axis is ``u`` in the frame of ``dR``'s rows, the
+        derivative of ``dR`` is ``[u]x dR``, whose entry (i, j) is ``(u x dR[:, j])_i``; times
+        the factor's gains it goes to the columns of the parameters that turn it.
+        """
+        params = self._check(params)
+        dR, axes = self._forward(params, True)
         n = self.variables.n
-        prefix = [self._rd]
-        for m in mats:
-            prefix.append(prefix[-1] @ m)
-        suffix = [np.broadcast_to(np.eye(3), (n, 3, 3))]
-        for m in reversed(mats):
-            suffix.append(m @ suffix[-1])
-        suffix = suffix[::-1]  # suffix[f] = product of factors f..end
         jac = np.zeros((n, 3, self.n_params))
-        for f, factor in enumerate(self._factors):
-            if factor.fixed is not None:
-                continue
-            generator = (
-                _GENERATORS[factor.axis] if isinstance(factor.axis, str) else skew(factor.axis)
-            )
-            d = prefix[f + 1] @ generator @ suffix[f + 1]
-            entries = np.stack([d[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)  # (N, 3)
-            jac += entries[:, :, None] * factor.gain[:, None, :]
-        return jac
+        entries = np.empty((n, 3))
+        factors = [f for f in self._factors if f.fixed is None]
+        for factor, u in zip(factors, axes, strict=True):
+            for e, (i, j) in enumerate(ANGLE_ENTRIES):
+                i1, i2 = (i + 1) % 3, (i + 2) % 3
+                entries[:, e] = u[:, i1] * dR[:, i2, j] - u[:, i2] * dR[:, i1, j]
+            for c, column in enumerate(factor.columns):
+                jac[:, :, column] += entries * factor.weights[:, c, None]
+        predicted = np.stack([dR[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)
+        return predicted, jac
 
     def parameter_vector(self, values: dict[str, float] | None = None) -> np.ndarray:
         """A parameter vector (internal units) from ``{name: value in internal units}``."""

@@ -52,6 +52,14 @@ class OrientationFitProblem:
         """Derivative of :meth:`predict` with respect to the parameters, (m, n_params)."""
         return self._measured(self.model.jacobian(params).reshape(-1, self.model.n_params))
 
+    def predict_and_jacobian(self, params: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`predict` (rad) and :meth:`jacobian` (a new array) from one pass of the model."""
+        predicted, jac = self.model.predict_and_jacobian(params)
+        return (
+            self._measured(predicted.reshape(-1)),
+            self._measured(jac.reshape(-1, self.model.n_params)),
+        )
+
 
 @dataclass(frozen=True)
 class OrientationFit:

@@ -37,6 +37,7 @@ __all__ = [
     "analyse_identifiability",
     "combination_name",
     "fit_least_squares",
+    "tall_r_factor",
 ]
 
 RANK_RTOL = 1e-6
@@ -59,6 +60,9 @@ class FitProblem(Protocol):
 
     def jacobian(self, params: np.ndarray) -> np.ndarray:
         """Derivative of :meth:`predict` with respect to the parameters, (m, n)."""
+
+    # Optional: ``predict_and_jacobian(params) -> (predicted (m,), jacobian (m, n))`` in one
+    # pass, the Jacobian a new array (the fit scales it in place).
 
 
 def _rref(matrix: np.ndarray, tol: float = 1e-9) -> np.ndarray:
@@ -123,14 +127,49 @@ class Identifiability:
     unresponsive: tuple[str, ...]
 
 
+TALL_ROWS = 4096
+"""Row blocks of :func:`tall_r_factor`; matrices with at most ``2 * TALL_ROWS`` rows and those
+not many times taller than wide are decomposed directly."""
+
+
+def tall_r_factor(matrix: np.ndarray) -> np.ndarray:
+    """The triangular factor R (n, n) of a tall matrix (m, n), ``matrix = Q R``, by blocks.
+
+    Blocks of :data:`TALL_ROWS` rows are reduced to their R factors at once (a stacked QR that
+    stays in cache) and the stacked factors reduced again: the same R up to the signs of its
+    rows as one QR of the whole matrix, several times faster on long tall matrices. The SVD of
+    R has the singular values and right singular vectors of ``matrix``.
+    """
+    m, n = matrix.shape
+    block = max(TALL_ROWS, 4 * n)
+    full = (m // block) * block
+    parts = []
+    if full:
+        stacked = matrix[:full].reshape(-1, block, n)
+        parts.append(np.linalg.qr(stacked, mode="r").reshape(-1, n))
+    if full < m:
+        parts.append(matrix[full:])
+    return np.linalg.qr(np.concatenate(parts) if len(parts) > 1 else parts[0], mode="r")
+
+
+def _singular_values_vt(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Singular values and (n, n) right singular vectors of ``matrix`` (m, n)."""
+    m, n = matrix.shape
+    if m > 2 * TALL_ROWS and m >= 8 * n:
+        _, s, vt = np.linalg.svd(tall_r_factor(matrix))
+        return s, vt
+    # vt must be square (n x n) to hold the null space; U need not be (m can be large).
+    _, s, vt = np.linalg.svd(matrix, full_matrices=m < n)
+    return s, vt
+
+
 def analyse_identifiability(jacobian_weighted: np.ndarray, names) -> Identifiability:
     """Rank, determined combinations and flat directions of a weighted Jacobian (m, n)."""
     norms = np.linalg.norm(jacobian_weighted, axis=0)
     dead = norms <= 1e-300
     scale = np.where(dead, 1.0, norms)
-    m, n = jacobian_weighted.shape
-    # vt must be square (n x n) to hold the null space; U need not be (m can be large).
-    _, s, vt = np.linalg.svd(jacobian_weighted / scale, full_matrices=m < n)
+    n = jacobian_weighted.shape[1]
+    s, vt = _singular_values_vt(jacobian_weighted / scale)
     rank = int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
     v_r = vt[:rank].T
     v_null = vt[rank:].T
@@ -341,23 +380,80 @@ def _replace(result: FitResult, **changes) -> FitResult:
     return replace(result, **changes)
 
 
+GAUSS_NEWTON_RTOL = 1e-8
+"""Gauss-Newton stops once a step is below this fraction of the solution (whitened
+coordinates); the next iterate, where the fit is evaluated, is then converged far beyond it."""
+
+GAUSS_NEWTON_MAX_STEPS = 30
+"""Gauss-Newton steps before the fit falls back to scipy's Levenberg-Marquardt."""
+
+
+def _evaluator(problem: FitProblem):
+    """``params -> (predicted (m,), jacobian (m, n))``, in one pass when the problem has
+    ``predict_and_jacobian``."""
+    both = getattr(problem, "predict_and_jacobian", None)
+    if both is not None:
+        return both  # its Jacobian is a new array: the fit scales it in place
+    return lambda params: (
+        problem.predict(params),
+        np.array(problem.jacobian(params), dtype=float),
+    )
+
+
+def _gauss_newton(evaluate, observed, weights, basis, first):
+    """Gauss-Newton from ``z = 0`` in coordinates where the weighted Jacobian there is
+    orthonormal; ``first`` is ``(predicted, weighted jacobian)`` at zero.
+
+    Returns ``(z, weighted residuals, weighted jacobian (m, n), evaluations)`` at the converged
+    point, or None when a step fails to lower the residual sum of squares or the steps do not
+    settle (the caller then uses scipy's Levenberg-Marquardt).
+    """
+    z = np.zeros(basis.shape[1])
+    predicted, jac = first
+    last_cost = None
+    converged = False
+    for count in range(1, GAUSS_NEWTON_MAX_STEPS + 2):
+        if count > 1:
+            predicted, jac = evaluate(basis @ z)
+            jac *= weights[:, None]
+        res = (observed - predicted) * weights
+        cost = float(res @ res)
+        if last_cost is not None and cost > last_cost * (1.0 + 1e-12) + 1e-300:
+            return None
+        if converged:
+            return z, res, jac, count
+        last_cost = cost
+        jz = jac @ basis  # d(predicted * weights)/dz = -d(res)/dz
+        step = np.linalg.solve(jz.T @ jz, jz.T @ res)
+        z = z + step
+        size = float(np.linalg.norm(step))
+        converged = size <= GAUSS_NEWTON_RTOL * float(np.linalg.norm(z)) or size <= 1e-15
+    return None
+
+
 def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = None) -> FitResult:
-    """Fit ``problem`` by weighted nonlinear least squares (scipy ``least_squares``).
+    """Fit ``problem`` by weighted nonlinear least squares (Gauss-Newton, else scipy's LM).
+
+    The models are nearly linear (second-order terms of the size of the fitted errors): in
+    coordinates where the weighted Jacobian at zero is orthonormal, Gauss-Newton converges in
+    two or three steps, each one evaluation of the model and its Jacobian; a step that does not
+    lower the residuals hands the fit to scipy's ``least_squares`` (Levenberg-Marquardt).
 
     Args:
-        problem: the model and data.
+        problem: the model and data (``predict_and_jacobian``, when present, is used for one
+            pass per step).
         noise_variance: unit-weight noise variance to judge the fit with when sigmas are unknown
             (default: estimated from this fit, ``rss / dof``). Ignored when sigmas are given.
 
     Raises:
         IdentifiabilityError: no parameter is determined, or no degree of freedom is left.
     """
-    from scipy import optimize  # imported on use: keeps the package's import light
-
     sigma_known = problem.sigma is not None
     weights = 1.0 / problem.sigma if sigma_known else np.ones_like(problem.observed)
     n = len(problem.parameter_names)
-    j0 = problem.jacobian(np.zeros(n)) * weights[:, None]
+    evaluate = _evaluator(problem)
+    predicted0, j0 = evaluate(np.zeros(n))
+    j0 *= weights[:, None]
     ident = analyse_identifiability(j0, problem.parameter_names)
     m = problem.observed.size
     if ident.rank == 0:
@@ -367,25 +463,18 @@ def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = Non
             f"{m} observations cannot fit {ident.rank} independent parameter combinations with a "
             "degree of freedom left; measure more positions"
         )
-    basis = ident.basis
-
-    def fun(z):
-        return (problem.observed - problem.predict(basis @ z)) * weights
-
-    def jac(z):
-        return -(problem.jacobian(basis @ z) * weights[:, None]) @ basis
-
-    # The models are nearly linear: one Gauss-Newton step from zero lands close to the optimum.
-    z0 = np.linalg.lstsq(-jac(np.zeros(ident.rank)), -fun(np.zeros(ident.rank)), rcond=None)[0]
-    solution = optimize.least_squares(
-        fun, z0, jac=jac, method="lm" if m >= ident.rank else "trf", xtol=1e-12, ftol=1e-12
-    )
-    z = solution.x
+    # Whitened coordinates: the weighted Jacobian at zero times ``basis`` is orthonormal, so the
+    # normal equations of every step are as well conditioned as the problem is nonlinear.
+    basis = ident.basis / ident.singular_values[: ident.rank]
+    solved = _gauss_newton(evaluate, problem.observed, weights, basis, (predicted0, j0))
+    del j0
+    if solved is None:
+        z, weighted_res, jac_weighted, nfev = _levenberg_marquardt(problem, weights, basis)
+    else:
+        z, weighted_res, jac_weighted, nfev = solved
     params = basis @ z
-    jz = jac(z)
-    weighted_res = solution.fun
-    # scipy's ``cost`` is already 0.5 * sum(f**2): the residual sum of squares is 2 * cost.
-    rss = float(2.0 * solution.cost)
+    jz = jac_weighted @ basis
+    rss = float(weighted_res @ weighted_res)
     dof = m - ident.rank
     if sigma_known:
         variance = 1.0
@@ -410,6 +499,26 @@ def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = Non
         identifiability=ident,
         user_unit_scale=float(problem.user_unit_scale),
         observation_unit=str(getattr(problem, "observation_unit", "")),
-        jacobian_weighted=problem.jacobian(params) * weights[:, None],
-        n_function_evaluations=int(solution.nfev),
+        jacobian_weighted=jac_weighted,
+        n_function_evaluations=int(nfev),
     )
+
+
+def _levenberg_marquardt(problem: FitProblem, weights: np.ndarray, basis: np.ndarray):
+    """scipy's Levenberg-Marquardt in the coordinates ``basis``: ``(z, weighted residuals,
+    weighted jacobian (m, n), evaluations)``."""
+    from scipy import optimize  # imported on use: keeps the package's import light
+
+    def fun(z):
+        return (problem.observed - problem.predict(basis @ z)) * weights
+
+    def jac(z):
+        return -(problem.jacobian(basis @ z) * weights[:, None]) @ basis
+
+    # The models are nearly linear: one Gauss-Newton step from zero lands close to the optimum.
+    rank = basis.shape[1]
+    z0 = np.linalg.lstsq(-jac(np.zeros(rank)), -fun(np.zeros(rank)), rcond=None)[0]
+    solution = optimize.least_squares(fun, z0, jac=jac, method="lm", xtol=1e-12, ftol=1e-12)
+    z = solution.x
+    jac_weighted = problem.jacobian(basis @ z) * weights[:, None]
+    return z, solution.fun, jac_weighted, solution.nfev
