@@ -44,12 +44,14 @@ BASE_PARAMETERS: tuple[ParameterSpec, ...] = base_parameters(ANGULAR_ERROR_NAMES
 
 @dataclass(frozen=True)
 class _Factor:
-    """One rotation of the chain: fixed matrices (N or 1, 3, 3) or ``R_axis(angle)``.
+    """One rotation of the chain: fixed matrices or ``R_axis(angle)``.
 
-    A parametrised factor's angle is ``weights @ p[columns]`` (rad): ``columns`` are the indices
-    of the few parameters that turn it, ``weights`` their gains per position, (N or 1, k). The
-    gains are kept sparse: a dense (N, n_params) gain per factor cost most of the memory and
-    time of the Jacobian on long logs.
+    Matrices are stored entry-major, (3, 3, N or 1): ``m[r, c]`` is the entry (r, c) at every
+    position, so products and the Jacobian work on contiguous vectors. A parametrised factor's
+    angle is ``p[columns] @ weights`` (rad): ``columns`` are the indices of the few parameters
+    that turn it, ``weights`` their gains per position, (k, N or 1). The gains are kept sparse:
+    a dense (N, n_params) gain per factor cost most of the memory and time of the Jacobian on
+    long logs.
     """
 
     fixed: np.ndarray | None = None
@@ -59,42 +61,56 @@ class _Factor:
 
     def angle(self, params: np.ndarray, n: int) -> np.ndarray:
         """The factor's angle at each of the ``n`` positions (rad), (n,)."""
-        angle = self.weights @ params[self.columns]
+        angle = params[self.columns] @ self.weights
         return angle if angle.shape[0] == n else np.full(n, angle[0])
 
 
 def _sparse_gain(gain: dict[int, np.ndarray], n: int) -> tuple[np.ndarray, np.ndarray]:
-    """``{parameter index: gain (N,) or scalar}`` as (columns, weights (N or 1, k))."""
+    """``{parameter index: gain (N,) or scalar}`` as (columns, weights (k, N or 1))."""
     columns = np.array(sorted(gain), dtype=int)
     rows = [np.asarray(gain[c], dtype=float) for c in columns]
     if all(r.ndim == 0 for r in rows):
-        return columns, np.array([[float(r) for r in rows]])
-    return columns, np.stack([np.broadcast_to(r, (n,)) for r in rows], axis=1)
+        return columns, np.array([[float(r)] for r in rows])
+    return columns, np.stack([np.broadcast_to(r, (n,)) for r in rows])
+
+
+def _entry_major(matrices: np.ndarray) -> np.ndarray:
+    """Stacked matrices (N, 3, 3) as (3, 3, N)."""
+    return np.ascontiguousarray(np.moveaxis(matrices, 0, -1))
+
+
+def _product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a @ b`` of entry-major stacks (3, 3, N or 1) (the last axes broadcast)."""
+    return sum(a[:, k, None, :] * b[None, k, :, :] for k in range(3))
 
 
 def _merge_fixed(chain: list[_Factor]) -> list[_Factor]:
     """The chain with runs of fixed factors multiplied into one (identities dropped)."""
+    identity = np.eye(3)[:, :, None]
     out: list[_Factor] = []
     for factor in chain:
         if factor.fixed is not None:
             fixed = factor.fixed
-            if fixed.shape[0] == 1 and np.array_equal(fixed[0], np.eye(3)):
+            if fixed.shape[-1] == 1 and np.array_equal(fixed, identity):
                 continue
             if out and out[-1].fixed is not None:
-                out[-1] = _Factor(fixed=out[-1].fixed @ fixed)
+                out[-1] = _Factor(fixed=_product(out[-1].fixed, fixed))
                 continue
         out.append(factor)
     return out
 
 
 def _rotate_columns(m: np.ndarray, axis: str, angle: np.ndarray) -> None:
-    """``m <- m @ R_axis(angle)`` in place for stacked (N, 3, 3) ``m``: only two columns mix."""
+    """``m <- m @ R_axis(angle)`` in place for an entry-major stack (3, 3, N): only two columns
+    mix."""
     i = AXIS_INDEX[axis]
     j, k = (i + 1) % 3, (i + 2) % 3
-    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
-    mj, mk = m[:, :, j].copy(), m[:, :, k]
-    m[:, :, j] = mj * c + mk * s
-    m[:, :, k] = mk * c - mj * s
+    c, s = np.cos(angle), np.sin(angle)
+    mj = m[:, j].copy()
+    m[:, j] *= c
+    m[:, j] += m[:, k] * s
+    m[:, k] *= c
+    m[:, k] -= mj * s
 
 
 class OrientationModel:
@@ -187,17 +203,17 @@ class OrientationModel:
         ideal = np.broadcast_to(np.eye(3), (n, 3, 3))
         for link in turntable.chain.links:
             placement = link.nominal[None, :3, :3]
-            chain.append(_Factor(fixed=placement))
+            chain.append(_Factor(fixed=_entry_major(placement)))
             chain.extend(
                 factor(f.axis, error_gain[f.error]) for f in link.factors if f.kind == ROTATION
             )
             ideal = ideal @ placement
             if link.is_joint:
                 rotation = axis_rotation(link.axis, np.asarray(next(joint_angles), float))
-                chain.append(_Factor(fixed=rotation))
+                chain.append(_Factor(fixed=_entry_major(rotation)))
                 ideal = ideal @ rotation
         chain.extend(post)
-        return _merge_fixed(chain), np.swapaxes(ideal, -1, -2).copy()
+        return _merge_fixed(chain), _entry_major(np.swapaxes(ideal, -1, -2))
 
     def _check(self, params) -> np.ndarray:
         params = np.asarray(params, dtype=float).reshape(-1)
@@ -206,42 +222,42 @@ class OrientationModel:
         return params
 
     def _forward(self, params: np.ndarray, axes: bool):
-        """``dR = Rd^T * factors`` (N, 3, 3) by one pass along the chain, and with ``axes`` the
-        rotation axis of every parametrised factor in the frame of ``Rd^T``'s rows, (N, 3) each.
+        """``dR = Rd^T * factors`` entry-major (3, 3, N) by one pass along the chain, and with
+        ``axes`` the rotation axis of every parametrised factor in the frame of ``dR``'s rows,
+        (3, N) each.
 
         The matrices are all rotations, so the suffix after factor f is ``P_f^T dR`` (``P_f``
         the prefix up to f): ``d dR / d angle_f = P_f [a_f]x P_f^T dR = [P_f a_f]x dR``, and the
-        Jacobian needs no suffix products (see :meth:`jacobian`).
+        Jacobian needs no suffix products (see :meth:`predict_and_jacobian`).
         """
         n = self.variables.n
         m = self._rd.copy()
         found = []
         for f in self._factors:
             if f.fixed is not None:
-                if f.fixed.shape[0] == 1:
-                    m = (m.reshape(-1, 3) @ f.fixed[0]).reshape(n, 3, 3)
-                else:
-                    m = m @ f.fixed
+                m = _product(m, f.fixed)
                 continue
             angle = f.angle(params, n)
             if isinstance(f.axis, str):
                 _rotate_columns(m, f.axis, angle)
                 if axes:
-                    found.append(m[:, :, AXIS_INDEX[f.axis]].copy())
+                    found.append(m[:, AXIS_INDEX[f.axis]].copy())
             else:
-                m = m @ axis_rotation(f.axis, angle)
+                m = _product(m, _entry_major(axis_rotation(f.axis, angle)))
                 if axes:
-                    found.append(m @ np.asarray(f.axis, dtype=float))
+                    generator_axis = np.asarray(f.axis, dtype=float)
+                    found.append(sum(m[:, k] * generator_axis[k] for k in range(3)))
         return m, found
 
     def rotation_error(self, params) -> np.ndarray:
         """``dR = Rd^T Rt`` at each position, (N, 3, 3)."""
-        return self._forward(self._check(params), False)[0]
+        dR = self._forward(self._check(params), False)[0]
+        return np.ascontiguousarray(np.moveaxis(dR, -1, 0))
 
     def predict(self, params) -> np.ndarray:
         """``[dpsi, dtheta, dgamma]`` (rad) at each position, (N, 3)."""
-        dR = self.rotation_error(params)
-        return np.stack([dR[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)
+        dR = self._forward(self._check(params), False)[0]
+        return np.stack([dR[i, j] for i, j in ANGLE_ENTRIES], axis=1)
 
     def jacobian(self, params) -> np.ndarray:
         """Exact derivative of :meth:`predict` with respect to the parameters, (N, 3, n)."""
@@ -252,22 +268,26 @@ class OrientationModel:
 
         For a factor ``R_a(angle)`` whose axis is ``u`` in the frame of ``dR``'s rows, the
         derivative of ``dR`` is ``[u]x dR``, whose entry (i, j) is ``(u x dR[:, j])_i``; times
-        the factor's gains it goes to the columns of the parameters that turn it.
+        the factor's gains it goes to the columns of the parameters that turn it. The Jacobian
+        is a new array, laid out parameter by parameter (a transposed view).
         """
         params = self._check(params)
         dR, axes = self._forward(params, True)
         n = self.variables.n
-        jac = np.zeros((n, 3, self.n_params))
+        jac = np.zeros((self.n_params, n, 3))
         entries = np.empty((n, 3))
         factors = [f for f in self._factors if f.fixed is None]
         for factor, u in zip(factors, axes, strict=True):
             for e, (i, j) in enumerate(ANGLE_ENTRIES):
                 i1, i2 = (i + 1) % 3, (i + 2) % 3
-                entries[:, e] = u[:, i1] * dR[:, i2, j] - u[:, i2] * dR[:, i1, j]
-            for c, column in enumerate(factor.columns):
-                jac[:, :, column] += entries * factor.weights[:, c, None]
-        predicted = np.stack([dR[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)
-        return predicted, jac
+                np.subtract(u[i1] * dR[i2, j], u[i2] * dR[i1, j], out=entries[:, e])
+            for column, weight in zip(factor.columns, factor.weights, strict=True):
+                if weight.size == 1 and weight[0] == 1.0:
+                    jac[column] += entries
+                else:
+                    jac[column] += entries * weight[:, None]
+        predicted = np.stack([dR[i, j] for i, j in ANGLE_ENTRIES], axis=1)
+        return predicted, jac.transpose(1, 2, 0)
 
     def parameter_vector(self, values: dict[str, float] | None = None) -> np.ndarray:
         """A parameter vector (internal units) from ``{name: value in internal units}``."""

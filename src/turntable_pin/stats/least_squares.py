@@ -127,7 +127,7 @@ class Identifiability:
     unresponsive: tuple[str, ...]
 
 
-TALL_ROWS = 4096
+TALL_ROWS = 256
 """Row blocks of :func:`tall_r_factor`; matrices with at most ``2 * TALL_ROWS`` rows and those
 not many times taller than wide are decomposed directly."""
 

@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .least_squares import TALL_ROWS, tall_r_factor
+
 __all__ = [
     "BIC_THRESHOLD",
     "NEW_FRACTION",
@@ -102,11 +104,48 @@ def delta_bic(rss_new: float, rss_old: float, added: int, m: int, noise_variance
 
 
 def _orthonormal_columns(matrix: np.ndarray) -> np.ndarray:
+    """An orthonormal basis (m, k) of the span of ``matrix`` (m, n): its directions with
+    singular values above 1e-9 of the largest."""
     if matrix.size == 0:
         return np.zeros((matrix.shape[0], 0))
-    u, s, _ = np.linalg.svd(matrix, full_matrices=False)
+    m, n = matrix.shape
+    if m <= 2 * TALL_ROWS or m < 8 * n:
+        u, s, _ = np.linalg.svd(matrix, full_matrices=False)
+        return u[:, s > 1e-9 * (s[0] if s.size else 1.0)]
+    # Long and thin: the right singular vectors from the small R factor, U = A V / s, then one
+    # more orthonormalisation against the rounding of the directions with small s.
+    _, s, vt = np.linalg.svd(tall_r_factor(matrix))
     keep = s > 1e-9 * (s[0] if s.size else 1.0)
-    return u[:, keep]
+    u = matrix @ (vt[keep].T / s[keep])
+    values, vectors = np.linalg.eigh(u.T @ u)
+    return u @ (vectors / np.sqrt(values)) @ vectors.T
+
+
+def _probe_fit(columns: np.ndarray, q: np.ndarray, qr_: np.ndarray, r: np.ndarray):
+    """What a probe's columns (m, g) add beyond the span of ``q`` (m, k) to explain ``r``.
+
+    Works on small matrices only: with ``t = columns - q q^T columns`` (the part ``q`` does not
+    span), ``t^T t = C^T C - (q^T C)^T (q^T C)`` and ``t^T r = C^T r - (q^T C)^T (q^T r)``; the
+    eigen-decomposition ``t^T t = V S^2 V^T`` gives the singular values of ``t`` and, for the
+    kept directions, ``U = t V / S``.
+
+    Returns:
+        ``(reduction, V kept (g, k), S kept, t^T r)`` or None when no direction is new.
+    """
+    gram = columns.T @ columns
+    if not gram.size:
+        return None
+    scale2 = float(np.linalg.eigvalsh(gram)[-1])
+    qc = q.T @ columns
+    tt = gram - qc.T @ qc
+    tr = columns.T @ r - qc.T @ qr_
+    values, vectors = np.linalg.eigh((tt + tt.T) / 2.0)
+    keep = values > NEW_FRACTION**2 * scale2
+    if not keep.any():
+        return None
+    v, s2 = vectors[:, keep], values[keep]
+    along = v.T @ tr  # s * (U^T r)
+    return float(np.sum(along**2 / s2)), v, np.sqrt(s2), along
 
 
 def search_structure(
@@ -118,6 +157,10 @@ def search_structure(
     max_terms: int = 5,
 ) -> list[FoundTerm]:
     """Greedy forward search of probes that explain residual structure.
+
+    Each probe is scored from small matrices (its Gram matrix and its products with the model's
+    orthonormal basis and the residuals, :func:`_probe_fit`): no decomposition of a tall matrix
+    per probe; only an accepted probe's new directions are formed.
 
     Args:
         weighted_residuals: (m,) residuals divided by sigma (unit weights if sigma unknown).
@@ -135,26 +178,20 @@ def search_structure(
     threshold = BIC_THRESHOLD - 2.0 * math.log(max(len(remaining), 1))
     for _ in range(max_terms):
         rss = float(r @ r)
+        qr_ = q.T @ r
         best = None
         for probe in remaining:
-            columns = probe.matrix()
-            scale = np.linalg.norm(columns, 2) if columns.size else 0.0
-            t = columns - q @ (q.T @ columns)
-            u, s, vt = np.linalg.svd(t, full_matrices=False)
-            keep = s > NEW_FRACTION * scale
-            if not keep.any():
-                continue
-            basis = u[:, keep]
-            reduction = float(np.sum((basis.T @ r) ** 2))
-            if best is None or reduction > best[0]:
-                best = (reduction, probe, basis, vt[keep].T / s[keep])
+            scored = _probe_fit(probe.matrix(), q, qr_, r)
+            if scored is not None and (best is None or scored[0] > best[0]):
+                best = (scored[0], probe, *scored[1:])
         if best is None:
             break
-        reduction, probe, basis, pseudo_inverse = best
-        dbic = delta_bic(rss - reduction, rss, basis.shape[1], m, noise_variance)
+        reduction, probe, v, s, along = best
+        dbic = delta_bic(rss - reduction, rss, v.shape[1], m, noise_variance)
         if dbic > threshold:
             break
-        coef = pseudo_inverse @ (basis.T @ r) * probe.unit_scale
+        # coefficients: V S^-1 U^T r = V S^-2 (V^T t^T r)
+        coef = (v @ (along / s**2)) * probe.unit_scale
         found.append(
             FoundTerm(
                 name=probe.name,
@@ -165,6 +202,8 @@ def search_structure(
                 coefficients=tuple(float(c) for c in coef),
             )
         )
+        columns = probe.matrix()
+        basis = (columns - q @ (q.T @ columns)) @ (v / s)
         r = r - basis @ (basis.T @ r)
         q = np.concatenate([q, basis], axis=1)
         remaining.remove(probe)
