@@ -89,11 +89,11 @@ def _merge_fixed(chain: list[_Factor]) -> list[_Factor]:
     identity = np.eye(3)[:, :, None]
     out: list[_Factor] = []
     for factor in chain:
-        if factor.fixed is not None:
+        if isinstance(factor, _Factor) and factor.fixed is not None:
             fixed = factor.fixed
             if fixed.shape[-1] == 1 and np.array_equal(fixed, identity):
                 continue
-            if out and out[-1].fixed is not None:
+            if out and isinstance(out[-1], _Factor) and out[-1].fixed is not None:
                 out[-1] = _Factor(fixed=_product(out[-1].fixed, fixed))
                 continue
         out.append(factor)
@@ -111,6 +111,41 @@ def _rotate_columns(m: np.ndarray, axis: str, angle: np.ndarray) -> None:
     m[:, j] += m[:, k] * s
     m[:, k] *= c
     m[:, k] -= mj * s
+
+
+_TABLE_PART: list = []
+"""The last table part built: ``[(turntable, joint_rad, part, rd)]`` (at most one entry)."""
+
+
+def _table_part(turntable: MeasuredTable, joint_rad: np.ndarray):
+    """The table's chain at these joint angles: fixed matrices (entry-major, runs multiplied)
+    and ``(axis, error name)`` of its error rotations, in chain order, and ``Rd^T`` (3, 3, N).
+
+    None of it depends on parameters or effects, so the models of one diagnosis (the base and
+    every candidate, each step) share the arrays: the last result is kept and reused when the
+    table and the joint angles are the same.
+    """
+    for table, joints, part, rd in _TABLE_PART:
+        if table is turntable and joints.shape == joint_rad.shape:
+            if np.array_equal(joints, joint_rad):
+                return part, rd
+    n = joint_rad.shape[0]
+    angles = iter(joint_rad.T)
+    chain: list = []
+    ideal = np.broadcast_to(np.eye(3), (n, 3, 3))
+    for link in turntable.chain.links:
+        placement = link.nominal[None, :3, :3]
+        chain.append(_Factor(fixed=_entry_major(placement)))
+        chain.extend((f.axis, f.error) for f in link.factors if f.kind == ROTATION)
+        ideal = ideal @ placement
+        if link.is_joint:
+            rotation = axis_rotation(link.axis, np.asarray(next(angles), float))
+            chain.append(_Factor(fixed=_entry_major(rotation)))
+            ideal = ideal @ rotation
+    part = _merge_fixed(chain)
+    rd = _entry_major(np.swapaxes(ideal, -1, -2))
+    _TABLE_PART[:] = [(turntable, joint_rad.copy(), part, rd)]
+    return part, rd
 
 
 class OrientationModel:
@@ -198,22 +233,16 @@ class OrientationModel:
                         f"this table; its errors: {', '.join(self.base_names)}"
                     )
 
-        joint_angles = iter(self.variables.joint_rad.T)
-        chain: list[_Factor] = list(pre)
-        ideal = np.broadcast_to(np.eye(3), (n, 3, 3))
-        for link in turntable.chain.links:
-            placement = link.nominal[None, :3, :3]
-            chain.append(_Factor(fixed=_entry_major(placement)))
-            chain.extend(
-                factor(f.axis, error_gain[f.error]) for f in link.factors if f.kind == ROTATION
-            )
-            ideal = ideal @ placement
-            if link.is_joint:
-                rotation = axis_rotation(link.axis, np.asarray(next(joint_angles), float))
-                chain.append(_Factor(fixed=_entry_major(rotation)))
-                ideal = ideal @ rotation
+        part, rd = _table_part(turntable, self.variables.joint_rad)
+        chain = [*pre]
+        for entry in part:
+            if isinstance(entry, _Factor):
+                chain.append(entry)
+            else:
+                axis, error = entry
+                chain.append(factor(axis, error_gain[error]))
         chain.extend(post)
-        return _merge_fixed(chain), _entry_major(np.swapaxes(ideal, -1, -2))
+        return _merge_fixed(chain), rd
 
     def _check(self, params) -> np.ndarray:
         params = np.asarray(params, dtype=float).reshape(-1)

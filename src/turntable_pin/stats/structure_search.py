@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .least_squares import TALL_ROWS, tall_r_factor
+from .least_squares import TALL_ROWS, tall_r_factor, tall_times
 
 __all__ = [
     "BIC_THRESHOLD",
@@ -116,9 +116,9 @@ def _orthonormal_columns(matrix: np.ndarray) -> np.ndarray:
     # more orthonormalisation against the rounding of the directions with small s.
     _, s, vt = np.linalg.svd(tall_r_factor(matrix))
     keep = s > 1e-9 * (s[0] if s.size else 1.0)
-    u = matrix @ (vt[keep].T / s[keep])
+    u = tall_times(matrix, vt[keep].T / s[keep])
     values, vectors = np.linalg.eigh(u.T @ u)
-    return u @ (vectors / np.sqrt(values)) @ vectors.T
+    return tall_times(u, (vectors / np.sqrt(values)) @ vectors.T)
 
 
 def _probe_fit(columns: np.ndarray, q: np.ndarray, qr_: np.ndarray, r: np.ndarray):
@@ -203,7 +203,7 @@ def search_structure(
             )
         )
         columns = probe.matrix()
-        basis = (columns - q @ (q.T @ columns)) @ (v / s)
+        basis = tall_times(columns - tall_times(q, q.T @ columns), v / s)
         r = r - basis @ (basis.T @ r)
         q = np.concatenate([q, basis], axis=1)
         remaining.remove(probe)
