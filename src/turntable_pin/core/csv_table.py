@@ -123,38 +123,17 @@ def read_csv_table(
         )
     wanted = [name for name in (*required, *optional) if name in header]
     index = {name: header.index(name) for name in wanted}
-    values = {name: [] for name in wanted}
-    blank_ok = set(blank)
     others = [n for n in header if n not in index and n] if extra else []
-    other_cells: dict[str, list[str]] = {n: [] for n in others}
-    row_numbers = []
-    for (line_no, _), cells in zip(lines[1:], parsed[1:], strict=True):
-        if len(cells) != len(header):
-            raise InputError(
-                f"expected {len(header)} cells as in the header, found {len(cells)}",
-                path=path,
-                row=line_no,
-            )
-        for name in others:
-            other_cells[name].append(cells[header.index(name)].strip())
-        for name in wanted:
-            text = cells[index[name]].strip()
-            if not text and name in blank_ok:
-                values[name].append(math.nan)
-                continue
-            try:
-                number = float(text)
-            except ValueError:
-                what = "an empty cell" if not text else f"'{text}'"
-                raise InputError(
-                    f"expected a number, found {what}", path=path, row=line_no, column=name
-                ) from None
-            if not math.isfinite(number):
-                raise InputError(
-                    f"expected a finite number, found '{text}'", path=path, row=line_no, column=name
-                )
-            values[name].append(number)
-        row_numbers.append(line_no)
+    data_rows = parsed[1:]
+    fast = _whole_columns(data_rows, len(header), index)
+    if fast is not None:
+        values = fast
+        row_numbers = [line_no for line_no, _ in lines[1:]]
+        other_cells = {n: [cells[header.index(n)].strip() for cells in data_rows] for n in others}
+    else:
+        values, other_cells, row_numbers = _cell_by_cell(
+            path, lines, data_rows, header, index, others, set(blank)
+        )
     if len(row_numbers) < min_rows:
         raise InputError(
             f"expected at least {min_rows} data row(s), found {len(row_numbers)}", path=path
@@ -176,6 +155,60 @@ def read_csv_table(
     )
 
 
+def _whole_columns(data_rows, width: int, index: dict[str, int]) -> dict | None:
+    """Every wanted column as floats at once, when the file is clean: each row as wide as the
+    header and every wanted cell a finite number (``float`` of the cell, as cell by cell).
+    ``None`` at the first doubt: :func:`_cell_by_cell` then finds and names the problem."""
+    if any(len(cells) != width for cells in data_rows):
+        return None
+    out = {}
+    for name, i in index.items():
+        try:
+            column = np.array([float(cells[i]) for cells in data_rows], dtype=float)
+        except ValueError:
+            return None
+        if not np.all(np.isfinite(column)):
+            return None
+        out[name] = column
+    return out
+
+
+def _cell_by_cell(path, lines, data_rows, header, index, others, blank_ok):
+    """Read the wanted columns row by row and cell by cell, raising at the first problem (its
+    row and column named); ``(values, other cells, row numbers)``."""
+    values = {name: [] for name in index}
+    other_cells: dict[str, list[str]] = {n: [] for n in others}
+    row_numbers = []
+    for (line_no, _), cells in zip(lines[1:], data_rows, strict=True):
+        if len(cells) != len(header):
+            raise InputError(
+                f"expected {len(header)} cells as in the header, found {len(cells)}",
+                path=path,
+                row=line_no,
+            )
+        for name in others:
+            other_cells[name].append(cells[header.index(name)].strip())
+        for name in index:
+            text = cells[index[name]].strip()
+            if not text and name in blank_ok:
+                values[name].append(math.nan)
+                continue
+            try:
+                number = float(text)
+            except ValueError:
+                what = "an empty cell" if not text else f"'{text}'"
+                raise InputError(
+                    f"expected a number, found {what}", path=path, row=line_no, column=name
+                ) from None
+            if not math.isfinite(number):
+                raise InputError(
+                    f"expected a finite number, found '{text}'", path=path, row=line_no, column=name
+                )
+            values[name].append(number)
+        row_numbers.append(line_no)
+    return values, other_cells, row_numbers
+
+
 def _numeric_column(cells: Sequence[str]) -> np.ndarray | None:
     """The cells as floats when every one is a finite number, else ``None``."""
     try:
@@ -192,9 +225,12 @@ def refuse_repeated_rows(table: CsvTable, key_columns: Sequence[str], advice: st
     the columns compared, then ``advice`` (what makes repeats legitimate).
     """
     present = [c for c in key_columns if table.has(c)]
+    rounded = [[round(v, 9) for v in table[c].tolist()] for c in present]
+    keys = list(zip(*rounded, strict=True)) if present else [()] * len(table)
+    if len(set(keys)) == len(keys):
+        return
     seen: dict[tuple, int] = {}
-    for i in range(len(table)):
-        key = tuple(round(float(table[c][i]), 9) for c in present)
+    for i, key in enumerate(keys):
         row = int(table.rows[i])
         if key in seen:
             raise InputError(

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 from ..core.exceptions import IdentifiabilityError
-from .least_squares import FitResult
+from .least_squares import FitResult, chi2_quantile, chi2_sf
 from .structure_search import BIC_THRESHOLD, FoundTerm, Probe, delta_bic, search_structure
 
 __all__ = [
@@ -114,15 +114,13 @@ def _chi2(result: FitResult, noise_variance: float) -> float:
 
 
 def _summary(result: FitResult, noise_variance: float) -> dict:
-    from scipy import stats  # imported on use: keeps the package's import light
-
     chi2 = _chi2(result, noise_variance)
     return {
         result.rms_key: result.rms_user,
         "chi2_reduced": chi2 / result.dof if result.dof > 0 else None,
         "n_params": result.n_params,
         "rank": result.rank,
-        "p_value": float(stats.chi2.sf(chi2, result.dof)) if result.sigma_known else None,
+        "p_value": chi2_sf(chi2, result.dof) if result.sigma_known else None,
     }
 
 
@@ -167,8 +165,6 @@ def _noise_variance(best: FitResult) -> float:
 
 
 def _mark_alternatives(candidates: list[Candidate], noise_variance: float) -> None:
-    from scipy import stats
-
     accepted = [c for c in candidates if c.significant]
     for a in accepted:
         chi2_a = _chi2(a.fit.result, noise_variance)
@@ -177,7 +173,7 @@ def _mark_alternatives(candidates: list[Candidate], noise_variance: float) -> No
             for b in accepted
             if b is not a
             and abs(_chi2(b.fit.result, noise_variance) - chi2_a)
-            <= stats.chi2.ppf(ALTERNATIVE_LEVEL, max(a.added_rank, b.added_rank, 1))
+            <= chi2_quantile(ALTERNATIVE_LEVEL, max(a.added_rank, b.added_rank, 1))
         ]
 
 
