@@ -59,10 +59,15 @@ class _Factor:
     columns: np.ndarray | None = None
     weights: np.ndarray | None = None
 
-    def angle(self, params: np.ndarray, n: int) -> np.ndarray:
-        """The factor's angle at each of the ``n`` positions (rad), (n,)."""
-        angle = params[self.columns] @ self.weights
+    def angle(self, params: np.ndarray, n: int, rows: slice = slice(None)) -> np.ndarray:
+        """The factor's angle at the ``n`` positions ``rows`` (rad), (n,)."""
+        weights = self.weights if self.weights.shape[-1] == 1 else self.weights[:, rows]
+        angle = params[self.columns] @ weights
         return angle if angle.shape[0] == n else np.full(n, angle[0])
+
+    def matrices(self, rows: slice) -> np.ndarray:
+        """The fixed matrices of the positions ``rows`` (3, 3, n or 1)."""
+        return self.fixed if self.fixed.shape[-1] == 1 else self.fixed[..., rows]
 
 
 def _sparse_gain(gain: dict[int, np.ndarray], n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -250,7 +255,7 @@ class OrientationModel:
             raise InputError(f"expected {self.n_params} parameters, got {params.size}")
         return params
 
-    def _forward(self, params: np.ndarray, axes: bool):
+    def _forward(self, params: np.ndarray, axes: bool, rows: slice = slice(None)):
         """``dR = Rd^T * factors`` entry-major (3, 3, N) by one pass along the chain, and with
         ``axes`` the rotation axis of every parametrised factor in the frame of ``dR``'s rows,
         (3, N) each.
@@ -259,14 +264,14 @@ class OrientationModel:
         the prefix up to f): ``d dR / d angle_f = P_f [a_f]x P_f^T dR = [P_f a_f]x dR``, and the
         Jacobian needs no suffix products (see :meth:`predict_and_jacobian`).
         """
-        n = self.variables.n
-        m = self._rd.copy()
+        m = self._rd[..., rows].copy()
+        n = m.shape[-1]
         found = []
         for f in self._factors:
             if f.fixed is not None:
-                m = _product(m, f.fixed)
+                m = _product(m, f.matrices(rows))
                 continue
-            angle = f.angle(params, n)
+            angle = f.angle(params, n, rows)
             if isinstance(f.axis, str):
                 _rotate_columns(m, f.axis, angle)
                 if axes:
@@ -292,8 +297,11 @@ class OrientationModel:
         """Exact derivative of :meth:`predict` with respect to the parameters, (N, 3, n)."""
         return self.predict_and_jacobian(params)[1]
 
-    def predict_and_jacobian(self, params) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`predict` (N, 3) and :meth:`jacobian` (N, 3, n) from one pass along the chain.
+    def predict_and_jacobian(
+        self, params, rows: slice = slice(None)
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`predict` (N, 3) and :meth:`jacobian` (N, 3, n) from one pass along the chain
+        (of the positions ``rows`` only: a block of a long log).
 
         For a factor ``R_a(angle)`` whose axis is ``u`` in the frame of ``dR``'s rows, the
         derivative of ``dR`` is ``[u]x dR``, whose entry (i, j) is ``(u x dR[:, j])_i``; times
@@ -301,8 +309,8 @@ class OrientationModel:
         is a new array, laid out parameter by parameter (a transposed view).
         """
         params = self._check(params)
-        dR, axes = self._forward(params, True)
-        n = self.variables.n
+        dR, axes = self._forward(params, True, rows)
+        n = dR.shape[-1]
         jac = np.zeros((self.n_params, n, 3))
         entries = np.empty((n, 3))
         factors = [f for f in self._factors if f.fixed is None]
@@ -310,7 +318,8 @@ class OrientationModel:
             for e, (i, j) in enumerate(ANGLE_ENTRIES):
                 i1, i2 = (i + 1) % 3, (i + 2) % 3
                 np.subtract(u[i1] * dR[i2, j], u[i2] * dR[i1, j], out=entries[:, e])
-            for column, weight in zip(factor.columns, factor.weights, strict=True):
+            weights = factor.weights if factor.weights.shape[-1] == 1 else factor.weights[:, rows]
+            for column, weight in zip(factor.columns, weights, strict=True):
                 if weight.size == 1 and weight[0] == 1.0:
                     jac[column] += entries
                 else:

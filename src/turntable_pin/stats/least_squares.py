@@ -31,6 +31,7 @@ from ..core.exceptions import IdentifiabilityError
 
 __all__ = [
     "RANK_RTOL",
+    "ZeroPoint",
     "FitProblem",
     "FitResult",
     "Identifiability",
@@ -41,6 +42,7 @@ __all__ = [
     "fit_least_squares",
     "tall_r_factor",
     "tall_times",
+    "zero_point",
 ]
 
 RANK_RTOL = 1e-6
@@ -414,11 +416,58 @@ def _replace(result: FitResult, **changes) -> FitResult:
 
 
 GAUSS_NEWTON_RTOL = 1e-8
-"""Gauss-Newton stops once a step is below this fraction of the solution (whitened
-coordinates); the next iterate, where the fit is evaluated, is then converged far beyond it."""
+"""The iteration stops once a step is below this fraction of the solution (whitened
+coordinates); the point it leads to, where the fit is evaluated, is converged far beyond it."""
 
-GAUSS_NEWTON_MAX_STEPS = 30
-"""Gauss-Newton steps before the fit falls back to scipy's Levenberg-Marquardt."""
+CHORD_MAX_STEPS = 20
+"""Steps with one Jacobian before the fit falls back to scipy's Levenberg-Marquardt."""
+
+
+@dataclass(frozen=True)
+class ZeroPoint:
+    """A model's weighted Jacobian at zero parameters, reduced to what a fit of any subset of its
+    parameters needs (a model whose parameters at zero leave every other parameter's response
+    unchanged, so the columns of a smaller model are columns of this one).
+
+    Attributes:
+        names: the parameters (n,).
+        r_factor: (k, n) with ``R^T R = J^T J`` for the weighted Jacobian J at zero (its
+            triangular factor; J itself when it has fewer rows than columns): the SVD of
+            ``R[:, S]`` has the singular values and right vectors of ``J[:, S]``.
+        gradient: ``J^T r0`` (n,), ``r0`` the weighted residuals at zero.
+        cost: ``r0 . r0``.
+    """
+
+    names: tuple[str, ...]
+    r_factor: np.ndarray
+    gradient: np.ndarray
+    cost: float
+
+    def indices(self, names) -> np.ndarray | None:
+        """The columns of ``names`` (None when one of them is not a parameter here)."""
+        where = {name: i for i, name in enumerate(self.names)}
+        if any(name not in where for name in names):
+            return None
+        return np.array([where[name] for name in names], dtype=int)
+
+
+def zero_point(names, blocks) -> ZeroPoint:
+    """The :class:`ZeroPoint` of a model from its weighted Jacobian at zero given in row blocks.
+
+    Args:
+        names: the parameters (n,).
+        blocks: ``(weighted jacobian (m_b, n), weighted residuals (m_b,))`` at zero parameters,
+            block by block of rows (so that a long data set never holds its whole Jacobian).
+    """
+    n = len(names)
+    factors, gradient, cost = [], np.zeros(n), 0.0
+    for jac, res in blocks:
+        gradient += jac.T @ res
+        cost += float(res @ res)
+        factors.append(tall_r_factor(jac) if jac.shape[0] > n else np.array(jac, dtype=float))
+    stacked = np.concatenate(factors) if factors else np.zeros((0, n))
+    r = tall_r_factor(stacked) if stacked.shape[0] > n else stacked
+    return ZeroPoint(tuple(names), r, gradient, cost)
 
 
 def _evaluator(problem: FitProblem):
@@ -440,69 +489,92 @@ def tall_times(tall: np.ndarray, small: np.ndarray) -> np.ndarray:
     return (small.T @ tall.T).T
 
 
-def _gauss_newton(problem, evaluate, weights, basis, first):
-    """Gauss-Newton from ``z = 0`` in coordinates where the weighted Jacobian there is
-    orthonormal; ``first`` is ``(predicted, weighted jacobian)`` at zero.
+def _iterate(problem, evaluate, weights, basis, start):
+    """Gauss-Newton, then chord steps, from ``z = 0`` in whitened coordinates.
 
-    A step smaller than :data:`GAUSS_NEWTON_RTOL` of the solution ends the iteration: the point
-    it leads to is then converged far beyond that (the models' nonlinearity shrinks each step by
-    the size of the fitted errors, 1e-5..1e-3), and is evaluated with ``predict`` only; the
-    weighted Jacobian returned is that of the last step, which differs from the one at the
-    solution by the step times that nonlinearity (< 1e-12 relative).
+    ``start`` is ``(cost, normal matrix, gradient)`` at zero (``jz^T jz`` and ``jz^T r`` for
+    the weighted Jacobian ``jz`` in these coordinates, orthonormal there). The first step uses
+    it; the model's Jacobian is evaluated once, at that first point ``z1``, and every further
+    step solves with it against fresh residuals (``predict`` only). Their fixed point differs
+    from the least-squares solution by ``(J(z) - J(z1))^T r``: the Jacobian changes by the
+    size of the first step's error in radians (the fitted errors squared, ~1e-10 relative), so
+    the solution is reached to ~1e-10 of its statistical uncertainty, and the steps shrink by
+    that factor each time. A step smaller than :data:`GAUSS_NEWTON_RTOL` of the solution ends
+    the iteration; the point it leads to is evaluated and returned.
 
-    Returns ``(z, weighted residuals, weighted jacobian (m, n), evaluations)``, or None when a
-    step fails to lower the residual sum of squares or the steps do not settle (the caller then
-    uses scipy's Levenberg-Marquardt).
+    Returns ``(z, weighted residuals, normal matrix at z1, evaluations)``, or None when a step
+    fails to lower the residual sum of squares or the steps do not settle (the caller then uses
+    scipy's Levenberg-Marquardt).
     """
     observed = problem.observed
-    z = np.zeros(basis.shape[1])
-    predicted, jac = first
-    last_cost = None
-    for count in range(1, GAUSS_NEWTON_MAX_STEPS + 1):
-        if count > 1:
-            predicted, jac = evaluate(basis @ z)
-            jac *= weights[:, None]
+    cost, normal, gradient = start
+    z = np.linalg.solve(normal, gradient)
+    predicted, jac = evaluate(basis @ z)
+    jac *= weights[:, None]
+    jz = tall_times(jac, basis)  # d(predicted * weights)/dz = -d(res)/dz
+    del jac
+    normal = jz.T @ jz
+    count = 2
+    converged = False
+    for _ in range(CHORD_MAX_STEPS):
         res = (observed - predicted) * weights
-        cost = float(res @ res)
-        if last_cost is not None and cost > last_cost * (1.0 + 1e-12) + 1e-300:
+        new_cost = float(res @ res)
+        if new_cost > cost * (1.0 + 1e-12) + 1e-300:
             return None
-        last_cost = cost
-        jz = tall_times(jac, basis)  # d(predicted * weights)/dz = -d(res)/dz
-        step = np.linalg.solve(jz.T @ jz, jz.T @ res)
+        cost = new_cost
+        if converged:
+            return z, res, normal, count
+        step = np.linalg.solve(normal, jz.T @ res)
         z = z + step
         size = float(np.linalg.norm(step))
-        if size <= GAUSS_NEWTON_RTOL * float(np.linalg.norm(z)) or size <= 1e-15:
-            res = (observed - problem.predict(basis @ z)) * weights
-            if float(res @ res) > cost * (1.0 + 1e-12) + 1e-300:
-                return None
-            return z, res, jac, count + 1
+        converged = size <= GAUSS_NEWTON_RTOL * float(np.linalg.norm(z)) or size <= 1e-15
+        predicted = problem.predict(basis @ z)
+        count += 1
     return None
 
 
-def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = None) -> FitResult:
-    """Fit ``problem`` by weighted nonlinear least squares (Gauss-Newton, else scipy's LM).
+def fit_least_squares(
+    problem: FitProblem,
+    *,
+    noise_variance: float | None = None,
+    zero_point: ZeroPoint | None = None,
+) -> FitResult:
+    """Fit ``problem`` by weighted nonlinear least squares (Gauss-Newton and chord steps, else
+    scipy's Levenberg-Marquardt).
 
     The models are nearly linear (second-order terms of the size of the fitted errors): in
-    coordinates where the weighted Jacobian at zero is orthonormal, Gauss-Newton converges in
-    two or three steps, each one evaluation of the model and its Jacobian; a step that does not
-    lower the residuals hands the fit to scipy's ``least_squares`` (Levenberg-Marquardt).
+    coordinates where the weighted Jacobian at zero is orthonormal, one Gauss-Newton step from
+    zero lands within that nonlinearity of the solution, and steps with the Jacobian there reach
+    it in two or three evaluations of ``predict`` (:func:`_iterate`); a step that does not lower
+    the residuals hands the fit to scipy's ``least_squares`` (Levenberg-Marquardt).
 
     Args:
         problem: the model and data (``predict_and_jacobian``, when present, is used for one
             pass per step).
         noise_variance: unit-weight noise variance to judge the fit with when sigmas are unknown
             (default: estimated from this fit, ``rss / dof``). Ignored when sigmas are given.
+        zero_point: the reduced Jacobian at zero of a model with these parameters and maybe more
+            (:func:`zero_point`): the identifiability and the first step are then read from it
+            instead of evaluating the Jacobian at zero (fits of many models of one data set).
 
     Raises:
         IdentifiabilityError: no parameter is determined, or no degree of freedom is left.
     """
     sigma_known = problem.sigma is not None
     weights = 1.0 / problem.sigma if sigma_known else np.ones_like(problem.observed)
-    n = len(problem.parameter_names)
+    names = tuple(problem.parameter_names)
+    n = len(names)
     evaluate = _evaluator(problem)
-    predicted0, j0 = evaluate(np.zeros(n))
-    j0 *= weights[:, None]
-    ident = analyse_identifiability(j0, problem.parameter_names)
+    columns = zero_point.indices(names) if zero_point is not None else None
+    if columns is not None:
+        j0 = zero_point.r_factor[:, columns]
+        gradient0, cost0 = zero_point.gradient[columns], zero_point.cost
+    else:
+        predicted0, j0 = evaluate(np.zeros(n))
+        j0 *= weights[:, None]
+        res0 = (problem.observed - predicted0) * weights
+        gradient0, cost0 = j0.T @ res0, float(res0 @ res0)
+    ident = analyse_identifiability(j0, names)
     m = problem.observed.size
     if ident.rank == 0:
         raise IdentifiabilityError("the data determine no parameter of the model")
@@ -514,14 +586,19 @@ def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = Non
     # Whitened coordinates: the weighted Jacobian at zero times ``basis`` is orthonormal, so the
     # normal equations of every step are as well conditioned as the problem is nonlinear.
     basis = ident.basis / ident.singular_values[: ident.rank]
-    solved = _gauss_newton(problem, evaluate, weights, basis, (predicted0, j0))
+    jz0 = tall_times(j0, basis)
     del j0
+    start = (cost0, jz0.T @ jz0, basis.T @ gradient0)
+    del jz0
+    solved = _iterate(problem, evaluate, weights, basis, start)
     if solved is None:
         z, weighted_res, jac_weighted, nfev = _levenberg_marquardt(problem, weights, basis)
+        jz = tall_times(jac_weighted, basis)
+        normal = jz.T @ jz
+        del jac_weighted, jz
     else:
-        z, weighted_res, jac_weighted, nfev = solved
+        z, weighted_res, normal, nfev = solved
     params = basis @ z
-    jz = tall_times(jac_weighted, basis)
     rss = float(weighted_res @ weighted_res)
     dof = m - ident.rank
     if sigma_known:
@@ -530,9 +607,9 @@ def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = Non
         variance = float(noise_variance)
     else:
         variance = rss / dof
-    cov_z = np.linalg.pinv(jz.T @ jz) * variance
+    cov_z = np.linalg.pinv(normal) * variance
     return FitResult(
-        parameter_names=tuple(problem.parameter_names),
+        parameter_names=names,
         parameter_units=tuple(problem.parameter_units),
         per_user_unit=np.asarray(problem.per_user_unit, dtype=float),
         params=params,

@@ -23,6 +23,7 @@ import numpy as np
 from .least_squares import TALL_ROWS, tall_r_factor, tall_times
 
 __all__ = [
+    "BATCH_VALUES",
     "BIC_THRESHOLD",
     "NEW_FRACTION",
     "FoundTerm",
@@ -121,24 +122,28 @@ def _orthonormal_columns(matrix: np.ndarray) -> np.ndarray:
     return tall_times(u, (vectors / np.sqrt(values)) @ vectors.T)
 
 
-def _probe_fit(columns: np.ndarray, q: np.ndarray, qr_: np.ndarray, r: np.ndarray):
-    """What a probe's columns (m, g) add beyond the span of ``q`` (m, k) to explain ``r``.
+BATCH_VALUES = 1 << 22
+"""Probe columns scored together hold at most about this many values (32 MB): one pass over
+the model's basis and the residuals serves the whole batch."""
 
-    Works on small matrices only: with ``t = columns - q q^T columns`` (the part ``q`` does not
-    span), ``t^T t = C^T C - (q^T C)^T (q^T C)`` and ``t^T r = C^T r - (q^T C)^T (q^T r)``; the
+
+def _probe_fit(gram: np.ndarray, qc: np.ndarray, cr: np.ndarray, qr_: np.ndarray):
+    """What a probe's columns C (m, g) add beyond the span of ``q`` (m, k) to explain ``r``.
+
+    Works on small matrices only: ``gram = C^T C``, ``qc = q^T C``, ``cr = C^T r``,
+    ``qr_ = q^T r``. With ``t = C - q q^T C`` (the part ``q`` does not span),
+    ``t^T t = C^T C - (q^T C)^T (q^T C)`` and ``t^T r = C^T r - (q^T C)^T (q^T r)``; the
     eigen-decomposition ``t^T t = V S^2 V^T`` gives the singular values of ``t`` and, for the
     kept directions, ``U = t V / S``.
 
     Returns:
-        ``(reduction, V kept (g, k), S kept, t^T r)`` or None when no direction is new.
+        ``(reduction, V kept (g, k), S kept, S U^T r)`` or None when no direction is new.
     """
-    gram = columns.T @ columns
     if not gram.size:
         return None
     scale2 = float(np.linalg.eigvalsh(gram)[-1])
-    qc = q.T @ columns
     tt = gram - qc.T @ qc
-    tr = columns.T @ r - qc.T @ qr_
+    tr = cr - qc.T @ qr_
     values, vectors = np.linalg.eigh((tt + tt.T) / 2.0)
     keep = values > NEW_FRACTION**2 * scale2
     if not keep.any():
@@ -146,6 +151,36 @@ def _probe_fit(columns: np.ndarray, q: np.ndarray, qr_: np.ndarray, r: np.ndarra
     v, s2 = vectors[:, keep], values[keep]
     along = v.T @ tr  # s * (U^T r)
     return float(np.sum(along**2 / s2)), v, np.sqrt(s2), along
+
+
+def _scored(probes: Sequence[Probe], q: np.ndarray, r: np.ndarray):
+    """``(probe, _probe_fit result)`` for each probe, the probes taken in batches of columns."""
+    m = r.size
+    qr_full = np.concatenate([q, r[:, None]], axis=1).T.copy()  # (k + 1, m)
+    qr_ = qr_full[:-1] @ r
+    budget = max(BATCH_VALUES // max(m, 1), 1)
+    batch: list[tuple[Probe, np.ndarray]] = []
+
+    def flush():
+        columns = np.concatenate([c for _, c in batch], axis=1)
+        products = qr_full @ columns  # (k + 1, G): q^T C and r^T C of every probe
+        gram = columns.T @ columns
+        start = 0
+        for probe, c in batch:
+            sl = slice(start, start + c.shape[1])
+            start = sl.stop
+            yield probe, _probe_fit(gram[sl, sl], products[:-1, sl], products[-1, sl], qr_)
+
+    width = 0
+    for probe in probes:
+        columns = probe.matrix()
+        if batch and width + columns.shape[1] > budget:
+            yield from flush()
+            batch, width = [], 0
+        batch.append((probe, columns))
+        width += columns.shape[1]
+    if batch:
+        yield from flush()
 
 
 def search_structure(
@@ -159,8 +194,9 @@ def search_structure(
     """Greedy forward search of probes that explain residual structure.
 
     Each probe is scored from small matrices (its Gram matrix and its products with the model's
-    orthonormal basis and the residuals, :func:`_probe_fit`): no decomposition of a tall matrix
-    per probe; only an accepted probe's new directions are formed.
+    orthonormal basis and the residuals, :func:`_probe_fit`), probes in batches of columns: no
+    decomposition of a tall matrix per probe; only an accepted probe's new directions are
+    formed.
 
     Args:
         weighted_residuals: (m,) residuals divided by sigma (unit weights if sigma unknown).
@@ -178,10 +214,8 @@ def search_structure(
     threshold = BIC_THRESHOLD - 2.0 * math.log(max(len(remaining), 1))
     for _ in range(max_terms):
         rss = float(r @ r)
-        qr_ = q.T @ r
         best = None
-        for probe in remaining:
-            scored = _probe_fit(probe.matrix(), q, qr_, r)
+        for probe, scored in _scored(remaining, q, r):
             if scored is not None and (best is None or scored[0] > best[0]):
                 best = (scored[0], probe, *scored[1:])
         if best is None:
