@@ -33,6 +33,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError
 from .least_squares import FitResult, chi2_quantile, chi2_sf
 from .structure_search import BIC_THRESHOLD, FoundTerm, Probe, delta_bic, search_structure
@@ -335,7 +336,16 @@ class Diagnosis:
 
 
 def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis:
-    """Test every catalogued effect against the base model and decide (module docstring)."""
+    """Test every catalogued effect against the base model and decide (module docstring).
+
+    Runs with one BLAS thread (:func:`~turntable_pin.core.blas_threads.one_blas_thread`): its
+    products of tall, thin matrices were many times slower split over the threads of busy
+    cores."""
+    with one_blas_thread():
+        return _diagnose(family, until_explained=until_explained)
+
+
+def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
     base_fit = family.fit([])
     candidates = compare_effects(family, [], base_fit, family.catalogue)
     steps: list[Step] = []
