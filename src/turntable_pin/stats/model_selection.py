@@ -338,7 +338,7 @@ class Diagnosis:
 def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis:
     """Test every catalogued effect against the base model and decide (module docstring).
 
-    Runs with one BLAS thread (:func:`~turntable_pin.core.blas_threads.one_blas_thread`): its
+    Runs with one BLAS thread (:func:`one_blas_thread` of ``core.blas_threads``): its
     products of tall, thin matrices were many times slower split over the threads of busy
     cores."""
     with one_blas_thread():
