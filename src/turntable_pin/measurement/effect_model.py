@@ -59,11 +59,11 @@ class _Factor:
     columns: np.ndarray | None = None
     weights: np.ndarray | None = None
 
-    def angle(self, params: np.ndarray, n: int, rows: slice = slice(None)) -> np.ndarray:
-        """The factor's angle at the ``n`` positions ``rows`` (rad), (n,)."""
+    def angle(self, params: np.ndarray, rows: slice = slice(None)) -> np.ndarray:
+        """The factor's angle at the positions ``rows`` (rad): (n,), or (1,) when it is the same
+        at every position (its cosine and sine are then computed once)."""
         weights = self.weights if self.weights.shape[-1] == 1 else self.weights[:, rows]
-        angle = params[self.columns] @ weights
-        return angle if angle.shape[0] == n else np.full(n, angle[0])
+        return params[self.columns] @ weights
 
     def matrices(self, rows: slice) -> np.ndarray:
         """The fixed matrices of the positions ``rows`` (3, 3, n or 1)."""
@@ -271,7 +271,9 @@ class OrientationModel:
             if f.fixed is not None:
                 m = _product(m, f.matrices(rows))
                 continue
-            angle = f.angle(params, n, rows)
+            angle = f.angle(params, rows)
+            if angle.shape[0] != n and not isinstance(f.axis, str):
+                angle = np.full(n, angle[0])
             if isinstance(f.axis, str):
                 _rotate_columns(m, f.axis, angle)
                 if axes:

@@ -62,8 +62,9 @@ class OrientationFitProblem:
         return self._measured(self.model.jacobian(params).reshape(-1, self.model.n_params))
 
     def zero_point_blocks(self, block: int = ZERO_POINT_BLOCK):
-        """``(weighted jacobian, weighted residuals)`` at zero parameters, ``block`` positions at
-        a time (the measured angles only), for ``zero_point`` of :mod:`..stats.least_squares`."""
+        """``(weighted jacobian, weighted residuals, weights)`` at zero parameters, ``block``
+        positions at a time (the measured angles only), for ``zero_point`` of
+        :mod:`..stats.least_squares`."""
         data, model = self.data, self.model
         zeros = np.zeros(model.n_params)
         for start in range(0, data.n_positions, block):
@@ -76,7 +77,7 @@ class OrientationFitProblem:
             else:
                 weights = 1.0 / data.sigma_rad[rows].reshape(-1)[mask]
             jac = jac.reshape(-1, model.n_params)[mask] * weights[:, None]
-            yield jac, (observed - predicted.reshape(-1)[mask]) * weights
+            yield jac, (observed - predicted.reshape(-1)[mask]) * weights, weights
 
     def predict_and_jacobian(self, params: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`predict` (rad) and :meth:`jacobian` (a new array) from one pass of the model."""

@@ -253,13 +253,9 @@ class FitResult:
 
     @property
     def jacobian_weighted(self) -> np.ndarray:
-        """The weighted Jacobian (m, n) at ``params`` (computed on first use, then kept: a
-        diagnosis holds many fits and needs the Jacobian of one)."""
-        jac = self._jacobian
-        if callable(jac):
-            jac = jac()
-            object.__setattr__(self, "_jacobian", jac)
-        return jac
+        """The weighted Jacobian (m, n) at ``params`` (computed on each use: a diagnosis holds
+        many fits and needs the Jacobian of one, once)."""
+        return self._jacobian() if callable(self._jacobian) else self._jacobian
 
     @property
     def n_obs(self) -> int:
@@ -436,12 +432,15 @@ class ZeroPoint:
             ``R[:, S]`` has the singular values and right vectors of ``J[:, S]``.
         gradient: ``J^T r0`` (n,), ``r0`` the weighted residuals at zero.
         cost: ``r0 . r0``.
+        weights: the weights (m,) of the observations (1/sigma): a fit that uses this zero
+            point checks them against its own and keeps this array (one for all the fits).
     """
 
     names: tuple[str, ...]
     r_factor: np.ndarray
     gradient: np.ndarray
     cost: float
+    weights: np.ndarray
 
     def indices(self, names) -> np.ndarray | None:
         """The columns of ``names`` (None when one of them is not a parameter here)."""
@@ -456,18 +455,20 @@ def zero_point(names, blocks) -> ZeroPoint:
 
     Args:
         names: the parameters (n,).
-        blocks: ``(weighted jacobian (m_b, n), weighted residuals (m_b,))`` at zero parameters,
-            block by block of rows (so that a long data set never holds its whole Jacobian).
+        blocks: ``(weighted jacobian (m_b, n), weighted residuals (m_b,), weights (m_b,))`` at
+            zero parameters, block by block of rows (so that a long data set never holds its
+            whole Jacobian).
     """
     n = len(names)
-    factors, gradient, cost = [], np.zeros(n), 0.0
-    for jac, res in blocks:
+    factors, gradient, cost, weights = [], np.zeros(n), 0.0, []
+    for jac, res, w in blocks:
+        weights.append(w)
         gradient += jac.T @ res
         cost += float(res @ res)
         factors.append(tall_r_factor(jac) if jac.shape[0] > n else np.array(jac, dtype=float))
     stacked = np.concatenate(factors) if factors else np.zeros((0, n))
     r = tall_r_factor(stacked) if stacked.shape[0] > n else stacked
-    return ZeroPoint(tuple(names), r, gradient, cost)
+    return ZeroPoint(tuple(names), r, gradient, cost, np.concatenate(weights) if weights else None)
 
 
 def _evaluator(problem: FitProblem):
@@ -566,6 +567,10 @@ def fit_least_squares(
     n = len(names)
     evaluate = _evaluator(problem)
     columns = zero_point.indices(names) if zero_point is not None else None
+    if columns is not None and np.array_equal(zero_point.weights, weights):
+        weights = zero_point.weights  # one array for all the fits of a data set
+    else:
+        columns = None
     if columns is not None:
         j0 = zero_point.r_factor[:, columns]
         gradient0, cost0 = zero_point.gradient[columns], zero_point.cost

@@ -113,17 +113,22 @@ def _orthonormal_columns(matrix: np.ndarray) -> np.ndarray:
     if m <= 2 * TALL_ROWS or m < 8 * n:
         u, s, _ = np.linalg.svd(matrix, full_matrices=False)
         return u[:, s > 1e-9 * (s[0] if s.size else 1.0)]
-    # Long and thin: the right singular vectors from the small R factor, U = A V / s, then one
-    # more orthonormalisation against the rounding of the directions with small s.
+    # Long and thin: the right singular vectors from the small R factor, U = A V / s, then
+    # made orthonormal once more against the rounding of the directions with small s (in place,
+    # block by block of rows: no third tall matrix).
     _, s, vt = np.linalg.svd(tall_r_factor(matrix))
     keep = s > 1e-9 * (s[0] if s.size else 1.0)
     u = tall_times(matrix, vt[keep].T / s[keep])
     values, vectors = np.linalg.eigh(u.T @ u)
-    return tall_times(u, (vectors / np.sqrt(values)) @ vectors.T)
+    correction = (vectors / np.sqrt(values)) @ vectors.T
+    for start in range(0, m, TALL_ROWS * 16):
+        block = u[start : start + TALL_ROWS * 16]
+        block[...] = block @ correction
+    return u
 
 
-BATCH_VALUES = 1 << 22
-"""Probe columns scored together hold at most about this many values (32 MB): one pass over
+BATCH_VALUES = 1 << 21
+"""Probe columns scored together hold at most about this many values (16 MB): one pass over
 the model's basis and the residuals serves the whole batch."""
 
 
@@ -159,28 +164,32 @@ def _scored(probes: Sequence[Probe], q: np.ndarray, r: np.ndarray):
     qr_full = np.concatenate([q, r[:, None]], axis=1).T.copy()  # (k + 1, m)
     qr_ = qr_full[:-1] @ r
     budget = max(BATCH_VALUES // max(m, 1), 1)
-    batch: list[tuple[Probe, np.ndarray]] = []
+    buffer = np.empty((m, budget))  # the batch's columns, side by side
+    batch: list[tuple[Probe, slice]] = []
 
-    def flush():
-        columns = np.concatenate([c for _, c in batch], axis=1)
+    def flush(width):
+        columns = buffer[:, :width]
         products = qr_full @ columns  # (k + 1, G): q^T C and r^T C of every probe
         gram = columns.T @ columns
-        start = 0
-        for probe, c in batch:
-            sl = slice(start, start + c.shape[1])
-            start = sl.stop
+        for probe, sl in batch:
             yield probe, _probe_fit(gram[sl, sl], products[:-1, sl], products[-1, sl], qr_)
 
     width = 0
     for probe in probes:
         columns = probe.matrix()
-        if batch and width + columns.shape[1] > budget:
-            yield from flush()
+        g = columns.shape[1]
+        if batch and width + g > budget:
+            yield from flush(width)
             batch, width = [], 0
-        batch.append((probe, columns))
-        width += columns.shape[1]
+        if g > budget:  # a probe wider than a batch is scored alone
+            buffer = np.empty((m, g))
+            budget = g
+        buffer[:, width : width + g] = columns
+        batch.append((probe, slice(width, width + g)))
+        width += g
+        del columns
     if batch:
-        yield from flush()
+        yield from flush(width)
 
 
 def search_structure(
