@@ -501,7 +501,8 @@ def _iterate(problem, evaluate, weights, basis, start):
     size of the first step's error in radians (the fitted errors squared, ~1e-10 relative), so
     the solution is reached to ~1e-10 of its statistical uncertainty, and the steps shrink by
     that factor each time. A step smaller than :data:`GAUSS_NEWTON_RTOL` of the solution ends
-    the iteration; the point it leads to is evaluated and returned.
+    the iteration at the point it leads to, whose residuals are those before it minus the
+    Jacobian times the step (exact to the step squared times the nonlinearity).
 
     Returns ``(z, weighted residuals, normal matrix at z1, evaluations)``, or None when a step
     fails to lower the residual sum of squares or the steps do not settle (the caller then uses
@@ -516,19 +517,19 @@ def _iterate(problem, evaluate, weights, basis, start):
     del jac
     normal = jz.T @ jz
     count = 2
-    converged = False
     for _ in range(CHORD_MAX_STEPS):
         res = (observed - predicted) * weights
         new_cost = float(res @ res)
         if new_cost > cost * (1.0 + 1e-12) + 1e-300:
             return None
         cost = new_cost
-        if converged:
-            return z, res, normal, count
         step = np.linalg.solve(normal, jz.T @ res)
         z = z + step
         size = float(np.linalg.norm(step))
-        converged = size <= GAUSS_NEWTON_RTOL * float(np.linalg.norm(z)) or size <= 1e-15
+        if size <= GAUSS_NEWTON_RTOL * float(np.linalg.norm(z)) or size <= 1e-15:
+            # The residuals after this last, tiny step: linear in it to its size squared times
+            # the nonlinearity (< 1e-20 relative), so no further evaluation is needed.
+            return z, res - jz @ step, normal, count
         predicted = problem.predict(basis @ z)
         count += 1
     return None
