@@ -93,3 +93,34 @@ def test_repeated_rows_found_by_keys_equal_as_python_compares_them(tmp_path):
     with pytest.raises(InputError, match="same position as row 3") as info:
         refuse_repeated_rows(table, ("p", "q"), "advice")
     assert "row 5" in str(info.value)
+
+
+def test_numpy_reading_of_a_clean_file_equals_cell_by_cell(tmp_path):
+    """An unquoted, all-numeric file is read by numpy at once: the same numbers as ``float``
+    cell by cell (CRLF line ends, spaces, exponents, signs), extra columns kept or skipped."""
+    import csv
+
+    from turntable_pin.core import csv_table
+
+    rng = np.random.default_rng(2)
+    lines = ["# comment", "a, b ,c,temp,bad"]
+    for k in range(400):
+        cells = [f"{rng.normal():.17g}", f" {rng.uniform(-1e3, 1e3):.6e} ", f"+{k}", f"{k / 7!r}",
+                 "inf" if k == 5 else "1"]  # fmt: skip
+        lines.append(",".join(cells))
+    path = write_file(tmp_path, "\r\n".join(lines) + "\r\n", "n.csv")
+    table = read_csv_table(path, ("a", "b"), ("c",), extra=True)
+    assert table.skipped == ("bad",) and list(table.extra) == ["temp"]
+    with path.open(newline="", encoding="utf-8-sig") as handle:
+        text = [(i, line) for i, line in enumerate(handle, start=1)]
+    text = [(i, line) for i, line in text if line.strip() and not line.startswith("#")]
+    rows = list(csv.reader([line for _, line in text]))
+    header = tuple(h.strip() for h in rows[0])
+    index = {name: header.index(name) for name in ("a", "b", "c")}
+    values, other, numbers = csv_table._cell_by_cell(
+        path, text, rows[1:], header, index, ["temp", "bad"], set()
+    )
+    for name in ("a", "b", "c"):
+        np.testing.assert_array_equal(table[name], np.asarray(values[name]))
+    np.testing.assert_array_equal(table.extra["temp"], [float(c) for c in other["temp"]])
+    np.testing.assert_array_equal(table.rows, numbers)

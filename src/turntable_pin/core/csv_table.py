@@ -95,9 +95,13 @@ def read_csv_table(
     lines = [(i, line) for i, line in lines if line.strip() and not line.lstrip().startswith("#")]
     if not lines:
         raise InputError("the file is empty (expected a header line)", path=path)
-    reader = csv.reader([line for _, line in lines])
-    parsed = list(reader)
-    header = tuple(name.strip() for name in parsed[0])
+    # Without quotes a line's cells are its comma-separated fields: the header alone is parsed
+    # here, and a clean body is read by numpy at once (:func:`_whole_table`).
+    quoted = any('"' in line for _, line in lines)
+    parsed = list(csv.reader([line for _, line in lines])) if quoted else None
+    header = tuple(
+        name.strip() for name in (parsed[0] if quoted else next(csv.reader([lines[0][1]])))
+    )
     header_line = lines[0][0]
     seen = set()
     for name in header:
@@ -124,23 +128,36 @@ def read_csv_table(
     wanted = [name for name in (*required, *optional) if name in header]
     index = {name: header.index(name) for name in wanted}
     others = [n for n in header if n not in index and n] if extra else []
-    data_rows = parsed[1:]
-    fast = _whole_columns(data_rows, len(header), index)
-    if fast is not None:
-        values = fast
+    whole = None if quoted else _whole_table([line for _, line in lines[1:]], len(header))
+    if whole is not None and all(np.all(np.isfinite(whole[:, i])) for i in index.values()):
+        values = {name: whole[:, i].copy() for name, i in index.items()}
         row_numbers = [line_no for line_no, _ in lines[1:]]
-        other_cells = {n: [cells[header.index(n)].strip() for cells in data_rows] for n in others}
+        other_cells = {n: whole[:, header.index(n)].copy() for n in others}
     else:
-        values, other_cells, row_numbers = _cell_by_cell(
-            path, lines, data_rows, header, index, others, set(blank)
-        )
+        if parsed is None:
+            parsed = list(csv.reader([line for _, line in lines]))
+        data_rows = parsed[1:]
+        fast = _whole_columns(data_rows, len(header), index)
+        if fast is not None:
+            values = fast
+            row_numbers = [line_no for line_no, _ in lines[1:]]
+            other_cells = {
+                n: [cells[header.index(n)].strip() for cells in data_rows] for n in others
+            }
+        else:
+            values, other_cells, row_numbers = _cell_by_cell(
+                path, lines, data_rows, header, index, others, set(blank)
+            )
     if len(row_numbers) < min_rows:
         raise InputError(
             f"expected at least {min_rows} data row(s), found {len(row_numbers)}", path=path
         )
     extra_columns, skipped = {}, []
     for name, cells in other_cells.items():
-        column = _numeric_column(cells)
+        if isinstance(cells, np.ndarray):  # read whole: numbers; kept if all finite
+            column = cells if cells.size and np.all(np.isfinite(cells)) else None
+        else:
+            column = _numeric_column(cells)
         if column is None:
             skipped.append(name)
         else:
@@ -153,6 +170,26 @@ def read_csv_table(
         extra=extra_columns,
         skipped=tuple(skipped),
     )
+
+
+def _whole_table(data_lines: list[str], width: int) -> np.ndarray | None:
+    """Every cell of unquoted data lines as floats (rows, ``width``), read by numpy's parser,
+    or ``None`` when any cell is not a number numpy reads or a row is not ``width`` cells wide
+    (the cell-by-cell reading then decides, with Python's ``float`` and its messages).
+
+    numpy's parser accepts no cell that ``float`` refuses and gives the same double for the
+    cells both accept (both round the decimal correctly); it refuses some ``float`` accepts
+    (``1_000``, non-ASCII digits), which then go the slow way.
+    """
+    if not data_lines:
+        return None
+    try:
+        table = np.loadtxt(
+            data_lines, delimiter=",", dtype=float, comments=None, ndmin=2, encoding=None
+        )
+    except ValueError:
+        return None
+    return table if table.shape == (len(data_lines), width) else None
 
 
 def _whole_columns(data_rows, width: int, index: dict[str, int]) -> dict | None:
