@@ -17,6 +17,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..core.exceptions import InputError
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD
 from ..stats.least_squares import RANK_RTOL
@@ -89,7 +90,10 @@ class OrientationFamily:
         if not hasattr(self, "_zero"):
             variables = self.data.variables()
             testable = [e for e in self.catalogue if not e.missing_columns(variables)]
-            self._zero = orientation_zero_point(self.data, testable, turntable=self.table)
+            try:
+                self._zero = orientation_zero_point(self.data, testable, turntable=self.table)
+            except InputError:  # effects that cannot share one model: each fit on its own
+                self._zero = None
         return self._zero
 
     def untestable_reason(self, effect: Effect) -> str | None:
