@@ -83,9 +83,7 @@ def main() -> None:
             wall, cpu, peak, out = _run(path, folder)
             verdict = out["verdict"]["missing_effect"]
             print(f"{name:26s} {str(verdict):26s} {wall:7.2f} {cpu:6.2f} {peak:8.0f}")
-    print(
-        "targets: < 5 s wall, < 500 MB peak (max RSS of the child); the wall time includes waiting"
-    )
+    print("targets: < 5 s wall, < 500 MB peak (max RSS of the child); the wall time includes")
     print("waiting for the CPU when other work runs (cpu s: the child's own user + system time)")
 
 
