@@ -44,3 +44,83 @@ def test_write_then_read_round_trip(tmp_path):
     table = read_csv_table(path, REQ)
     for name, values in cols.items():
         np.testing.assert_array_equal(table[name], values)
+
+
+def test_whole_column_reading_equals_cell_by_cell(tmp_path):
+    """The fast path (every cell clean) gives what the checked cell-by-cell reading gives."""
+    from turntable_pin.core import csv_table
+
+    rng = np.random.default_rng(0)
+    lines = ["# comment", "a, b ,c,note"]
+    for _ in range(300):
+        lines.append(f"{rng.normal():.17g}, {rng.uniform(-1e3, 1e3)!r} ,{rng.integers(9)},x y")
+    path = write_file(tmp_path, "\n".join(lines) + "\n", "t.csv")
+    table = read_csv_table(path, ("a", "b"), ("c",), extra=True)
+    import csv
+
+    text = [(i, line) for i, line in enumerate(path.read_text().splitlines(True), start=1)]
+    text = [(i, line) for i, line in text if line.strip() and not line.startswith("#")]
+    rows = list(csv.reader([line for _, line in text]))
+    header = tuple(h.strip() for h in rows[0])
+    index = {name: header.index(name) for name in ("a", "b", "c")}
+    values, other, numbers = csv_table._cell_by_cell(
+        path, text, rows[1:], header, index, ["note"], set()
+    )
+    for name in ("a", "b", "c"):
+        np.testing.assert_array_equal(table[name], np.asarray(values[name]))
+    np.testing.assert_array_equal(table.rows, numbers)
+    assert table.skipped == ("note",)
+
+
+def test_vectorised_rounding_equals_python_round():
+    from turntable_pin.core.csv_table import _rounded_9
+
+    rng = np.random.default_rng(1)
+    grids = [np.arange(0, 360, 0.9), np.arange(0, 360, 1.44), np.arange(0, 3e4, 30.0)]
+    samples = [*grids, rng.uniform(-400, 400, 5000), np.array([-1e-12, 0.0, -0.0, 1.0, -1.0]),
+               np.arange(0, 3e7, 30.0)]  # fmt: skip
+    for values in samples:
+        expected = np.array([round(v, 9) for v in values.tolist()])
+        np.testing.assert_array_equal(_rounded_9(values), expected)
+
+
+def test_repeated_rows_found_by_keys_equal_as_python_compares_them(tmp_path):
+    """-0.0 and 0.0 are the same position (as Python's tuples compare them)."""
+    from turntable_pin.core.csv_table import refuse_repeated_rows
+
+    path = write_file(tmp_path, "p,q\n1,2\n-0.0000000000001,5\n3,4\n0,5\n", "r.csv")
+    table = read_csv_table(path, ("p", "q"))
+    with pytest.raises(InputError, match="same position as row 3") as info:
+        refuse_repeated_rows(table, ("p", "q"), "advice")
+    assert "row 5" in str(info.value)
+
+
+def test_numpy_reading_of_a_clean_file_equals_cell_by_cell(tmp_path):
+    """An unquoted, all-numeric file is read by numpy at once: the same numbers as ``float``
+    cell by cell (CRLF line ends, spaces, exponents, signs), extra columns kept or skipped."""
+    import csv
+
+    from turntable_pin.core import csv_table
+
+    rng = np.random.default_rng(2)
+    lines = ["# comment", "a, b ,c,temp,bad"]
+    for k in range(400):
+        cells = [f"{rng.normal():.17g}", f" {rng.uniform(-1e3, 1e3):.6e} ", f"+{k}", f"{k / 7!r}",
+                 "inf" if k == 5 else "1"]  # fmt: skip
+        lines.append(",".join(cells))
+    path = write_file(tmp_path, "\r\n".join(lines) + "\r\n", "n.csv")
+    table = read_csv_table(path, ("a", "b"), ("c",), extra=True)
+    assert table.skipped == ("bad",) and list(table.extra) == ["temp"]
+    with path.open(newline="", encoding="utf-8-sig") as handle:
+        text = [(i, line) for i, line in enumerate(handle, start=1)]
+    text = [(i, line) for i, line in text if line.strip() and not line.startswith("#")]
+    rows = list(csv.reader([line for _, line in text]))
+    header = tuple(h.strip() for h in rows[0])
+    index = {name: header.index(name) for name in ("a", "b", "c")}
+    values, other, numbers = csv_table._cell_by_cell(
+        path, text, rows[1:], header, index, ["temp", "bad"], set()
+    )
+    for name in ("a", "b", "c"):
+        np.testing.assert_array_equal(table[name], np.asarray(values[name]))
+    np.testing.assert_array_equal(table.extra["temp"], [float(c) for c in other["temp"]])
+    np.testing.assert_array_equal(table.rows, numbers)

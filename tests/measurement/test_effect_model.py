@@ -55,3 +55,84 @@ def test_jacobian_matches_finite_differences_for_all_effects(seed):
         fd = (model.predict(p + step) - model.predict(p - step)) / (2 * h)
         tol = 1e-8 * max(1.0, np.abs(fd).max())
         np.testing.assert_allclose(jac[:, :, k], fd, atol=tol, err_msg=model.parameter_names[k])
+
+
+def _reference_jacobian(model, params):
+    """The Jacobian from prefix and suffix products of the chain's (N, 3, 3) matrices:
+    ``d dR = P_f [a]x S_f`` for every rotation, the gains dense (the straightforward way)."""
+    from turntable_pin.core.rotations import axis_rotation
+    from turntable_pin.model.chain import skew
+
+    n = model.variables.n
+    mats, generators, gains = [], [], []
+    for f in model._factors:
+        if f.fixed is not None:
+            mats.append(np.broadcast_to(np.moveaxis(f.fixed, -1, 0), (n, 3, 3)))
+            generators.append(None)
+            gains.append(None)
+            continue
+        angle = np.broadcast_to(f.angle(params), (n,))
+        mats.append(axis_rotation(f.axis, angle))
+        axis = np.eye(3)["xyz".index(f.axis)] if isinstance(f.axis, str) else f.axis
+        generators.append(skew(axis))
+        gain = np.zeros((n, model.n_params))
+        for column, weight in zip(f.columns, f.weights, strict=True):
+            gain[:, column] += np.broadcast_to(weight, (n,))
+        gains.append(gain)
+    prefix = [np.moveaxis(model._rd, -1, 0)]
+    for m in mats:
+        prefix.append(prefix[-1] @ m)
+    suffix = [np.broadcast_to(np.eye(3), (n, 3, 3))]
+    for m in reversed(mats):
+        suffix.append(m @ suffix[-1])
+    suffix = suffix[::-1]
+    jac = np.zeros((n, 3, model.n_params))
+    for f, (generator, gain) in enumerate(zip(generators, gains, strict=True)):
+        if generator is None:
+            continue
+        d = prefix[f + 1] @ generator @ suffix[f + 1]
+        entries = np.stack([d[:, 0, 2], d[:, 1, 0], d[:, 2, 1]], axis=1)
+        jac += entries[:, :, None] * gain[:, None, :]
+    return prefix[-1], jac
+
+
+def test_one_pass_jacobian_equals_prefix_suffix_products_for_every_effect():
+    """The fast Jacobian (``[P a]x dR``, one forward pass, sparse gains) against the
+    straightforward prefix/suffix products with dense gains, at large parameters."""
+    rng = np.random.default_rng(3)
+    v = _grid_variables(3, n=40)
+    for effects in [[], *([e] for e in EFFECTS.values()), list(EFFECTS.values())]:
+        model = OrientationModel(v, effects)
+        p = rng.normal(0, 1e-3, model.n_params)
+        predicted, jac = model.predict_and_jacobian(p)
+        rotation, expected = _reference_jacobian(model, p)
+        np.testing.assert_allclose(jac, expected, atol=1e-14)
+        np.testing.assert_allclose(model.rotation_error(p), rotation, atol=1e-15)
+        np.testing.assert_allclose(
+            predicted, np.stack([rotation[:, 0, 2], rotation[:, 1, 0], rotation[:, 2, 1]], 1),
+            atol=1e-15,
+        )  # fmt: skip
+        np.testing.assert_array_equal(model.jacobian(p), jac)
+
+
+def test_blocks_of_positions_equal_the_whole():
+    v = _grid_variables(4, n=50)
+    model = OrientationModel(v, list(EFFECTS.values()))
+    p = np.random.default_rng(4).normal(0, 1e-4, model.n_params)
+    predicted, jac = model.predict_and_jacobian(p)
+    for rows in (slice(0, 17), slice(17, 50), slice(49, 50)):
+        part_predicted, part_jac = model.predict_and_jacobian(p, rows)
+        np.testing.assert_allclose(part_predicted, predicted[rows], atol=1e-16)
+        np.testing.assert_allclose(part_jac, jac[rows], atol=1e-16)
+
+
+def test_models_of_the_same_positions_share_the_table_matrices():
+    v = _grid_variables(5, n=30)
+    a = OrientationModel(v)
+    b = OrientationModel(
+        PositionVariables(v.joint_rad.copy(), v.time_s, v.dirs), list(EFFECTS.values())
+    )
+    assert a._rd is b._rd
+    other = OrientationModel(_grid_variables(6, n=30))
+    assert other._rd is not a._rd
+    assert not np.allclose(other.predict(np.full(8, 1e-4)), a.predict(np.full(8, 1e-4)))

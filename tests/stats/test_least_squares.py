@@ -121,3 +121,90 @@ def test_sigma_estimated_when_absent():
     assert fit.result.chi2_reduced == pytest.approx(1.0)
     assert np.median(fit.sigma_rad) * 206264.8 == pytest.approx(2.0, rel=0.1)
     assert fit.to_dict()["p_value"] is None and fit.to_dict()["sigma_source"] == "estimated"
+
+
+def _simulated(effects=None, n_step=30.0):
+    from turntable_pin.measurement.simulation import Schedule
+
+    errors = TurntableErrors.from_arcsec(dphi_y1=5, dalpha_x2=-6, deps_x=7, dalpha_z1=4)
+    schedule = Schedule(phi1_step_deg=n_step, phi2_step_deg=n_step, order="random")
+    return simulate_measurements(errors, effects or {}, schedule=schedule, seed=4).data
+
+
+def test_gauss_newton_and_chord_steps_reach_the_levenberg_marquardt_solution(monkeypatch):
+    """The fast iteration (one Jacobian per fit) against scipy's LM from the same start."""
+    import turntable_pin.stats.least_squares as ls
+
+    data = _simulated({"inner_encoder_harmonics": {"c1": 3.0, "s2": -2.0}})
+    for effects in ([], [EFFECTS["inner_encoder_harmonics"]], [EFFECTS["outer_wobble_harmonics"]]):
+        fast = fit_orientation(data, effects).result
+        with monkeypatch.context() as patch:
+            patch.setattr(ls, "_iterate", lambda *args: None)
+            slow = fit_orientation(data, effects).result
+        assert fast.rank == slow.rank
+        assert fast.rss == pytest.approx(slow.rss, rel=1e-9)
+        std = np.sqrt(np.diag(slow.covariance))
+        determined = slow.individually_determined()
+        assert np.all(np.abs(fast.params - slow.params)[determined] <= 1e-5 * std[determined])
+        scale = np.abs(slow.covariance).max()
+        np.testing.assert_allclose(fast.covariance, slow.covariance, rtol=0, atol=1e-6 * scale)
+
+
+def test_a_shared_zero_point_gives_the_same_fits():
+    from turntable_pin.measurement.fit import orientation_zero_point
+
+    data = _simulated({"gravity_sag": {"k": 3.0}})
+    shared = orientation_zero_point(data, list(EFFECTS.values()))
+    for effects in ([], [EFFECTS["gravity_sag"]], [EFFECTS["backlash"], EFFECTS["base_tilt"]]):
+        direct = fit_orientation(data, effects).result
+        reused = fit_orientation(data, effects, zero_point=shared).result
+        assert reused.weights is shared.weights
+        assert reused.rank == direct.rank
+        assert reused.rss == pytest.approx(direct.rss, rel=1e-10)
+        np.testing.assert_allclose(
+            reused.identifiability.determined, direct.identifiability.determined, atol=1e-9
+        )
+        np.testing.assert_allclose(reused.params, direct.params, rtol=1e-6, atol=1e-14)
+
+
+def test_blocked_r_factor_equals_one_qr():
+    from turntable_pin.stats.least_squares import tall_r_factor
+
+    rng = np.random.default_rng(0)
+    for m in (3000, 5000 + 17):
+        a = rng.normal(size=(m, 7)) * np.array([1, 10, 1e-3, 1, 5, 1, 1])
+        r = tall_r_factor(a)
+        np.testing.assert_allclose(r.T @ r, a.T @ a, rtol=1e-12, atol=1e-9)
+        np.testing.assert_allclose(
+            np.abs(np.diag(r)), np.abs(np.diag(np.linalg.qr(a, mode="r"))), rtol=1e-12
+        )
+
+
+def test_identifiability_of_a_tall_jacobian_equals_the_direct_svd():
+    """Long data go through the blocked R factor; the rank and combinations are the same."""
+    import turntable_pin.stats.least_squares as ls
+
+    rng = np.random.default_rng(1)
+    base = rng.normal(size=(4000, 4))
+    jac = np.column_stack([base, base[:, 1] + 2 * base[:, 2], np.zeros(4000)])  # flat, dead
+    names = tuple("abcdef")
+    tall = ls.analyse_identifiability(jac, names)
+    _, s, vt = np.linalg.svd(jac / np.where(np.linalg.norm(jac, axis=0) > 0,
+                                            np.linalg.norm(jac, axis=0), 1.0))  # fmt: skip
+    assert tall.rank == 4 == int(np.sum(s > ls.RANK_RTOL * s[0]))
+    np.testing.assert_allclose(tall.singular_values[:4], s[:4], rtol=1e-12)
+    assert tall.unresponsive == ("f",)
+    small = ls.analyse_identifiability(jac[:300], names)  # the direct path
+    np.testing.assert_allclose(tall.undetermined, small.undetermined, atol=1e-9)
+    np.testing.assert_allclose(tall.determined, small.determined, atol=1e-9)
+
+
+def test_chi2_tail_and_quantile_equal_scipy_stats():
+    from scipy import stats
+
+    from turntable_pin.stats.least_squares import chi2_quantile, chi2_sf
+
+    for dof in (1, 2, 4, 8, 431, 299_990):
+        for x in (0.3, 5.0, 40.0, 500.0, 3e5):
+            assert chi2_sf(x, dof) == pytest.approx(stats.chi2.sf(x, dof), rel=1e-14, abs=0)
+        assert chi2_quantile(0.99, dof) == pytest.approx(stats.chi2.ppf(0.99, dof), rel=1e-14)

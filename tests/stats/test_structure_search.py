@@ -126,3 +126,62 @@ def test_a_term_of_a_probe_without_factors_cannot_be_projected():
         term.projection()
     with pytest.raises(ValueError, match="no factors"):
         term.curve(x)
+
+
+def _reference_search(r, model_jac, probes, noise_variance, max_terms=5):
+    """The search done the straightforward way: an SVD of every projected probe."""
+    import math
+
+    from turntable_pin.stats.structure_search import BIC_THRESHOLD, NEW_FRACTION
+
+    u, s, _ = np.linalg.svd(model_jac, full_matrices=False)
+    q = u[:, s > 1e-9 * s[0]]
+    r = r.copy()
+    remaining = list(probes)
+    threshold = BIC_THRESHOLD - 2.0 * math.log(len(remaining))
+    found = []
+    for _ in range(max_terms):
+        rss = float(r @ r)
+        best = None
+        for probe in remaining:
+            columns = probe.matrix()
+            t = columns - q @ (q.T @ columns)
+            u, s, vt = np.linalg.svd(t, full_matrices=False)
+            keep = s > NEW_FRACTION * np.linalg.norm(columns, 2)
+            if keep.any():
+                basis = u[:, keep]
+                reduction = float(np.sum((basis.T @ r) ** 2))
+                if best is None or reduction > best[0]:
+                    best = (reduction, probe, basis, vt[keep].T / s[keep])
+        if best is None:
+            break
+        reduction, probe, basis, pinv = best
+        dbic = delta_bic(rss - reduction, rss, basis.shape[1], r.size, noise_variance)
+        if dbic > threshold:
+            break
+        found.append((probe.name, dbic, pinv @ (basis.T @ r)))
+        r = r - basis @ (basis.T @ r)
+        q = np.concatenate([q, basis], axis=1)
+        remaining.remove(probe)
+    return found
+
+
+@pytest.mark.parametrize("m", [240, 6000])
+def test_small_matrix_scoring_equals_the_svd_of_every_probe(m):
+    """Scores from Gram matrices (batched, tall bases from the R factor) against SVDs."""
+    rng = np.random.default_rng(2)
+    x = np.linspace(0, 2 * np.pi, m, endpoint=False)
+    y = rng.uniform(0, 2 * np.pi, m)
+    model = np.column_stack([np.ones(m), np.cos(x), np.cos(x), np.sin(y)])  # rank 3
+    r = 0.9 * np.cos(3 * x + 0.5) - 0.7 * np.sin(2 * y) + rng.normal(0, 0.3, m)
+    probes = _probes(x) + [
+        Probe(f"y {k}/rev", "", lambda k=k: np.stack([np.cos(k * y), np.sin(k * y)], axis=1))
+        for k in range(1, 4)
+    ]
+    for variance in (0.09, None):
+        found = search_structure(r, model, probes, noise_variance=variance)
+        expected = _reference_search(r, model, probes, variance)
+        assert [t.name for t in found] == [e[0] for e in expected] != []
+        for term, (_, dbic, coef) in zip(found, expected, strict=True):
+            assert term.delta_bic == pytest.approx(dbic, rel=1e-9)
+            np.testing.assert_allclose(term.coefficients, coef, rtol=1e-8, atol=1e-12)

@@ -34,16 +34,22 @@ MAX_MONTE_CARLO_TURNTABLES = 10_000_000
 """Most random turntables of one Monte Carlo run (240 MB of per-turntable maxima)."""
 
 MAX_DIAGNOSED_ROWS = 200_000
-"""Most measurement rows one diagnosis takes (about 20 KB a row: 4 GB at the limit)."""
+"""Most measurement rows one diagnosis takes (about 5 KB a row: 1 GB at the limit)."""
 
-DIAGNOSIS_ROW_BYTES = 20_000
-"""Peak memory of a diagnosis per measurement row (measured: 18.7 KB on 20,736 rows), bytes."""
+DIAGNOSIS_ROW_BYTES = 5_000
+"""Peak memory of a diagnosis per measurement row, bytes. Measured: the whole ``diagnose --json``
+command peaked at 470 MB on 100,000 rows (4.7 KB a row, including about 110 MB of interpreter
+and libraries; 3.6 KB a row at the margin between 20,000 and 100,000 rows), with a hidden effect
+found (two rounds of candidate fits). It was 18.7 KB a row before the fits shared one reduced
+Jacobian at zero and stopped keeping their Jacobians (``benchmarks/bench_diagnose_long.py``)."""
 
 MAX_FITTED_ROWS = 1_000_000
-"""Most measurement rows one fit takes (about 5 KB a row)."""
+"""Most measurement rows one fit takes (about 3 KB a row)."""
 
-FIT_ROW_BYTES = 5_000
-"""Peak memory of a fit per measurement row (measured: 4.6 KB), bytes."""
+FIT_ROW_BYTES = 3_000
+"""Peak memory of a fit per measurement row, bytes. Measured: ``fit FILE --effects
+inner_encoder_harmonics --json`` peaked at 292 MB on 100,000 rows (2.9 KB a row, including about
+110 MB of interpreter and libraries); it was 4.6 KB a row with the dense per-factor gains."""
 
 
 def turn_grid_count(step_deg: float) -> int:

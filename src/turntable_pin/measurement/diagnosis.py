@@ -17,7 +17,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..core.exceptions import IdentifiabilityError
+from ..core.exceptions import IdentifiabilityError, InputError
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..stats.least_squares import RANK_RTOL
@@ -28,7 +28,7 @@ from .catalogue import resolve_effect
 from .data import ANGLE_NAMES, OrientationMeasurements
 from .effect_model import OrientationModel
 from .effects.base import Effect, PositionVariables
-from .fit import OrientationFit, fit_orientation
+from .fit import OrientationFit, fit_orientation, orientation_zero_point
 from .table import measured_table
 
 __all__ = [
@@ -119,8 +119,22 @@ class OrientationFamily:
         """The fit of the base errors plus ``effects`` (cached per effect list)."""
         key = tuple(e.name for e in effects)
         if key not in self._cache:
-            self._cache[key] = fit_orientation(self.data, effects, turntable=self.table)
+            self._cache[key] = fit_orientation(
+                self.data, effects, turntable=self.table, zero_point=self._zero_point()
+            )
         return self._cache[key]
+
+    def _zero_point(self):
+        """The reduced Jacobian at zero of the base and every testable catalogued effect, shared
+        by all fits of the diagnosis (computed on first use)."""
+        if not hasattr(self, "_zero"):
+            variables = self.data.variables()
+            testable = [e for e in self.catalogue if not e.missing_columns(variables)]
+            try:
+                self._zero = orientation_zero_point(self.data, testable, turntable=self.table)
+            except InputError:  # effects that cannot share one model: each fit on its own
+                self._zero = None
+        return self._zero
 
     def untestable_reason(self, effect: Effect) -> str | None:
         """Why ``effect`` cannot be tested here (its data columns are missing), or None."""

@@ -25,7 +25,7 @@ from ..core.exceptions import InputError
 from ..core.rotations import AXIS_INDEX, axis_rotation
 from ..core.units import ARCSEC_PER_RAD
 from ..model.angles import ANGLE_ENTRIES, ANGLE_NAMES
-from ..model.chain import ROTATION, skew
+from ..model.chain import ROTATION
 from ..model.errors import ANGULAR_ERROR_NAMES
 from .effects.base import MEASURED, POST, PRE, Effect, ParameterSpec, PositionVariables
 from .table import MeasuredTable, measured_table
@@ -41,23 +41,116 @@ def base_parameters(names) -> tuple[ParameterSpec, ...]:
 BASE_PARAMETERS: tuple[ParameterSpec, ...] = base_parameters(ANGULAR_ERROR_NAMES)
 """The paper's base errors as parameters."""
 
-_GENERATORS = {
-    axis: np.array(m, dtype=float)
-    for axis, m in {
-        "x": [[0, 0, 0], [0, 0, -1], [0, 1, 0]],
-        "y": [[0, 0, 1], [0, 0, 0], [-1, 0, 0]],
-        "z": [[0, -1, 0], [1, 0, 0], [0, 0, 0]],
-    }.items()
-}
-
 
 @dataclass(frozen=True)
 class _Factor:
-    """One rotation of the chain: fixed matrices (N or 1, 3, 3) or ``R_axis(G @ p)``."""
+    """One rotation of the chain: fixed matrices or ``R_axis(angle)``.
+
+    Matrices are stored entry-major, (3, 3, N or 1): ``m[r, c]`` is the entry (r, c) at every
+    position, so products and the Jacobian work on contiguous vectors. A parametrised factor's
+    angle is ``p[columns] @ weights`` (rad): ``columns`` are the indices of the few parameters
+    that turn it, ``weights`` their gains per position, (k, N or 1). The gains are kept sparse:
+    a dense (N, n_params) gain per factor cost most of the memory and time of the Jacobian on
+    long logs.
+    """
 
     fixed: np.ndarray | None = None
-    axis: str | None = None
-    gain: np.ndarray | None = None  # (N, n_params): angle = gain @ p
+    axis: str | np.ndarray | None = None
+    columns: np.ndarray | None = None
+    weights: np.ndarray | None = None
+
+    def angle(self, params: np.ndarray, rows: slice = slice(None)) -> np.ndarray:
+        """The factor's angle at the positions ``rows`` (rad): (n,), or (1,) when it is the same
+        at every position (its cosine and sine are then computed once)."""
+        weights = self.weights if self.weights.shape[-1] == 1 else self.weights[:, rows]
+        return params[self.columns] @ weights
+
+    def matrices(self, rows: slice) -> np.ndarray:
+        """The fixed matrices of the positions ``rows`` (3, 3, n or 1)."""
+        return self.fixed if self.fixed.shape[-1] == 1 else self.fixed[..., rows]
+
+
+def _sparse_gain(gain: dict[int, np.ndarray], n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``{parameter index: gain (N,) or scalar}`` as (columns, weights (k, N or 1))."""
+    columns = np.array(sorted(gain), dtype=int)
+    rows = [np.asarray(gain[c], dtype=float) for c in columns]
+    if all(r.ndim == 0 for r in rows):
+        return columns, np.array([[float(r)] for r in rows])
+    return columns, np.stack([np.broadcast_to(r, (n,)) for r in rows])
+
+
+def _entry_major(matrices: np.ndarray) -> np.ndarray:
+    """Stacked matrices (N, 3, 3) as (3, 3, N)."""
+    return np.ascontiguousarray(np.moveaxis(matrices, 0, -1))
+
+
+def _product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a @ b`` of entry-major stacks (3, 3, N or 1) (the last axes broadcast)."""
+    return sum(a[:, k, None, :] * b[None, k, :, :] for k in range(3))
+
+
+def _merge_fixed(chain: list[_Factor]) -> list[_Factor]:
+    """The chain with runs of fixed factors multiplied into one (identities dropped)."""
+    identity = np.eye(3)[:, :, None]
+    out: list[_Factor] = []
+    for factor in chain:
+        if isinstance(factor, _Factor) and factor.fixed is not None:
+            fixed = factor.fixed
+            if fixed.shape[-1] == 1 and np.array_equal(fixed, identity):
+                continue
+            if out and isinstance(out[-1], _Factor) and out[-1].fixed is not None:
+                out[-1] = _Factor(fixed=_product(out[-1].fixed, fixed))
+                continue
+        out.append(factor)
+    return out
+
+
+def _rotate_columns(m: np.ndarray, axis: str, angle: np.ndarray) -> None:
+    """``m <- m @ R_axis(angle)`` in place for an entry-major stack (3, 3, N): only two columns
+    mix."""
+    i = AXIS_INDEX[axis]
+    j, k = (i + 1) % 3, (i + 2) % 3
+    c, s = np.cos(angle), np.sin(angle)
+    mj = m[:, j].copy()
+    m[:, j] *= c
+    m[:, j] += m[:, k] * s
+    m[:, k] *= c
+    m[:, k] -= mj * s
+
+
+_TABLE_PART: list = []
+"""The last table part built: ``[(turntable, joint_rad, part, rd)]`` (at most one entry)."""
+
+
+def _table_part(turntable: MeasuredTable, joint_rad: np.ndarray):
+    """The table's chain at these joint angles: fixed matrices (entry-major, runs multiplied)
+    and ``(axis, error name)`` of its error rotations, in chain order, and ``Rd^T`` (3, 3, N).
+
+    None of it depends on parameters or effects, so the models of one diagnosis (the base and
+    every candidate, each step) share the arrays: the last result is kept and reused when the
+    table and the joint angles are the same.
+    """
+    for table, joints, part, rd in _TABLE_PART:
+        if table is turntable and joints.shape == joint_rad.shape:
+            if np.array_equal(joints, joint_rad):
+                return part, rd
+    n = joint_rad.shape[0]
+    angles = iter(joint_rad.T)
+    chain: list = []
+    ideal = np.broadcast_to(np.eye(3), (n, 3, 3))
+    for link in turntable.chain.links:
+        placement = link.nominal[None, :3, :3]
+        chain.append(_Factor(fixed=_entry_major(placement)))
+        chain.extend((f.axis, f.error) for f in link.factors if f.kind == ROTATION)
+        ideal = ideal @ placement
+        if link.is_joint:
+            rotation = axis_rotation(link.axis, np.asarray(next(angles), float))
+            chain.append(_Factor(fixed=_entry_major(rotation)))
+            ideal = ideal @ rotation
+    part = _merge_fixed(chain)
+    rd = _entry_major(np.swapaxes(ideal, -1, -2))
+    _TABLE_PART[:] = [(turntable, joint_rad.copy(), part, rd)]
+    return part, rd
 
 
 class OrientationModel:
@@ -104,7 +197,7 @@ class OrientationModel:
         self.parameter_units = tuple(s.unit for s in specs)
         self.per_user_unit = np.array([s.per_user_unit for s in specs])
         self._index = {name: i for i, name in enumerate(names)}
-        self._added = None  # (N, 3, n_params): terms added to a measured angle, if any
+        self._added: list[tuple[int, dict[int, np.ndarray]]] = []  # (angle, gain) added to it
         self._factors, self._rd = self._build_chain(turntable, terms_by_effect)
 
     @property
@@ -112,67 +205,52 @@ class OrientationModel:
         """Number of parameters: the base errors plus every effect's parameters."""
         return len(self.parameter_names)
 
-    def _gain(self, weights: dict[str, np.ndarray], prefix: str) -> np.ndarray:
-        gain = np.zeros((self.variables.n, self.n_params))
+    def _gain(self, weights: dict[str, np.ndarray], prefix: str) -> dict[int, np.ndarray]:
+        gain: dict[int, np.ndarray] = {}
         for name, w in weights.items():
-            gain[:, self._index[f"{prefix}{name}"]] += np.asarray(w, dtype=float)
+            i = self._index[f"{prefix}{name}"]
+            gain[i] = gain.get(i, 0.0) + np.asarray(w, dtype=float)
         return gain
 
     def _build_chain(self, turntable: MeasuredTable, terms_by_effect):
         n = self.variables.n
         pre, post = [], []
-        error_gain = {}
-        for name in self.base_names:
-            gain = np.zeros((n, self.n_params))
-            gain[:, self._index[name]] = 1.0
-            error_gain[name] = gain
+        error_gain = {name: {self._index[name]: np.asarray(1.0)} for name in self.base_names}
+
+        def factor(axis, gain):
+            columns, weights = _sparse_gain(gain, n)
+            return _Factor(axis=axis, columns=columns, weights=weights)
+
         for effect, terms in terms_by_effect:
             for term in terms:
                 gain = self._gain(term.weights, f"{effect.name}.")
                 if term.site == PRE:
-                    pre.append(_Factor(axis=term.axis, gain=gain))
+                    pre.append(factor(term.axis, gain))
                 elif term.site == POST:
-                    post.append(_Factor(axis=term.axis, gain=gain))
+                    post.append(factor(term.axis, gain))
                 elif term.site == MEASURED and term.axis in ANGLE_NAMES:
-                    if self._added is None:
-                        self._added = np.zeros((n, 3, self.n_params))
-                    self._added[:, ANGLE_NAMES.index(term.axis)] += gain
+                    self._added.append((ANGLE_NAMES.index(term.axis), gain))
                 elif term.site in error_gain:
-                    error_gain[term.site] = error_gain[term.site] + gain
+                    merged = dict(error_gain[term.site])
+                    for i, w in gain.items():
+                        merged[i] = merged.get(i, 0.0) + w
+                    error_gain[term.site] = merged
                 else:
                     raise InputError(
                         f"effect '{effect.name}' changes '{term.site}', which is not an error of "
                         f"this table; its errors: {', '.join(self.base_names)}"
                     )
 
-        joint_angles = iter(self.variables.joint_rad.T)
-        chain: list[_Factor] = list(pre)
-        ideal = np.broadcast_to(np.eye(3), (n, 3, 3))
-        for link in turntable.chain.links:
-            placement = link.nominal[None, :3, :3]
-            chain.append(_Factor(fixed=placement))
-            chain.extend(
-                _Factor(axis=f.axis, gain=error_gain[f.error])
-                for f in link.factors
-                if f.kind == ROTATION
-            )
-            ideal = ideal @ placement
-            if link.is_joint:
-                rotation = axis_rotation(link.axis, np.asarray(next(joint_angles), float))
-                chain.append(_Factor(fixed=rotation))
-                ideal = ideal @ rotation
-        chain.extend(post)
-        return chain, np.swapaxes(ideal, -1, -2).copy()
-
-    def _matrices(self, params: np.ndarray) -> list[np.ndarray]:
-        n = self.variables.n
-        out = []
-        for f in self._factors:
-            if f.fixed is not None:
-                out.append(np.broadcast_to(f.fixed, (n, 3, 3)))
+        part, rd = _table_part(turntable, self.variables.joint_rad)
+        chain = [*pre]
+        for entry in part:
+            if isinstance(entry, _Factor):
+                chain.append(entry)
             else:
-                out.append(axis_rotation(f.axis, f.gain @ params))
-        return out
+                axis, error = entry
+                chain.append(factor(axis, error_gain[error]))
+        chain.extend(post)
+        return _merge_fixed(chain), rd
 
     def _check(self, params) -> np.ndarray:
         params = np.asarray(params, dtype=float).reshape(-1)
@@ -180,41 +258,92 @@ class OrientationModel:
             raise InputError(f"expected {self.n_params} parameters, got {params.size}")
         return params
 
+    def _forward(self, params: np.ndarray, axes: bool, rows: slice = slice(None)):
+        """``dR = Rd^T * factors`` entry-major (3, 3, N) by one pass along the chain, and with
+        ``axes`` the rotation axis of every parametrised factor in the frame of ``dR``'s rows,
+        (3, N) each.
+
+        The matrices are all rotations, so the suffix after factor f is ``P_f^T dR`` (``P_f``
+        the prefix up to f): ``d dR / d angle_f = P_f [a_f]x P_f^T dR = [P_f a_f]x dR``, and the
+        Jacobian needs no suffix products (see :meth:`predict_and_jacobian`).
+        """
+        m = self._rd[..., rows].copy()
+        n = m.shape[-1]
+        found = []
+        for f in self._factors:
+            if f.fixed is not None:
+                m = _product(m, f.matrices(rows))
+                continue
+            angle = f.angle(params, rows)
+            if angle.shape[0] != n and not isinstance(f.axis, str):
+                angle = np.full(n, angle[0])
+            if isinstance(f.axis, str):
+                _rotate_columns(m, f.axis, angle)
+                if axes:
+                    found.append(m[:, AXIS_INDEX[f.axis]].copy())
+            else:
+                m = _product(m, _entry_major(axis_rotation(f.axis, angle)))
+                if axes:
+                    generator_axis = np.asarray(f.axis, dtype=float)
+                    found.append(sum(m[:, k] * generator_axis[k] for k in range(3)))
+        return m, found
+
     def rotation_error(self, params) -> np.ndarray:
         """``dR = Rd^T Rt`` at each position, (N, 3, 3)."""
-        total = None
-        for m in self._matrices(self._check(params)):
-            total = m if total is None else total @ m
-        return self._rd @ total
+        dR = self._forward(self._check(params), False)[0]
+        return np.ascontiguousarray(np.moveaxis(dR, -1, 0))
 
     def predict(self, params) -> np.ndarray:
         """``[dpsi, dtheta, dgamma]`` (rad) at each position, (N, 3)."""
-        dR = self.rotation_error(params)
-        angles = np.stack([dR[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)
-        return angles if self._added is None else angles + self._added @ params
+        params = self._check(params)
+        dR = self._forward(params, False)[0]
+        return self._with_added(np.stack([dR[i, j] for i, j in ANGLE_ENTRIES], axis=1), params)
 
     def jacobian(self, params) -> np.ndarray:
         """Exact derivative of :meth:`predict` with respect to the parameters, (N, 3, n)."""
-        mats = self._matrices(self._check(params))
-        n = self.variables.n
-        prefix = [self._rd]
-        for m in mats:
-            prefix.append(prefix[-1] @ m)
-        suffix = [np.broadcast_to(np.eye(3), (n, 3, 3))]
-        for m in reversed(mats):
-            suffix.append(m @ suffix[-1])
-        suffix = suffix[::-1]  # suffix[f] = product of factors f..end
-        jac = np.zeros((n, 3, self.n_params)) if self._added is None else self._added.copy()
-        for f, factor in enumerate(self._factors):
-            if factor.fixed is not None:
-                continue
-            generator = (
-                _GENERATORS[factor.axis] if isinstance(factor.axis, str) else skew(factor.axis)
-            )
-            d = prefix[f + 1] @ generator @ suffix[f + 1]
-            entries = np.stack([d[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)  # (N, 3)
-            jac += entries[:, :, None] * factor.gain[:, None, :]
-        return jac
+        return self.predict_and_jacobian(params)[1]
+
+    def predict_and_jacobian(
+        self, params, rows: slice = slice(None)
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`predict` (N, 3) and :meth:`jacobian` (N, 3, n) from one pass along the chain
+        (of the positions ``rows`` only: a block of a long log).
+
+        For a factor ``R_a(angle)`` whose axis is ``u`` in the frame of ``dR``'s rows, the
+        derivative of ``dR`` is ``[u]x dR``, whose entry (i, j) is ``(u x dR[:, j])_i``; times
+        the factor's gains it goes to the columns of the parameters that turn it. The Jacobian
+        is a new array, laid out parameter by parameter (a transposed view).
+        """
+        params = self._check(params)
+        dR, axes = self._forward(params, True, rows)
+        n = dR.shape[-1]
+        jac = np.zeros((self.n_params, n, 3))
+        entries = np.empty((n, 3))
+        factors = [f for f in self._factors if f.fixed is None]
+        for factor, u in zip(factors, axes, strict=True):
+            for e, (i, j) in enumerate(ANGLE_ENTRIES):
+                i1, i2 = (i + 1) % 3, (i + 2) % 3
+                np.subtract(u[i1] * dR[i2, j], u[i2] * dR[i1, j], out=entries[:, e])
+            weights = factor.weights if factor.weights.shape[-1] == 1 else factor.weights[:, rows]
+            for column, weight in zip(factor.columns, weights, strict=True):
+                if weight.size == 1 and weight[0] == 1.0:
+                    jac[column] += entries
+                else:
+                    jac[column] += entries * weight[:, None]
+        for a, gain in self._added:  # terms added to a measured angle itself: linear
+            for column, weight in gain.items():
+                w = np.asarray(weight, dtype=float)
+                jac[column][:, a] += w if w.ndim == 0 else w[rows]
+        predicted = np.stack([dR[i, j] for i, j in ANGLE_ENTRIES], axis=1)
+        return self._with_added(predicted, params, rows), jac.transpose(1, 2, 0)
+
+    def _with_added(self, predicted: np.ndarray, params, rows: slice = slice(None)) -> np.ndarray:
+        """``predicted`` (N, 3) plus the terms added to a measured angle itself."""
+        for a, gain in self._added:
+            for column, weight in gain.items():
+                w = np.asarray(weight, dtype=float)
+                predicted[:, a] += (w if w.ndim == 0 else w[rows]) * params[column]
+        return predicted
 
     def parameter_vector(self, values: dict[str, float] | None = None) -> np.ndarray:
         """A parameter vector (internal units) from ``{name: value in internal units}``."""

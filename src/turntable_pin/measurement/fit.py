@@ -16,12 +16,21 @@ import numpy as np
 
 from ..core.sizes import FIT_ROW_BYTES, MAX_FITTED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD
-from ..stats.least_squares import FitResult, fit_least_squares
+from ..stats.least_squares import FitResult, ZeroPoint, fit_least_squares, zero_point
 from .data import ANGLE_NAMES, OrientationMeasurements
 from .effect_model import OrientationModel
 from .effects.base import Effect
 
-__all__ = ["OrientationFit", "OrientationFitProblem", "fit_orientation"]
+__all__ = [
+    "ZERO_POINT_BLOCK",
+    "OrientationFit",
+    "OrientationFitProblem",
+    "fit_orientation",
+    "orientation_zero_point",
+]
+
+ZERO_POINT_BLOCK = 8192
+"""Positions per block of :meth:`OrientationFitProblem.zero_point_blocks` (a few MB each)."""
 
 
 class OrientationFitProblem:
@@ -51,6 +60,32 @@ class OrientationFitProblem:
     def jacobian(self, params: np.ndarray) -> np.ndarray:
         """Derivative of :meth:`predict` with respect to the parameters, (m, n_params)."""
         return self._measured(self.model.jacobian(params).reshape(-1, self.model.n_params))
+
+    def zero_point_blocks(self, block: int = ZERO_POINT_BLOCK):
+        """``(weighted jacobian, weighted residuals, weights)`` at zero parameters, ``block``
+        positions at a time (the measured angles only), for ``zero_point`` of
+        :mod:`..stats.least_squares`."""
+        data, model = self.data, self.model
+        zeros = np.zeros(model.n_params)
+        for start in range(0, data.n_positions, block):
+            rows = slice(start, min(start + block, data.n_positions))
+            predicted, jac = model.predict_and_jacobian(zeros, rows)
+            mask = data.measured[rows].reshape(-1)
+            observed = data.angles_rad[rows].reshape(-1)[mask]
+            if data.sigma_rad is None:
+                weights = np.ones_like(observed)
+            else:
+                weights = 1.0 / data.sigma_rad[rows].reshape(-1)[mask]
+            jac = jac.reshape(-1, model.n_params)[mask] * weights[:, None]
+            yield jac, (observed - predicted.reshape(-1)[mask]) * weights, weights
+
+    def predict_and_jacobian(self, params: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`predict` (rad) and :meth:`jacobian` (a new array) from one pass of the model."""
+        predicted, jac = self.model.predict_and_jacobian(params)
+        return (
+            self._measured(predicted.reshape(-1)),
+            self._measured(jac.reshape(-1, self.model.n_params)),
+        )
 
 
 @dataclass(frozen=True)
@@ -154,6 +189,7 @@ def fit_orientation(
     *,
     noise_variance: float | None = None,
     turntable=None,
+    zero_point: ZeroPoint | None = None,
 ) -> OrientationFit:
     """Fit the base error model plus ``effects`` to ``data``.
 
@@ -164,11 +200,27 @@ def fit_orientation(
             with (default: estimated from this fit).
         turntable: the table (a ``MeasuredTable``, ``TurntableModel`` or ``GenericTable``;
             default: the bundled paper table).
+        zero_point: :func:`orientation_zero_point` of these data with these effects and maybe
+            more (fits of many effect sets of one data set share it).
 
     Raises:
         InputError: more rows than :data:`~turntable_pin.core.sizes.MAX_FITTED_ROWS`.
     """
     check_count(data.n_positions, MAX_FITTED_ROWS, "measurement rows", FIT_ROW_BYTES)
     model = OrientationModel(data.variables(), effects, turntable)
-    result = fit_least_squares(OrientationFitProblem(data, model), noise_variance=noise_variance)
+    result = fit_least_squares(
+        OrientationFitProblem(data, model), noise_variance=noise_variance, zero_point=zero_point
+    )
     return OrientationFit(data, model, result)
+
+
+def orientation_zero_point(
+    data: OrientationMeasurements, effects: Sequence[Effect] = (), *, turntable=None
+) -> ZeroPoint:
+    """The weighted Jacobian at zero of the base errors plus ``effects`` on ``data``, reduced
+    (:class:`~turntable_pin.stats.least_squares.ZeroPoint`): computed block by block of
+    positions, it serves every fit of these data whose effects are among ``effects``."""
+    check_count(data.n_positions, MAX_FITTED_ROWS, "measurement rows", FIT_ROW_BYTES)
+    model = OrientationModel(data.variables(), effects, turntable)
+    problem = OrientationFitProblem(data, model)
+    return zero_point(model.parameter_names, problem.zero_point_blocks())

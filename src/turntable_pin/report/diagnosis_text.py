@@ -99,9 +99,10 @@ def header_lines(d: dict) -> list[str]:
         + (f", p-value {b['p_value']:.3g}" if b["p_value"] is not None else "")
     )
     lines += [f"warning: {text}" for text in d.get("warnings", [])]
+    threshold = d.get("decision_rule", {}).get("threshold", -6.0)
     lines.append(
-        f"candidates (best first; delta_bic <= {d['decision_rule']['threshold']:.1f} accepts: "
-        "-6 - 2 ln K for K candidates):"
+        f"candidates (best first; delta_bic <= {threshold:.1f} accepts: -6 - 2 ln K for K "
+        "candidates):"
     )
     first = d["steps"][0]["added"] if d["steps"] else None
     for c in d["candidates"]:

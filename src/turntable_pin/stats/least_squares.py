@@ -23,7 +23,7 @@ an estimated sigma is 1 per degree of freedom by construction, so no p-value is 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -32,12 +32,18 @@ from ..core.exceptions import IdentifiabilityError
 __all__ = [
     "DEAD_COLUMN_RTOL",
     "RANK_RTOL",
+    "ZeroPoint",
     "FitProblem",
     "FitResult",
     "Identifiability",
     "analyse_identifiability",
+    "chi2_quantile",
+    "chi2_sf",
     "combination_name",
     "fit_least_squares",
+    "tall_r_factor",
+    "tall_times",
+    "zero_point",
 ]
 
 DEAD_COLUMN_RTOL = 1e-12
@@ -64,6 +70,31 @@ class FitProblem(Protocol):
 
     def jacobian(self, params: np.ndarray) -> np.ndarray:
         """Derivative of :meth:`predict` with respect to the parameters, (m, n)."""
+
+    # Optional: ``predict_and_jacobian(params) -> (predicted (m,), jacobian (m, n))`` in one
+    # pass, the Jacobian a new array (the fit scales it in place).
+
+
+def chi2_sf(chi2: float, dof: float) -> float:
+    """``P(X > chi2)`` for X chi-squared with ``dof`` degrees of freedom.
+
+    ``scipy.special.chdtrc``: the function ``scipy.stats.chi2.sf`` evaluates (the same numbers),
+    without importing ``scipy.stats`` (about a second of start-up).
+    """
+    from scipy import special  # imported on use: keeps the package's import light
+
+    return float(special.chdtrc(dof, chi2))
+
+
+def chi2_quantile(probability: float, dof: float) -> float:
+    """The ``probability`` quantile of chi-squared with ``dof`` degrees of freedom.
+
+    ``2 * gammaincinv(dof / 2, p)``: what ``scipy.stats.chi2.ppf`` evaluates, without importing
+    ``scipy.stats``.
+    """
+    from scipy import special
+
+    return float(2.0 * special.gammaincinv(dof / 2.0, probability))
 
 
 def _rref(matrix: np.ndarray, tol: float = 1e-9) -> np.ndarray:
@@ -128,6 +159,42 @@ class Identifiability:
     unresponsive: tuple[str, ...]
 
 
+TALL_ROWS = 256
+"""Row blocks of :func:`tall_r_factor`; matrices with at most ``2 * TALL_ROWS`` rows and those
+not many times taller than wide are decomposed directly."""
+
+
+def tall_r_factor(matrix: np.ndarray) -> np.ndarray:
+    """The triangular factor R (n, n) of a tall matrix (m, n), ``matrix = Q R``, by blocks.
+
+    Blocks of :data:`TALL_ROWS` rows are reduced to their R factors at once (a stacked QR that
+    stays in cache) and the stacked factors reduced again: the same R up to the signs of its
+    rows as one QR of the whole matrix, several times faster on long tall matrices. The SVD of
+    R has the singular values and right singular vectors of ``matrix``.
+    """
+    m, n = matrix.shape
+    block = max(TALL_ROWS, 4 * n)
+    full = (m // block) * block
+    parts = []
+    if full:
+        stacked = matrix[:full].reshape(-1, block, n)
+        parts.append(np.linalg.qr(stacked, mode="r").reshape(-1, n))
+    if full < m:
+        parts.append(matrix[full:])
+    return np.linalg.qr(np.concatenate(parts) if len(parts) > 1 else parts[0], mode="r")
+
+
+def _singular_values_vt(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Singular values and (n, n) right singular vectors of ``matrix`` (m, n)."""
+    m, n = matrix.shape
+    if m > 2 * TALL_ROWS and m >= 8 * n:
+        _, s, vt = np.linalg.svd(tall_r_factor(matrix))
+        return s, vt
+    # vt must be square (n x n) to hold the null space; U need not be (m can be large).
+    _, s, vt = np.linalg.svd(matrix, full_matrices=m < n)
+    return s, vt
+
+
 def analyse_identifiability(jacobian_weighted: np.ndarray, names) -> Identifiability:
     """Rank, determined combinations and flat directions of a weighted Jacobian (m, n)."""
     norms = np.linalg.norm(jacobian_weighted, axis=0)
@@ -135,9 +202,8 @@ def analyse_identifiability(jacobian_weighted: np.ndarray, names) -> Identifiabi
     # data do not see), not a direction to normalise up to unit length and call determined.
     dead = norms <= DEAD_COLUMN_RTOL * max(float(norms.max(initial=0.0)), 1e-300)
     scale = np.where(dead, 1.0, norms)
-    m, n = jacobian_weighted.shape
-    # vt must be square (n x n) to hold the null space; U need not be (m can be large).
-    _, s, vt = np.linalg.svd(jacobian_weighted / scale, full_matrices=m < n)
+    n = jacobian_weighted.shape[1]
+    s, vt = _singular_values_vt(jacobian_weighted / scale)
     rank = int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
     v_r = vt[:rank].T
     v_null = vt[rank:].T
@@ -188,9 +254,15 @@ class FitResult:
     sigma_known: bool
     identifiability: Identifiability
     user_unit_scale: float
-    jacobian_weighted: np.ndarray = field(repr=False)
+    _jacobian: Any = field(repr=False)  # (m, n) array, or a function computing it on first use
     n_function_evaluations: int = 0
     observation_unit: str = ""
+
+    @property
+    def jacobian_weighted(self) -> np.ndarray:
+        """The weighted Jacobian (m, n) at ``params`` (computed on each use: a diagnosis holds
+        many fits and needs the Jacobian of one, once)."""
+        return self._jacobian() if callable(self._jacobian) else self._jacobian
 
     @property
     def n_obs(self) -> int:
@@ -217,9 +289,7 @@ class FitResult:
         """Probability of a chi2 at least this large if the model were right (sigma known)."""
         if not self.sigma_known or self.dof <= 0:
             return None
-        from scipy import stats  # imported on use: keeps the package's import light
-
-        return float(stats.chi2.sf(self.chi2, self.dof))
+        return chi2_sf(self.chi2, self.dof)
 
     @property
     def rms_key(self) -> str:
@@ -348,24 +418,176 @@ def _replace(result: FitResult, **changes) -> FitResult:
     return replace(result, **changes)
 
 
-def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = None) -> FitResult:
-    """Fit ``problem`` by weighted nonlinear least squares (scipy ``least_squares``).
+GAUSS_NEWTON_RTOL = 1e-8
+"""The iteration stops once a step is below this fraction of the solution (whitened
+coordinates); the point it leads to, where the fit is evaluated, is converged far beyond it."""
+
+CHORD_MAX_STEPS = 20
+"""Steps with one Jacobian before the fit falls back to scipy's Levenberg-Marquardt."""
+
+
+@dataclass(frozen=True)
+class ZeroPoint:
+    """A model's weighted Jacobian at zero parameters, reduced to what a fit of any subset of its
+    parameters needs (a model whose parameters at zero leave every other parameter's response
+    unchanged, so the columns of a smaller model are columns of this one).
+
+    Attributes:
+        names: the parameters (n,).
+        r_factor: (k, n) with ``R^T R = J^T J`` for the weighted Jacobian J at zero (its
+            triangular factor; J itself when it has fewer rows than columns): the SVD of
+            ``R[:, S]`` has the singular values and right vectors of ``J[:, S]``.
+        gradient: ``J^T r0`` (n,), ``r0`` the weighted residuals at zero.
+        cost: ``r0 . r0``.
+        weights: the weights (m,) of the observations (1/sigma): a fit that uses this zero
+            point checks them against its own and keeps this array (one for all the fits).
+    """
+
+    names: tuple[str, ...]
+    r_factor: np.ndarray
+    gradient: np.ndarray
+    cost: float
+    weights: np.ndarray
+
+    def indices(self, names) -> np.ndarray | None:
+        """The columns of ``names`` (None when one of them is not a parameter here)."""
+        where = {name: i for i, name in enumerate(self.names)}
+        if any(name not in where for name in names):
+            return None
+        return np.array([where[name] for name in names], dtype=int)
+
+
+def zero_point(names, blocks) -> ZeroPoint:
+    """The :class:`ZeroPoint` of a model from its weighted Jacobian at zero given in row blocks.
 
     Args:
-        problem: the model and data.
+        names: the parameters (n,).
+        blocks: ``(weighted jacobian (m_b, n), weighted residuals (m_b,), weights (m_b,))`` at
+            zero parameters, block by block of rows (so that a long data set never holds its
+            whole Jacobian).
+    """
+    n = len(names)
+    factors, gradient, cost, weights = [], np.zeros(n), 0.0, []
+    for jac, res, w in blocks:
+        weights.append(w)
+        gradient += jac.T @ res
+        cost += float(res @ res)
+        factors.append(tall_r_factor(jac) if jac.shape[0] > n else np.array(jac, dtype=float))
+    stacked = np.concatenate(factors) if factors else np.zeros((0, n))
+    r = tall_r_factor(stacked) if stacked.shape[0] > n else stacked
+    return ZeroPoint(tuple(names), r, gradient, cost, np.concatenate(weights) if weights else None)
+
+
+def _evaluator(problem: FitProblem):
+    """``params -> (predicted (m,), jacobian (m, n))``, in one pass when the problem has
+    ``predict_and_jacobian``."""
+    both = getattr(problem, "predict_and_jacobian", None)
+    if both is not None:
+        return both  # its Jacobian is a new array: the fit scales it in place
+    return lambda params: (
+        problem.predict(params),
+        np.array(problem.jacobian(params), dtype=float),
+    )
+
+
+def tall_times(tall: np.ndarray, small: np.ndarray) -> np.ndarray:
+    """``tall @ small`` for a tall (m, n) and a small (n, k) matrix, computed as
+    ``(small^T tall^T)^T``: the same numbers, but OpenBLAS's threaded kernel for the direct
+    product was 10-20 times slower on a busy two-core machine."""
+    return (small.T @ tall.T).T
+
+
+def _iterate(problem, evaluate, weights, basis, start):
+    """Gauss-Newton, then chord steps, from ``z = 0`` in whitened coordinates.
+
+    ``start`` is ``(cost, normal matrix, gradient)`` at zero (``jz^T jz`` and ``jz^T r`` for
+    the weighted Jacobian ``jz`` in these coordinates, orthonormal there). The first step uses
+    it; the model's Jacobian is evaluated once, at that first point ``z1``, and every further
+    step solves with it against fresh residuals (``predict`` only). Their fixed point differs
+    from the least-squares solution by ``(J(z) - J(z1))^T r``: the Jacobian changes by the
+    size of the first step's error in radians (the fitted errors squared, ~1e-10 relative), so
+    the solution is reached to ~1e-10 of its statistical uncertainty, and the steps shrink by
+    that factor each time. A step smaller than :data:`GAUSS_NEWTON_RTOL` of the solution ends
+    the iteration at the point it leads to, whose residuals are those before it minus the
+    Jacobian times the step (exact to the step squared times the nonlinearity).
+
+    Returns ``(z, weighted residuals, normal matrix at z1, evaluations)``, or None when a step
+    fails to lower the residual sum of squares or the steps do not settle (the caller then uses
+    scipy's Levenberg-Marquardt).
+    """
+    observed = problem.observed
+    cost, normal, gradient = start
+    z = np.linalg.solve(normal, gradient)
+    predicted, jac = evaluate(basis @ z)
+    jac *= weights[:, None]
+    jz = tall_times(jac, basis)  # d(predicted * weights)/dz = -d(res)/dz
+    del jac
+    normal = jz.T @ jz
+    count = 2
+    for _ in range(CHORD_MAX_STEPS):
+        res = (observed - predicted) * weights
+        new_cost = float(res @ res)
+        if new_cost > cost * (1.0 + 1e-12) + 1e-300:
+            return None
+        cost = new_cost
+        step = np.linalg.solve(normal, jz.T @ res)
+        z = z + step
+        size = float(np.linalg.norm(step))
+        if size <= GAUSS_NEWTON_RTOL * float(np.linalg.norm(z)) or size <= 1e-15:
+            # The residuals after this last, tiny step: linear in it to its size squared times
+            # the nonlinearity (< 1e-20 relative), so no further evaluation is needed.
+            return z, res - jz @ step, normal, count
+        predicted = problem.predict(basis @ z)
+        count += 1
+    return None
+
+
+def fit_least_squares(
+    problem: FitProblem,
+    *,
+    noise_variance: float | None = None,
+    zero_point: ZeroPoint | None = None,
+) -> FitResult:
+    """Fit ``problem`` by weighted nonlinear least squares (Gauss-Newton and chord steps, else
+    scipy's Levenberg-Marquardt).
+
+    The models are nearly linear (second-order terms of the size of the fitted errors): in
+    coordinates where the weighted Jacobian at zero is orthonormal, one Gauss-Newton step from
+    zero lands within that nonlinearity of the solution, and steps with the Jacobian there reach
+    it in two or three evaluations of ``predict`` (:func:`_iterate`); a step that does not lower
+    the residuals hands the fit to scipy's ``least_squares`` (Levenberg-Marquardt).
+
+    Args:
+        problem: the model and data (``predict_and_jacobian``, when present, is used for one
+            pass per step).
         noise_variance: unit-weight noise variance to judge the fit with when sigmas are unknown
             (default: estimated from this fit, ``rss / dof``). Ignored when sigmas are given.
+        zero_point: the reduced Jacobian at zero of a model with these parameters and maybe more
+            (:func:`zero_point`): the identifiability and the first step are then read from it
+            instead of evaluating the Jacobian at zero (fits of many models of one data set).
 
     Raises:
         IdentifiabilityError: no parameter is determined, or no degree of freedom is left.
     """
-    from scipy import optimize  # imported on use: keeps the package's import light
-
     sigma_known = problem.sigma is not None
     weights = 1.0 / problem.sigma if sigma_known else np.ones_like(problem.observed)
-    n = len(problem.parameter_names)
-    j0 = problem.jacobian(np.zeros(n)) * weights[:, None]
-    ident = analyse_identifiability(j0, problem.parameter_names)
+    names = tuple(problem.parameter_names)
+    n = len(names)
+    evaluate = _evaluator(problem)
+    columns = zero_point.indices(names) if zero_point is not None else None
+    if columns is not None and np.array_equal(zero_point.weights, weights):
+        weights = zero_point.weights  # one array for all the fits of a data set
+    else:
+        columns = None
+    if columns is not None:
+        j0 = zero_point.r_factor[:, columns]
+        gradient0, cost0 = zero_point.gradient[columns], zero_point.cost
+    else:
+        predicted0, j0 = evaluate(np.zeros(n))
+        j0 *= weights[:, None]
+        res0 = (problem.observed - predicted0) * weights
+        gradient0, cost0 = j0.T @ res0, float(res0 @ res0)
+    ident = analyse_identifiability(j0, names)
     m = problem.observed.size
     if ident.rank == 0:
         raise IdentifiabilityError("the data determine no parameter of the model")
@@ -374,25 +596,23 @@ def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = Non
             f"{m} observations cannot fit {ident.rank} independent parameter combinations with a "
             "degree of freedom left; measure more positions"
         )
-    basis = ident.basis
-
-    def fun(z):
-        return (problem.observed - problem.predict(basis @ z)) * weights
-
-    def jac(z):
-        return -(problem.jacobian(basis @ z) * weights[:, None]) @ basis
-
-    # The models are nearly linear: one Gauss-Newton step from zero lands close to the optimum.
-    z0 = np.linalg.lstsq(-jac(np.zeros(ident.rank)), -fun(np.zeros(ident.rank)), rcond=None)[0]
-    solution = optimize.least_squares(
-        fun, z0, jac=jac, method="lm" if m >= ident.rank else "trf", xtol=1e-12, ftol=1e-12
-    )
-    z = solution.x
+    # Whitened coordinates: the weighted Jacobian at zero times ``basis`` is orthonormal, so the
+    # normal equations of every step are as well conditioned as the problem is nonlinear.
+    basis = ident.basis / ident.singular_values[: ident.rank]
+    jz0 = tall_times(j0, basis)
+    del j0
+    start = (cost0, jz0.T @ jz0, basis.T @ gradient0)
+    del jz0
+    solved = _iterate(problem, evaluate, weights, basis, start)
+    if solved is None:
+        z, weighted_res, jac_weighted, nfev = _levenberg_marquardt(problem, weights, basis)
+        jz = tall_times(jac_weighted, basis)
+        normal = jz.T @ jz
+        del jac_weighted, jz
+    else:
+        z, weighted_res, normal, nfev = solved
     params = basis @ z
-    jz = jac(z)
-    weighted_res = solution.fun
-    # scipy's ``cost`` is already 0.5 * sum(f**2): the residual sum of squares is 2 * cost.
-    rss = float(2.0 * solution.cost)
+    rss = float(weighted_res @ weighted_res)
     dof = m - ident.rank
     if sigma_known:
         variance = 1.0
@@ -400,9 +620,9 @@ def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = Non
         variance = float(noise_variance)
     else:
         variance = rss / dof
-    cov_z = np.linalg.pinv(jz.T @ jz) * variance
+    cov_z = np.linalg.pinv(normal) * variance
     return FitResult(
-        parameter_names=tuple(problem.parameter_names),
+        parameter_names=names,
         parameter_units=tuple(problem.parameter_units),
         per_user_unit=np.asarray(problem.per_user_unit, dtype=float),
         params=params,
@@ -417,6 +637,35 @@ def fit_least_squares(problem: FitProblem, *, noise_variance: float | None = Non
         identifiability=ident,
         user_unit_scale=float(problem.user_unit_scale),
         observation_unit=str(getattr(problem, "observation_unit", "")),
-        jacobian_weighted=problem.jacobian(params) * weights[:, None],
-        n_function_evaluations=int(solution.nfev),
+        _jacobian=_weighted_jacobian(problem, params, weights),
+        n_function_evaluations=int(nfev),
     )
+
+
+def _weighted_jacobian(problem: FitProblem, params: np.ndarray, weights: np.ndarray):
+    """A function of no argument: the weighted Jacobian (m, n) at ``params``."""
+
+    def compute() -> np.ndarray:
+        return np.array(problem.jacobian(params), dtype=float) * weights[:, None]
+
+    return compute
+
+
+def _levenberg_marquardt(problem: FitProblem, weights: np.ndarray, basis: np.ndarray):
+    """scipy's Levenberg-Marquardt in the coordinates ``basis``: ``(z, weighted residuals,
+    weighted jacobian (m, n), evaluations)``."""
+    from scipy import optimize  # imported on use: keeps the package's import light
+
+    def fun(z):
+        return (problem.observed - problem.predict(basis @ z)) * weights
+
+    def jac(z):
+        return -tall_times(problem.jacobian(basis @ z) * weights[:, None], basis)
+
+    # The models are nearly linear: one Gauss-Newton step from zero lands close to the optimum.
+    rank = basis.shape[1]
+    z0 = np.linalg.lstsq(-jac(np.zeros(rank)), -fun(np.zeros(rank)), rcond=None)[0]
+    solution = optimize.least_squares(fun, z0, jac=jac, method="lm", xtol=1e-12, ftol=1e-12)
+    z = solution.x
+    jac_weighted = problem.jacobian(basis @ z) * weights[:, None]
+    return z, solution.fun, jac_weighted, solution.nfev

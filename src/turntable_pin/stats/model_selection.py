@@ -38,8 +38,9 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError
-from .least_squares import FitResult
+from .least_squares import FitResult, chi2_quantile, chi2_sf
 from .structure_search import BIC_THRESHOLD, FoundTerm, Probe, delta_bic, search_structure
 
 __all__ = [
@@ -128,15 +129,13 @@ def _chi2(result: FitResult, noise_variance: float) -> float:
 
 
 def _summary(result: FitResult, noise_variance: float) -> dict:
-    from scipy import stats  # imported on use: keeps the package's import light
-
     chi2 = _chi2(result, noise_variance)
     return {
         result.rms_key: result.rms_user,
         "chi2_reduced": chi2 / result.dof if result.dof > 0 else None,
         "n_params": result.n_params,
         "rank": result.rank,
-        "p_value": float(stats.chi2.sf(chi2, result.dof)) if result.sigma_known else None,
+        "p_value": chi2_sf(chi2, result.dof) if result.sigma_known else None,
     }
 
 
@@ -184,8 +183,6 @@ def _noise_variance(best: FitResult) -> float:
 
 
 def _mark_alternatives(candidates: list[Candidate], noise_variance: float) -> None:
-    from scipy import stats
-
     accepted = [c for c in candidates if c.significant]
     for a in accepted:
         chi2_a = _chi2(a.fit.result, noise_variance)
@@ -194,7 +191,7 @@ def _mark_alternatives(candidates: list[Candidate], noise_variance: float) -> No
             for b in accepted
             if b is not a
             and abs(_chi2(b.fit.result, noise_variance) - chi2_a)
-            <= stats.chi2.ppf(ALTERNATIVE_LEVEL, max(a.added_rank, b.added_rank, 1))
+            <= chi2_quantile(ALTERNATIVE_LEVEL, max(a.added_rank, b.added_rank, 1))
         ]
 
 
@@ -376,7 +373,16 @@ class Diagnosis:
 
 
 def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis:
-    """Test every catalogued effect against the base model and decide (module docstring)."""
+    """Test every catalogued effect against the base model and decide (module docstring).
+
+    Runs with one BLAS thread (:func:`one_blas_thread` of ``core.blas_threads``): its
+    products of tall, thin matrices were many times slower split over the threads of busy
+    cores."""
+    with one_blas_thread():
+        return _diagnose(family, until_explained=until_explained)
+
+
+def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
     base_fit = family.fit([])
     candidates = compare_effects(family, [], base_fit, family.catalogue)
     steps: list[Step] = []

@@ -26,7 +26,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .least_squares import TALL_ROWS, tall_r_factor, tall_times
+
 __all__ = [
+    "BATCH_VALUES",
     "BIC_THRESHOLD",
     "NEW_FRACTION",
     "FoundTerm",
@@ -245,11 +248,91 @@ def delta_bic(rss_new: float, rss_old: float, added: int, m: int, noise_variance
 
 
 def _orthonormal_columns(matrix: np.ndarray) -> np.ndarray:
+    """An orthonormal basis (m, k) of the span of ``matrix`` (m, n): its directions with
+    singular values above 1e-9 of the largest."""
     if matrix.size == 0:
         return np.zeros((matrix.shape[0], 0))
-    u, s, _ = np.linalg.svd(matrix, full_matrices=False)
+    m, n = matrix.shape
+    if m <= 2 * TALL_ROWS or m < 8 * n:
+        u, s, _ = np.linalg.svd(matrix, full_matrices=False)
+        return u[:, s > 1e-9 * (s[0] if s.size else 1.0)]
+    # Long and thin: the right singular vectors from the small R factor, U = A V / s, then
+    # made orthonormal once more against the rounding of the directions with small s (in place,
+    # block by block of rows: no third tall matrix).
+    _, s, vt = np.linalg.svd(tall_r_factor(matrix))
     keep = s > 1e-9 * (s[0] if s.size else 1.0)
-    return u[:, keep]
+    u = tall_times(matrix, vt[keep].T / s[keep])
+    values, vectors = np.linalg.eigh(u.T @ u)
+    correction = (vectors / np.sqrt(values)) @ vectors.T
+    for start in range(0, m, TALL_ROWS * 16):
+        block = u[start : start + TALL_ROWS * 16]
+        block[...] = block @ correction
+    return u
+
+
+BATCH_VALUES = 1 << 21
+"""Probe columns scored together hold at most about this many values (16 MB): one pass over
+the model's basis and the residuals serves the whole batch."""
+
+
+def _probe_fit(gram: np.ndarray, qc: np.ndarray, cr: np.ndarray, qr_: np.ndarray):
+    """What a probe's columns C (m, g) add beyond the span of ``q`` (m, k) to explain ``r``.
+
+    Works on small matrices only: ``gram = C^T C``, ``qc = q^T C``, ``cr = C^T r``,
+    ``qr_ = q^T r``. With ``t = C - q q^T C`` (the part ``q`` does not span),
+    ``t^T t = C^T C - (q^T C)^T (q^T C)`` and ``t^T r = C^T r - (q^T C)^T (q^T r)``; the
+    eigen-decomposition ``t^T t = V S^2 V^T`` gives the singular values of ``t`` and, for the
+    kept directions, ``U = t V / S``.
+
+    Returns:
+        ``(reduction, V kept (g, k), S kept, S U^T r)`` or None when no direction is new.
+    """
+    if not gram.size:
+        return None
+    scale2 = float(np.linalg.eigvalsh(gram)[-1])
+    tt = gram - qc.T @ qc
+    tr = cr - qc.T @ qr_
+    values, vectors = np.linalg.eigh((tt + tt.T) / 2.0)
+    keep = values > NEW_FRACTION**2 * scale2
+    if not keep.any():
+        return None
+    v, s2 = vectors[:, keep], values[keep]
+    along = v.T @ tr  # s * (U^T r)
+    return float(np.sum(along**2 / s2)), v, np.sqrt(s2), along
+
+
+def _scored(probes: Sequence[Probe], q: np.ndarray, r: np.ndarray):
+    """``(probe, _probe_fit result)`` for each probe, the probes taken in batches of columns."""
+    m = r.size
+    qr_full = np.concatenate([q, r[:, None]], axis=1).T.copy()  # (k + 1, m)
+    qr_ = qr_full[:-1] @ r
+    budget = max(BATCH_VALUES // max(m, 1), 1)
+    buffer = np.empty((m, budget))  # the batch's columns, side by side
+    batch: list[tuple[Probe, slice]] = []
+
+    def flush(width):
+        columns = buffer[:, :width]
+        products = qr_full @ columns  # (k + 1, G): q^T C and r^T C of every probe
+        gram = columns.T @ columns
+        for probe, sl in batch:
+            yield probe, _probe_fit(gram[sl, sl], products[:-1, sl], products[-1, sl], qr_)
+
+    width = 0
+    for probe in probes:
+        columns = probe.matrix()
+        g = columns.shape[1]
+        if batch and width + g > budget:
+            yield from flush(width)
+            batch, width = [], 0
+        if g > budget:  # a probe wider than a batch is scored alone
+            buffer = np.empty((m, g))
+            budget = g
+        buffer[:, width : width + g] = columns
+        batch.append((probe, slice(width, width + g)))
+        width += g
+        del columns
+    if batch:
+        yield from flush(width)
 
 
 def search_structure(
@@ -261,6 +344,11 @@ def search_structure(
     max_terms: int = 5,
 ) -> list[FoundTerm]:
     """Greedy forward search of probes that explain residual structure.
+
+    Each probe is scored from small matrices (its Gram matrix and its products with the model's
+    orthonormal basis and the residuals, :func:`_probe_fit`), probes in batches of columns: no
+    decomposition of a tall matrix per probe; only an accepted probe's new directions are
+    formed.
 
     Args:
         weighted_residuals: (m,) residuals divided by sigma (unit weights if sigma unknown).
@@ -279,26 +367,20 @@ def search_structure(
     for _ in range(max_terms):
         rss = float(r @ r)
         best = None
-        for probe in remaining:
-            columns = probe.matrix()
-            scale = np.linalg.norm(columns, 2) if columns.size else 0.0
-            t = columns - q @ (q.T @ columns)
-            u, s, vt = np.linalg.svd(t, full_matrices=False)
-            keep = s > NEW_FRACTION * scale
-            if not keep.any():
-                continue
-            basis = u[:, keep]
-            reduction = float(np.sum((basis.T @ r) ** 2))
-            if best is None or reduction > best[0]:
-                best = (reduction, probe, basis, vt[keep].T / s[keep])
+        for probe, scored in _scored(remaining, q, r):
+            if scored is not None and (best is None or scored[0] > best[0]):
+                best = (scored[0], probe, *scored[1:])
         if best is None:
             break
-        reduction, probe, basis, pseudo_inverse = best
-        dbic = delta_bic(rss - reduction, rss, basis.shape[1], m, noise_variance)
+        reduction, probe, v, s, along = best
+        dbic = delta_bic(rss - reduction, rss, v.shape[1], m, noise_variance)
         if dbic > threshold:
             break
-        coef_internal = pseudo_inverse @ (basis.T @ r)
+        # coefficients: V S^-1 U^T r = V S^-2 (V^T t^T r)
+        coef_internal = v @ (along / s**2)
         coef = coef_internal * probe.unit_scale
+        columns = probe.matrix()
+        basis = tall_times(columns - tall_times(q, q.T @ columns), v / s)
         explained = basis @ (basis.T @ r)
         term = FoundTerm(
             name=probe.name,
@@ -311,7 +393,7 @@ def search_structure(
             factors=probe.factors,
             effect_spec=probe.effect_spec,
         )
-        found.append((term, probe.matrix() @ coef_internal, explained))
+        found.append((term, columns @ coef_internal, explained))
         r = r - explained
         q = np.concatenate([q, basis], axis=1)
         remaining.remove(probe)
