@@ -265,17 +265,17 @@ class OrientationFamily:
             )
         return out
 
-    def _probe(self, name: str, description: str, factors: ProbeFactors, spec: str) -> Probe:
-        """A probe whose columns are ``factors``' direction (N, 3) times its functions (N, g),
-        as rows of the measured observations; ``spec``: its ``effect_spec`` (what ``fit
-        --effects`` takes to add it)."""
+    def _probe(
+        self, name: str, description: str, factors: ProbeFactors, spec: str, basis: np.ndarray
+    ) -> Probe:
+        """A probe whose columns are ``factors``' direction (N, 3) times its functions at the
+        data, ``basis`` (N, g) (computed once for the probes that share them), as rows of the
+        measured observations; ``spec``: its ``effect_spec`` (what ``fit --effects`` takes to
+        add it)."""
         mask = self._mask
 
         def columns():
-            cols = (
-                factors.direction_matrix()[:, :, None]
-                * factors.functions(factors.values)[:, None, :]
-            )
+            cols = factors.direction_matrix()[:, :, None] * basis[:, None, :]
             cols = cols.reshape(-1, cols.shape[-1])
             return cols if mask.all() else cols[mask]
 
@@ -291,6 +291,7 @@ class OrientationFamily:
         ``spec`` is the shape part of its ``effect_spec`` (``h3(phi1)``)."""
         probes = []
         var, values, functions, scale, unit = plot
+        basis = functions(values)
         for a, angle in enumerate(ANGLE_NAMES):
             if not self.data.measured[:, a].any():
                 continue
@@ -299,7 +300,11 @@ class OrientationFamily:
             )
             probes.append(
                 self._probe(
-                    f"{angle} {shape}", text.format(angle=angle), factors, f"{angle}~{spec}"
+                    f"{angle} {shape}",
+                    text.format(angle=angle),
+                    factors,
+                    f"{angle}~{spec}",
+                    basis,
                 )
             )
         return probes
@@ -313,6 +318,7 @@ class OrientationFamily:
         fitted errors is a second-order remainder, and a shape along it is no finding)."""
         probes = []
         var, values, functions, scale, unit = plot
+        basis = functions(values)
         for e, name in enumerate(self.table.base_names):
             if name in unseen:
                 continue
@@ -322,7 +328,9 @@ class OrientationFamily:
 
             factors = ProbeFactors(var, values, functions, direction, scale, unit, self._observed)
             description = f"a {text} of {name} ({self.table.descriptions.get(name, name)})"
-            probes.append(self._probe(f"{name} {shape}", description, factors, f"{name}~{spec}"))
+            probes.append(
+                self._probe(f"{name} {shape}", description, factors, f"{name}~{spec}", basis)
+            )
         return probes
 
     def probes(self, fit: OrientationFit) -> list[Probe]:
@@ -392,6 +400,18 @@ class OrientationFamily:
                 f"in {column}", f"a {text} of {{angle}}", plot, w, spec
             )
         return probes
+
+    def suspect_probes(self, fit: OrientationFit) -> list[Probe]:
+        """The probes of shapes in inputs other than the joint angles (time, approach direction,
+        other numeric columns): what a catalogued effect may mimic through the measurement
+        order, but cannot be."""
+        angles = {self.table.angle_label(k) for k in range(1, self.data.n_joints + 1)}
+
+        def of_angles(probe) -> bool:
+            variable = probe.factors.variable if probe.factors is not None else ""
+            return bool(variable) and set(variable.replace("-", "+").split("+")) <= angles
+
+        return [p for p in self.probes(fit) if not of_angles(p)]
 
     def _dense_variables(self) -> PositionVariables:
         """A dense design over every axis (15-degree grid; 30 degrees for three axes), with a
@@ -476,9 +496,9 @@ def _screen(data, effects, table) -> tuple[np.ndarray, str | None]:
             return np.zeros_like(flagged), None
         result = fit.result
         angle_of = np.broadcast_to(np.arange(3), clean.angles_rad.shape)[clean.measured]
-        test = screen_outliers(
-            result.residuals * result.weights, result.jacobian_weighted, groups=angle_of
-        )
+        # The leverages need the span of the Jacobian only: its determined part is enough.
+        span = result.jacobian_weighted @ result.identifiability.basis
+        test = screen_outliers(result.residuals * result.weights, span, groups=angle_of)
         if not test.flagged.size:
             break
         cells = np.flatnonzero(clean.measured.reshape(-1))[test.flagged]

@@ -41,7 +41,13 @@ import numpy as np
 from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError
 from .least_squares import FitResult, chi2_quantile, chi2_sf
-from .structure_search import BIC_THRESHOLD, FoundTerm, Probe, delta_bic, search_structure
+from .structure_search import (
+    BIC_THRESHOLD,
+    FoundTerm,
+    Probe,
+    delta_bic,
+    search_structure,
+)
 
 __all__ = [
     "ALTERNATIVE_LEVEL",
@@ -96,6 +102,10 @@ class ModelFamily(Protocol):
 
     def design_warnings(self, base_fit: Any) -> list[str]:
         """What the data's design cannot tell (e.g. too few distinct inputs), in words."""
+
+    def suspect_probes(self, fit: Any) -> list[Probe]:
+        """Optional: the probes of shapes no catalogued effect has (terms in other inputs of
+        the data), tried when judging whether an accepted effect only mimics one of them."""
 
 
 @dataclass
@@ -450,24 +460,55 @@ def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
     )
 
 
-def _search(family, fit, known) -> tuple[list[FoundTerm], list[Probe]]:
-    """The structure search in the residuals of ``fit``, with the probes it used."""
-    probes = family.probes(fit)
+def _search(
+    family, fit, known, max_terms: int = 5, suspects_only: bool = False
+) -> tuple[list[FoundTerm], list[Probe]]:
+    """The structure search in the residuals of ``fit``, with the probes it used (with
+    ``suspects_only``, the family's ``suspect_probes`` when it has them)."""
+    if suspects_only and hasattr(family, "suspect_probes"):
+        probes = family.suspect_probes(fit)
+    else:
+        probes = family.probes(fit)
     result = fit.result
     found = search_structure(
-        result.residuals * result.weights, result.jacobian_weighted, probes, noise_variance=known
+        result.residuals * result.weights,
+        result.jacobian_weighted,
+        probes,
+        noise_variance=known,
+        max_terms=max_terms,
     )
     return found, probes
 
 
-def _projected_rss(residuals: np.ndarray, columns: np.ndarray) -> tuple[float, int]:
-    """The rss of ``residuals`` left after projecting out ``columns``, and their rank."""
-    norms = np.linalg.norm(columns, axis=0)
-    columns = columns[:, norms > 0] / norms[norms > 0]
-    u, s, _ = np.linalg.svd(columns, full_matrices=False)
-    u = u[:, s > 1e-9 * (s[0] if s.size else 1.0)]
-    left = residuals - u @ (u.T @ residuals)
-    return float(left @ left), int(u.shape[1])
+def _projected_rss(residuals: np.ndarray, blocks: Sequence[np.ndarray]) -> tuple[float, int]:
+    """The rss of ``residuals`` left after projecting out the columns of ``blocks`` (tall
+    matrices side by side), and their rank.
+
+    From the small Gram matrix of the unit-normalised columns (no tall matrix is copied or
+    decomposed): ``rss = r.r - b^T G^+ b`` with ``b`` the columns' products with ``r``; the
+    directions with eigenvalues below 1e-12 of the largest (singular values below 1e-6) are not
+    in the span.
+    """
+    norms = [np.linalg.norm(b, axis=0) for b in blocks]
+    scaled = [
+        b[:, n > 0] / n[n > 0] if (n > 0).any() else b[:, :0]
+        for b, n in zip(blocks, norms, strict=True)
+    ]
+    k = sum(b.shape[1] for b in scaled)
+    gram = np.zeros((k, k))
+    along = np.zeros(k)
+    starts = np.cumsum([0] + [b.shape[1] for b in scaled])
+    for i, a in enumerate(scaled):
+        along[starts[i] : starts[i + 1]] = a.T @ residuals
+        for j in range(i, len(scaled)):
+            block = a.T @ scaled[j]
+            gram[starts[i] : starts[i + 1], starts[j] : starts[j + 1]] = block
+            gram[starts[j] : starts[j + 1], starts[i] : starts[i + 1]] = block.T
+    values, vectors = np.linalg.eigh(gram)
+    keep = values > 1e-12 * max(float(values.max(initial=0.0)), 1e-300)
+    coordinates = vectors[:, keep].T @ along
+    explained = float(np.sum(coordinates**2 / values[keep]))
+    return max(float(residuals @ residuals) - explained, 0.0), int(keep.sum())
 
 
 def _least_needed(family, current, current_fit, structure, probes, known, threshold):
@@ -480,12 +521,14 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
 
     - with the same structure: an effect that only soaked up part of a structure it does not
       explain (a backlash taking a little of a 3/rev term) costs little to remove;
-    - with the structure the search finds in the residuals of the model without E (what E was
-      standing for), when that structure is not E's own shape (it lies outside the span of the
-      model with E) and fits the data at least as well as E does: then E is a mimic of a shape
-      it does not have (an 8-parameter wobble following a slow temperature change through the
-      measurement order), and the found shape describes the data better. When the found shape
-      is E's own (a step with dir where E is a backlash) or fits worse, E is kept: it is the
+    - with the structure the search finds, among the family's suspect shapes (terms in inputs
+      no catalogued effect depends on: time, other columns), in the residuals of the model
+      without E (what E was standing for), when that structure is not E's own shape (it lies
+      outside the span of the model with E) and fits the data at least as well as E does: then
+      E is a mimic of a shape it does not have (an 8-parameter wobble following a slow
+      temperature change through the measurement order), and the found shape describes the
+      data better. When the found shape is E's own (a step with dir where E is a backlash) or
+      fits worse, E is kept: it is the
       physical hypothesis, and its extra harmonics are not held against it.
 
     Each structure term pays the search's look-elsewhere penalty ``2 ln G`` besides its
@@ -500,7 +543,7 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
         result = fit.result
         by_name = {p.name: p for p in term_probes}
         columns = [result.jacobian_weighted] + [by_name[t.name].matrix() for t in terms]
-        rss, rank = _projected_rss(result.residuals * result.weights, np.concatenate(columns, 1))
+        rss, rank = _projected_rss(result.residuals * result.weights, columns)
         fit_term = rss / known if known is not None else m * math.log(max(rss, 1e-300))
         return fit_term + rank * math.log(m) + penalty * len(terms), fit_term
 
@@ -512,7 +555,9 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
         except IdentifiabilityError:
             continue
         costs = [score(without, structure, probes)[0] - full]
-        own, own_probes = _search(family, without, known)
+        # What E stood for, in at most two shapes (more would pay more than E's own
+        # parameters in penalties).
+        own, own_probes = _search(family, without, known, max_terms=2, suspects_only=True)
         if own and not _within(own, own_probes, current_fit.result.jacobian_weighted):
             bic_own, fit_own = score(without, own, own_probes)
             if fit_own <= full_fit:
@@ -532,12 +577,12 @@ def _within(terms, term_probes, jacobian_weighted: np.ndarray) -> bool:
     """Whether the probe columns of ``terms`` lie (up to :data:`OWN_SHAPE_FRACTION`) in the span
     of ``jacobian_weighted``."""
     by_name = {p.name: p for p in term_probes}
-    columns = np.concatenate([by_name[t.name].matrix() for t in terms], axis=1)
-    norms = np.linalg.norm(jacobian_weighted, axis=0)
-    u, s, _ = np.linalg.svd(jacobian_weighted[:, norms > 0] / norms[norms > 0], full_matrices=False)
-    u = u[:, s > 1e-9 * (s[0] if s.size else 1.0)]
-    outside = columns - u @ (u.T @ columns)
-    return bool(np.linalg.norm(outside) <= OWN_SHAPE_FRACTION * np.linalg.norm(columns))
+    total = outside = 0.0
+    for t in terms:
+        for column in by_name[t.name].matrix().T:
+            total += float(column @ column)
+            outside += _projected_rss(column, [jacobian_weighted])[0]
+    return bool(outside <= OWN_SHAPE_FRACTION**2 * total)
 
 
 def _steps_of(family, effects, base_fit) -> list[Step]:

@@ -67,10 +67,10 @@ def leverages(jacobian_weighted: np.ndarray) -> np.ndarray:
     j = np.asarray(jacobian_weighted, dtype=float)
     if j.size == 0:
         return np.zeros(j.shape[0])
+    from .structure_search import orthonormal_columns
+
     norms = np.linalg.norm(j, axis=0)
-    j = j[:, norms > 0] / norms[norms > 0]
-    u, s, _ = np.linalg.svd(j, full_matrices=False)
-    u = u[:, s > 1e-9 * (s[0] if s.size else 1.0)]
+    u = orthonormal_columns(j[:, norms > 0] / norms[norms > 0])
     return np.clip(np.sum(u * u, axis=1), 0.0, 1.0)
 
 

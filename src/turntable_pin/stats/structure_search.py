@@ -29,6 +29,7 @@ import numpy as np
 from .least_squares import TALL_ROWS, tall_r_factor, tall_times
 
 __all__ = [
+    "orthonormal_columns",
     "BATCH_VALUES",
     "BIC_THRESHOLD",
     "NEW_FRACTION",
@@ -247,7 +248,7 @@ def delta_bic(rss_new: float, rss_old: float, added: int, m: int, noise_variance
     return m * math.log(max(rss_new, 1e-300) / max(rss_old, 1e-300)) + added * math.log(m)
 
 
-def _orthonormal_columns(matrix: np.ndarray) -> np.ndarray:
+def orthonormal_columns(matrix: np.ndarray) -> np.ndarray:
     """An orthonormal basis (m, k) of the span of ``matrix`` (m, n): its directions with
     singular values above 1e-9 of the largest."""
     if matrix.size == 0:
@@ -360,7 +361,7 @@ def search_structure(
     """
     r = np.asarray(weighted_residuals, dtype=float).copy()
     m = r.size
-    q = _orthonormal_columns(model_jacobian_weighted)
+    q = orthonormal_columns(model_jacobian_weighted)
     found: list[tuple] = []
     remaining = list(probes)
     threshold = BIC_THRESHOLD - 2.0 * math.log(max(len(remaining), 1))

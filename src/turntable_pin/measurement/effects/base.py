@@ -101,10 +101,12 @@ class PositionVariables:
     extra: Mapping[str, np.ndarray] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        joints = np.array(self.joint_rad, dtype=float)
+        joints = np.asarray(self.joint_rad, dtype=float)  # no copy of read-only data arrays
         if joints.ndim == 1:
             joints = joints[:, None]
-        joints.setflags(write=False)
+        if joints.flags.writeable:
+            joints = joints.copy()
+            joints.setflags(write=False)
         object.__setattr__(self, "joint_rad", joints)
         dirs = tuple(self.dirs) + (None,) * (joints.shape[1] - len(self.dirs))
         object.__setattr__(self, "dirs", dirs[: joints.shape[1]])
