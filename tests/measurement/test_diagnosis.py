@@ -293,3 +293,20 @@ def test_clean_data_false_alarm_rate_is_zero_with_outliers_and_missing_angles():
         if d["verdict"]["missing_effect"] or d["verdict"]["unexplained"]:
             alarms.append((seed, d["verdict"]["missing_effect"]))
     assert alarms == []
+
+
+def test_noise_that_differs_per_angle_is_estimated_per_angle_when_sigma_is_not_given():
+    from turntable_pin.measurement.simulation import Schedule
+
+    sim = simulate_measurements(
+        random_errors(np.random.default_rng(5)), {"inner_encoder_harmonics": {"c1": 3.0}},
+        schedule=Schedule(30, 30), noise_arcsec=(0.5, 2.0, 1.0), seed=5,
+    )  # fmt: skip
+    d = diagnose_measurements(sim.data.without_sigma()).to_dict()
+    assert d["verdict"]["missing_effect"] == "inner_encoder_harmonics"
+    assert not d["verdict"]["unexplained"]
+    [note] = [w for w in d["warnings"] if "noise differ" in w]
+    assert "dtheta 2" in note or "dtheta 1.9" in note or "dtheta 2.1" in note, note
+    same = simulate_measurements(random_errors(np.random.default_rng(5)), seed=5)
+    warnings = diagnose_measurements(same.data.without_sigma()).to_dict()["warnings"]
+    assert not any("noise differ" in w for w in warnings)

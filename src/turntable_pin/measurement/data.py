@@ -87,6 +87,9 @@ class OrientationMeasurements:
         rows: spreadsheet row of each position in the file (N,) (2 = first data row).
         source: the file read, or a description.
         joint_names: the table's joint names (for column names and labels), or ``()``.
+        sigma_relative: ``sigma_rad`` gives only the relative noise of the angles (weights); the
+            noise level itself is estimated from the fit (the diagnosis sets this when no sigma
+            is given and the three angles' noise differ).
     """
 
     joint_rad: np.ndarray
@@ -98,6 +101,7 @@ class OrientationMeasurements:
     rows: np.ndarray | None = None
     source: str = ""
     joint_names: tuple[str, ...] = ()
+    sigma_relative: bool = False
 
     def __post_init__(self) -> None:
         joints = np.array(self.joint_rad, dtype=float)
@@ -245,7 +249,7 @@ class OrientationMeasurements:
 
     def without_sigma(self) -> OrientationMeasurements:
         """The same data with the noise level left to be estimated from the fit."""
-        return self.replace(sigma_rad=None)
+        return self.replace(sigma_rad=None, sigma_relative=False)
 
     def select(self, keep) -> OrientationMeasurements:
         """The rows where ``keep`` (a mask or index array over the rows) holds."""

@@ -33,6 +33,7 @@ from .table import measured_table
 
 __all__ = [
     "MAX_HARMONIC",
+    "NOISE_PER_ANGLE_ALPHA",
     "OUTLIER_RULE",
     "SEPARATION_CHI2",
     "OrientationFamily",
@@ -529,6 +530,46 @@ def _outlier_records(diagnosis: Diagnosis, data, cells: np.ndarray) -> list[dict
     return sorted(out, key=lambda o: -abs(o["residual_sigma"]))
 
 
+NOISE_PER_ANGLE_ALPHA = 0.01
+"""Without sigmas, the three angles get their own noise level when an F test of their residual
+variances rejects equal noise at this level (over the pairs, Bonferroni)."""
+
+
+def _noise_per_angle(diagnosis: Diagnosis) -> tuple[np.ndarray, str] | None:
+    """Without sigmas: the residual rms of each measured angle under the best model (rad) and a
+    sentence, when the angles' noise differ (F test at :data:`NOISE_PER_ANGLE_ALPHA`), else None.
+    """
+    from scipy import special
+
+    fit = diagnosis.best_fit
+    residuals = fit.residuals_rad  # NaN where not measured or left out
+    counts = np.sum(np.isfinite(residuals), axis=0)
+    share = fit.result.dof / max(fit.result.n_obs, 1)  # the degrees of freedom, shared out
+    dof = counts * share
+    variance = np.nansum(residuals**2, axis=0) / np.maximum(dof, 1.0)
+    present = [a for a in range(3) if counts[a] >= 10]
+    if len(present) < 2:
+        return None
+    pairs = [(a, b) for i, a in enumerate(present) for b in present[i + 1 :]]
+    alpha = NOISE_PER_ANGLE_ALPHA / len(pairs)
+    differ = False
+    for a, b in pairs:
+        hi, lo = (a, b) if variance[a] >= variance[b] else (b, a)
+        p = 2.0 * float(special.fdtrc(dof[hi], dof[lo], variance[hi] / max(variance[lo], 1e-300)))
+        differ |= p < alpha
+    if not differ:
+        return None
+    sigma = np.sqrt(variance)
+    for a in set(range(3)) - set(present):
+        sigma[a] = np.sqrt(np.mean(variance[present]))
+    words = ", ".join(f"{ANGLE_NAMES[a]} {sigma[a] * ARCSEC_PER_RAD:.3g}" for a in present)
+    return sigma, (
+        f"sigma not given, and the measured angles' noise differ (estimated {words} arcsec; F "
+        f"test p < {NOISE_PER_ANGLE_ALPHA:g}): each angle is weighted by its own estimated noise "
+        "(state it with sigma_dpsi_arcsec, sigma_dtheta_arcsec, sigma_dgamma_arcsec)"
+    )
+
+
 def diagnose_measurements(
     data: OrientationMeasurements,
     *,
@@ -541,13 +582,32 @@ def diagnose_measurements(
 
     With ``outliers`` (the default) gross outliers are found by :data:`OUTLIER_RULE`, left out of
     every fit of the verdict and listed in ``Diagnosis.outliers``; ``outliers=False`` keeps every
-    measured angle.
+    measured angle. Without sigmas, when the residuals show that the three angles' noise differ
+    (:func:`_noise_per_angle`), the diagnosis is made again with each angle weighted by its own
+    estimated noise, and a warning says so.
 
     Raises:
         InputError: more rows than :data:`~turntable_pin.core.sizes.MAX_DIAGNOSED_ROWS`.
     """
     check_count(data.n_positions, MAX_DIAGNOSED_ROWS, "measurement rows", DIAGNOSIS_ROW_BYTES)
     table = measured_table(turntable)
+    diagnosis = _diagnose(data, until_explained, catalogue, table, outliers)
+    if data.sigma_rad is None:
+        per_angle = _noise_per_angle(diagnosis)
+        if per_angle is not None:
+            sigma, note = per_angle
+            weighted = data.replace(
+                sigma_rad=np.broadcast_to(sigma, data.angles_rad.shape).copy(),
+                sigma_relative=True,
+            )
+            diagnosis = None  # free the first one's fits before the second
+            diagnosis = _diagnose(weighted, until_explained, catalogue, table, outliers)
+            diagnosis.warnings.append(note)
+    return diagnosis
+
+
+def _diagnose(data, until_explained, catalogue, table, outliers) -> Diagnosis:
+    """The diagnosis of ``data`` with the outlier rule (or without it)."""
 
     def run(cells):
         family = OrientationFamily(_without(data, cells), catalogue, table)
@@ -566,6 +626,7 @@ def diagnose_measurements(
         note = note_again if note_again else note
         if not np.array_equal(again, cells):
             cells = again
+            diagnosis = None
             diagnosis = run(cells)
     diagnosis.outliers = _outlier_records(diagnosis, data, cells)
     diagnosis.outlier_rule = OUTLIER_RULE

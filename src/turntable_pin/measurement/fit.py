@@ -49,6 +49,7 @@ class OrientationFitProblem:
         self.all_measured = bool(self.mask.all())
         self.observed = self._measured(data.angles_rad.reshape(-1))
         self.sigma = None if data.sigma_rad is None else self._measured(data.sigma_rad.reshape(-1))
+        self.sigma_relative = bool(data.sigma_relative and data.sigma_rad is not None)
 
     def _measured(self, values: np.ndarray) -> np.ndarray:
         return values if self.all_measured else values[self.mask]

@@ -569,8 +569,11 @@ def fit_least_squares(
     Raises:
         IdentifiabilityError: no parameter is determined, or no degree of freedom is left.
     """
-    sigma_known = problem.sigma is not None
-    weights = 1.0 / problem.sigma if sigma_known else np.ones_like(problem.observed)
+    # ``sigma_relative``: the sigmas give the observations' relative noise only (weights), and the
+    # unit-weight variance is estimated as when no sigma is given.
+    relative = bool(getattr(problem, "sigma_relative", False))
+    sigma_known = problem.sigma is not None and not relative
+    weights = 1.0 / problem.sigma if problem.sigma is not None else np.ones_like(problem.observed)
     names = tuple(problem.parameter_names)
     n = len(names)
     evaluate = _evaluator(problem)
