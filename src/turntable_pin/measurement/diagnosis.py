@@ -482,9 +482,10 @@ def _without(data: OrientationMeasurements, cells: np.ndarray) -> OrientationMea
     return data.replace(angles_rad=angles)
 
 
-def _screen(data, effects, table) -> tuple[np.ndarray, str | None]:
+def _screen(data, effects, table, first=None) -> tuple[np.ndarray, str | None]:
     """The outlier cells (N, 3) of ``data`` under base + ``effects`` by the iterated rule, and a
-    note when the rule would flag more than its share (then none is left out)."""
+    note when the rule would flag more than its share (then none is left out); ``first``: the
+    fit of base + ``effects`` on all of ``data`` when it is at hand."""
     from ..stats.outliers import MAX_OUTLIER_FRACTION, screen_outliers
 
     flagged = np.zeros(data.angles_rad.shape, bool)
@@ -492,7 +493,8 @@ def _screen(data, effects, table) -> tuple[np.ndarray, str | None]:
     for _ in range(_MAX_SCREEN_ROUNDS):
         clean = _without(data, flagged)
         try:
-            fit = fit_orientation(clean, effects, turntable=table)
+            fit = first if first is not None and not flagged.any() else None
+            fit = fit or fit_orientation(clean, effects, turntable=table)
         except IdentifiabilityError:
             return np.zeros_like(flagged), None
         result = fit.result
@@ -622,7 +624,8 @@ def _diagnose(data, until_explained, catalogue, table, outliers) -> Diagnosis:
     # are not outliers, and an outlier the effects' fit shows up is.
     effects = list(diagnosis.best_fit.model.effects)
     if effects:
-        again, note_again = _screen(data, effects, table)
+        first = diagnosis.best_fit if not cells.any() else None  # the same fit, already made
+        again, note_again = _screen(data, effects, table, first)
         note = note_again if note_again else note
         if not np.array_equal(again, cells):
             cells = again
