@@ -40,13 +40,17 @@ DESIGNS = {
 KNOWN_FALSE_ALARMS: dict[tuple[str, int, str], str] = {
     ("unknown_noise", 4, "empty"): "names base_tilt (delta_bic -13.7 with the noise estimated "
     "from m = 72 angles; threshold -9.9)",
+    ("unknown_noise", 4, "outliers"): "the two outliers are found and left out; the rest shows "
+    "'dalpha_x1 1/rev in phi1' at delta_bic -14.6, as the same data without those two cells "
+    "and no outliers do: the same chance data set",
 }
 """(design, seed, cells) -> the false alarm found there: with the noise estimated from few
 observations the profiled likelihood ratio m ln(rss ratio) overstates the evidence (an F test
-would not), so a chance improvement passes the catalogue's threshold. The catalogue's look-elsewhere
-penalty (delta_bic <= -6 - 2 ln K) removed the three alarms of the 60-degree grid and the random
-positions with sigma given. It is an xfail(strict) test below; the loops skip it and hold every
-other data set to zero."""
+would not), so a chance improvement passes the catalogue's (or the structure search's)
+threshold; one data set (seed 4 of the smallest design without sigma) does it twice. The
+catalogue's look-elsewhere penalty (delta_bic <= -6 - 2 ln K) removed the three alarms of the
+60-degree grid and the random positions with sigma given. Each is an xfail(strict) test below;
+the loops skip them and hold every other data set to zero."""
 
 
 def simulate(design: str, seed: int, effects=None):
@@ -71,6 +75,16 @@ def with_empty_cells(data, seed: int):
     return data.replace(angles_rad=angles)
 
 
+def with_outliers(data, seed: int):
+    """Two gross outliers (30 arcsec, on random angles of random rows) in ``data``."""
+    rng = np.random.default_rng(10_000 + seed)
+    angles = data.angles_rad.copy()
+    rows = rng.choice(data.n_positions, 2, replace=False)
+    columns = rng.integers(0, 3, 2)
+    angles[rows, columns] += rng.choice([-1.0, 1.0], 2) * 30.0 / 206264.80624709636
+    return data.replace(angles_rad=angles)
+
+
 def alarm(data) -> str | None:
     """What the diagnosis of clean ``data`` wrongly says, or None."""
     verdict = diagnose_measurements(data).to_dict()["verdict"]
@@ -89,7 +103,12 @@ def test_no_false_alarm_on_clean_data(design, capsys):
     alarms = {}
     for seed in range(N_SEEDS):
         data = simulate(design, seed)
-        for cells, sample in (("all", data), ("empty", with_empty_cells(data, seed))):
+        samples = (
+            ("all", data),
+            ("empty", with_empty_cells(data, seed)),
+            ("outliers", with_outliers(data, seed)),
+        )
+        for cells, sample in samples:
             if (design, seed, cells) in KNOWN_FALSE_ALARMS:
                 continue
             found = alarm(sample)
@@ -98,7 +117,7 @@ def test_no_false_alarm_on_clean_data(design, capsys):
     with capsys.disabled():
         print(
             f"\n{design}: {data.n_positions} rows, {len(alarms)} false alarms in "
-            f"{2 * N_SEEDS} clean data sets ({time.perf_counter() - start:.1f} s)"
+            f"{3 * N_SEEDS} clean data sets ({time.perf_counter() - start:.1f} s)"
         )
     assert alarms == {}
 
@@ -112,7 +131,8 @@ def test_no_false_alarm_on_clean_data(design, capsys):
 def test_known_false_alarm(key):
     design, seed, cells = key
     data = simulate(design, seed)
-    assert alarm(data if cells == "all" else with_empty_cells(data, seed)) is None
+    variant = {"all": data, "empty": with_empty_cells(data, seed)}.get(cells)
+    assert alarm(variant if variant is not None else with_outliers(data, seed)) is None
 
 
 def test_no_remainder_probe_on_a_sweep_without_dtheta():

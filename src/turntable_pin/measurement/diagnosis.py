@@ -465,12 +465,13 @@ OUTLIER_RULE = (
     "studentized residual |t| = |r| / (s sqrt(1 - h)) above the two-sided normal quantile at "
     "0.01 / m (m measured angles; h the leverage; s the robust scale 1.4826 median "
     "|r| / sqrt(1 - h), the larger of that of the same angle, dpsi, dtheta or dgamma, and that "
-    "of all), iterated: left out, refitted, tested again; first on the base model, then on the "
-    "model with the accepted effects; at most 5 % of the angles"
+    "of all), iterated: the worst (|t| at least half the largest) left out, refitted, tested "
+    "again; first on the base model, then on the model with the accepted effects; at most 5 % "
+    "of the angles"
 )
 """The outlier rule of :func:`diagnose_measurements` in words (``turntable_pin.stats.outliers``)."""
 
-_MAX_SCREEN_ROUNDS = 10
+_MAX_SCREEN_ROUNDS = 20
 
 
 def _without(data: OrientationMeasurements, cells: np.ndarray) -> OrientationMeasurements:
@@ -504,7 +505,11 @@ def _screen(data, effects, table, first=None) -> tuple[np.ndarray, str | None]:
         test = screen_outliers(result.residuals * result.weights, span, groups=angle_of)
         if not test.flagged.size:
             break
-        cells = np.flatnonzero(clean.measured.reshape(-1))[test.flagged]
+        # Leave out the clearly worst ones only (at least half the largest |t|), then refit: a
+        # gross outlier pulls the fit and makes its neighbours look bad too (swamping), which
+        # the refit undoes.
+        worst = test.flagged[test.studentized[test.flagged] >= 0.5 * test.studentized.max()]
+        cells = np.flatnonzero(clean.measured.reshape(-1))[worst]
         flagged.reshape(-1)[cells] = True
         if flagged.sum() > MAX_OUTLIER_FRACTION * total:
             return np.zeros_like(flagged), (
