@@ -251,7 +251,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
              for c in d["candidates"] if c.get("reason")]  # fmt: skip
     if notes:
         parts.append("<p>Not testable here:</p><ul>" + "".join(notes) + "</ul>")
-    words = "<br>".join(html.escape(line) for line in verdict_lines(d))
+    words = "<br>".join(html.escape(line) for line in verdict_lines(d, data.source or "DATA.csv"))
     parts.append(f'<div class="{cls}">{words}</div>')
     if verdict["missing_effect"]:
         story = verdict["effect_story"]
