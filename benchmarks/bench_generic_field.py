@@ -46,7 +46,7 @@ def main() -> None:
         os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
     rng = np.random.default_rng(args.seed)
     print(f"seed {args.seed}, {args.tuples} random joint-angle tuples, one core")
-    head = ('table', 'axes', 'batch evals/s', 'Pinocchio/s', 'max gap rad')
+    head = ("table", "axes", "batch evals/s", "Pinocchio/s", "max gap rad")
     print(f"{head[0]:32s}{head[1]:>5s}{head[2]:>15s}{head[3]:>13s}{head[4]:>13s}")
     for name in TABLES:
         table = GenericTable(models_dir() / name)

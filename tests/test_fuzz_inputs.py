@@ -27,7 +27,6 @@ from conftest import EXAMPLES_DIR, cli
 pytestmark = pytest.mark.slow
 
 
-
 def fuzz(examples: int):
     """Hypothesis settings of these tests: ``examples`` inputs, no deadline, no database."""
     return settings(

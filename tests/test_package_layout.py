@@ -93,9 +93,7 @@ def test_layers_import_only_downwards():
             other = _layer(target)
             if other is None or other == layer:
                 continue
-            if LAYER_RANK[other] > LAYER_RANK[layer] or (
-                LAYER_RANK[other] == LAYER_RANK[layer]
-            ):
+            if LAYER_RANK[other] > LAYER_RANK[layer] or (LAYER_RANK[other] == LAYER_RANK[layer]):
                 wrong.append(f"{module} -> {target}")
     assert not wrong, "upward or sideways imports: " + ", ".join(sorted(wrong))
 

@@ -308,8 +308,10 @@ def test_montecarlo_interrupted_stops_its_workers(signum, tmp_path):
     try:
         # Two workers exist and the first chunks came back: the workers are computing.
         command.wait_until(
-            lambda: len(watch.descendant_pids) >= 2
-            and any(line.startswith("Monte Carlo:") for line in command.stderr),
+            lambda: (
+                len(watch.descendant_pids) >= 2
+                and any(line.startswith("Monte Carlo:") for line in command.stderr)
+            ),
             "Monte Carlo progress",
         )
         elapsed = command.interrupt(signum)

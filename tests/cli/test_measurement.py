@@ -148,6 +148,8 @@ def test_the_measurement_loop_on_a_three_axis_table(tmp_path):
     # The paper's names are no names of this table.
     proc = cli("fit", str(data), "--urdf", urdf, "--effects", "inner_encoder_harmonics")
     assert proc.returncode == 2 and "unknown effect 'inner_encoder_harmonics'" in proc.stderr
+
+
 # --- simulate: the designs engineers run ---------------------------------------------------------
 
 

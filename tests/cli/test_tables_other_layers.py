@@ -225,20 +225,14 @@ def test_a_bad_urdf_is_one_line_exit_2_in_every_command(command, case, tmp_path)
     text, fragment = BAD_URDFS[case]
     urdf = write_file(tmp_path, text, "bad.urdf")
     run = write_file(tmp_path, "phi1_deg,out_x_dph,out_y_dph\n0,1,2\n", "run.csv")
-    extra = [
-        _placeholder(a, run, tmp_path)
-        for a in COMMANDS[command]
-    ]
+    extra = [_placeholder(a, run, tmp_path) for a in COMMANDS[command]]
     _one_line_exit_2(cli(command, *extra, "--urdf", str(urdf)), fragment)
 
 
 @pytest.mark.parametrize("command", sorted(COMMANDS))
 def test_a_missing_payload_frame_is_one_line_exit_2_in_every_command(command, tmp_path):
     run = write_file(tmp_path, "phi1_deg,out_x_dph,out_y_dph\n0,1,2\n", "run.csv")
-    extra = [
-        _placeholder(a, run, tmp_path)
-        for a in COMMANDS[command]
-    ]
+    extra = [_placeholder(a, run, tmp_path) for a in COMMANDS[command]]
     proc = cli(command, *extra, "--urdf", THREE, "--payload-frame", "nowhere")
     _one_line_exit_2(proc, "no frame 'nowhere'")
 

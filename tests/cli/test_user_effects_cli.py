@@ -135,12 +135,21 @@ def test_a_term_in_an_extra_column_round_trips(planted, tmp_path):
 BAD_FILES = [
     ("name: x\nterms: []\n", "x.yaml", "terms: expected a list of at least one term"),
     ("name: x\nname: y\nterms: []\n", "x.yaml", "key 'name' is given twice"),
-    ("name: x\nterms:\n  - site: dphi_q\n    harmonics: 3\n    of: phi2\n", "x.yaml",
-     "line 3: terms[1]: unknown site 'dphi_q'"),
-    ("name: x\nterms:\n  - site: dpsi\n    harmonic: 3\n    of: phi2\n", "x.yaml",
-     "line 4: terms[1].harmonic: unknown key"),
-    ("name: x\nterms:\n  - site: dpsi\n    harmonics: [1, two]\n    of: phi2\n", "x.yaml",
-     "line 4: terms[1].harmonics: expected an order"),
+    (
+        "name: x\nterms:\n  - site: dphi_q\n    harmonics: 3\n    of: phi2\n",
+        "x.yaml",
+        "line 3: terms[1]: unknown site 'dphi_q'",
+    ),
+    (
+        "name: x\nterms:\n  - site: dpsi\n    harmonic: 3\n    of: phi2\n",
+        "x.yaml",
+        "line 4: terms[1].harmonic: unknown key",
+    ),
+    (
+        "name: x\nterms:\n  - site: dpsi\n    harmonics: [1, two]\n    of: phi2\n",
+        "x.yaml",
+        "line 4: terms[1].harmonics: expected an order",
+    ),
     ("name: x\nterms:\n  - site: dpsi\n    polynomial: 1\n", "x.yaml", "needs 'of'"),
     ("name: x y\nterms: [dpsi~h1(phi1)]\n", "x.yaml", "line 1: name: 'x y'"),
     ("terms: [dpsi~h1(phi1)]\n", "x.yaml", "the key 'name' is missing"),
@@ -174,12 +183,26 @@ def test_bad_effect_files_exit_2_with_one_line(planted, tmp_path, text, name, me
         (["fit", "{data}", "--effects", "no_such_effect"], "unknown effect 'no_such_effect'"),
         (["fit", "{data}", "--effects", "dpsi~poly1(temperature_c)"], "temperature_c"),
         (["fit", "{data}", "--effects-module", "{folder}/none.py"], "no such Python file"),
-        (["simulate", "--effect", "inner_encoder_harmonics", "-o", "{folder}/o.csv"],
-         "without parameters would simulate nothing"),
-        (["simulate", "--effect", "inner_encoder_3rev", "--catalogue", "{effect}", "-o",
-          "{folder}/o.csv"], "without parameters would simulate nothing"),
-        (["simulate", "--effect", "inner_encoder_3rev:c3=1", "-o", "{folder}/o.csv"],
-         "unknown effect 'inner_encoder_3rev'"),
+        (
+            ["simulate", "--effect", "inner_encoder_harmonics", "-o", "{folder}/o.csv"],
+            "without parameters would simulate nothing",
+        ),
+        (
+            [
+                "simulate",
+                "--effect",
+                "inner_encoder_3rev",
+                "--catalogue",
+                "{effect}",
+                "-o",
+                "{folder}/o.csv",
+            ],
+            "without parameters would simulate nothing",
+        ),
+        (
+            ["simulate", "--effect", "inner_encoder_3rev:c3=1", "-o", "{folder}/o.csv"],
+            "unknown effect 'inner_encoder_3rev'",
+        ),
     ],
 )
 def test_bad_effect_options_exit_2_with_one_line(planted, args, message):

@@ -54,8 +54,11 @@ def test_view_serves_until_interrupted_then_stops_its_server(stop):
         if proc.poll() is None:
             proc.kill()
     assert proc.returncode == 128 + stop  # 130 on Ctrl-C, 143 on SIGTERM
-    assert proc.stderr.read().strip().splitlines()[-1].endswith(
-        f"interrupted ({signal.Signals(stop).name})"
+    assert (
+        proc.stderr.read()
+        .strip()
+        .splitlines()[-1]
+        .endswith(f"interrupted ({signal.Signals(stop).name})")
     )
     assert not alive(server_pid)
 

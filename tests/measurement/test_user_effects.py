@@ -69,8 +69,11 @@ def encoder_data():
 
 @pytest.mark.parametrize(
     "text, catalogued",
-    [(INNER_ENCODER_FILE, "inner_encoder_harmonics"), (WOBBLE_FILE, "outer_wobble_harmonics"),
-     (INLINE_FILE, "inner_encoder_harmonics")],
+    [
+        (INNER_ENCODER_FILE, "inner_encoder_harmonics"),
+        (WOBBLE_FILE, "outer_wobble_harmonics"),
+        (INLINE_FILE, "inner_encoder_harmonics"),
+    ],
 )
 def test_an_effect_file_fits_exactly_like_the_catalogued_effect(
     tmp_path, encoder_data, text, catalogued
@@ -167,8 +170,10 @@ def test_effect_spec_round_trip_a_planted_term_falls_to_the_noise(encoder_data, 
     assert 0.75 < after["chi2_reduced"] < 1.25
     assert after["p_value"] > 0.001
     text = "\n".join(diagnosis_lines(out, data="run.csv"))
-    assert ("turntable-pin fit run.csv --effects 'inner_encoder_harmonics,"
-            f"{','.join(t['effect_spec'] for t in terms)}'") in text
+    assert (
+        "turntable-pin fit run.csv --effects 'inner_encoder_harmonics,"
+        f"{','.join(t['effect_spec'] for t in terms)}'"
+    ) in text
 
 
 TILT_MODULE = '''\

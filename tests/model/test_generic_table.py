@@ -65,8 +65,13 @@ def independent_three_axis_dR(e: dict, az, pitch, roll):
         @ _rpy(0.1, 0.2, 0.3) @ Rx(g("sensor_mount.rot_x")) @ Ry(g("sensor_mount.rot_y"))
         @ Rz(g("sensor_mount.rot_z"))
     )  # fmt: skip
-    rd = Rz(az) @ _rpy(0.02, 0, -0.01) @ Ry(pitch) @ _rpy(0, 0.03, 0) @ Rx(roll) @ _rpy(
-        0.1, 0.2, 0.3
+    rd = (
+        Rz(az)
+        @ _rpy(0.02, 0, -0.01)
+        @ Ry(pitch)
+        @ _rpy(0, 0.03, 0)
+        @ Rx(roll)
+        @ _rpy(0.1, 0.2, 0.3)
     )
     return rd.T @ rt
 
@@ -128,9 +133,7 @@ def test_regressor_equals_finite_differences(three_axis, rng):
 
 
 def test_written_urdf_reproduces_the_errors_in_plain_pinocchio(three_axis, tmp_path, rng):
-    values = three_axis.values(
-        {n: rng.uniform(-1e-3, 1e-3) for n in three_axis.parameter_names}
-    )
+    values = three_axis.values({n: rng.uniform(-1e-3, 1e-3) for n in three_axis.parameter_names})
     written = three_axis.write_urdf(values, tmp_path / "fitted.urdf")
     plain = pin.buildModelFromUrdf(str(written))
     nominal = three_axis.nominal_pin_model
@@ -290,6 +293,4 @@ def test_batch_field_equals_the_chain_for_one_two_and_three_axes(
     got = field.rotation(*angles)
     for k in range(3):
         np.testing.assert_allclose(got[k], table.rotation_error(sets[k], angles), atol=1e-12)
-    np.testing.assert_allclose(
-        field.angles(*angles)[:, :, 0], got[:, :, 0, 2], atol=0, rtol=0
-    )
+    np.testing.assert_allclose(field.angles(*angles)[:, :, 0], got[:, :, 0, 2], atol=0, rtol=0)

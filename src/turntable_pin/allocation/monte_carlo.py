@@ -204,9 +204,7 @@ def _chunk_results(worker, tasks, sizes, workers: int, progress: bool):
     finally:
         # On an interruption kill them and wait for no chunk; on an error let running chunks end.
         # A generator closed before its end (GeneratorExit) was abandoned: kill as well.
-        _stop_workers(
-            pools, kill=isinstance(sys.exc_info()[1], (KeyboardInterrupt, GeneratorExit))
-        )
+        _stop_workers(pools, kill=isinstance(sys.exc_info()[1], (KeyboardInterrupt, GeneratorExit)))
         unregister()
 
 

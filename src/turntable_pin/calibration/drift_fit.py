@@ -425,9 +425,7 @@ def simulate_run(
     outputs = outputs + rng.normal(0.0, noise_dph, size=outputs.shape)
     positions = inputs.positions
     if hasattr(positions, "angles_rad"):  # any table: phi1_deg .. phiN_deg in chain order
-        columns = {
-            f"phi{i + 1}_deg": rad_to_deg(a) for i, a in enumerate(positions.angles_rad.T)
-        }
+        columns = {f"phi{i + 1}_deg": rad_to_deg(a) for i, a in enumerate(positions.angles_rad.T)}
     else:
         columns = {
             "phi1_deg": rad_to_deg(positions.phi1_rad),

@@ -191,8 +191,7 @@ def _sweep_axes(text: str, table) -> tuple[str, ...]:
         axis = part.strip()
         if axis not in known:
             raise InputError(
-                f"--sweep '{text}': unknown axis '{axis}'; the table's axes are "
-                f"{', '.join(known)}"
+                f"--sweep '{text}': unknown axis '{axis}'; the table's axes are {', '.join(known)}"
             )
         if known[axis] in out:
             raise InputError(f"--sweep '{text}': axis '{axis}' is swept twice")

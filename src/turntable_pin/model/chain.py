@@ -334,9 +334,7 @@ class ErrorChain:
         return out
 
 
-def apply_chain_errors(
-    chain: ErrorChain, nominal, model, error_values: np.ndarray
-) -> None:
+def apply_chain_errors(chain: ErrorChain, nominal, model, error_values: np.ndarray) -> None:
     """Write ``chain``'s error transforms for ``error_values`` into the placements of ``model``.
 
     ``model`` is a copy of the Pinocchio model ``nominal`` the chain was read off. Joint

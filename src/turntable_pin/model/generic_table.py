@@ -322,9 +322,13 @@ class GenericTable:
                 if factor.kind != ROTATION:
                     continue
                 # Rt = P R_u(e) S with Rd = P S: d(Rd^T Rt)/de = Rd^T P [u]x P^T Rd.
-                d = np.swapaxes(rd, -1, -2) @ prefix @ skew(factor.unit) @ np.swapaxes(
-                    prefix, -1, -2
-                ) @ rd
+                d = (
+                    np.swapaxes(rd, -1, -2)
+                    @ prefix
+                    @ skew(factor.unit)
+                    @ np.swapaxes(prefix, -1, -2)
+                    @ rd
+                )
                 col = self.parameter_names.index(factor.error)
                 out[:, :, col] = np.stack([d[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)
             if link.is_joint:

@@ -60,6 +60,7 @@ __all__ = [
     "paper_chain",
 ]
 
+
 @lru_cache(maxsize=8)
 def _load_nominal(urdf_path: str) -> tuple[pin.Model, ErrorChain]:
     try:

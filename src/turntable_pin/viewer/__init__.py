@@ -1,5 +1,5 @@
-"""The meshcat viewer: the 3-D setup scene, the meshcat server, headless Chromium and PNG snapshots.
-"""
+"""The meshcat viewer: the 3-D setup scene, the meshcat server, headless Chromium and PNG
+snapshots."""
 
 from ..core.lazy import lazy_exports
 

@@ -103,9 +103,7 @@ class MeshcatServer:
             import zmq
 
             # Without a timeout a dead server would block the client's recv() forever.
-            self.visualizer.window.zmq_socket.setsockopt(
-                zmq.RCVTIMEO, int(REPLY_TIMEOUT_S * 1000)
-            )
+            self.visualizer.window.zmq_socket.setsockopt(zmq.RCVTIMEO, int(REPLY_TIMEOUT_S * 1000))
         except BaseException:
             self._abandon()
             self._unregister()
