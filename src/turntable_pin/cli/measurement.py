@@ -182,7 +182,7 @@ def _noise_arcsec(text: str) -> float | tuple[float, float, float]:
 
 def _sweep_axes(text: str, table) -> tuple[str, ...]:
     """``--sweep``: comma-separated axes (``phiK`` or the table's joint names) as ``phiK``."""
-    names = tuple(getattr(table, "joint_names", ())) if hasattr(table, "identifiable") else ()
+    names = _generic_joints(table) or ()
     n_joints = len(names) if names else 2
     known = {f"phi{k}": f"phi{k}" for k in range(1, n_joints + 1)}
     known.update({name: f"phi{k}" for k, name in enumerate(names, start=1)})
@@ -235,11 +235,19 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _generic_joints(table) -> tuple[str, ...] | None:
+    """The joints of a table other than the paper's (its angle columns ``phiK_deg`` or
+    ``<joint>_deg``), or ``None`` for the paper's table (``phi1_deg, phi2_deg``)."""
+    from ..measurement.table import measured_table
+
+    measured = measured_table(table)
+    return None if measured.paper else measured.joint_names
+
+
 def _read(args: argparse.Namespace, table=None):
     """The measurements of ``args.data`` for ``table`` (angle columns ``phiK_deg`` or
     ``<joint>_deg`` of its joints; the paper's ``phi1_deg, phi2_deg`` when ``None``)."""
-    joints = getattr(table, "joint_names", None) if hasattr(table, "identifiable") else None
-    data = read_measurements(args.data, joints)
+    data = read_measurements(args.data, _generic_joints(table))
     return data.without_sigma() if args.ignore_sigma else data
 
 
@@ -270,13 +278,14 @@ def run_simulate(args: argparse.Namespace) -> int:
     from ..measurement.user_effects import inline_effect, load_catalogue
 
     table = table_from_args(args)
-    generic = hasattr(table, "identifiable")
+    joints = _generic_joints(table)
+    generic = joints is not None
     user = load_catalogue(args.catalogue, table)
     effects = _parse_effect_options(args.effect, table, user)
     user = (*user, *(inline_effect(name, table) for name in effects if "~" in name))
     design = {}
     if args.positions is not None:
-        design = read_positions(args.positions, table.joint_names if generic else None)
+        design = read_positions(args.positions, joints)
         given = [f"dir{k}" for k, d in enumerate(design["positions_dirs"], start=1) if d]
         for option, value in (("--repeats", args.repeats > 1), ("--passes", args.passes)):
             if value and design["positions_time_s"] is not None:
@@ -321,7 +330,7 @@ def run_simulate(args: argparse.Namespace) -> int:
         passes=args.passes,
         **design,
     )
-    n_joints = len(table.joint_names) if generic else 2
+    n_joints = len(joints) if generic else 2
     if schedule.duration_s(n_joints) > MAX_TIME_S:
         raise InputError(
             f"--dwell-s {args.dwell_s:g}: the run would last "
