@@ -435,18 +435,15 @@ def _diagnosis(args: argparse.Namespace):
 
 
 def run_diagnose(args: argparse.Namespace) -> int:
-    from ..measurement.residuals import orientation_residuals
+    from ..measurement.diagnosis import diagnosis_residuals
     from ..report.diagnosis_text import diagnosis_lines
     from ..report.measurement_figures import write_residual_plots, write_structure_plots
 
     diagnosis = _diagnosis(args)
     out = diagnosis.to_dict()
     if args.plots:
-        base = diagnosis.base_fit.with_noise_variance(diagnosis.noise_variance)
-        left_out = diagnosis.family.left_out_rad
-        sets = [orientation_residuals(base, left_out_rad=left_out)]
-        if diagnosis.steps:
-            sets.append(orientation_residuals(diagnosis.best_fit, left_out_rad=left_out))
+        base, best = diagnosis_residuals(diagnosis)
+        sets = [base, best] if diagnosis.steps else [base]
         out["plots"] = [str(p) for p in write_residual_plots(sets, args.plots)]
         out["plots"] += [str(p) for p in write_structure_plots(diagnosis.structure, args.plots)]
     if args.json:

@@ -29,6 +29,7 @@ from .data import ANGLE_NAMES, OrientationMeasurements
 from .effect_model import OrientationModel
 from .effects.base import Effect, PositionVariables
 from .fit import OrientationFit, fit_orientation, orientation_zero_point
+from .residuals import ResidualSet, orientation_residuals
 from .table import measured_table
 
 __all__ = [
@@ -38,6 +39,7 @@ __all__ = [
     "SEPARATION_CHI2",
     "OrientationFamily",
     "diagnose_measurements",
+    "diagnosis_residuals",
 ]
 
 MAX_HARMONIC = 5
@@ -90,6 +92,8 @@ class OrientationFamily:
         data: the measurements.
         catalogue: the candidate effects (default: the table's catalogue).
         turntable: the table (see :func:`~turntable_pin.measurement.table.measured_table`).
+        left_out_rad: the measured values (N, 3) of the angles left out of ``data`` as
+            outliers, NaN elsewhere (shown in the plots, never fitted), or ``None``.
     """
 
     record_label = "positions"
@@ -100,8 +104,10 @@ class OrientationFamily:
         data: OrientationMeasurements,
         catalogue: Sequence[Effect] | None = None,
         turntable=None,
+        left_out_rad: np.ndarray | None = None,
     ) -> None:
         self.data = data
+        self.left_out_rad = left_out_rad
         self.table = measured_table(turntable)
         self.turntable = self.table
         self.catalogue = tuple(catalogue if catalogue is not None else table_catalogue(self.table))
@@ -113,7 +119,6 @@ class OrientationFamily:
         )
         self._observed = data.measured
         self._mask = data.measured.reshape(-1)
-        self.left_out_rad: np.ndarray | None = None  # outliers' measured values (N, 3), NaN else
         self._cache: dict[tuple[str, ...], OrientationFit] = {}
 
     def fit(self, effects: Sequence[Effect], noise_variance: float | None = None) -> OrientationFit:
@@ -577,6 +582,17 @@ def _noise_per_angle(diagnosis: Diagnosis) -> tuple[np.ndarray, str] | None:
     )
 
 
+def diagnosis_residuals(diagnosis: Diagnosis) -> tuple[ResidualSet, ResidualSet]:
+    """The residuals of an orientation diagnosis' base and best fits, both judged with its noise
+    variance, with the angles left out as outliers kept apart for the plots."""
+    left_out = diagnosis.family.left_out_rad
+    return tuple(
+        orientation_residuals(fit.with_noise_variance(diagnosis.noise_variance),
+                              left_out_rad=left_out)
+        for fit in (diagnosis.base_fit, diagnosis.best_fit)
+    )  # fmt: skip
+
+
 def diagnose_measurements(
     data: OrientationMeasurements,
     *,
@@ -617,8 +633,8 @@ def _diagnose(data, until_explained, catalogue, table, outliers) -> Diagnosis:
     """The diagnosis of ``data`` with the outlier rule (or without it)."""
 
     def run(cells):
-        family = OrientationFamily(_without(data, cells), catalogue, table)
-        family.left_out_rad = np.where(cells, data.angles_rad, np.nan)
+        left_out = np.where(cells, data.angles_rad, np.nan)
+        family = OrientationFamily(_without(data, cells), catalogue, table, left_out)
         return diagnose(family, until_explained=until_explained)
 
     if not outliers:

@@ -15,7 +15,8 @@ from pathlib import Path
 from ..core.files import write_text_atomic
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..measurement.data import ANGLE_NAMES
-from ..measurement.residuals import analyse_residuals, orientation_residuals
+from ..measurement.diagnosis import diagnosis_residuals
+from ..measurement.residuals import analyse_residuals
 from ..stats.model_selection import Diagnosis
 from .diagnosis_text import headline, verdict_lines
 from .figures import pyplot, save_png
@@ -119,9 +120,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
     verdict = d["verdict"]
     base_fit = diagnosis.base_fit.with_noise_variance(diagnosis.noise_variance)
     best_fit = diagnosis.best_fit.with_noise_variance(diagnosis.noise_variance)
-    left_out = diagnosis.family.left_out_rad
-    base_rs = orientation_residuals(base_fit, left_out_rad=left_out)
-    best_rs = orientation_residuals(best_fit, left_out_rad=left_out)
+    base_rs, best_rs = diagnosis_residuals(diagnosis)
     base_an = analyse_residuals(base_rs)
     explained = not verdict["unexplained"]
     parts = [f"<h1>{html.escape(title or 'Turntable measurement diagnosis')}</h1>"]
