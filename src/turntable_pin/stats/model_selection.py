@@ -481,8 +481,8 @@ def _search(
 
 
 def _projected_rss(residuals: np.ndarray, blocks: Sequence[np.ndarray]) -> tuple[float, int]:
-    """The rss of ``residuals`` left after projecting out the columns of ``blocks`` (tall
-    matrices side by side), and their rank.
+    """The rss of ``residuals`` (m,) left after projecting out the columns of ``blocks`` (tall
+    matrices side by side), and their rank; residuals (m, g) give the sum over their columns.
 
     From the small Gram matrix of the unit-normalised columns (no tall matrix is copied or
     decomposed): ``rss = r.r - b^T G^+ b`` with ``b`` the columns' products with ``r``; the
@@ -496,7 +496,7 @@ def _projected_rss(residuals: np.ndarray, blocks: Sequence[np.ndarray]) -> tuple
     ]
     k = sum(b.shape[1] for b in scaled)
     gram = np.zeros((k, k))
-    along = np.zeros(k)
+    along = np.zeros((k, *residuals.shape[1:]))
     starts = np.cumsum([0] + [b.shape[1] for b in scaled])
     for i, a in enumerate(scaled):
         along[starts[i] : starts[i + 1]] = a.T @ residuals
@@ -506,9 +506,9 @@ def _projected_rss(residuals: np.ndarray, blocks: Sequence[np.ndarray]) -> tuple
             gram[starts[j] : starts[j + 1], starts[i] : starts[i + 1]] = block.T
     values, vectors = np.linalg.eigh(gram)
     keep = values > 1e-12 * max(float(values.max(initial=0.0)), 1e-300)
-    coordinates = vectors[:, keep].T @ along
-    explained = float(np.sum(coordinates**2 / values[keep]))
-    return max(float(residuals @ residuals) - explained, 0.0), int(keep.sum())
+    coordinates = (vectors[:, keep].T @ along).reshape(int(keep.sum()), -1)
+    explained = float(np.sum(coordinates**2 / values[keep, None]))
+    return max(float(np.sum(residuals**2)) - explained, 0.0), int(keep.sum())
 
 
 def _least_needed(family, current, current_fit, structure, probes, known, threshold):
@@ -577,12 +577,9 @@ def _within(terms, term_probes, jacobian_weighted: np.ndarray) -> bool:
     """Whether the probe columns of ``terms`` lie (up to :data:`OWN_SHAPE_FRACTION`) in the span
     of ``jacobian_weighted``."""
     by_name = {p.name: p for p in term_probes}
-    total = outside = 0.0
-    for t in terms:
-        for column in by_name[t.name].matrix().T:
-            total += float(column @ column)
-            outside += _projected_rss(column, [jacobian_weighted])[0]
-    return bool(outside <= OWN_SHAPE_FRACTION**2 * total)
+    columns = np.concatenate([by_name[t.name].matrix() for t in terms], axis=1)
+    outside = _projected_rss(columns, [jacobian_weighted])[0]
+    return bool(outside <= OWN_SHAPE_FRACTION**2 * float(np.sum(columns**2)))
 
 
 def _steps_of(family, effects, base_fit) -> list[Step]:
