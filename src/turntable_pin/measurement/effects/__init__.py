@@ -52,15 +52,6 @@ def get_effect(name: str) -> Effect:
         ) from None
 
 
-def parse_effect_list(text: str, resolve=None) -> tuple[Effect, ...]:
-    """``"a,b"`` -> the effects a and b (duplicates refused, empty items ignored); ``resolve``
-    finds an effect by name (default: the paper's catalogue, :func:`get_effect`)."""
-    names = [item.strip() for item in text.split(",") if item.strip()]
-    if len(set(names)) != len(names):
-        raise InputError(f"an effect is listed twice in '{text}'")
-    return tuple((resolve or get_effect)(n) for n in names)
-
-
 def parameter_names(effect: Effect) -> tuple[str, ...]:
     """Every parameter ``effect`` can have (those that need ``time_s``/``dir1``/``dir2`` too)."""
     return tuple(spec.name for spec in _every_parameter(effect))
@@ -123,7 +114,6 @@ __all__ = [
     "ParameterSpec",
     "PositionVariables",
     "get_effect",
-    "parse_effect_list",
     "parameter_names",
     "parse_effect_spec",
 ]
