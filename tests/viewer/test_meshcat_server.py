@@ -40,14 +40,19 @@ def test_missing_meshcat_says_how_to_install_it(monkeypatch):
         import_meshcat()
 
 
-def test_a_dead_server_is_an_error_not_a_hang(monkeypatch):
+def test_a_silent_server_is_an_error_not_a_hang(monkeypatch):
     pytest.importorskip("meshcat")
+    import os
+    import signal
+
     import zmq
 
     with pytest.raises(MeshcatServerError, match="did not answer"):
         with MeshcatServer() as server:
             server.visualizer.window.zmq_socket.setsockopt(zmq.RCVTIMEO, 300)
-            server.visualizer.window.server_proc.kill()
-            server.visualizer.window.server_proc.wait()
+            # Stopped, not killed: a killed server frees its port, and a server started meanwhile by
+            # another test worker may take that port and answer the request (a flaky pass of the
+            # recv). A stopped server keeps its port and never answers; the exit kills it anyway.
+            os.kill(server.pid, signal.SIGSTOP)
             server.visualizer.static_html()
     assert not alive(server.pid)
