@@ -125,8 +125,19 @@ def test_csv_positions_by_number_or_by_joint_name(tmp_path):
     np.testing.assert_allclose(a.angles_rad, b.angles_rad)
     np.testing.assert_allclose(np.degrees(a.angles_rad), [[0, 10, 20], [30, 40, 50]])
     partial = write_file(tmp_path, "phi1_deg,phi2_deg\n0,10\n", "c.csv")
-    with pytest.raises(InputError, match="phi1_deg, phi2_deg, phi3_deg"):
+    with pytest.raises(InputError, match="'phi3_deg' or 'inner_gimbal_deg'") as missing:
         JointPositions.parse(table, str(partial))
+    assert missing.value.row == 1
+    # The rule of the measurement files: a joint with both spellings is refused, at the header's
+    # row (here after two comment lines), never resolved by a silent preference.
+    both = write_file(
+        tmp_path,
+        "# a campaign\n# two lines\nphi1_deg,phi2_deg,phi3_deg,outer_gimbal_deg\n0,1,2,0\n",
+        "d.csv",
+    )
+    with pytest.raises(InputError, match="joint 1 has two angle columns") as twice:
+        JointPositions.parse(table, str(both))
+    assert twice.value.row == 3
 
 
 def test_the_paper_table_through_the_generic_path_equals_its_own_path():

@@ -3,7 +3,7 @@ import pytest
 
 from conftest import write_file
 from turntable_pin import InputError
-from turntable_pin.core.csv_table import read_csv_table, write_csv_table
+from turntable_pin.core.csv_table import read_csv_table, read_header, write_csv_table
 
 REQ = ("phi1_deg", "phi2_deg", "dpsi_arcsec")
 HEAD = "phi1_deg,phi2_deg,dpsi_arcsec\n"
@@ -124,3 +124,12 @@ def test_numpy_reading_of_a_clean_file_equals_cell_by_cell(tmp_path):
         np.testing.assert_array_equal(table[name], np.asarray(values[name]))
     np.testing.assert_array_equal(table.extra["temp"], [float(c) for c in other["temp"]])
     np.testing.assert_array_equal(table.rows, numbers)
+
+
+def test_the_header_read_alone_agrees_with_the_whole_reading(tmp_path):
+    text = "# made by hand\n\n# second comment\n a , b,c\n1,2,3\n"
+    path = write_file(tmp_path, text)
+    table = read_csv_table(path, ("a",), extra=True)
+    assert read_header(path) == (table.header, table.header_row) == (("a", "b", "c"), 4)
+    assert read_header(tmp_path / "absent.csv") == ((), 0)
+    assert read_header(write_file(tmp_path, "# only a comment\n", "empty.csv")) == ((), 0)

@@ -17,6 +17,7 @@ closed form of paper eq. 3.
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -36,6 +37,7 @@ __all__ = [
     "POSITION_BYTES",
     "PositionInputs",
     "PositionSet",
+    "angle_columns",
     "base_frame_inputs",
     "check_commanded_angles",
     "position_inputs",
@@ -199,6 +201,37 @@ def check_commanded_angles(table, columns=("phi1_deg", "phi2_deg")) -> None:
                 row=int(table.rows[bad[0]]),
                 column=column,
             )
+
+
+def angle_columns(
+    header: Sequence[str], joint_names: Sequence[str] | None, path=None, header_row: int = 1
+) -> tuple[str, ...]:
+    """The commanded-angle column of each joint in a CSV ``header``: ``phiK_deg`` (K counted
+    from the base, chain order) or ``<joint>_deg``; the one rule of every file with positions.
+
+    Without ``joint_names`` the table is the paper's two-axis one (``phi1_deg, phi2_deg``).
+
+    Raises:
+        InputError: a joint without its column, or with both spellings (at the header's row).
+    """
+    names = tuple(joint_names) if joint_names else ("", "")
+    out = []
+    for k, joint in enumerate(names, start=1):
+        found = [c for c in (f"phi{k}_deg", f"{joint}_deg" if joint else None) if c in header]
+        if not found:
+            spelled = f"'phi{k}_deg'" + (f" or '{joint}_deg'" if joint else "")
+            raise InputError(
+                f"missing required column {spelled} (the commanded angle of joint {k}"
+                f"{' ' + joint if joint else ''}); the header has {', '.join(header)}",
+                path=path, row=header_row,
+            )  # fmt: skip
+        if len(found) > 1:
+            raise InputError(
+                f"joint {k} has two angle columns, {found[0]} and {found[1]}; keep one",
+                path=path, row=header_row,
+            )  # fmt: skip
+        out.append(found[0])
+    return tuple(out)
 
 
 def base_frame_inputs(latitude_rad: float) -> tuple[np.ndarray, np.ndarray]:

@@ -28,23 +28,16 @@ from ..core.exceptions import InputError
 from ..core.sizes import MAX_POSITIONS, check_count, turn_grid_count
 from ..core.units import deg_to_rad, rad_to_deg
 from ..model.chain import compose_rotation
-from .positions import MAX_COMMANDED_ANGLE_DEG, POSITION_BYTES, check_commanded_angles
+from .positions import (
+    MAX_COMMANDED_ANGLE_DEG,
+    POSITION_BYTES,
+    angle_columns,
+    check_commanded_angles,
+)
 
-__all__ = ["JointPositions", "angle_columns"]
+__all__ = ["JointPositions"]
 
 _GRID = re.compile(r"^grid:\s*([0-9.eE+-]+(?:\s*x\s*[0-9.eE+-]+)*)$")
-
-
-def angle_columns(table, header) -> tuple[str, ...]:
-    """The angle columns of a CSV ``header`` for ``table``: ``phi1_deg .. phiN_deg`` when all
-    are there, else ``<joint>_deg`` when all are there; :class:`InputError` otherwise."""
-    numbered = tuple(f"phi{i + 1}_deg" for i in range(len(table.joint_names)))
-    named = tuple(f"{j}_deg" for j in table.joint_names)
-    present = set(header)
-    for columns in (numbered, named):
-        if all(c in present for c in columns):
-            return columns
-    return ()
 
 
 @dataclass(frozen=True)
@@ -150,17 +143,7 @@ class JointPositions:
     @staticmethod
     def columns_of(table, csv: CsvTable) -> tuple[str, ...]:
         """The angle columns present in ``csv`` for ``table``, or :class:`InputError`."""
-        columns = angle_columns(table, [c for c in JointPositions.candidate_columns(table)
-                                        if csv.has(c)])  # fmt: skip
-        if not columns:
-            numbered = ", ".join(f"phi{i + 1}_deg" for i in range(len(table.joint_names)))
-            named = ", ".join(f"{j}_deg" for j in table.joint_names)
-            raise InputError(
-                f"expected one angle column per joint of the table: {numbered} (chain order) "
-                f"or {named}",
-                path=csv.path,
-            )
-        return columns
+        return angle_columns(csv.header, table.joint_names, csv.path, csv.header_row)
 
     @classmethod
     def parse(cls, table, spec: str) -> JointPositions:

@@ -16,7 +16,7 @@ import numpy as np
 
 from .exceptions import InputError
 
-__all__ = ["CsvTable", "read_csv_table", "refuse_repeated_rows", "write_csv_table"]
+__all__ = ["CsvTable", "read_csv_table", "read_header", "refuse_repeated_rows", "write_csv_table"]
 
 
 @dataclass(frozen=True)
@@ -30,6 +30,7 @@ class CsvTable:
         rows: the spreadsheet row number of each data row (2 for the first).
         extra: with ``extra=True``, the other columns whose every cell is a finite number.
         skipped: with ``extra=True``, the other columns that are not (kept out, named here).
+        header_row: the spreadsheet row of the header (1 unless ``#`` lines come before it).
     """
 
     path: Path
@@ -38,6 +39,7 @@ class CsvTable:
     rows: np.ndarray
     extra: dict[str, np.ndarray] = field(default_factory=dict)
     skipped: tuple[str, ...] = ()
+    header_row: int = 1
 
     def __len__(self) -> int:
         return int(self.rows.size)
@@ -58,6 +60,20 @@ class CsvTable:
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.columns[name]
+
+
+def read_header(path: str | Path) -> tuple[tuple[str, ...], int]:
+    """The column names of a CSV file and the spreadsheet row of its header line, read before the
+    whole file (to choose which columns to ask for); ``((), 0)`` when the file is unreadable or
+    empty, which :func:`read_csv_table` then reports."""
+    try:
+        with Path(path).open(newline="", encoding="utf-8-sig") as handle:
+            for row, line in enumerate(handle, start=1):
+                if line.strip() and not line.lstrip().startswith("#"):
+                    return tuple(c.strip() for c in next(csv.reader([line]))), row
+    except (OSError, UnicodeDecodeError):
+        pass
+    return (), 0
 
 
 def read_csv_table(
@@ -169,6 +185,7 @@ def read_csv_table(
         rows=np.asarray(row_numbers, dtype=int),
         extra=extra_columns,
         skipped=tuple(skipped),
+        header_row=header_line,
     )
 
 

@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..calibration.positions import MAX_COMMANDED_ANGLE_DEG, check_commanded_angles
-from ..core.csv_table import read_csv_table, refuse_repeated_rows
+from ..calibration.positions import MAX_COMMANDED_ANGLE_DEG, angle_columns, check_commanded_angles
+from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows
 from ..core.exceptions import InputError
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.angles import ANGLE_NAMES
@@ -286,46 +286,6 @@ def _check_at_most(table, column: str, limit: float, rule: str) -> None:
     table.refuse(column, np.abs(table[column]) > limit, rule)
 
 
-def angle_columns(header: Sequence[str], joint_names: Sequence[str] | None, path=None):
-    """The commanded-angle column of each joint: ``phiK_deg`` or ``<joint>_deg``.
-
-    Without ``joint_names`` the table is the paper's two-axis one (``phi1_deg, phi2_deg``).
-
-    Raises:
-        InputError: a joint without its column, or with both spellings.
-    """
-    names = tuple(joint_names) if joint_names else ("", "")
-    out = []
-    for k, joint in enumerate(names, start=1):
-        found = [c for c in (f"phi{k}_deg", f"{joint}_deg" if joint else None) if c in header]
-        if not found:
-            spelled = f"'phi{k}_deg'" + (f" or '{joint}_deg'" if joint else "")
-            raise InputError(
-                f"missing required column {spelled} (the commanded angle of joint {k}"
-                f"{' ' + joint if joint else ''}); the header has {', '.join(header)}",
-                path=path, row=1,
-            )  # fmt: skip
-        if len(found) > 1:
-            raise InputError(
-                f"joint {k} has two angle columns, {found[0]} and {found[1]}; keep one",
-                path=path, row=1,
-            )  # fmt: skip
-        out.append(found[0])
-    return tuple(out)
-
-
-def _header(path: Path) -> tuple[str, ...]:
-    """The header of a CSV file (the shared reader reports what is wrong with it)."""
-    try:
-        with path.open(newline="", encoding="utf-8-sig") as handle:
-            for line in handle:
-                if line.strip() and not line.lstrip().startswith("#"):
-                    return tuple(c.strip() for c in line.split(","))
-    except (OSError, UnicodeDecodeError):
-        pass
-    return ()
-
-
 def read_measurements(
     path: str | Path, joint_names: Sequence[str] | None = None
 ) -> OrientationMeasurements:
@@ -340,8 +300,10 @@ def read_measurements(
         InputError: naming file, row and column of the first problem found.
     """
     path = Path(path)
-    header = _header(path)
-    joint_columns = angle_columns(header, joint_names, path) if header else ("phi1_deg",)
+    header, header_row = read_header(path)
+    joint_columns = (
+        angle_columns(header, joint_names, path, header_row) if header else ("phi1_deg",)
+    )
     n_joints = len(joint_names) if joint_names else 2
     value_columns = tuple(f"{n}_arcsec" for n in ANGLE_NAMES)
     sigma_columns = tuple(f"sigma_{n}_arcsec" for n in ANGLE_NAMES)

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.csv_table import read_csv_table, refuse_repeated_rows, write_csv_table
+from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows, write_csv_table
 from ..core.exceptions import InputError, check_seed
 from ..core.sizes import MAX_SIMULATED_ROWS, check_count, turn_grid_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
@@ -27,7 +27,6 @@ from .data import (
     MAX_TIME_S,
     MIN_SIGMA_ARCSEC,
     OrientationMeasurements,
-    angle_columns,
 )
 from .effect_model import OrientationModel
 from .effects.base import Effect, PositionVariables
@@ -351,20 +350,12 @@ def read_positions(path: str | Path, joint_names: Sequence[str] | None = None) -
     Raises:
         InputError: naming the file, row and column of the first problem.
     """
-    from ..calibration.positions import check_commanded_angles
+    from ..calibration.positions import angle_columns, check_commanded_angles
 
     path = Path(path)
     names = tuple(joint_names) if joint_names else ("", "")
-    header = ()
-    try:
-        with path.open(newline="", encoding="utf-8-sig") as handle:
-            for line in handle:
-                if line.strip() and not line.lstrip().startswith("#"):
-                    header = tuple(c.strip() for c in line.split(","))
-                    break
-    except (OSError, UnicodeDecodeError):
-        pass
-    columns = angle_columns(header, joint_names, path) if header else ("phi1_deg",)
+    header, header_row = read_header(path)
+    columns = angle_columns(header, joint_names, path, header_row) if header else ("phi1_deg",)
     dir_columns = tuple(f"dir{k}" for k in range(1, len(names) + 1))
     table = read_csv_table(path, columns, ("time_s", *dir_columns), min_rows=1)
     check_commanded_angles(table, columns)
