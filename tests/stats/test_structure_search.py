@@ -46,10 +46,34 @@ def test_what_the_model_absorbs_is_not_structure_and_noise_is_quiet():
 
 
 def test_delta_bic_forms():
-    assert delta_bic(90.0, 100.0, 2, 100, 1.0) == pytest.approx(-10 + 2 * np.log(100))
-    assert delta_bic(90.0, 100.0, 2, 100, None) == pytest.approx(
-        100 * np.log(0.9) + 2 * np.log(100)
+    assert delta_bic(90.0, 100.0, 2, 100, 1.0, 12) == pytest.approx(-10 + 2 * np.log(100))
+    # Variance profiled out: weighted by the larger model's residual degrees of freedom, 100 - 12,
+    # plus added / 2 - 1 (zero for two added parameters).
+    assert delta_bic(90.0, 100.0, 2, 100, None, 12) == pytest.approx(
+        88 * np.log(0.9) + 2 * np.log(100)
     )
+    assert delta_bic(90.0, 100.0, 4, 100, None, 12) == pytest.approx(
+        89 * np.log(0.9) + 4 * np.log(100)
+    )
+
+
+@pytest.mark.parametrize("added", [1, 2, 3, 4, 6, 8])
+@pytest.mark.parametrize("dof", [60, 200, 2000])
+@pytest.mark.parametrize("tail", [1e-2, 1e-4, 1e-8])
+def test_the_profiled_ratio_has_the_tail_of_the_exact_f_test(added, dof, tail):
+    """With the noise estimated, the improvement of nested linear models has an exact F
+    distribution; the calibrated ratio, read on its chi2(added) reference, gives the same tail
+    probability: exactly for two added parameters, within 10 % up to eight once the larger model
+    has 60 residual degrees of freedom. The textbook weight m overstates the evidence."""
+    stats = pytest.importorskip("scipy.stats")
+    rank_new = 10
+    m = dof + rank_new
+    f_value = stats.f.isf(tail, added, dof)
+    ratio = 1.0 / (1.0 + added * f_value / dof)  # rss_new / rss_old at that F
+    statistic = -(delta_bic(ratio, 1.0, added, m, None, rank_new) - added * np.log(m))
+    assert stats.chi2.sf(statistic, added) == pytest.approx(tail, rel=1e-9 if added == 2 else 0.1)
+    textbook = -m * np.log(ratio)
+    assert stats.chi2.sf(textbook, added) < stats.chi2.sf(statistic, added)
 
 
 def test_a_shape_the_model_spans_to_first_order_is_not_new_structure():
@@ -156,7 +180,8 @@ def _reference_search(r, model_jac, probes, noise_variance, max_terms=5):
         if best is None:
             break
         reduction, probe, basis, pinv = best
-        dbic = delta_bic(rss - reduction, rss, basis.shape[1], r.size, noise_variance)
+        added = basis.shape[1]
+        dbic = delta_bic(rss - reduction, rss, added, r.size, noise_variance, q.shape[1] + added)
         if dbic > threshold:
             break
         found.append((probe.name, dbic, pinv @ (basis.T @ r)))

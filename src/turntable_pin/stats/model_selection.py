@@ -5,9 +5,11 @@ probes for the structure search), so any model with a catalogue of extensions ca
 
 Decision rule, and why. Each testable effect is fitted together with the current model and
 compared by the Bayesian information criterion, ``delta_bic = delta_chi2 + added_rank ln m``
-(sigma given) or ``m ln(rss_new / rss_old) + added_rank ln m`` (sigma estimated: the variance
-profiled out), where ``added_rank`` is the number of *new* determined combinations (parameters the
-current model already absorbs do not count) and ``m`` the number of observations. An effect is
+(sigma given) or ``w ln(rss_new / rss_old) + added_rank ln m`` (sigma estimated: the variance
+profiled out, ``w`` about the residual degrees of freedom so that the ratio keeps the F test's
+tail on small samples, :func:`~.structure_search.profiled_weight`), where ``added_rank`` is the
+number of *new* determined combinations (parameters the current model already absorbs do not
+count) and ``m`` the number of observations. An effect is
 accepted when ``delta_bic <= -6 - 2 ln K`` for the K candidates tested in that round (the
 look-elsewhere penalty the structure search pays for its probes: trying K effects is K chances of
 a false alarm). On clean data the improvement is chi2-distributed with ``added_rank`` degrees of
@@ -46,6 +48,7 @@ from .structure_search import (
     FoundTerm,
     Probe,
     delta_bic,
+    profiled_weight,
     search_structure,
 )
 
@@ -178,7 +181,7 @@ def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, ca
                 )
             )
             continue
-        dbic = delta_bic(fit.result.rss, base.rss, added, m, known)
+        dbic = delta_bic(fit.result.rss, base.rss, added, m, known, fit.result.rank)
         out.append(Candidate(effect.name, True, None, fit, added, float(dbic)))
     threshold = acceptance_threshold(sum(c.testable for c in out))
     for c in out:
@@ -537,17 +540,24 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
     """
     m = current_fit.result.n_obs
     penalty = 2.0 * math.log(max(len(probes), 1))
+    weight = None  # of ln(rss) when the variance is profiled: set from the best description
 
-    def score(fit, terms, term_probes) -> tuple[float, float]:
-        """(BIC, its fit part) of ``fit`` with the probe columns of ``terms`` added."""
+    def score(fit, terms, term_probes) -> tuple[float, float, int]:
+        """(BIC, its fit part, rank) of ``fit`` with the probe columns of ``terms`` added."""
         result = fit.result
         by_name = {p.name: p for p in term_probes}
         columns = [result.jacobian_weighted] + [by_name[t.name].matrix() for t in terms]
         rss, rank = _projected_rss(result.residuals * result.weights, columns)
-        fit_term = rss / known if known is not None else m * math.log(max(rss, 1e-300))
-        return fit_term + rank * math.log(m) + penalty * len(terms), fit_term
+        if known is not None:
+            fit_term = rss / known
+        else:
+            # The small-sample weight of delta_bic, with the residual degrees of freedom of
+            # the best description (the larger model of each comparison).
+            fit_term = (weight or profiled_weight(m, rank, 2)) * math.log(max(rss, 1e-300))
+        return fit_term + rank * math.log(m) + penalty * len(terms), fit_term, rank
 
-    full, full_fit = score(current_fit, structure, probes)
+    full, full_fit, full_rank = score(current_fit, structure, probes)
+    weight = profiled_weight(m, full_rank, 2)
     worst = None
     for effect in current:
         try:
@@ -559,7 +569,7 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
         # parameters in penalties).
         own, own_probes = _search(family, without, known, max_terms=2, suspects_only=True)
         if own and not _within(own, own_probes, current_fit.result.jacobian_weighted):
-            bic_own, fit_own = score(without, own, own_probes)
+            bic_own, fit_own, _ = score(without, own, own_probes)
             if fit_own <= full_fit:
                 costs.append(bic_own - full)
         cost = float(min(costs))
@@ -591,7 +601,8 @@ def _steps_of(family, effects, base_fit) -> list[Step]:
     for k in range(len(effects)):
         fit = family.fit(effects[: k + 1])
         added = fit.result.rank - previous.result.rank
-        dbic = delta_bic(fit.result.rss, previous.result.rss, added, fit.result.n_obs, known)
+        result = fit.result
+        dbic = delta_bic(result.rss, previous.result.rss, added, result.n_obs, known, result.rank)
         steps.append(Step(effects[k].name, float(dbic), fit, []))
         previous = fit
     return steps
