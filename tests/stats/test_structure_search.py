@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from turntable_pin.stats import structure_search
 from turntable_pin.stats.structure_search import (
     Probe,
     ProbeFactors,
@@ -210,3 +211,53 @@ def test_small_matrix_scoring_equals_the_svd_of_every_probe(m):
         for term, (_, dbic, coef) in zip(found, expected, strict=True):
             assert term.delta_bic == pytest.approx(dbic, rel=1e-9)
             np.testing.assert_allclose(term.coefficients, coef, rtol=1e-8, atol=1e-12)
+
+
+@pytest.mark.parametrize("observed_fraction", [1.0, 0.8])
+def test_probes_scored_from_their_factors_equal_probes_scored_from_their_columns(
+    observed_fraction, monkeypatch
+):
+    """The search scores probes with factors without forming their columns (a direction shared
+    by several shapes contracted once); the same probes given by their columns alone give the
+    same terms, sizes and delta_bic, with observations left out too."""
+    rng = np.random.default_rng(8)
+    n, k = 300, 3
+    x = rng.uniform(0, 2 * np.pi, n)
+    y = rng.uniform(0, 2 * np.pi, n)
+    observed = rng.random((n, k)) < observed_fraction
+    observed[~observed.any(axis=1), 0] = True
+    mask = observed.reshape(-1)
+    arrays = [rng.normal(size=(n, k)), rng.normal(size=(n, k)), np.zeros((n, k))]
+    arrays[2][:, 0] = 1.0  # a term on one observation alone
+    directions = [lambda a=a: a for a in arrays]
+    probes = []
+    for j, direction in enumerate(directions):
+        for var, values in (("x", x), ("y", y)):
+            for order in (1, 2, 3):
+
+                def functions(v, order=order):
+                    return np.stack([np.cos(order * v), np.sin(order * v)], axis=-1)
+
+                basis = functions(values)
+                factors = ProbeFactors(var, values, functions, direction, observed=observed,
+                                       basis=basis if order != 2 else None)  # fmt: skip
+                columns = (direction()[:, :, None] * basis[:, None, :]).reshape(-1, 2)[mask]
+                probes.append(Probe(f"d{j} {order}/rev in {var}", "", columns, 1.0, "", factors))
+    model = np.column_stack([np.ones(n * k), rng.normal(size=(n * k, 2))])[mask]
+    d0 = directions[0]()
+    r = (d0 * (0.7 * np.cos(2 * y) - 0.4 * np.sin(2 * y))[:, None]).reshape(-1)[mask]
+    r = r + (directions[2]() * (0.5 * np.sin(3 * x))[:, None]).reshape(-1)[mask]
+    r = r + rng.normal(0, 0.2, r.size)
+    r -= model @ np.linalg.lstsq(model, r, rcond=None)[0]
+    plain = [Probe(p.name, p.description, p.columns) for p in probes]
+    by_columns = structure_search._scored_columns
+    for variance in (0.04, None):
+        expected = search_structure(r, model, plain, noise_variance=variance)
+        monkeypatch.setattr(structure_search, "_scored_columns", None)  # not used: all factored
+        found = search_structure(r, model, probes, noise_variance=variance)
+        monkeypatch.setattr(structure_search, "_scored_columns", by_columns)
+        assert [t.name for t in found] == [t.name for t in expected]
+        assert {"d0 2/rev in y", "d2 3/rev in x"} <= {t.name for t in found}
+        for a, b in zip(found, expected, strict=True):
+            assert a.delta_bic == pytest.approx(b.delta_bic, rel=1e-10)
+            np.testing.assert_allclose(a.coefficients, b.coefficients, rtol=1e-9, atol=1e-12)

@@ -13,6 +13,7 @@ Probes of the structure search (what "shape" the missing part has):
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
 import numpy as np
@@ -75,6 +76,15 @@ def _one_angle(w: np.ndarray, a: int):
         d = np.zeros_like(w)
         d[:, a] = w[:, a]
         return d
+
+    return direction
+
+
+def _along_error(jac: np.ndarray, w: np.ndarray, e: int):
+    """The direction a change of base error ``e`` enters the angles, weighted, (N, 3)."""
+
+    def direction():
+        return jac[:, :, e] * w
 
     return direction
 
@@ -280,6 +290,8 @@ class OrientationFamily:
         add it)."""
         mask = self._mask
 
+        factors = dataclasses.replace(factors, basis=basis)
+
         def columns():
             cols = factors.direction_matrix()[:, :, None] * basis[:, None, :]
             cols = cols.reshape(-1, cols.shape[-1])
@@ -290,11 +302,12 @@ class OrientationFamily:
         )
 
     def _measured_angle_probes(
-        self, shape: str, text: str, plot: tuple, w, spec: str
+        self, shape: str, text: str, plot: tuple, directions, spec: str
     ) -> list[Probe]:
         """One probe per measured angle: the shape ``plot`` (variable, values, functions, value
-        scale, unit) added to that angle itself; ``text`` describes it (``{angle}``: the angle),
-        ``spec`` is the shape part of its ``effect_spec`` (``h3(phi1)``)."""
+        scale, unit) added to that angle itself (``directions[a]``, shared by the probes of every
+        shape); ``text`` describes it (``{angle}``: the angle), ``spec`` is the shape part of its
+        ``effect_spec`` (``h3(phi1)``)."""
         probes = []
         var, values, functions, scale, unit = plot
         basis = functions(values)
@@ -302,7 +315,7 @@ class OrientationFamily:
             if not self.data.measured[:, a].any():
                 continue
             factors = ProbeFactors(
-                var, values, functions, _one_angle(w, a), scale, unit, self._observed
+                var, values, functions, directions[a], scale, unit, self._observed
             )
             probes.append(
                 self._probe(
@@ -316,10 +329,11 @@ class OrientationFamily:
         return probes
 
     def _error_probes(
-        self, jac, w, shape: str, text: str, plot: tuple, spec: str, unseen=frozenset()
+        self, directions, shape: str, text: str, plot: tuple, spec: str, unseen=frozenset()
     ) -> list[Probe]:
-        """One probe per base error: its derivative (the direction it enters the angles) times
-        the shape ``plot`` (variable, values, functions, value scale, unit); none for the errors
+        """One probe per base error: its derivative (the direction it enters the angles,
+        ``directions[e]``, shared by the probes of every shape) times the shape ``plot``
+        (variable, values, functions, value scale, unit); none for the errors
         ``unseen`` (those the measured angles do not see to first order: their derivative at the
         fitted errors is a second-order remainder, and a shape along it is no finding)."""
         probes = []
@@ -328,11 +342,9 @@ class OrientationFamily:
         for e, name in enumerate(self.table.base_names):
             if name in unseen:
                 continue
-
-            def direction(e=e):
-                return jac[:, :, e] * w
-
-            factors = ProbeFactors(var, values, functions, direction, scale, unit, self._observed)
+            factors = ProbeFactors(
+                var, values, functions, directions[e], scale, unit, self._observed
+            )
             description = f"a {text} of {name} ({self.table.descriptions.get(name, name)})"
             probes.append(
                 self._probe(f"{name} {shape}", description, factors, f"{name}~{spec}", basis)
@@ -345,6 +357,8 @@ class OrientationFamily:
         w = np.nan_to_num(fit.per_angle(fit.result.weights))  # (N, 3), 0 where not measured
         jac = fit.model.jacobian(fit.result.params)  # (N, 3, n)
         unseen = set(fit.result.identifiability.unresponsive)
+        along = [_along_error(jac, w, e) for e in range(len(self.table.base_names))]
+        on_angle = [_one_angle(w, a) for a in range(len(ANGLE_NAMES))]  # a term on one angle
         probes = []
         labels = [self.table.angle_label(k) for k in range(1, data.n_joints + 1)]
         for var, phi in zip(labels, data.joint_rad.T, strict=True):
@@ -353,10 +367,10 @@ class OrientationFamily:
                 shape = f"{k}/rev in {var}"
                 spec = f"h{k}({var})"
                 probes += self._error_probes(
-                    jac, w, shape, f"{k}/rev term in {var}", plot, spec, unseen
+                    along, shape, f"{k}/rev term in {var}", plot, spec, unseen
                 )
                 probes += self._measured_angle_probes(
-                    shape, f"a {k}/rev term in {var} of {{angle}} itself", plot, w, spec
+                    shape, f"a {k}/rev term in {var} of {{angle}} itself", plot, on_angle, spec
                 )
         # Terms coupling two angles (k/rev in phiA + phiB or phiA - phiB) on each angle: the
         # shapes above are separable in the angles and would miss them.
@@ -371,7 +385,7 @@ class OrientationFamily:
                             f"{k}/rev in {label}",
                             f"a {k}/rev term in {label} of {{angle}} itself",
                             plot,
-                            w,
+                            on_angle,
                             f"h{k}({label})",
                         )
         if data.time_s is not None and np.ptp(data.time_s) > 0:
@@ -380,7 +394,7 @@ class OrientationFamily:
                 "drift in time",
                 "a drift with time (quadratic over the run) in {angle}",
                 plot,
-                w,
+                on_angle,
                 "poly2(time_s)",
             )
         for k, value in enumerate(data.dirs, start=1):
@@ -390,7 +404,7 @@ class OrientationFamily:
                     f"with dir{k}",
                     f"a step with the approach direction dir{k} in {{angle}}",
                     plot,
-                    w,
+                    on_angle,
                     f"sign(dir{k})",
                 )
         # Other numeric columns (temperature, load, ...) as suspects: each base error and each
@@ -401,9 +415,9 @@ class OrientationFamily:
             plot = (column, values, _polynomial(values), 1.0, "")
             text = f"term linear and quadratic in {column}"
             spec = f"poly2({column})"
-            probes += self._error_probes(jac, w, f"in {column}", text, plot, spec, unseen)
+            probes += self._error_probes(along, f"in {column}", text, plot, spec, unseen)
             probes += self._measured_angle_probes(
-                f"in {column}", f"a {text} of {{angle}}", plot, w, spec
+                f"in {column}", f"a {text} of {{angle}}", plot, on_angle, spec
             )
         return probes
 

@@ -74,6 +74,11 @@ class ProbeFactors:
         value_unit: the user unit of ``values``.
         observed: (n, k) which observations the data hold (``None``: all); the residuals and
             columns list only these.
+        basis: ``functions(values)`` (n, g) when already computed (probes of one shape share it).
+
+    Probes whose factors share one ``direction`` object are scored together by the search: the
+    model's basis is contracted with that direction once, record by record, and each probe then
+    costs a product with its ``(n, g)`` functions only (:func:`_scored_factored`).
     """
 
     variable: str
@@ -82,12 +87,19 @@ class ProbeFactors:
     direction: np.ndarray | Callable[[], np.ndarray]
     value_scale: float = 1.0
     value_unit: str = ""
-    observed: np.ndarray | None = None
+    observed: np.ndarray | None = field(default=None, repr=False)
+    basis: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def direction_matrix(self) -> np.ndarray:
         """The (n, k) direction (computed now when it was given as a function)."""
         d = self.direction() if callable(self.direction) else self.direction
         return np.asarray(d, dtype=float)
+
+    def basis_matrix(self) -> np.ndarray:
+        """``functions(values)`` as an (n, g) matrix (the given ``basis`` when there is one)."""
+        b = self.basis if self.basis is not None else self.functions(np.asarray(self.values))
+        b = np.asarray(b, dtype=float)
+        return b.reshape(b.shape[0], -1)
 
 
 @dataclass(frozen=True)
@@ -330,10 +342,91 @@ def _probe_fit(gram: np.ndarray, qc: np.ndarray, cr: np.ndarray, qr_: np.ndarray
 
 
 def _scored(probes: Sequence[Probe], q: np.ndarray, r: np.ndarray):
-    """``(probe, _probe_fit result)`` for each probe, the probes taken in batches of columns."""
+    """``(probe, _probe_fit result)`` for each probe, in the order of ``probes``: those with
+    factors from their factors (:func:`_scored_factored`), the others from their columns taken
+    in batches (:func:`_scored_columns`)."""
     m = r.size
-    qr_full = np.concatenate([q, r[:, None]], axis=1).T.copy()  # (k + 1, m)
-    qr_ = qr_full[:-1] @ r
+    qr_ = q.T @ r
+    factored = [p for p in probes if _factorable(p, m)]
+    results = dict(_scored_factored(factored, q, r, qr_))
+    rest = [p for p in probes if id(p) not in results]
+    if rest:
+        qr_full = np.concatenate([q, r[:, None]], axis=1).T.copy()  # (k + 1, m)
+        results.update((id(p), fit) for p, fit in _scored_columns(rest, qr_full, qr_))
+    for probe in probes:
+        yield probe, results[id(probe)]
+
+
+def _factorable(probe: Probe, m: int) -> bool:
+    """Whether ``probe`` says how its m columns factor (direction times functions)."""
+    f = probe.factors
+    if f is None:
+        return False
+    n = np.shape(f.values)[0]
+    if f.observed is not None:
+        return np.shape(f.observed)[0] == n and int(np.count_nonzero(f.observed)) == m
+    return n > 0 and m % n == 0
+
+
+def _by_observation(q: np.ndarray, r: np.ndarray, n: int, k: int, observed) -> np.ndarray:
+    """``[q r]`` laid out as (k, K + 1, n): for each of a record's k observations, the model's
+    basis and the residual at every record (zero where not observed)."""
+    out = np.zeros((k, q.shape[1] + 1, n))
+    if observed is None:
+        for c in range(k):
+            out[c, :-1] = q[c::k].T
+            out[c, -1] = r[c::k]
+        return out
+    index = np.flatnonzero(np.asarray(observed, dtype=bool).reshape(-1))
+    record, channel = np.divmod(index, k)
+    for c in range(k):
+        rows = np.flatnonzero(channel == c)
+        out[c, :-1, record[rows]] = q[rows]
+        out[c, -1, record[rows]] = r[rows]
+    return out
+
+
+def _scored_factored(probes: Sequence[Probe], q: np.ndarray, r: np.ndarray, qr_: np.ndarray):
+    """``(id(probe), _probe_fit result)`` of probes whose columns are ``direction[i, c] *
+    basis[i, j]`` at observation ``i k + c`` (:class:`ProbeFactors`), without forming them.
+
+    With the model's basis ``q`` and the residuals ``r`` laid out by observation,
+    ``Q[c, :, i]``, the products are ``[q r]^T C = (sum_c Q[c] direction[:, c]) @ basis`` and the
+    Gram matrix is ``basis^T (|direction|^2 basis)``: the contraction with a direction is done
+    once for all the probes that share that direction object, and each probe then costs one
+    (K + 1, n) by (n, g) product.
+    """
+    by_direction: dict[int, list[Probe]] = {}
+    for probe in probes:
+        by_direction.setdefault(id(probe.factors.direction), []).append(probe)
+    layouts: dict[int, np.ndarray] = {}
+    for group in by_direction.values():
+        f = group[0].factors
+        d = f.direction_matrix()
+        n, k = d.shape
+        observed = None if f.observed is None else np.asarray(f.observed, dtype=bool)
+        if observed is not None and observed.all():
+            observed = None
+        if observed is not None:
+            d = np.where(observed, d, 0.0)
+        key = -1 if observed is None else id(f.observed)
+        if key not in layouts:
+            layouts[key] = _by_observation(q, r, n, k, observed)
+        layout = layouts[key]
+        contracted = layout[0] * d[:, 0]  # (K + 1, n)
+        for c in range(1, k):
+            contracted += layout[c] * d[:, c]
+        norm2 = np.einsum("ic,ic->i", d, d)
+        for probe in group:
+            basis = probe.factors.basis_matrix()
+            products = contracted @ basis
+            gram = basis.T @ (basis * norm2[:, None])
+            yield id(probe), _probe_fit(gram, products[:-1], products[-1], qr_)
+
+
+def _scored_columns(probes: Sequence[Probe], qr_full: np.ndarray, qr_: np.ndarray):
+    """``(probe, _probe_fit result)`` for each probe from its columns, taken in batches."""
+    m = qr_full.shape[1]
     budget = max(BATCH_VALUES // max(m, 1), 1)
     buffer = np.empty((m, budget))  # the batch's columns, side by side
     batch: list[tuple[Probe, slice]] = []
