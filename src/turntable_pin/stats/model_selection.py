@@ -492,21 +492,23 @@ def _projected_rss(residuals: np.ndarray, blocks: Sequence[np.ndarray]) -> tuple
     directions with eigenvalues below 1e-12 of the largest (singular values below 1e-6) are not
     in the span.
     """
-    norms = [np.linalg.norm(b, axis=0) for b in blocks]
-    scaled = [
-        b[:, n > 0] / n[n > 0] if (n > 0).any() else b[:, :0]
-        for b, n in zip(blocks, norms, strict=True)
-    ]
-    k = sum(b.shape[1] for b in scaled)
+    k = sum(b.shape[1] for b in blocks)
     gram = np.zeros((k, k))
     along = np.zeros((k, *residuals.shape[1:]))
-    starts = np.cumsum([0] + [b.shape[1] for b in scaled])
-    for i, a in enumerate(scaled):
+    starts = np.cumsum([0] + [b.shape[1] for b in blocks])
+    for i, a in enumerate(blocks):
         along[starts[i] : starts[i + 1]] = a.T @ residuals
-        for j in range(i, len(scaled)):
-            block = a.T @ scaled[j]
+        for j in range(i, len(blocks)):
+            block = a.T @ blocks[j]
             gram[starts[i] : starts[i + 1], starts[j] : starts[j + 1]] = block
             gram[starts[j] : starts[j + 1], starts[i] : starts[i + 1]] = block.T
+    # Unit-normalised columns (zero columns left out), scaled on the small matrices: no copy of
+    # the tall blocks.
+    norms = np.sqrt(np.diag(gram))
+    nonzero = norms > 0
+    scale = 1.0 / norms[nonzero]
+    gram = gram[np.ix_(nonzero, nonzero)] * scale[:, None] * scale[None, :]
+    along = along[nonzero] * scale.reshape(-1, *([1] * (along.ndim - 1)))
     values, vectors = np.linalg.eigh(gram)
     keep = values > 1e-12 * max(float(values.max(initial=0.0)), 1e-300)
     coordinates = (vectors[:, keep].T @ along).reshape(int(keep.sum()), -1)

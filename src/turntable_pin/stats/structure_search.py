@@ -482,6 +482,7 @@ def search_structure(
     r = np.asarray(weighted_residuals, dtype=float).copy()
     m = r.size
     q = orthonormal_columns(model_jacobian_weighted)
+    del model_jacobian_weighted  # (m, n): its span is all the search needs
     found: list[tuple] = []
     remaining = list(probes)
     threshold = BIC_THRESHOLD - 2.0 * math.log(max(len(remaining), 1))
