@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from turntable_pin import ANGULAR_ERROR_NAMES, InfeasibleError, InputError
 from turntable_pin.allocation.capability import ManufacturingCapability
 from turntable_pin.allocation.solver import (
+    MIN_LIMIT_ARCSEC,
     ORIENTATION_ANGLES,
     PHI2_INTERVALS_RAD,
     OrientationLimits,
@@ -24,7 +25,7 @@ from turntable_pin.allocation.solver import (
     solve_subproblem,
     worst_case_full_circle,
 )
-from turntable_pin.core.units import ARCMIN_PER_RAD, arcmin_to_rad, arcsec_to_rad
+from turntable_pin.core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, arcmin_to_rad, arcsec_to_rad
 
 TABLE4_ARCMIN = {
     "dphi_y1": 0.4235, "dphi_z2": 0.7800, "dalpha_x1": 0.4234, "dalpha_z1": 0.7800,
@@ -312,10 +313,13 @@ def test_default_limits_are_the_calibration_layers_requirement():
     assert np.all(default_orientation_limits(0.02).as_array() > limits.as_array())
 
 
-@pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), float("inf")])
-def test_limits_must_be_positive_and_finite(bad):
+@pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), float("inf"), 2.2e-313, 4.8e-12])
+def test_limits_must_be_positive_finite_and_not_absurdly_small(bad):
+    # 2.2e-313 rad (a subnormal, found by the fuzz tests) once gave an allocation of inf and nan
     with pytest.raises(InputError, match="psi"):
         OrientationLimits(bad, 1e-4, 1e-4)
+    smallest = MIN_LIMIT_ARCSEC / ARCSEC_PER_RAD
+    assert OrientationLimits(smallest, smallest, smallest).psi_rad == smallest
 
 
 def test_unknown_weights_scheme():

@@ -81,12 +81,13 @@ def test_calibrate_a_run_with_joint_named_columns(tmp_path):
 )
 def test_tables_that_cannot_calibrate_the_gyrowheel_exit_2(command, urdf, fragment, tmp_path):
     if command == "calibrate":
-        run = write_file(
-            tmp_path,
-            "phi1_deg,phi2_deg,out_x_dph,out_y_dph\n"
-            + "".join(f"{a},{b},1,2\n" for a in range(0, 360, 30) for b in (0, 45, 90)),
-            "run.csv",
-        )
+        rows = [(a, b) for a in range(0, 360, 30) for b in (0, 45, 90)]
+        if urdf == ONE:  # one joint: one angle column (a phi2_deg would be refused)
+            header, rows = "phi1_deg", sorted({(a,) for a, _ in rows})
+        else:
+            header = "phi1_deg,phi2_deg"
+        text = "".join(",".join(map(str, (*row, 1, 2))) + "\n" for row in rows)
+        run = write_file(tmp_path, f"{header},out_x_dph,out_y_dph\n" + text, "run.csv")
         proc = cli("calibrate", str(run), "--urdf", urdf)
         fragment = ("too few distinct", "cannot determine")
     else:

@@ -107,6 +107,13 @@ def test_joint_angle_columns_by_position_or_joint_name(tmp_path):
         write_file(tmp_path, "phi1_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec,dir1\n5,1,2,3,-1\n"),
         ("spindle",),
     )
+    # Data of a table with more joints, read with the wrong URDF: refused, not kept as an extra
+    # column that the structure search would then take for a suspect.
+    with pytest.raises(InputError, match="phi2_deg is the angle of a joint this table does not"):
+        read_measurements(write_file(tmp_path, by_k), ("spindle",))
+    with pytest.raises(InputError, match="it has 2 joint"):
+        three = "phi1_deg,phi2_deg,phi3_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec\n1,2,3,1,2,3\n"
+        read_measurements(write_file(tmp_path, three))
     assert one.n_joints == 1 and one.dirs[0].tolist() == [-1.0]
 
 

@@ -35,7 +35,7 @@ from scipy.optimize import minimize_scalar
 
 from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.exceptions import InputError
-from ..core.units import ARCMIN_PER_RAD, DEG_PER_RAD, arcmin_by_name
+from ..core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, arcmin_by_name
 from ..model.errors import ANGULAR_ERROR_NAMES, MAX_ANGULAR_ERROR_DEG, TurntableErrors
 from ..model.small_angle import small_angle_matrix
 from .capability import ManufacturingCapability
@@ -54,6 +54,7 @@ from .sensitivity import PAPER_FIGURE8_TRIG, AverageSensitivities, average_sensi
 __all__ = [
     "DEFAULT_ACCURACY_DPH",
     "DEFAULT_POSITIONS",
+    "MIN_LIMIT_ARCSEC",
     "ORIENTATION_ANGLES",
     "PHI2_INTERVALS_RAD",
     "WEIGHT_SCHEMES",
@@ -84,12 +85,17 @@ WEIGHT_SCHEMES: tuple[str, ...] = ("model", "paper", "equal")
 _EQ16_LIMIT_DEG = 0.027
 
 
+MIN_LIMIT_ARCSEC = 1e-6
+"""Smallest orientation limit accepted, arcsec (a micro-arcsecond; turntables work in arcsec)."""
+
+
 @dataclass(frozen=True)
 class OrientationLimits:
     """Required bounds I_psi, I_theta, I_gamma on |dpsi|, |dtheta|, |dgamma|, radians.
 
-    Each is > 0 and at most ``MAX_ANGULAR_ERROR_DEG`` (5 deg, ``model.errors``): the allocation
-    is one of small errors (eq. 26), and a limit of more than a few degrees is not a small one.
+    Each is at least :data:`MIN_LIMIT_ARCSEC` and at most ``MAX_ANGULAR_ERROR_DEG`` (5 deg,
+    ``model.errors``): the allocation is one of small errors (eq. 26), and a limit of more than a
+    few degrees is not a small one.
     """
 
     psi_rad: float
@@ -101,6 +107,12 @@ class OrientationLimits:
             value = float(getattr(self, f"{name}_rad"))
             if not math.isfinite(value) or value <= 0.0:
                 raise InputError(f"orientation limit for {name} must be a positive number")
+            if value < MIN_LIMIT_ARCSEC / ARCSEC_PER_RAD:
+                raise InputError(
+                    f"orientation limit for {name} is {value * ARCSEC_PER_RAD:.3g} arcsec; it must "
+                    f"be at least {MIN_LIMIT_ARCSEC:g} arcsec (below that no turntable is built, "
+                    "and the ratios of the allocation overflow: a unit mix-up?)"
+                )
             if value > MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD * (1.0 + 1e-12):
                 raise InputError(
                     f"orientation limit for {name} is {value * DEG_PER_RAD:g} deg; it must be at "

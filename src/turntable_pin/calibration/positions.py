@@ -212,9 +212,18 @@ def angle_columns(
     Without ``joint_names`` the table is the paper's two-axis one (``phi1_deg, phi2_deg``).
 
     Raises:
-        InputError: a joint without its column, or with both spellings (at the header's row).
+        InputError: a joint without its column, or with both spellings, or a ``phiK_deg`` column
+            for a joint the table does not have (data of another table), at the header's row.
     """
     names = tuple(joint_names) if joint_names else ("", "")
+    beyond = [c for c in header if (k := _numbered_joint(c)) is not None and k > len(names)]
+    if beyond:
+        joints = ", ".join(n for n in names if n) or "the paper's phi1, phi2"
+        raise InputError(
+            f"column {beyond[0]} is the angle of a joint this table does not have: it has "
+            f"{len(names)} joint(s) ({joints}); are these data of the table given by --urdf?",
+            path=path, row=header_row, column=beyond[0],
+        )  # fmt: skip
     out = []
     for k, joint in enumerate(names, start=1):
         found = [c for c in (f"phi{k}_deg", f"{joint}_deg" if joint else None) if c in header]
@@ -232,6 +241,12 @@ def angle_columns(
             )  # fmt: skip
         out.append(found[0])
     return tuple(out)
+
+
+def _numbered_joint(column: str) -> int | None:
+    """K of a column named ``phiK_deg``, else None."""
+    match = re.fullmatch(r"phi([0-9]+)_deg", column)
+    return int(match.group(1)) if match else None
 
 
 def base_frame_inputs(latitude_rad: float) -> tuple[np.ndarray, np.ndarray]:

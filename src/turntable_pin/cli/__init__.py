@@ -47,7 +47,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     ),
     "allocate": (
         "allocation",
-        "allocate the eight angular turntable errors to meet orientation limits",
+        "allocate the angular turntable errors to meet orientation limits",
     ),
     "montecarlo": (
         "allocation",
@@ -84,8 +84,9 @@ def _parser(wanted: set[str]) -> argparse.ArgumentParser:
     """The parser with the options of the commands of the modules ``wanted``; others listed."""
     parser = argparse.ArgumentParser(
         prog="turntable-pin",
-        description="Error analysis, error allocation and measurement diagnosis of a two-axis "
-        "turntable for inertial-instrument calibration (Pinocchio URDF model).",
+        description="Error analysis, error allocation and measurement diagnosis of a turntable "
+        "for inertial-instrument calibration, from its URDF (one to three revolute axes, --urdf; "
+        "the paper's two-axis table is bundled and the default).",
     )
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     subparsers.required = True
