@@ -10,6 +10,7 @@ from turntable_pin import IdentifiabilityError, InputError
 from turntable_pin.calibration.drift_fit import (
     calibrate,
     calibrate_run,
+    regressor_matrix,
     simulate_run,
     write_simulated_run,
 )
@@ -147,3 +148,26 @@ def test_run_file_problems_are_named(tmp_path):
     sigma.write_text("phi1_deg,phi2_deg,out_x_dph,out_y_dph,sigma_dph\n0,0,1,2,0\n")
     with pytest.raises(InputError, match="sigma_dph must be positive"):
         calibrate_run(sigma, LAT_RAD)
+
+
+def test_a_barely_identifying_position_set_still_has_real_standard_errors():
+    """17 positions within about 0.04 deg of one another identify the seven coefficients with a
+    condition number near 1e11; the inverse of the normal matrix then had negative variances
+    (rounding), and their square roots NaN. The variances are sums of squares now, equal to
+    those of the pseudo-inverse of the weighted design."""
+    rng = np.random.default_rng(0)
+    for _ in range(2):  # the second draw is the barely identifying set
+        n = rng.integers(12, 20)
+        base = rng.uniform(0, 360, 2)
+        spread = 10 ** rng.uniform(-6, 0)
+        phi = base + rng.normal(0, spread, (n, 2)) * rng.uniform(0, 360)
+    p = np.radians(phi)
+    inputs = position_inputs(PositionSet(p[:, 0], p[:, 1]), 0.7)
+    gyro = GyroWheelModel.nominal()
+    outputs = gyro.outputs_dph(inputs.specific_force_g, inputs.earth_rate_dph)
+    noise = np.random.default_rng(1).normal(0, 0.01, outputs.shape)
+    result = calibrate(inputs, *(outputs + noise).T, np.full(len(p), 0.01))
+    assert result.x.condition_number > 1e10
+    design = regressor_matrix("x", inputs.specific_force_g) / 0.01
+    expected = np.sqrt(np.sum(np.linalg.pinv(design) ** 2, axis=1))
+    np.testing.assert_allclose(result.x.standard_errors_dph, expected, rtol=1e-6)

@@ -275,7 +275,11 @@ def fit_axis(
     coefficients, *_ = np.linalg.lstsq(weighted, rhs * weights, rcond=None)
     residuals = rhs - design @ coefficients
     dof = len(inputs) - N_COEFFICIENTS
-    cov_unit = np.linalg.inv(weighted.T @ weighted)
+    # (W A)^T (W A) inverted through the SVD of W A: V S^-2 V^T, whose diagonal is a sum of
+    # squares (an inverse of the normal matrix of a barely identifying position set had tiny
+    # negative variances from rounding).
+    _, s, vt = np.linalg.svd(weighted, full_matrices=False)
+    cov_unit = (vt.T / s**2) @ vt
     if sigma_dph is not None:
         covariance = cov_unit
         source = "sigma_dph"
