@@ -136,3 +136,27 @@ def test_models_of_the_same_positions_share_the_table_matrices():
     other = OrientationModel(_grid_variables(6, n=30))
     assert other._rd is not a._rd
     assert not np.allclose(other.predict(np.full(8, 1e-4)), a.predict(np.full(8, 1e-4)))
+
+
+def test_models_on_one_data_set_share_their_gains_and_predict_as_models_built_alone():
+    """Models built on one PositionVariables (the base and the candidates of a diagnosis) share
+    the stacked gains of the same effect terms while a model holds them; each predicts and
+    differentiates exactly as a model built on variables of its own."""
+    v = _grid_variables(3)
+    encoder, wobble = EFFECTS["inner_encoder_harmonics"], EFFECTS["outer_wobble_harmonics"]
+    a = OrientationModel(v, [encoder])
+    b = OrientationModel(v, [wobble, encoder])
+
+    def gains(model):
+        return {id(f.weights) for f in model._factors if f.weights is not None}
+
+    assert gains(a) < gains(b)  # every factor of a is b's too; b has the wobble's besides
+    alone = PositionVariables(v.joint_rad, v.time_s, v.dirs, dict(v.extra))
+    rng = np.random.default_rng(4)
+    for model, effects in ((a, [encoder]), (b, [wobble, encoder])):
+        fresh = OrientationModel(alone, effects)
+        assert not gains(fresh) & gains(model)
+        params = rng.normal(0, 1e-4, model.n_params)
+        np.testing.assert_array_equal(model.predict(params), fresh.predict(params))
+        np.testing.assert_array_equal(model.jacobian(params), fresh.jacobian(params))
+        alone = PositionVariables(v.joint_rad, v.time_s, v.dirs, dict(v.extra))

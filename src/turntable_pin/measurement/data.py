@@ -23,6 +23,7 @@ reader's checks (missing columns, non-numbers, NaN), a file is refused, naming r
 from __future__ import annotations
 
 import dataclasses
+import weakref
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -216,8 +217,16 @@ class OrientationMeasurements:
         return self.sigma_rad is not None
 
     def variables(self) -> PositionVariables:
-        """What effects may depend on at each position."""
-        return PositionVariables(self.joint_rad, self.time_s, self.dirs, dict(self.extra))
+        """What effects may depend on at each position: one object while any model built on
+        these data lives (the arrays are read-only, and the models share what they compute from
+        it, :meth:`PositionVariables.memo`); the data set holds it weakly, so that what the
+        models computed goes with them."""
+        ref = self.__dict__.get("_variables")
+        cached = ref() if ref is not None else None
+        if cached is None:
+            cached = PositionVariables(self.joint_rad, self.time_s, self.dirs, dict(self.extra))
+            self.__dict__["_variables"] = weakref.ref(cached)
+        return cached
 
     def columns(self) -> dict[str, np.ndarray]:
         """The CSV columns of ``docs/measurements.md`` in user units (degrees, arcsec, s)."""

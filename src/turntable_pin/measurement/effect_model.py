@@ -70,13 +70,25 @@ class _Factor:
         return self.fixed if self.fixed.shape[-1] == 1 else self.fixed[..., rows]
 
 
-def _sparse_gain(gain: dict[int, np.ndarray], n: int) -> tuple[np.ndarray, np.ndarray]:
-    """``{parameter index: gain (N,) or scalar}`` as (columns, weights (k, N or 1))."""
-    columns = np.array(sorted(gain), dtype=int)
-    rows = [np.asarray(gain[c], dtype=float) for c in columns]
+_UNIT_GAIN = np.asarray(1.0)
+"""The gain of a base error on its own rotation (one object: models share what is built on it)."""
+_UNIT_GAIN.setflags(write=False)
+
+
+def _merged(entry: tuple | None, new: tuple) -> tuple:
+    """Two ``(gain, origin)`` of one parameter added (``new`` itself when there is no ``entry``)."""
+    return new if entry is None else (entry[0] + new[0], entry[1] + new[1])
+
+
+def _stacked_gain(rows: tuple[np.ndarray, ...], n: int) -> np.ndarray:
+    """Gains (each (N,) or a scalar) as the weights (k, N or 1) of a factor."""
+    rows = tuple(np.asarray(r, dtype=float) for r in rows)
     if all(r.ndim == 0 for r in rows):
-        return columns, np.array([[float(r)] for r in rows])
-    return columns, np.stack([np.broadcast_to(r, (n,)) for r in rows])
+        out = np.array([[float(r)] for r in rows])
+    else:
+        out = np.stack([np.broadcast_to(r, (n,)) for r in rows])
+    out.setflags(write=False)
+    return out
 
 
 def _entry_major(matrices: np.ndarray) -> np.ndarray:
@@ -205,35 +217,52 @@ class OrientationModel:
         """Number of parameters: the base errors plus every effect's parameters."""
         return len(self.parameter_names)
 
-    def _gain(self, weights: dict[str, np.ndarray], prefix: str) -> dict[int, np.ndarray]:
-        gain: dict[int, np.ndarray] = {}
+    def _gain(self, effect: Effect, t: int, weights: dict[str, np.ndarray]) -> dict[int, tuple]:
+        """``{parameter index: (gain, origin)}`` of term ``t`` of ``effect``; the origin names
+        where the gain comes from: ``((id(effect), t, weight name), ...)``."""
+        gain: dict[int, tuple] = {}
         for name, w in weights.items():
-            i = self._index[f"{prefix}{name}"]
-            gain[i] = gain.get(i, 0.0) + np.asarray(w, dtype=float)
+            i = self._index[f"{effect.name}.{name}"]
+            entry = (np.asarray(w, dtype=float), ((id(effect), t, name),))
+            gain[i] = _merged(gain.get(i), entry)
         return gain
 
     def _build_chain(self, turntable: MeasuredTable, terms_by_effect):
-        n = self.variables.n
+        variables = self.variables
         pre, post = [], []
-        error_gain = {name: {self._index[name]: np.asarray(1.0)} for name in self.base_names}
+        unit = (_UNIT_GAIN, (("unit",),))
+        error_gain = {name: {self._index[name]: unit} for name in self.base_names}
+        by_id = {id(e): e for e in self.effects}
 
         def factor(axis, gain):
-            columns, weights = _sparse_gain(gain, n)
+            columns = np.array(sorted(gain), dtype=int)
+            rows = tuple(gain[c][0] for c in columns)
+            origins = tuple(gain[c][1] for c in columns)
+            # Gains of the same origins are the same numbers: the models of one data set (a
+            # diagnosis's base and candidates) share their stacked weights while any uses them.
+            effects = tuple(by_id[o[0]] for origin in origins for o in origin if o[0] != "unit")
+            weights = variables.memo(
+                ("gain", origins),
+                effects,
+                lambda: _stacked_gain(rows, variables.n),
+                weak=True,
+            )
             return _Factor(axis=axis, columns=columns, weights=weights)
 
         for effect, terms in terms_by_effect:
-            for term in terms:
-                gain = self._gain(term.weights, f"{effect.name}.")
+            for t, term in enumerate(terms):
+                gain = self._gain(effect, t, term.weights)
                 if term.site == PRE:
                     pre.append(factor(term.axis, gain))
                 elif term.site == POST:
                     post.append(factor(term.axis, gain))
                 elif term.site == MEASURED and term.axis in ANGLE_NAMES:
-                    self._added.append((ANGLE_NAMES.index(term.axis), gain))
+                    angle = ANGLE_NAMES.index(term.axis)
+                    self._added.append((angle, {i: w for i, (w, _) in gain.items()}))
                 elif term.site in error_gain:
                     merged = dict(error_gain[term.site])
-                    for i, w in gain.items():
-                        merged[i] = merged.get(i, 0.0) + w
+                    for i, entry in gain.items():
+                        merged[i] = _merged(merged.get(i), entry)
                     error_gain[term.site] = merged
                 else:
                     raise InputError(

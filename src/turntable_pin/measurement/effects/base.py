@@ -18,8 +18,10 @@ factors of the chain and differentiates them analytically.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import weakref
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -110,6 +112,26 @@ class PositionVariables:
         object.__setattr__(self, "joint_rad", joints)
         dirs = tuple(self.dirs) + (None,) * (joints.shape[1] - len(self.dirs))
         object.__setattr__(self, "dirs", dirs[: joints.shape[1]])
+
+    def memo(
+        self, key: tuple, keep: tuple, compute: Callable[[], Any], *, weak: bool = False
+    ) -> Any:
+        """``compute()``, once for these variables: the models built on one data set (the base
+        and every candidate of a diagnosis) share what they compute from it, an effect's terms
+        and their gain arrays. ``key`` names the value, with the ``id`` of the objects ``keep``
+        it depends on; the memo holds those objects, and a key whose objects are not the same
+        ones (by identity) is computed anew. With ``weak`` the memo holds the value only while
+        something else does (a value only some models use goes with them)."""
+        store = self.__dict__.setdefault("_memo", {})
+        found = store.get(key)
+        if found is not None and len(found[0]) == len(keep):
+            if all(a is b for a, b in zip(found[0], keep, strict=True)):
+                value = found[1]() if weak else found[1]
+                if value is not None:
+                    return value
+        value = compute()
+        store[key] = (tuple(keep), weakref.ref(value) if weak else value)
+        return value
 
     @classmethod
     def of(cls, *angles_rad, time_s=None, dirs=(), extra=None) -> PositionVariables:
@@ -222,7 +244,11 @@ class Effect:
         raise NotImplementedError
 
     def chain_terms(self, variables: PositionVariables) -> tuple[ChainTerm, ...]:
-        """How it changes the chain at each position (see the module docstring)."""
+        """How it changes the chain at each position (see the module docstring).
+
+        A function of ``variables`` alone: the models built on one data set share the gains of
+        an effect's terms (:meth:`PositionVariables.memo`), so the same effect object must give
+        the same terms for the same variables."""
         raise NotImplementedError
 
     def describe(self) -> dict:
