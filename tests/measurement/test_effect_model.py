@@ -160,3 +160,20 @@ def test_models_on_one_data_set_share_their_gains_and_predict_as_models_built_al
         np.testing.assert_array_equal(model.predict(params), fresh.predict(params))
         np.testing.assert_array_equal(model.jacobian(params), fresh.jacobian(params))
         alone = PositionVariables(v.joint_rad, v.time_s, v.dirs, dict(v.extra))
+
+
+def test_variables_and_data_pickle_and_copy_without_their_memo():
+    import copy
+    import pickle
+
+    from turntable_pin.measurement.simulation import simulate_measurements
+
+    data = simulate_measurements(None, seed=1).data
+    v = data.variables()
+    OrientationModel(v, [EFFECTS["backlash"]])  # fills the memo (weak references)
+    for clone in (pickle.loads(pickle.dumps(data)), copy.deepcopy(data), copy.copy(data)):
+        np.testing.assert_array_equal(clone.angles_rad, data.angles_rad)
+        assert clone.variables() is not v
+    w = pickle.loads(pickle.dumps(v))
+    np.testing.assert_array_equal(w.joint_rad, v.joint_rad)
+    assert "_memo" not in w.__dict__

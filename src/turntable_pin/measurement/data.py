@@ -74,6 +74,10 @@ def _frozen(value, dtype=float) -> np.ndarray:
     return out
 
 
+_VARIABLES = "_variables"
+"""Where an :class:`OrientationMeasurements` keeps its :class:`PositionVariables` (weakly)."""
+
+
 @dataclass(frozen=True)
 class OrientationMeasurements:
     """Measured orientation errors at N positions (radians and seconds inside).
@@ -221,12 +225,19 @@ class OrientationMeasurements:
         these data lives (the arrays are read-only, and the models share what they compute from
         it, :meth:`PositionVariables.memo`); the data set holds it weakly, so that what the
         models computed goes with them."""
-        ref = self.__dict__.get("_variables")
+        ref = self.__dict__.get(_VARIABLES)
         cached = ref() if ref is not None else None
         if cached is None:
             cached = PositionVariables(self.joint_rad, self.time_s, self.dirs, dict(self.extra))
-            self.__dict__["_variables"] = weakref.ref(cached)
+            self.__dict__[_VARIABLES] = weakref.ref(cached)
         return cached
+
+    def __getstate__(self) -> dict:
+        """The fields (for pickle and copy): the weakly held variables stay behind."""
+        return {k: v for k, v in self.__dict__.items() if k != _VARIABLES}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
 
     def columns(self) -> dict[str, np.ndarray]:
         """The CSV columns of ``docs/measurements.md`` in user units (degrees, arcsec, s)."""

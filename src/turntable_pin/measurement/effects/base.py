@@ -133,6 +133,13 @@ class PositionVariables:
         store[key] = (tuple(keep), weakref.ref(value) if weak else value)
         return value
 
+    def __getstate__(self) -> dict:
+        """The fields (for pickle and copy): the memo stays behind."""
+        return {k: v for k, v in self.__dict__.items() if k != "_memo"}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+
     @classmethod
     def of(cls, *angles_rad, time_s=None, dirs=(), extra=None) -> PositionVariables:
         """The variables of joint angle arrays given one per joint (``phi1, phi2, ...``)."""
