@@ -82,6 +82,8 @@ def test_positions_from_csv_and_distinct_count(tmp_path):
         ("grid:abc", "expected grid:STEP"),
         ("grid:500", "grid step must be in (0, 360]"),
         ("nothing.csv", "neither a scheme (grid:STEP) nor an existing CSV file"),
+        ("grid:30x30x30", "3 steps for the paper's table of 2 joints"),
+        ("grid:30x", "expected grid:STEP"),
     ],
 )
 def test_bad_position_specs(spec, fragment):
@@ -100,3 +102,15 @@ def test_csv_missing_column_is_named(tmp_path):
 def test_latitude_is_checked():
     with pytest.raises(InputError, match="latitude"):
         position_inputs(PositionSet([0.0], [0.0]), np.radians(95))
+
+
+@pytest.mark.parametrize("spec", ["grid:30", "grid:30x45", "grid:45x30", "grid: 60 x 90"])
+def test_the_paper_grid_is_the_generic_grid_of_the_paper_urdf(spec):
+    from conftest import REPO_DIR
+    from turntable_pin.calibration.table_positions import JointPositions
+    from turntable_pin.model.generic_table import GenericTable
+
+    paper = PositionSet.parse(spec)
+    generic = JointPositions.parse(GenericTable(REPO_DIR / "models" / "turntable.urdf"), spec)
+    np.testing.assert_array_equal(generic.angles_rad, np.stack([paper.phi1_rad, paper.phi2_rad], 1))
+    assert paper.name == generic.name

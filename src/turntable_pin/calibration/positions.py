@@ -40,6 +40,8 @@ __all__ = [
     "angle_columns",
     "base_frame_inputs",
     "check_commanded_angles",
+    "grid_angles_deg",
+    "grid_steps",
     "position_inputs",
 ]
 
@@ -54,7 +56,49 @@ or a typo, and trigonometry of huge angles only returns rounding noise."""
 POSITION_BYTES = 4096
 """Memory a position costs in the calibration layer's computations (rough upper bound), bytes."""
 
-_GRID = re.compile(r"^grid:\s*([0-9.eE+-]+)(?:\s*x\s*([0-9.eE+-]+))?$")
+_GRID = re.compile(r"^grid:\s*([0-9.eE+-]+(?:\s*x\s*[0-9.eE+-]+)*)$")
+
+
+def grid_steps(text: str) -> list[float] | None:
+    """The steps (degrees: one for every joint, or one per joint) of a ``grid:STEP`` or
+    ``grid:S1xS2[xS3]`` spec, or ``None`` when ``text`` is no grid spec (a file name).
+
+    Raises:
+        InputError: a spec that starts with ``grid`` but is malformed.
+    """
+    match = _GRID.match(text)
+    if match is None:
+        if text.startswith("grid"):
+            raise InputError(
+                f"positions '{text}': expected grid:STEP or grid:S1xS2[xS3] (degrees, one step "
+                "per joint)"
+            )
+        return None
+    try:
+        return [float(s) for s in re.split(r"\s*x\s*", match.group(1).strip())]
+    except ValueError:
+        raise InputError(f"positions '{text}': bad grid step") from None
+
+
+def grid_angles_deg(steps_deg: Sequence[float]) -> tuple[np.ndarray, str]:
+    """Every joint in {0, step, ..., < 360} degrees, every combination: (N, J) angles in degrees
+    (the last joint varies fastest) and the grid's name (``grid:30``, ``grid:30x45``).
+
+    Raises:
+        InputError: a step outside (0, 360], or more positions than ``MAX_POSITIONS``.
+    """
+    for step in steps_deg:
+        if not (np.isfinite(step) and 0 < step <= 360):
+            raise InputError(f"grid step must be in (0, 360] degrees, got {step!r}")
+    same = all(s == steps_deg[0] for s in steps_deg)
+    name = f"grid:{steps_deg[0]:g}" if same else "grid:" + "x".join(f"{s:g}" for s in steps_deg)
+    count = 1.0
+    for step in steps_deg:
+        count *= float(turn_grid_count(step))
+    check_count(count, MAX_POSITIONS, f"positions of {name}", POSITION_BYTES)
+    axes = [np.arange(0.0, 360.0 - 1e-9, s) for s in steps_deg]
+    mesh = np.meshgrid(*axes, indexing="ij")
+    return np.stack([m.ravel() for m in mesh], axis=1), name
 
 
 @dataclass(frozen=True)
@@ -98,22 +142,8 @@ class PositionSet:
     def grid(cls, step1_deg: float, step2_deg: float | None = None) -> PositionSet:
         """phi1 in {0, step1, ... < 360} and phi2 in {0, step2, ... < 360} degrees, all pairs."""
         step2_deg = step1_deg if step2_deg is None else step2_deg
-        for step in (step1_deg, step2_deg):
-            if not (np.isfinite(step) and 0 < step <= 360):
-                raise InputError(f"grid step must be in (0, 360] degrees, got {step!r}")
-        check_count(
-            float(turn_grid_count(step1_deg)) * turn_grid_count(step2_deg),
-            MAX_POSITIONS,
-            f"positions of grid:{step1_deg:g}x{step2_deg:g}",
-            POSITION_BYTES,
-        )
-        phi1 = np.arange(0.0, 360.0 - 1e-9, step1_deg)
-        phi2 = np.arange(0.0, 360.0 - 1e-9, step2_deg)
-        p1, p2 = np.meshgrid(phi1, phi2, indexing="ij")
-        name = (
-            f"grid:{step1_deg:g}" if step2_deg == step1_deg else f"grid:{step1_deg:g}x{step2_deg:g}"
-        )
-        return cls(deg_to_rad(p1.ravel()), deg_to_rad(p2.ravel()), name)
+        angles, name = grid_angles_deg([step1_deg, step2_deg])
+        return cls(deg_to_rad(angles[:, 0]), deg_to_rad(angles[:, 1]), name)
 
     @classmethod
     def from_csv(cls, path: str | Path) -> PositionSet:
@@ -126,18 +156,14 @@ class PositionSet:
     def parse(cls, spec: str) -> PositionSet:
         """A scheme name (``grid:STEP``, ``grid:STEP1xSTEP2``) or the path of a CSV file."""
         text = str(spec).strip()
-        match = _GRID.match(text)
-        if match:
-            try:
-                step1 = float(match.group(1))
-                step2 = float(match.group(2)) if match.group(2) else None
-            except ValueError:
-                raise InputError(f"positions '{text}': bad grid step") from None
-            return cls.grid(step1, step2)
-        if text.startswith("grid"):
-            raise InputError(
-                f"positions '{text}': expected grid:STEP or grid:STEP1xSTEP2 (degrees)"
-            )
+        steps = grid_steps(text)
+        if steps is not None:
+            if len(steps) > 2:
+                raise InputError(
+                    f"grid: {len(steps)} steps for the paper's table of 2 joints; give one "
+                    "step, or one per joint"
+                )
+            return cls.grid(*steps)
         path = Path(text)
         if not path.exists():
             raise InputError(

@@ -17,7 +17,6 @@ placements Pinocchio reads from the URDF).
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -25,7 +24,7 @@ import numpy as np
 
 from ..core.csv_table import CsvTable, read_csv_table
 from ..core.exceptions import InputError
-from ..core.sizes import MAX_POSITIONS, check_count, turn_grid_count
+from ..core.sizes import MAX_POSITIONS, check_count
 from ..core.units import deg_to_rad, rad_to_deg
 from ..model.chain import compose_rotation
 from .positions import (
@@ -33,11 +32,11 @@ from .positions import (
     POSITION_BYTES,
     angle_columns,
     check_commanded_angles,
+    grid_angles_deg,
+    grid_steps,
 )
 
 __all__ = ["JointPositions"]
-
-_GRID = re.compile(r"^grid:\s*([0-9.eE+-]+(?:\s*x\s*[0-9.eE+-]+)*)$")
 
 
 @dataclass(frozen=True)
@@ -97,27 +96,14 @@ class JointPositions:
         """Every joint in {0, step, ..., < 360} degrees, every combination (one step for all
         joints, or one per joint in chain order)."""
         n_joints = len(table.joint_names)
-        if len(steps_deg) == 1:
-            steps = list(steps_deg) * n_joints
-        elif len(steps_deg) == n_joints:
-            steps = list(steps_deg)
-        else:
+        if len(steps_deg) not in (1, n_joints):
             raise InputError(
                 f"grid: {len(steps_deg)} steps for a table of {n_joints} joint(s) "
                 f"({', '.join(table.joint_names)}); give one step, or one per joint"
             )
-        for step in steps:
-            if not (np.isfinite(step) and 0 < step <= 360):
-                raise InputError(f"grid step must be in (0, 360] degrees, got {step!r}")
-        text = "x".join(f"{s:g}" for s in steps_deg)
-        count = 1.0
-        for step in steps:
-            count *= float(turn_grid_count(step))
-        check_count(count, MAX_POSITIONS, f"positions of grid:{text}", POSITION_BYTES)
-        axes = [np.arange(0.0, 360.0 - 1e-9, s) for s in steps]
-        mesh = np.meshgrid(*axes, indexing="ij")
-        angles = np.stack([m.ravel() for m in mesh], axis=1)
-        return cls(deg_to_rad(angles), table, f"grid:{text}")
+        steps = list(steps_deg) * n_joints if len(steps_deg) == 1 else list(steps_deg)
+        angles, name = grid_angles_deg(steps)
+        return cls(deg_to_rad(angles), table, name)
 
     @classmethod
     def from_table(cls, table, csv: CsvTable, columns: tuple[str, ...], name: str):
@@ -149,18 +135,9 @@ class JointPositions:
     def parse(cls, table, spec: str) -> JointPositions:
         """A scheme name (``grid:STEP``, ``grid:S1xS2[xS3]``) or the path of a CSV file."""
         text = str(spec).strip()
-        match = _GRID.match(text)
-        if match:
-            try:
-                steps = [float(s) for s in re.split(r"\s*x\s*", match.group(1).strip())]
-            except ValueError:
-                raise InputError(f"positions '{text}': bad grid step") from None
+        steps = grid_steps(text)
+        if steps is not None:
             return cls.grid(table, *steps)
-        if text.startswith("grid"):
-            raise InputError(
-                f"positions '{text}': expected grid:STEP or grid:S1xS2[xS3] (degrees, one step "
-                "per joint)"
-            )
         path = Path(text)
         if not path.exists():
             raise InputError(
