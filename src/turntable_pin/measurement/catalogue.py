@@ -14,6 +14,7 @@ aliases of them (``encoder_harmonics@outer_axis`` is ``outer_encoder_harmonics``
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Sequence
 
 import numpy as np
@@ -37,7 +38,10 @@ PAPER_ALIASES = {
 }
 """The paper's catalogue names of per-joint effects on its table."""
 
-_CATALOGUES: dict[int, tuple[MeasuredTable, tuple[Effect, ...]]] = {}
+_CATALOGUES: weakref.WeakKeyDictionary[MeasuredTable, tuple[Effect, ...]] = (
+    weakref.WeakKeyDictionary()
+)
+"""The catalogue of each table in use (found once per table; gone with the table)."""
 
 
 def catalogue(turntable=None) -> tuple[Effect, ...]:
@@ -51,9 +55,9 @@ def catalogue(turntable=None) -> tuple[Effect, ...]:
     table = measured_table(turntable)
     if table.paper:
         return tuple(EFFECTS.values())
-    cached = _CATALOGUES.get(id(table))
-    if cached is not None and cached[0] is table:
-        return cached[1]
+    cached = _CATALOGUES.get(table)
+    if cached is not None:
+        return cached
     # Keep the parameters the data determine; when none is, keep the whole effect, so that the
     # diagnosis says it is absorbed by the base errors (a base tilt by the first joint's tilts).
     sag = GravityCompliance(table.rotation)
@@ -69,7 +73,7 @@ def catalogue(turntable=None) -> tuple[Effect, ...]:
         *(joint_effect("backlash", j) for j in table.joints),
         PayloadMount(),
     )
-    _CATALOGUES[id(table)] = (table, out)
+    _CATALOGUES[table] = out
     return out
 
 
