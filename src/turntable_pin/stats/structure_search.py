@@ -115,7 +115,8 @@ class Probe:
         unit_scale: user units per internal unit of the probe's coefficients (for amplitudes).
         unit: the user unit of the coefficients.
         factors: how the columns factor per record (optional: lets the report plot a found
-            term against its variable).
+            term against its variable, and the search score the probe without forming its
+            columns, which it then forms only for a probe it accepts).
         effect_spec: how the model family's users add this shape to their model (a text the
             family defines), or ``None``.
     """
