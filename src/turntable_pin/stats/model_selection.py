@@ -542,24 +542,28 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
     """
     m = current_fit.result.n_obs
     penalty = 2.0 * math.log(max(len(probes), 1))
-    weight = None  # of ln(rss) when the variance is profiled: set from the best description
 
-    def score(fit, terms, term_probes) -> tuple[float, float, int]:
-        """(BIC, its fit part, rank) of ``fit`` with the probe columns of ``terms`` added."""
+    def projected(fit, terms, term_probes) -> tuple[float, int]:
+        """(rss, rank) of ``fit`` with the probe columns of ``terms`` added."""
         result = fit.result
         by_name = {p.name: p for p in term_probes}
         columns = [result.jacobian_weighted] + [by_name[t.name].matrix() for t in terms]
-        rss, rank = _projected_rss(result.residuals * result.weights, columns)
-        if known is not None:
-            fit_term = rss / known
-        else:
-            # The small-sample weight of delta_bic, with the residual degrees of freedom of
-            # the best description (the larger model of each comparison).
-            fit_term = (weight or profiled_weight(m, rank, 2)) * math.log(max(rss, 1e-300))
-        return fit_term + rank * math.log(m) + penalty * len(terms), fit_term, rank
+        return _projected_rss(result.residuals * result.weights, columns)
 
-    full, full_fit, full_rank = score(current_fit, structure, probes)
+    full_rss, full_rank = projected(current_fit, structure, probes)
+    # With the variance profiled, ln(rss) weighs as in delta_bic, with the residual degrees of
+    # freedom of the best description (the larger model of each comparison).
     weight = profiled_weight(m, full_rank, 2)
+
+    def score(fit, terms, term_probes) -> tuple[float, float]:
+        """(BIC, its fit part) of ``fit`` with the probe columns of ``terms`` added."""
+        return bic(*projected(fit, terms, term_probes), len(terms))
+
+    def bic(rss: float, rank: int, n_terms: int) -> tuple[float, float]:
+        fit_term = rss / known if known is not None else weight * math.log(max(rss, 1e-300))
+        return fit_term + rank * math.log(m) + penalty * n_terms, fit_term
+
+    full, full_fit = bic(full_rss, full_rank, len(structure))
     worst = None
     for effect in current:
         try:
@@ -571,7 +575,7 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
         # parameters in penalties).
         own, own_probes = _search(family, without, known, max_terms=2, suspects_only=True)
         if own and not _within(own, own_probes, current_fit.result.jacobian_weighted):
-            bic_own, fit_own, _ = score(without, own, own_probes)
+            bic_own, fit_own = score(without, own, own_probes)
             if fit_own <= full_fit:
                 costs.append(bic_own - full)
         cost = float(min(costs))

@@ -117,8 +117,8 @@ class PositionVariables:
         self, key: tuple, keep: tuple, compute: Callable[[], Any], *, weak: bool = False
     ) -> Any:
         """``compute()``, once for these variables: the models built on one data set (the base
-        and every candidate of a diagnosis) share what they compute from it, an effect's terms
-        and their gain arrays. ``key`` names the value, with the ``id`` of the objects ``keep``
+        and every candidate of a diagnosis) share what they compute from it (the stacked gains
+        of their effects' terms). ``key`` names the value, with the ``id`` of the objects ``keep``
         it depends on; the memo holds those objects, and a key whose objects are not the same
         ones (by identity) is computed anew. With ``weak`` the memo holds the value only while
         something else does (a value only some models use goes with them)."""
