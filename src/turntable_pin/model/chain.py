@@ -108,17 +108,27 @@ def skew(vector) -> np.ndarray:
 
 
 def joint_axis(model, joint_id: int) -> np.ndarray:
-    """Unit rotation axis of a revolute joint of the Pinocchio ``model``, in the joint frame."""
+    """Unit rotation axis of a revolute joint of the Pinocchio ``model``, in the joint frame.
+
+    Read off the joint's motion subspace (its angular part), which every revolute type has --
+    aligned or not, bounded or continuous -- whereas only some expose an ``axis`` attribute
+    (Pinocchio 4's ``JointModelRevoluteUnboundedUnaligned`` has none).
+    """
+    import pinocchio as pin
+
     joint = model.joints[joint_id]
     short = joint.shortname()
-    if short in ("JointModelRX", "JointModelRY", "JointModelRZ",
-                 "JointModelRUBX", "JointModelRUBY", "JointModelRUBZ"):  # fmt: skip
-        axis = np.zeros(3)
-        axis[AXIS_INDEX[short[-1].lower()]] = 1.0
-        return axis
-    if short in ("JointModelRevoluteUnaligned", "JointModelRevoluteUnboundedUnaligned"):
-        return np.array(joint.extract().axis, dtype=float)
-    raise ModelError(f"joint '{model.names[joint_id]}' is {short}, not a revolute joint")
+    data = joint.createData()
+    joint.calc(data, pin.neutral(model))
+    subspace = data.S
+    subspace = np.asarray(subspace.matrix() if hasattr(subspace, "matrix") else subspace, float)
+    if subspace.size == 6:
+        subspace = subspace.reshape(6, 1)
+    # A revolute joint moves along one twist with no linear part (a helical one has both).
+    if subspace.shape != (6, 1) or np.linalg.norm(subspace[:3]) > 1e-12:
+        raise ModelError(f"joint '{model.names[joint_id]}' is {short}, not a revolute joint")
+    axis = subspace[3:, 0]
+    return axis / np.linalg.norm(axis)
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:
