@@ -42,6 +42,23 @@ def _still_unexplained(d: dict) -> str:
     return ""
 
 
+def _short(names: list[str]) -> str:
+    """Parameter names without their effect's prefix (``c1, s1``)."""
+    return ", ".join(n.rsplit(".", 1)[-1] for n in names)
+
+
+def _parameter_words(entry: dict) -> str:
+    """``c1 = -57.3 +- 37.4 arcsec (correlation with the model 0.91)``."""
+    name = entry["name"].rsplit(".", 1)[-1]
+    if entry["std"] is None:
+        return f"{name} not seen on its own (absorbed into the model's errors on these data)"
+    mark = "" if entry["determined"] else ", not determined"
+    return (
+        f"{name} = {entry['value']:.3g} +- {entry['std']:.2g} {entry['unit']} (correlation "
+        f"with the model {entry['correlation']:.2f}{mark})"
+    )
+
+
 def headline(d: dict) -> str:
     """The verdict in one line, from ``Diagnosis.to_dict()``.
 
@@ -60,7 +77,11 @@ def headline(d: dict) -> str:
             f"rms {_number(base[key])} -> {_number(best[key])} {unit}, chi2_reduced "
             f"{_number(base['chi2_reduced'])} -> {_number(best['chi2_reduced'])}"
         )
-        named = " + ".join(effects) + (f" (also significant: {', '.join(also)})" if also else "")
+        loose = verdict.get("named_undetermined", {})
+        named = " + ".join(
+            e + (f" (parameters not determined: {_short(loose[e])})" if e in loose else "")
+            for e in effects
+        ) + (f" (also significant: {', '.join(also)})" if also else "")
         if verdict["unexplained"]:
             return f"Partial explanation: {named} -- {change}; still unexplained: " + (
                 _still_unexplained(d)
@@ -111,13 +132,19 @@ def header_lines(d: dict) -> list[str]:
             continue
         alt = f"  same as: {', '.join(c['alternatives'])}" if c["alternatives"] else ""
         later = c.get("delta_bic_after_first")
-        if c["significant"] and later is not None:
-            alt += f"  (on top of {first}: {later:+.1f})"
+        accepted = c.get("in_best_model", c["significant"])
+        if c["significant"] and not accepted:
+            alt += "  (significant alone" + (
+                f"; on top of {first}: {later:+.1f})" if later is not None else ")"
+            )
+        if c.get("determined") is False:
+            alt += "  parameters not determined"
         lines.append(
             f"  {c['effect']:26s} delta_bic {c['delta_bic']:10.1f}  rms "
             f"{c['rms_arcsec']:.3f}  chi2_red {c['chi2_reduced']:.3f}"
-            f"{'  *' if c['significant'] else ''}{alt}"
+            f"{'  *' if accepted else ''}{alt}"
         )
+    lines.append("  (* in the final model)")
     return lines
 
 
@@ -142,6 +169,18 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
             lines.append(f"missing effect: {verdict['missing_effect']} ({story['title']})")
         lines.append(f"  why: {story['explanation']}")
         lines.append(f"  confirm on the machine: {story['confirm']}")
+        for name, entries in verdict.get("named_parameters", {}).items():
+            if entries:
+                lines.append(
+                    f"  {name} parameters: " + "; ".join(_parameter_words(e) for e in entries)
+                )
+        for name, loose in verdict.get("named_undetermined", {}).items():
+            lines.append(
+                f"  caution: {_short(loose)} of {name} are not determined (traded off against "
+                "the model's other parameters, correlation > 0.95, or none reaches 3 sigma): the "
+                "data support only the part of it they do determine; "
+                "read it as the shape it adds, not as these values"
+            )
     else:
         lines.append("missing effect: none (no catalogued effect improves the base fit)")
     if verdict["also_significant"]:
@@ -152,6 +191,18 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
         )
     for name, text in verdict["separations"].items():
         lines.append(f"  alternative {name}: {text}")
+    kept = (
+        "the effect named, whose parameters are determined, is kept"
+        if d["steps"] and not verdict.get("named_undetermined")
+        else "no effect is preferred for it"
+    )
+    for entry in verdict.get("not_named_undetermined", []):
+        lines.append(
+            f"not named: {entry['effect']} (delta_bic {entry['delta_bic']:.1f}, significant "
+            f"alone), but the data do not determine its {_short(entry['undetermined'])} "
+            f"(correlation > 0.95 with the model's other parameters, or none reaches 3 sigma); "
+            f"{kept}"
+        )
     for entry in verdict.get("unneeded_given_structure", []):
         lines.append(
             f"not named: {entry['effect']} was significant on its own, but the best description "

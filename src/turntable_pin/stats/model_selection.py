@@ -54,6 +54,10 @@ from .structure_search import (
 
 __all__ = [
     "ALTERNATIVE_LEVEL",
+    "DETERMINED_SIGMAS",
+    "MAX_CORRELATION",
+    "parameter_determination",
+    "undetermined_parameters",
     "acceptance_threshold",
     "FIT_TEST_ALPHA",
     "Candidate",
@@ -69,6 +73,13 @@ FIT_TEST_ALPHA = 1e-3
 
 ALTERNATIVE_LEVEL = 0.99
 """Quantile of chi2(added_rank) within which another effect's fit counts as equally good."""
+
+DETERMINED_SIGMAS = 3.0
+"""An effect is significant in its values when one of its parameters reaches this many standard
+errors (:func:`undetermined_parameters`)."""
+
+MAX_CORRELATION = 0.95
+"""A parameter is traded off against the model's others above this multiple correlation."""
 
 
 class ModelFamily(Protocol):
@@ -123,11 +134,96 @@ class Candidate:
     delta_bic: float | None = None
     alternatives: list[str] = field(default_factory=list)
     threshold: float = BIC_THRESHOLD
+    parameters: list[dict] = field(default_factory=list)
 
     @property
     def significant(self) -> bool:
         """Whether the effect lowers BIC by at least its round's threshold (:func:`threshold`)."""
         return self.delta_bic is not None and self.delta_bic <= self.threshold
+
+    @property
+    def determined(self) -> bool:
+        """Whether the data determine the effect (:func:`parameter_determination`; true when its
+        parameters were not examined): at least one of its parameters is determined on its own,
+        and every such one is determined (significant, not traded off against the model). The
+        parameters that only move along combinations the data cannot see (absorbed into the
+        model's errors, or acting on an angle not measured) do not count either way."""
+        return not self.parameters or not undetermined_parameters(self.parameters)
+
+    @property
+    def undetermined_parameters(self) -> list[str]:
+        """The added parameters that make it undetermined (:func:`undetermined_parameters`)."""
+        return undetermined_parameters(self.parameters)
+
+
+def undetermined_parameters(entries: Sequence[dict]) -> list[str]:
+    """The names among :func:`parameter_determination` ``entries`` that make an effect
+    undetermined; empty: the effect is determined.
+
+    An effect is determined when the data see at least one of its parameters on its own, every
+    such parameter is determined (not traded off against the others, correlation at most
+    :data:`MAX_CORRELATION`) and at least one is significant (``|value| >=``
+    :data:`DETERMINED_SIGMAS` ``std``). Parameters that only move along combinations the data
+    cannot see (absorbed into the model's errors, or acting on an angle not measured) count
+    neither way; a coefficient determined to be near zero (the 2/rev term of a 1/rev
+    eccentricity) is determined, not a flaw.
+    """
+    seen = [p for p in entries if p["std"] is not None]
+    if not seen:
+        return [p["name"] for p in entries]
+    loose = [p["name"] for p in seen if not p["determined"]]
+    if loose:
+        return loose
+    if not any(p["sigmas"] >= DETERMINED_SIGMAS for p in seen):
+        return [p["name"] for p in seen]
+    return []
+
+
+def parameter_determination(result: FitResult, names: Sequence[str], rank: int) -> list[dict]:
+    """Whether the data determine each parameter ``names`` of a fit, in user units.
+
+    Each entry: ``name``, ``value``, ``std`` (None when the parameter is not determined on its
+    own: it moves along a combination the data cannot see), ``unit``, ``sigmas``
+    (``|value| / std``), ``correlation`` and ``determined``.
+
+    ``correlation`` is the parameter's largest correlation with any combination of all the
+    other parameters of the model (the base errors and its own effect's others): the multiple
+    correlation ``|P_others J_i| / |J_i|`` of its weighted Jacobian column with the span of
+    theirs, that span cut to ``rank - 1`` directions (``rank``: the model's rank, so that
+    directions a large error makes barely visible at second order do not count); 1 when not
+    determined alone. A parameter is ``determined`` when that correlation is at most
+    :data:`MAX_CORRELATION`: it is not traded off against the others (the practice of
+    pointing-model fitting). Whether the effect as a whole is significant is
+    :func:`undetermined_parameters`' question.
+    """
+    table = result.parameter_table()
+    index = {n: i for i, n in enumerate(result.parameter_names)}
+    jac = result.jacobian_weighted
+    out = []
+    for name in names:
+        i = index[name]
+        entry = table[name]
+        std = entry["std"]
+        correlation = 1.0
+        column = jac[:, i]
+        norm = float(np.linalg.norm(column))
+        if std is not None and std > 0 and norm > 0:
+            others = np.delete(jac, i, axis=1)
+            u, _, _ = np.linalg.svd(others, full_matrices=False)
+            span = u[:, : max(int(rank) - 1, 0)]
+            correlation = min(float(np.linalg.norm(span.T @ column)) / norm, 1.0)
+        out.append(
+            {
+                "name": name,
+                "value": entry["value"],
+                "std": std,
+                "unit": entry["unit"],
+                "sigmas": abs(entry["value"]) / std if std else None,
+                "correlation": correlation,
+                "determined": bool(std is not None and correlation <= MAX_CORRELATION),
+            }
+        )
+    return out
 
 
 def acceptance_threshold(n_testable: int) -> float:
@@ -184,9 +280,22 @@ def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, ca
         dbic = delta_bic(fit.result.rss, base.rss, added, m, known, fit.result.rank)
         out.append(Candidate(effect.name, True, None, fit, added, float(dbic)))
     threshold = acceptance_threshold(sum(c.testable for c in out))
+    known_names = set(base.parameter_names)
     for c in out:
         c.threshold = threshold
-    out.sort(key=lambda c: (not c.testable, c.delta_bic if c.delta_bic is not None else 0.0))
+        if c.significant:
+            added_names = [n for n in c.fit.result.parameter_names if n not in known_names]
+            c.parameters = parameter_determination(c.fit.result, added_names, c.fit.result.rank)
+    # Best first: the significant effects whose parameters are determined, then the others by
+    # delta_bic (a richer effect whose extra parameters the data do not determine is not
+    # preferred to the simpler one that explains the signal with determined ones).
+    out.sort(
+        key=lambda c: (
+            not c.testable,
+            not (c.significant and c.determined),
+            c.delta_bic if c.delta_bic is not None else 0.0,
+        )
+    )
     return out
 
 
@@ -307,6 +416,17 @@ class Diagnosis:
         """Whether the observations' sigmas were given (not estimated)."""
         return self.base_fit.result.sigma_known
 
+    def named_parameters(self) -> dict[str, list[dict]]:
+        """``{effect: parameter_determination entries}`` of every named effect in the best fit
+        (values, standard errors, correlations with the other parameters)."""
+        result = self.best_fit.result
+        out = {}
+        for step in self.steps:
+            prefix = f"{step.added}."
+            names = [n for n in result.parameter_names if n.startswith(prefix)]
+            out[step.added] = parameter_determination(result, names, result.rank) if names else []
+        return out
+
     def _first_threshold(self) -> float:
         """The acceptance threshold of the first round (against the base model)."""
         return next((c.threshold for c in self.candidates if c.testable), BIC_THRESHOLD)
@@ -318,6 +438,7 @@ class Diagnosis:
     def to_dict(self) -> dict:
         """The spec's diagnosis JSON (plus steps, structure and per-effect explanations)."""
         nv = self.noise_variance
+        named = {s.added for s in self.steps}
         candidates = []
         for c in self.candidates:
             entry = {
@@ -330,6 +451,10 @@ class Diagnosis:
                 "significant": c.significant,
                 "alternatives": list(c.alternatives),
             }
+            entry["in_best_model"] = c.effect in named
+            if c.parameters:
+                entry["determined"] = c.determined
+                entry["parameters"] = [dict(p) for p in c.parameters]
             if self.steps and c.effect != self.steps[0].added:
                 entry["delta_bic_after_first"] = self.after_first.get(c.effect)
             if c.reason:
@@ -352,6 +477,23 @@ class Diagnosis:
                 for name, value in self.unneeded_given_structure.items()
             ],
         }
+        named_parameters = self.named_parameters()
+        verdict["named_parameters"] = named_parameters
+        verdict["named_undetermined"] = {
+            name: undetermined_parameters(entries)
+            for name, entries in named_parameters.items()
+            if entries and undetermined_parameters(entries)
+        }
+        verdict["not_named_undetermined"] = [
+            {
+                "effect": c.effect,
+                "delta_bic": c.delta_bic,
+                "undetermined": c.undetermined_parameters,
+                "parameters": [dict(p) for p in c.parameters],
+            }
+            for c in self.candidates
+            if c.significant and not c.determined and c.effect not in named
+        ]
         if self.missing_effect:
             verdict["effect_story"] = self.family.describe(self.missing_effect)
         unit = self.family.observation_unit
