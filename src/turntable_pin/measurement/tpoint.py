@@ -1,0 +1,711 @@
+"""TPOINT pointing runs in: a telescope mount's star-pointing run as an orientation-measurement CSV.
+
+A telescope mount is a two-axis table. A TPOINT run file records, per star, where the star is
+(the *observed* position) and where the encoders say the mount pointed (the *raw* position). This
+module reads such a file (:func:`read_tpoint`, a frozen :class:`TpointRun`) and converts it
+(:func:`convert_tpoint`) into rows of the measurement CSV of ``docs/measurements.md`` for the
+bundled mount URDFs, ``models/altaz_mount.urdf`` and ``models/german_equatorial_mount.urdf``.
+
+Units: angles in the file and in the CSV's ``phi1_deg, phi2_deg`` are degrees (sexagesimal in the
+equatorial records: hours or degrees, minutes, seconds); the measured angles ``dpsi_arcsec,
+dtheta_arcsec`` are arc seconds; temperature degrees Celsius, pressure millibar (hPa), height
+metres, humidity a fraction 0..1. Inside, angles are radians.
+
+The file (what is read; anything else is refused with the file and line named):
+
+- ``!`` starts a comment line; blank lines are skipped; a line ``END`` ends the data.
+- The first other line is the caption (free text).
+- Option lines ``: NAME`` (or ``:NAME``): ``ALTAZ`` (an alt-az mount), ``EQUAT`` (an equatorial
+  mount), ``NODA`` and ``ALLSKY`` (recorded, no effect on the conversion). ``J2000`` (mean places)
+  is refused: the conversion does no precession, nutation or aberration. Any other option is
+  refused as unknown.
+- The run-parameter line: latitude ``+-d m s``, then optionally the date ``y m d``, temperature
+  (C), pressure (mbar), height (m), relative humidity (0..1), wavelength (micron), lapse rate
+  (K/m); 3, or 6 to 12 numbers.
+- Alt-az data lines: ``az_obs el_obs az_raw el_raw`` in decimal degrees (TPOINT's "format 4", the
+  layout of the bundled MMT run and of pytelpoint's reader). The azimuth is TPOINT's (South = 0,
+  East = 90) unless ``azimuth_origin``/``azimuth_direction`` say otherwise.
+- Equatorial data lines: ``RA h m s, Dec +-d m s, raw RA h m s, raw Dec +-d m s, sidereal time
+  h m`` (14 numbers; the layout TPOINT exporters such as ACP's ModelToTpoint and RTS2's
+  rts2-tpm write). Hour angles are ``LST - RA`` (positive West), for the star and the raw reading
+  alike; the star places are taken as apparent places of date.
+
+The conversion (the project's definition, docs/model.md): ``dR = Rd(raw)^T Rt``, with ``Rd`` the
+URDF's nominal chain and ``Rt`` the orientation that points at the star, taken as ``Rd(observed)``:
+``dtheta = dR[1,0]`` is the boresight's own error across the second axis' circle and exact;
+``dpsi = dR[0,2]`` uses the roll of the nominal chain at the observed angles, which a pointing run
+does not observe: exact for index errors, off by (roll error) x (cross-axis error) otherwise;
+``dgamma`` (the roll) is not measured and left empty.
+
+Refraction: with ``refraction="apply"`` the observed position is lifted towards the zenith by the
+Saemundsson refraction at the run's temperature and pressure before ``Rd(observed)`` is formed;
+``"none"`` uses the positions as given. The default follows the file: ``none`` for alt-az runs
+(their observed az/el are where the star is seen, refraction included, as in the bundled MMT
+run and pytelpoint), ``apply`` for equatorial runs (their star places are catalogue places, which
+TPOINT refracts with the run parameters).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..core.exceptions import InputError
+from ..core.files import write_text_atomic
+from ..core.units import ARCSEC_PER_RAD
+from .data import MAX_MEASURED_ANGLE_ARCSEC
+
+__all__ = [
+    "ALTAZ",
+    "AZIMUTH_DIRECTIONS",
+    "AZIMUTH_ORIGINS",
+    "EQUATORIAL",
+    "KNOWN_OPTIONS",
+    "MOUNTS",
+    "MOUNT_URDFS",
+    "REFRACTION_MODES",
+    "TpointConversion",
+    "TpointRun",
+    "convert_tpoint",
+    "mount_urdf_text",
+    "read_tpoint",
+    "saemundsson_refraction_arcsec",
+]
+
+ALTAZ = "altaz"
+"""Mount type of an alt-azimuth run (``: ALTAZ``)."""
+EQUATORIAL = "equatorial"
+"""Mount type of an equatorial run (``: EQUAT``), converted on the German-equatorial URDF."""
+MOUNTS = (ALTAZ, EQUATORIAL)
+"""The mount types this module converts."""
+MOUNT_URDFS = {ALTAZ: "altaz_mount.urdf", EQUATORIAL: "german_equatorial_mount.urdf"}
+"""The bundled URDF (in the models folder) of each mount type."""
+REFRACTION_MODES = ("apply", "none")
+"""``apply``: refract the observed positions (Saemundsson); ``none``: use them as given."""
+AZIMUTH_ORIGINS = ("south", "north")
+"""Where the file's azimuth is 0."""
+AZIMUTH_DIRECTIONS = ("east", "west")
+"""Which side the file's azimuth 90 deg lies on."""
+KNOWN_OPTIONS = ("ALTAZ", "EQUAT", "NODA", "ALLSKY", "J2000")
+"""Option lines recognised (``J2000`` is recognised to be refused: mean places)."""
+
+_OPTION_MOUNT = {"ALTAZ": ALTAZ, "EQUAT": EQUATORIAL}
+_RECORD_NUMBERS = {ALTAZ: 4, EQUATORIAL: 14}
+_RECORD_LAYOUT = {
+    ALTAZ: "az_obs el_obs az_raw el_raw (decimal degrees)",
+    EQUATORIAL: "RA h m s, Dec d m s, raw RA h m s, raw Dec d m s, sidereal time h m",
+}
+_RUN_FIELDS = (
+    "temperature_c", "pressure_mbar", "height_m", "humidity", "wavelength_um", "lapse_rate_k_per_m",
+)  # fmt: skip
+_NUMBER = re.compile(r"^[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?$")
+_ORIGIN_NOTE = re.compile(r"\b(north|south)\s*=\s*0\b", re.I)
+_DIRECTION_NOTE = re.compile(r"\b(east|west)\s*=\s*90\b", re.I)
+
+
+@dataclass(frozen=True)
+class TpointRun:
+    """A TPOINT run as read (angles in degrees, in the table's conventions).
+
+    Attributes:
+        path: the file.
+        caption: its caption line.
+        options: the option names in file order (``ALTAZ``, ``NODA``, ...).
+        mount: :data:`ALTAZ` or :data:`EQUATORIAL`.
+        mount_line: the line of the option naming the mount (``None`` if given by the caller).
+        latitude_deg: the site latitude of the run-parameter line (deg, North positive).
+        latitude_text: the latitude as written (``+31 41 19.6``).
+        run_parameters: ``date`` (y, m, d) and the present fields of the run-parameter line:
+            ``temperature_c`` (C), ``pressure_mbar`` (mbar), ``height_m`` (m), ``humidity``
+            (0..1), ``wavelength_um`` (micron), ``lapse_rate_k_per_m`` (K/m).
+        observed_deg: (N, 2) observed first and second angle: alt-az: azimuth (South = 0, East =
+            90) and elevation; equatorial: hour angle (positive West) and declination (deg).
+        raw_deg: (N, 2) the raw (encoder) angles in the same convention (deg).
+        lines: (N,) line number of each star's record (1 = first line of the file).
+        azimuth_origin, azimuth_direction: the file's azimuth convention (alt-az), converted.
+    """
+
+    path: str
+    caption: str
+    options: tuple[str, ...]
+    mount: str
+    mount_line: int | None
+    latitude_deg: float
+    latitude_text: str
+    run_parameters: dict = field(hash=False, compare=False)
+    observed_deg: np.ndarray = field(hash=False, compare=False)
+    raw_deg: np.ndarray = field(hash=False, compare=False)
+    lines: tuple[int, ...] = ()
+    azimuth_origin: str = "south"
+    azimuth_direction: str = "east"
+
+    @property
+    def n_stars(self) -> int:
+        """Number of data lines (stars)."""
+        return len(self.lines)
+
+
+@dataclass(frozen=True)
+class TpointConversion:
+    """A run converted to measurement rows (see the module docstring for the definitions).
+
+    Attributes:
+        run: the :class:`TpointRun`.
+        phi_deg: (N, 2) the raw (commanded) joint angles written as ``phi1_deg, phi2_deg`` (deg).
+        dpsi_arcsec, dtheta_arcsec: (N,) the measured orientation error angles (arcsec).
+        refraction: ``apply`` or ``none``: what was done.
+        refraction_arcsec: (N,) the refraction added to each observed elevation (arcsec; zeros
+            for ``none``).
+        latitude_deg: the latitude of the URDF's polar axis (equatorial; the file's for alt-az).
+        urdf_name: the bundled URDF the rows belong to.
+        urdf_text: that URDF (for an equatorial run: tilted to ``latitude_deg``).
+        urdf_written: where that URDF was written, if it was (named in the comments).
+    """
+
+    run: TpointRun
+    phi_deg: np.ndarray = field(hash=False, compare=False)
+    dpsi_arcsec: np.ndarray = field(hash=False, compare=False)
+    dtheta_arcsec: np.ndarray = field(hash=False, compare=False)
+    refraction: str = "none"
+    refraction_arcsec: np.ndarray = field(default=None, hash=False, compare=False)
+    latitude_deg: float = 0.0
+    urdf_name: str = ""
+    urdf_text: str = ""
+    urdf_written: str | None = None
+
+    def comment_lines(self) -> list[str]:
+        """The provenance written above the CSV header (each without its ``# ``)."""
+        run = self.run
+        p = run.run_parameters
+        params = [f"latitude {run.latitude_text} ({run.latitude_deg:.6f} deg)"]
+        if "date" in p:
+            params.append("date {:04d}-{:02d}-{:02d}".format(*p["date"]))
+        units = dict(zip(_RUN_FIELDS, (" C", " mbar", " m", "", " micron", " K/m"), strict=True))
+        params += [f"{k.split('_')[0]} {p[k]:g}{units[k]}" for k in _RUN_FIELDS if k in p]
+        first, second = ("azimuth", "elevation") if run.mount == ALTAZ else ("hour angle", "dec")
+        if run.mount == ALTAZ:
+            table = f"models/{self.urdf_name}"
+        else:
+            table = f"a copy of models/{self.urdf_name} with its polar axis at latitude " + (
+                f"{self.latitude_deg:.6f} deg"
+            )
+        urdf = self.urdf_written or (f"models/{self.urdf_name}" if run.mount == ALTAZ else None)
+        out = [
+            f"imported by turntable-pin import-tpoint from {Path(run.path).name} (TPOINT run)",
+            f"caption: {run.caption}",
+            f"mount: {run.mount}, table {table}" + (f"; read with --urdf {urdf}" if urdf else ""),
+            "options: " + (" ".join(run.options) or "none"),
+            "run parameters: " + ", ".join(params),
+        ]
+        if run.mount == ALTAZ:
+            out.append(
+                f"azimuth of the file: {run.azimuth_origin} = 0, {run.azimuth_direction} = 90; "
+                "written in TPOINT's convention (South = 0, East = 90, right-handed about the "
+                "upward vertical)"
+            )
+        else:
+            out.append("hour angle = sidereal time - RA (positive West), star and raw alike; "
+                       "star places taken as apparent places of date")  # fmt: skip
+        if self.refraction == "apply":
+            r = self.refraction_arcsec
+            out.append(
+                "refraction: applied (Saemundsson at the run's temperature and pressure; "
+                f"{r.min():.2f} to {r.max():.2f} arcsec added to the observed elevations)"
+            )
+        else:
+            out.append("refraction: none (the observed positions used as given)")
+        out += [
+            f"phi1_deg, phi2_deg = raw (encoder) {first} and {second}: the commanded angles",
+            "dR = Rd(raw)^T Rd(observed) with the URDF's nominal chain; dpsi_arcsec = dR[0,2], "
+            "dtheta_arcsec = dR[1,0]; dgamma_arcsec empty (the roll is not measured); no sigma",
+            "dpsi takes the roll of the nominal chain at the observed angles (exact for index "
+            "errors; off by roll error x cross-axis error otherwise)",
+            "source lines of the rows, in order: " + _ranges(run.lines),
+        ]
+        return out
+
+    def csv_text(self) -> str:
+        """The measurement CSV (comment lines, header, one row per star)."""
+        lines = [f"# {c}" for c in self.comment_lines()]
+        lines.append("phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec")
+        for (p1, p2), dpsi, dtheta in zip(
+            self.phi_deg, self.dpsi_arcsec, self.dtheta_arcsec, strict=True
+        ):
+            lines.append(f"{_num(p1)},{_num(p2)},{dpsi:.12f},{dtheta:.12f},")
+        return "\n".join(lines) + "\n"
+
+    def write_csv(self, path: str | Path) -> Path:
+        """Write :meth:`csv_text` to ``path`` atomically; returns the path."""
+        return write_text_atomic(path, self.csv_text())
+
+    def write_urdf(self, path: str | Path) -> Path:
+        """Write :attr:`urdf_text` to ``path`` atomically; returns the path."""
+        return write_text_atomic(path, self.urdf_text)
+
+
+def _num(value: float) -> str:
+    """A float written so that it reads back exactly (shortest round-trip form)."""
+    return repr(float(value))
+
+
+def _ranges(lines) -> str:
+    """``21-100, 104`` for the sorted runs of consecutive numbers in ``lines``."""
+    out, start, prev = [], None, None
+    for n in lines:
+        if start is None:
+            start = prev = n
+        elif n == prev + 1:
+            prev = n
+        else:
+            out.append(f"{start}-{prev}" if prev != start else f"{start}")
+            start = prev = n
+    if start is not None:
+        out.append(f"{start}-{prev}" if prev != start else f"{start}")
+    return ", ".join(out)
+
+
+# --- reading ---------------------------------------------------------------------------------
+def _numbers(tokens: list[str], path: Path, line: int, what: str) -> list[float]:
+    """The tokens as floats, or :class:`InputError` naming the first that is not a number."""
+    for tok in tokens:
+        if not _NUMBER.match(tok):
+            raise InputError(f"{what}: '{tok}' is not a number", path=path, line=line)
+    return [float(t) for t in tokens]
+
+
+def _sexagesimal(tokens: list[str], path: Path, line: int, what: str, limit: float) -> float:
+    """``+-d m s`` (or ``h m s``) as a decimal number, sign from the first token's text."""
+    d, m, s = _numbers(tokens, path, line, what)
+    if not (d == int(d) and 0 <= m < 60 and 0 <= s < 60):
+        raise InputError(
+            f"{what} '{' '.join(tokens)}': expected whole degrees (hours), minutes < 60 and "
+            "seconds < 60",
+            path=path,
+            line=line,
+        )
+    value = abs(d) + m / 60.0 + s / 3600.0
+    value = -value if tokens[0].startswith("-") else value
+    if abs(value) > limit:
+        raise InputError(f"{what} '{' '.join(tokens)}' is beyond +-{limit:g}", path=path, line=line)
+    return value
+
+
+def _azimuth_to_tpoint(az, origin: str, direction: str):
+    """The file's azimuth (deg) in TPOINT's convention (South = 0, East = 90)."""
+    if origin == "south":
+        return az if direction == "east" else -az
+    # North = 0: the right-handed (West = 90) one is TPOINT's turned by 180 deg; the common
+    # North-through-East one is its mirror image.
+    return az - 180.0 if direction == "west" else 180.0 - az
+
+
+def read_tpoint(
+    path: str | Path,
+    *,
+    mount: str | None = None,
+    azimuth_origin: str = "south",
+    azimuth_direction: str = "east",
+) -> TpointRun:
+    """Read a TPOINT run file (the layout of the module docstring).
+
+    Args:
+        path: the file.
+        mount: :data:`ALTAZ` or :data:`EQUATORIAL` when the file has no mount option line; a file
+            that states the other mount is refused.
+        azimuth_origin, azimuth_direction: the azimuth convention of an alt-az file (default
+            TPOINT's: South = 0, East = 90); converted to TPOINT's. A comment of the file that
+            states another origin ("North = 0") or direction ("West = 90") is refused.
+
+    Raises:
+        InputError: naming the file and line of the first problem.
+    """
+    path = Path(path)
+    if mount is not None and mount not in MOUNTS:
+        raise InputError(f"unknown mount '{mount}': expected one of {', '.join(MOUNTS)}")
+    if azimuth_origin not in AZIMUTH_ORIGINS or azimuth_direction not in AZIMUTH_DIRECTIONS:
+        raise InputError(
+            f"azimuth convention '{azimuth_origin}, {azimuth_direction}': expected origin "
+            f"{'|'.join(AZIMUTH_ORIGINS)} and direction {'|'.join(AZIMUTH_DIRECTIONS)}"
+        )
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except OSError as exc:
+        raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
+    except UnicodeDecodeError:
+        raise InputError("not a text (UTF-8) TPOINT file", path=path) from None
+
+    caption = None
+    options: list[str] = []
+    file_mount, mount_line = None, None
+    run_line = None
+    latitude = latitude_text = None
+    params: dict = {}
+    observed, raw, lines = [], [], []
+    notes = []  # (line, text) of the comment lines, for the azimuth convention check
+    for number, raw_line in enumerate(text.splitlines(), start=1):
+        line = raw_line.strip()
+        if not line:
+            continue
+        if line.startswith("!"):
+            notes.append((number, line))
+            continue
+        if caption is None:
+            caption = line
+            continue
+        if line.upper() == "END":
+            break
+        if line.startswith(":"):
+            name = line[1:].strip().split()[0].upper() if line[1:].strip() else ""
+            if run_line is not None:
+                raise InputError(
+                    f"option line '{line}' after the run-parameter line (line {run_line}): "
+                    "options come between the caption and the run parameters",
+                    path=path,
+                    line=number,
+                )
+            if name not in KNOWN_OPTIONS:
+                raise InputError(
+                    f"unknown option line '{line}': this importer knows "
+                    + ", ".join(f": {o}" for o in KNOWN_OPTIONS),
+                    path=path,
+                    line=number,
+                )
+            if name == "J2000":
+                raise InputError(
+                    "': J2000' (mean J2000 star places) is not supported: the importer does no "
+                    "precession, nutation or aberration; give apparent places of date",
+                    path=path,
+                    line=number,
+                )
+            if name in _OPTION_MOUNT:
+                if file_mount is not None and _OPTION_MOUNT[name] != file_mount:
+                    raise InputError(
+                        f"'{line}' contradicts the mount option on line {mount_line}",
+                        path=path,
+                        line=number,
+                    )
+                file_mount, mount_line = _OPTION_MOUNT[name], number
+                if mount is not None and mount != file_mount:
+                    raise InputError(
+                        f"the file states an {file_mount} mount ('{line}'), but --mount "
+                        f"{mount} was given",
+                        path=path,
+                        line=number,
+                    )
+            options.append(name)
+            continue
+        tokens = line.split()
+        if run_line is None:
+            kind = file_mount or mount
+            if kind is None:
+                raise InputError(
+                    "the file states no mount (no ': ALTAZ' or ': EQUAT' option line before "
+                    "the run parameters); give --mount altaz|equatorial",
+                    path=path,
+                    line=number,
+                )
+            if len(tokens) == _RECORD_NUMBERS[kind] or len(tokens) not in (3, *range(6, 13)):
+                raise InputError(
+                    f"expected the run-parameter line (latitude d m s [year month day "
+                    f"temperature_C pressure_mbar height_m humidity ...]: 3 or 6 to 12 numbers), "
+                    f"got {len(tokens)} fields: the run-parameter line is missing",
+                    path=path,
+                    line=number,
+                )
+            latitude = _sexagesimal(tokens[:3], path, number, "latitude", 90.0)
+            latitude_text = " ".join(tokens[:3])
+            rest = _numbers(tokens[3:], path, number, "run parameter")
+            if rest:
+                y, mo, d = rest[:3]
+                if not (y == int(y) and mo == int(mo) and d == int(d) and 1 <= mo <= 12
+                        and 1 <= d <= 31):  # fmt: skip
+                    raise InputError(
+                        f"date '{' '.join(tokens[3:6])}': expected year month day",
+                        path=path,
+                        line=number,
+                    )
+                params["date"] = (int(y), int(mo), int(d))
+                params.update(zip(_RUN_FIELDS, rest[3:], strict=False))
+            _check_run_parameters(params, path, number)
+            run_line = number
+            continue
+        kind = file_mount or mount
+        expected = _RECORD_NUMBERS[kind]
+        if len(tokens) != expected:
+            raise InputError(
+                f"expected {expected} numbers ({_RECORD_LAYOUT[kind]}), got {len(tokens)} fields",
+                path=path,
+                line=number,
+            )
+        values = _numbers(tokens, path, number, "data")
+        if kind == ALTAZ:
+            az_o, el_o, az_r, el_r = values
+            for label, el in (("observed", el_o), ("raw", el_r)):
+                if not -90.0 <= el <= 90.0:
+                    raise InputError(
+                        f"{label} elevation {el:g} deg is outside [-90, 90]", path=path, line=number
+                    )
+            for label, az in (("observed", az_o), ("raw", az_r)):
+                if abs(az) > 720.0:
+                    raise InputError(
+                        f"{label} azimuth {az:g} deg is beyond +-720 deg", path=path, line=number
+                    )
+            observed.append((_azimuth_to_tpoint(az_o, azimuth_origin, azimuth_direction), el_o))
+            raw.append((_azimuth_to_tpoint(az_r, azimuth_origin, azimuth_direction), el_r))
+        else:
+            ra = _sexagesimal(tokens[0:3], path, number, "RA", 24.0)
+            dec = _sexagesimal(tokens[3:6], path, number, "Dec", 90.0)
+            ra_raw = _sexagesimal(tokens[6:9], path, number, "raw RA", 24.0)
+            dec_raw = _sexagesimal(tokens[9:12], path, number, "raw Dec", 180.0)
+            h, m = values[12:14]
+            if not (h == int(h) and 0 <= h < 24 and 0 <= m < 60):
+                raise InputError(
+                    f"sidereal time '{tokens[12]} {tokens[13]}': expected hours < 24 and "
+                    "minutes < 60",
+                    path=path,
+                    line=number,
+                )
+            lst = h + m / 60.0
+            observed.append((15.0 * (lst - ra), dec))
+            raw.append((15.0 * (lst - ra_raw), dec_raw))
+        lines.append(number)
+    if caption is None:
+        raise InputError("no caption line, no run-parameter line and no data lines", path=path)
+    if run_line is None:
+        raise InputError(
+            "no run-parameter line (latitude d m s [date temperature pressure ...]) after the "
+            "caption and options",
+            path=path,
+        )
+    if not lines:
+        raise InputError(f"no data lines after the run-parameter line (line {run_line})", path=path)
+    kind = file_mount or mount
+    if kind == ALTAZ:
+        _check_azimuth_notes(notes, azimuth_origin, azimuth_direction, path)
+    return TpointRun(
+        path=str(path),
+        caption=caption,
+        options=tuple(options),
+        mount=kind,
+        mount_line=mount_line,
+        latitude_deg=float(latitude),
+        latitude_text=latitude_text,
+        run_parameters=params,
+        observed_deg=np.array(observed, dtype=float),
+        raw_deg=np.array(raw, dtype=float),
+        lines=tuple(lines),
+        azimuth_origin=azimuth_origin,
+        azimuth_direction=azimuth_direction,
+    )
+
+
+def _check_run_parameters(params: dict, path: Path, line: int) -> None:
+    """Refuse run parameters outside physical ranges (refraction would be meaningless)."""
+    ranges = {
+        "temperature_c": (-100.0, 60.0),
+        "pressure_mbar": (0.0, 1200.0),
+        "height_m": (-500.0, 10000.0),
+        "humidity": (0.0, 1.0),
+    }
+    for key, (low, high) in ranges.items():
+        if key in params and not low <= params[key] <= high:
+            raise InputError(
+                f"run parameter {key} = {params[key]:g} is outside [{low:g}, {high:g}]",
+                path=path,
+                line=line,
+            )
+
+
+def _check_azimuth_notes(notes, origin: str, direction: str, path: Path) -> None:
+    """Refuse an azimuth convention that a comment of the file contradicts."""
+    for number, text in notes:
+        found = _ORIGIN_NOTE.search(text)
+        if found and found.group(1).lower() != origin:
+            raise InputError(
+                f"the file's comment states '{found.group(0)}', but the azimuth origin is "
+                f"taken as {origin} (--azimuth-origin); give --azimuth-origin "
+                f"{found.group(1).lower()} or correct the comment",
+                path=path,
+                line=number,
+            )
+        found = _DIRECTION_NOTE.search(text)
+        if found and found.group(1).lower() != direction:
+            raise InputError(
+                f"the file's comment states '{found.group(0)}', but azimuth 90 is taken as "
+                f"{direction} (--azimuth-direction); give --azimuth-direction "
+                f"{found.group(1).lower()} or correct the comment",
+                path=path,
+                line=number,
+            )
+
+
+# --- the mount URDFs --------------------------------------------------------------------------
+def mount_urdf_text(mount: str, latitude_deg: float | None = None, note: str = "") -> str:
+    """The bundled URDF of ``mount``; for :data:`EQUATORIAL` with the ``hour_angle`` joint's
+    origin ``rpy`` set to ``(0, latitude - 90 deg, 0)`` (an XML edit; comments kept, a note added).
+    """
+    import xml.etree.ElementTree as ET
+
+    from ..core.resources import models_dir
+
+    source = models_dir() / MOUNT_URDFS[mount]
+    text = source.read_text(encoding="utf-8")
+    if mount != EQUATORIAL:
+        return text
+    if latitude_deg is None or not -90.0 <= latitude_deg <= 90.0:
+        raise InputError(f"latitude {latitude_deg!r}: expected a value in [-90, 90] deg")
+    parser = ET.XMLParser(target=ET.TreeBuilder(insert_comments=True))
+    root = ET.fromstring(text, parser=parser)
+    joint = root.find("./joint[@name='hour_angle']")
+    origin = None if joint is None else joint.find("origin")
+    if origin is None:
+        raise InputError(f"{source}: no origin of the joint 'hour_angle' to tilt")
+    pitch = math.radians(latitude_deg - 90.0)
+    origin.set("rpy", f"0 {pitch!r} 0")
+    comment = ET.Comment(
+        f" Copy tilted to latitude {latitude_deg!r} deg: hour_angle origin rpy = (0, latitude - "
+        f"90 deg, 0) = (0, {pitch!r}, 0). {note}".rstrip()
+        + " "
+    )
+    root.insert(0, comment)
+    body = ET.tostring(root, encoding="unicode")
+    header = text[: text.index("<robot")]  # the XML declaration and the frames comment
+    return header + body + "\n"
+
+
+# --- refraction -------------------------------------------------------------------------------
+def saemundsson_refraction_arcsec(elevation_deg, temperature_c: float, pressure_mbar: float):
+    """Atmospheric refraction (arcsec) at the true (unrefracted) elevation ``elevation_deg``.
+
+    Saemundsson's formula, ``R = 1.02' / tan(h + 10.3 / (h + 5.11))`` (h in degrees), scaled by
+    ``(P / 1010 mbar) * (283 K / (273 K + T))``; good to a few arc seconds above ~5 deg elevation.
+    """
+    h = np.asarray(elevation_deg, dtype=float)
+    r_arcmin = 1.02 / np.tan(np.radians(h + 10.3 / (h + 5.11)))
+    return r_arcmin * 60.0 * (pressure_mbar / 1010.0) * (283.0 / (273.0 + temperature_c))
+
+
+def _boresight(placements, q_rad) -> np.ndarray:
+    """The payload's x axis in the base frame at joint angles ``q_rad`` (2, ...) -> (..., 3)."""
+    from ..model.chain import compose_rotation
+
+    return compose_rotation(placements, list(q_rad))[..., :, 0]
+
+
+def _lift(v: np.ndarray, angle_rad: np.ndarray) -> np.ndarray:
+    """Directions ``v`` (N, 3) turned towards the zenith (+z) by ``angle_rad`` (N,)."""
+    up = np.array([0.0, 0.0, 1.0])
+    across = up - v[:, 2:3] * v
+    across /= np.linalg.norm(across, axis=1, keepdims=True)
+    return np.cos(angle_rad)[:, None] * v + np.sin(angle_rad)[:, None] * across
+
+
+def _angles_pointing_at(placements, target: np.ndarray, start_rad: np.ndarray) -> np.ndarray:
+    """Joint angles (2, N) near ``start_rad`` whose boresight is ``target`` (N, 3): Gauss-Newton
+    with the chain's own boresight, to 1e-13 rad."""
+    q = np.array(start_rad, dtype=float)
+    step = 1e-7
+    for _ in range(20):
+        f = _boresight(placements, q)
+        jac = np.stack(
+            [(_boresight(placements, q + step * e[:, None]) - f) / step for e in np.eye(2)],
+            axis=-1,
+        )  # (N, 3, 2)
+        dq = np.einsum("nij,nj->ni", np.linalg.pinv(jac), target - f).T
+        q = q + dq
+        if np.max(np.abs(dq)) < 1e-13:
+            break
+    return q
+
+
+# --- conversion -------------------------------------------------------------------------------
+def convert_tpoint(
+    run: TpointRun, *, refraction: str | None = None, latitude_deg: float | None = None
+) -> TpointConversion:
+    """The measurement rows of ``run`` (see the module docstring).
+
+    Args:
+        run: a :class:`TpointRun`.
+        refraction: ``apply`` or ``none``; ``None``: the file type's default (``none`` for alt-az,
+            ``apply`` for equatorial).
+        latitude_deg: the polar axis' latitude of an equatorial run (default: the file's).
+
+    Raises:
+        InputError: refraction requested without temperature and pressure, or at an observed
+            elevation below 0 deg; an observed/raw pair more than the small-error limit (5 deg)
+            apart on the sky (not a pointing error), naming the line.
+    """
+    from ..model.chain import compose_rotation
+    from ..model.generic_table import GenericTable
+
+    if refraction is None:
+        refraction = "none" if run.mount == ALTAZ else "apply"
+    if refraction not in REFRACTION_MODES:
+        raise InputError(
+            f"refraction '{refraction}': expected one of {', '.join(REFRACTION_MODES)}"
+        )
+    latitude = run.latitude_deg if latitude_deg is None else float(latitude_deg)
+    urdf_text = mount_urdf_text(
+        run.mount,
+        latitude,
+        note=f"Written for {Path(run.path).name}." if run.mount == EQUATORIAL else "",
+    )
+    with tempfile.TemporaryDirectory(prefix="turntable-pin-tpoint-") as folder:
+        urdf = Path(folder) / MOUNT_URDFS[run.mount]
+        urdf.write_text(urdf_text, encoding="utf-8")
+        placements = GenericTable(urdf).chain.placements()
+    raw = np.radians(run.raw_deg).T  # (2, N)
+    obs = np.radians(run.observed_deg).T
+    refr = np.zeros(run.n_stars)
+    if refraction == "apply":
+        p = run.run_parameters
+        if "temperature_c" not in p or "pressure_mbar" not in p:
+            raise InputError(
+                "--refraction apply needs the temperature and pressure of the run-parameter "
+                "line, which gives none; use --refraction none or complete the line",
+                path=run.path,
+            )
+        v = _boresight(placements, obs)
+        elevation = np.degrees(np.arcsin(np.clip(v[:, 2], -1.0, 1.0)))
+        low = np.flatnonzero(elevation < 0.0)
+        if low.size:
+            raise InputError(
+                f"observed elevation {elevation[low[0]]:.3f} deg is below the horizon: refraction "
+                "is not defined there",
+                path=run.path,
+                line=run.lines[low[0]],
+            )
+        refr = saemundsson_refraction_arcsec(elevation, p["temperature_c"], p["pressure_mbar"])
+        obs = _angles_pointing_at(placements, _lift(v, refr / ARCSEC_PER_RAD), obs)
+    d_r = np.swapaxes(compose_rotation(placements, list(raw)), -1, -2) @ compose_rotation(
+        placements, list(obs)
+    )
+    separation = np.degrees(np.arccos(np.clip(d_r[:, 0, 0], -1.0, 1.0))) * 3600.0
+    far = np.flatnonzero(separation > MAX_MEASURED_ANGLE_ARCSEC)
+    if far.size:
+        i = far[0]
+        raise InputError(
+            f"the observed and raw positions are {separation[i] / 3600.0:.3f} deg apart on the "
+            f"sky (observed {run.observed_deg[i, 0]:g}, {run.observed_deg[i, 1]:g}; raw "
+            f"{run.raw_deg[i, 0]:g}, {run.raw_deg[i, 1]:g} deg): more than "
+            f"{MAX_MEASURED_ANGLE_ARCSEC / 3600.0:g} deg is not a pointing error (a column or "
+            "convention mix-up?)",
+            path=run.path,
+            line=run.lines[i],
+        )
+    return TpointConversion(
+        run=run,
+        phi_deg=run.raw_deg.copy(),
+        dpsi_arcsec=d_r[:, 0, 2] * ARCSEC_PER_RAD,
+        dtheta_arcsec=d_r[:, 1, 0] * ARCSEC_PER_RAD,
+        refraction=refraction,
+        refraction_arcsec=refr,
+        latitude_deg=latitude,
+        urdf_name=MOUNT_URDFS[run.mount],
+        urdf_text=urdf_text,
+    )
