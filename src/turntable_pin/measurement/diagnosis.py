@@ -421,6 +421,11 @@ class OrientationFamily:
             )
         return probes
 
+    def inputs(self, effect: Effect) -> set[str]:
+        """The data columns ``effect`` depends on beyond the joint angles (``time_s``,
+        ``dirK``, ``temperature_c``): a shape in one of them is its own kind."""
+        return set(effect.required_columns)
+
     def suspect_probes(self, fit: OrientationFit) -> list[Probe]:
         """The probes of shapes in inputs other than the joint angles (time, approach direction,
         other numeric columns): what a catalogued effect may mimic through the measurement

@@ -121,6 +121,11 @@ class ModelFamily(Protocol):
         """Optional: the probes of shapes no catalogued effect has (terms in other inputs of
         the data), tried when judging whether an accepted effect only mimics one of them."""
 
+    def inputs(self, effect: Any) -> set[str]:
+        """Optional: the data inputs ``effect`` itself depends on beyond the base model's (a
+        drift's time): a suspect shape in one of them is the effect's own kind, not one it
+        mimics (the probes' ``factors.variable`` names the inputs)."""
+
 
 @dataclass
 class Candidate:
@@ -606,12 +611,17 @@ def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
 
 
 def _search(
-    family, fit, known, max_terms: int = 5, suspects_only: bool = False
+    family, fit, known, max_terms: int = 5, suspects_only: bool = False, skip_inputs=frozenset()
 ) -> tuple[list[FoundTerm], list[Probe]]:
     """The structure search in the residuals of ``fit``, with the probes it used (with
-    ``suspects_only``, the family's ``suspect_probes`` when it has them)."""
+    ``suspects_only``, the family's ``suspect_probes`` when it has them, without those in the
+    inputs ``skip_inputs``)."""
     if suspects_only and hasattr(family, "suspect_probes"):
-        probes = family.suspect_probes(fit)
+        probes = [
+            p
+            for p in family.suspect_probes(fit)
+            if p.factors is None or p.factors.variable not in skip_inputs
+        ]
     else:
         probes = family.probes(fit)
     result = fit.result
@@ -712,14 +722,31 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
             without = family.fit([e for e in current if e is not effect])
         except IdentifiabilityError:
             continue
-        costs = [score(without, structure, probes)[0] - full]
+        # Structure terms describe what remains after the catalogued effects: when they span
+        # E's own signal (a harmonic of the very error E moves), E is the physical name of
+        # that signal and is not judged against them.
+        costs = []
+        if not _duplicated(current_fit.result, without.result, structure, probes):
+            costs.append(score(without, structure, probes)[0] - full)
         # What E stood for, in at most two shapes (more would pay more than E's own
-        # parameters in penalties).
-        own, own_probes = _search(family, without, known, max_terms=2, suspects_only=True)
-        if own and not _within(own, own_probes, current_fit.result.jacobian_weighted):
+        # parameters in penalties), among inputs E does not depend on itself (a drift in time
+        # is a thermal drift's own kind) and in no more parameters than E adds (a physical
+        # effect does not lose to a generic shape with more parameters).
+        inputs = family.inputs(effect) if hasattr(family, "inputs") else set()
+        own, own_probes = _search(
+            family, without, known, max_terms=2, suspects_only=True, skip_inputs=inputs
+        )
+        if (
+            own
+            and sum(len(t.coefficients) for t in own)
+            <= current_fit.result.rank - without.result.rank
+            and not _within(own, own_probes, current_fit.result.jacobian_weighted)
+        ):
             bic_own, fit_own = score(without, own, own_probes)
             if fit_own <= full_fit:
                 costs.append(bic_own - full)
+        if not costs:
+            continue
         cost = float(min(costs))
         if cost < -threshold and (worst is None or cost < worst[1]):
             worst = (effect.name, cost)
@@ -729,6 +756,23 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
 OWN_SHAPE_FRACTION = 0.05
 """A found shape is an effect's own when less than this fraction of its columns (Frobenius norm)
 lies outside the span of the model with the effect."""
+
+
+def _duplicated(full: FitResult, without: FitResult, terms, term_probes) -> bool:
+    """Whether the columns of the effect that ``full`` has and ``without`` lacks lie (up to
+    :data:`OWN_SHAPE_FRACTION`) in the span of ``without``'s Jacobian and the probe columns of
+    the structure ``terms``: the structure then describes the effect's own signal."""
+    if not terms:
+        return False
+    known = set(without.parameter_names)
+    own = [i for i, n in enumerate(full.parameter_names) if n not in known]
+    if not own:
+        return False
+    columns = full.jacobian_weighted[:, own]
+    by_name = {p.name: p for p in term_probes}
+    blocks = [without.jacobian_weighted] + [by_name[t.name].matrix() for t in terms]
+    outside = _projected_rss(columns, blocks)[0]
+    return bool(outside <= OWN_SHAPE_FRACTION**2 * float(np.sum(columns**2)))
 
 
 def _within(terms, term_probes, jacobian_weighted: np.ndarray) -> bool:
