@@ -310,3 +310,38 @@ def test_noise_that_differs_per_angle_is_estimated_per_angle_when_sigma_is_not_g
     same = simulate_measurements(random_errors(np.random.default_rng(5)), seed=5)
     warnings = diagnose_measurements(same.data.without_sigma()).to_dict()["warnings"]
     assert not any("noise differ" in w for w in warnings)
+
+
+@pytest.mark.slow
+def test_a_drift_in_time_is_named_thermal_drift_and_the_headline_agrees_with_the_table():
+    # Issue 17: the candidate table listed thermal_drift at delta_bic -9950 while the headline
+    # said "no catalogued effect" and offered dtheta~poly2(time_s) (1 seed in 8).
+    from turntable_pin.measurement.simulation import Schedule
+    from turntable_pin.report.diagnosis_text import headline
+
+    for seed in range(1, 9):
+        sim = simulate_measurements(
+            random_errors(np.random.default_rng(seed)), {"thermal_drift": {"rz": 12.0}},
+            seed=seed, schedule=Schedule(order="random"),
+        )  # fmt: skip
+        d = diagnose_measurements(sim.data).to_dict()
+        assert d["verdict"]["missing_effect"] == "thermal_drift", seed
+        assert headline(d).startswith("Missing effect: thermal_drift"), seed
+        top = d["candidates"][0]
+        assert top["effect"] == "thermal_drift" and top["in_best_model"], seed
+        # the accept mark means "in the final model", nothing else
+        assert all(c["in_best_model"] == (c["effect"] in d["best"]["effects"])
+                   for c in d["candidates"])  # fmt: skip
+
+
+def test_named_effects_show_determined_parameters():
+    sim = simulate_measurements(
+        random_errors(np.random.default_rng(2)), {"inner_encoder_harmonics": {"c1": 4.0}}, seed=2
+    )
+    d = diagnose_measurements(sim.data).to_dict()
+    entries = d["verdict"]["named_parameters"]["inner_encoder_harmonics"]
+    by_name = {e["name"].rsplit(".", 1)[-1]: e for e in entries}
+    assert set(by_name) == {"c1", "s1", "c2", "s2"}
+    assert by_name["c1"]["value"] == pytest.approx(4.0, abs=4 * by_name["c1"]["std"])
+    assert all(e["correlation"] < 0.95 and e["determined"] for e in entries)
+    assert d["verdict"]["named_undetermined"] == {}

@@ -24,3 +24,66 @@ def test_projected_rss_equals_a_qr_projection_and_counts_the_rank():
     assert rank == 6
     assert rss == pytest.approx(float(np.sum(left**2)), rel=1e-9)
     assert _projected_rss(r[:, 0], [a, b])[0] == pytest.approx(float(left[:, 0] @ left[:, 0]))
+
+
+class _Polynomial:
+    """y = sum_k p_k x^k over x in [lo, hi]: on a short span the powers trade off."""
+
+    per_user_unit = None
+    user_unit_scale = 1.0
+    observation_unit = ""
+
+    def __init__(self, x, y, degree):
+        self.observed, self.sigma = y, np.ones_like(y)
+        self.design = np.stack([x**k for k in range(degree + 1)], axis=1)
+        self.parameter_names = tuple(f"p{k}" for k in range(degree + 1))
+        self.parameter_units = ("u",) * (degree + 1)
+        self.per_user_unit = np.ones(degree + 1)
+
+    def predict(self, p):
+        return self.design @ p
+
+    def jacobian(self, p):
+        return self.design
+
+
+def test_parameter_determination_is_the_variance_inflation_of_a_full_rank_fit():
+    from turntable_pin.stats.least_squares import fit_least_squares
+    from turntable_pin.stats.model_selection import parameter_determination
+
+    rng = np.random.default_rng(5)
+    x = np.linspace(0.2, 1.0, 60)
+    y = 1.0 + 2.0 * x + rng.normal(0, 1.0, x.size)
+    result = fit_least_squares(_Polynomial(x, y, 2))
+    entries = parameter_determination(result, result.parameter_names, result.rank)
+    design = result.jacobian_weighted
+    inverse = np.linalg.inv(design.T @ design)
+    for i, entry in enumerate(entries):
+        # R^2 = 1 - 1/VIF with VIF = (J^T J)^-1_ii |J_i|^2: the textbook multiple correlation.
+        vif = inverse[i, i] * float(design[:, i] @ design[:, i])
+        assert entry["correlation"] == pytest.approx(np.sqrt(1.0 - 1.0 / vif), rel=1e-9)
+        assert entry["std"] == pytest.approx(np.sqrt(result.covariance[i, i]), rel=1e-12)
+        assert entry["determined"] == (entry["correlation"] <= 0.95)
+
+
+def test_an_effect_is_undetermined_when_traded_off_or_insignificant_absorbed_ones_aside():
+    from turntable_pin.stats.model_selection import undetermined_parameters
+
+    def entry(name, value, std, correlation):
+        determined = std is not None and correlation <= 0.95
+        sigmas = abs(value) / std if std else None
+        return {"name": name, "value": value, "std": std, "sigmas": sigmas,
+                "correlation": correlation, "determined": determined}  # fmt: skip
+
+    # a 1/rev eccentricity: c2, s2 determined to be near zero, c1 significant
+    assert undetermined_parameters([entry("c1", 3.0, 0.1, 0.2), entry("c2", 0.05, 0.1, 0.2)]) == []
+    # traded off against the model (the MMT run's elevation encoder: c1 -57 +- 37)
+    assert undetermined_parameters([entry("c1", -57, 37, 0.999), entry("c2", -22, 4, 0.3)]) == [
+        "c1"
+    ]
+    # none reaches 3 sigma
+    assert undetermined_parameters([entry("k", 2.0, 1.0, 0.1)]) == ["k"]
+    # a parameter the data cannot see (absorbed) counts neither way
+    assert undetermined_parameters([entry("k_xx", 0.0, None, 1.0), entry("k", 9, 1, 0.5)]) == []
+    # nothing seen at all: undetermined
+    assert undetermined_parameters([entry("a", 1.0, None, 1.0)]) == ["a"]
