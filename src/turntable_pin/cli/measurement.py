@@ -405,6 +405,8 @@ def run_fit(args: argparse.Namespace) -> int:
     if out["unobserved_combinations"]:
         print("not observed because cells are empty (angles not measured): "
               + "; ".join(out["unobserved_combinations"]))  # fmt: skip
+    if "pointing_terms" in out:
+        _print_pointing_terms(out["pointing_terms"])
     print(f"positions beyond {args.k_sigma:g} sigma: {len(analysis.failing)}")
     for f in analysis.failing[:10]:
         where = " ".join(f"phi{k} {f[f'phi{k}_deg']:g}" for k in range(1, data.n_joints + 1))
@@ -418,6 +420,18 @@ def run_fit(args: argparse.Namespace) -> int:
         written = out["identified_urdf"]
         print(f"wrote {written['path']}: {written['rule']}")
     return 0
+
+
+def _print_pointing_terms(block: dict) -> None:
+    """The ``TPOINT terms`` block of ``fit`` on a telescope mount."""
+    where = (
+        f", latitude {block['latitude_deg']:.4g} deg" if block["latitude_deg"] is not None else ""
+    )
+    print(f"TPOINT terms ({block['mount']} mount{where}; {block['convention']}):")
+    for t in block["terms"]:
+        std = f"+- {t['std']:.3f}" if t["std"] is not None else "(not determined)"
+        print(f"  {t['name']:5s} {t['value']:12.3f} {std} {t['unit']:8s} {t['formula']}")
+    print(f"  {block['note']}")
 
 
 def _diagnosis(args: argparse.Namespace):

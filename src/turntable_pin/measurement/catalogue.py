@@ -4,6 +4,8 @@
 - Table-wide: ``gravity_sag`` (a compliance ``K`` with the entries orientation data determine
   beyond the base errors), ``base_tilt`` (about the base axes the data tell apart from the base
   errors), ``thermal_drift``, ``payload_mount``.
+- On a telescope mount (:func:`~.pointing_terms.mount_kind`), TPOINT's flexure terms by name:
+  ``TF``, ``TX`` (alt-az); ``TF``, ``FO``, ``DAF`` (equatorial).
 
 Which entries of ``K`` and which base axes are kept is found like the base errors: QR with column
 pivoting of the effect's columns, after projecting out the base errors, on generic positions.
@@ -50,6 +52,7 @@ def catalogue(turntable=None) -> tuple[Effect, ...]:
     from .effects.base_rotation import BaseRotation
     from .effects.gravity_compliance import GravityCompliance
     from .effects.payload_mount import PayloadMount
+    from .effects.pointing_flexure import pointing_flexures
     from .effects.thermal_drift import ThermalDrift
 
     table = measured_table(turntable)
@@ -72,6 +75,7 @@ def catalogue(turntable=None) -> tuple[Effect, ...]:
         ThermalDrift(),
         *(joint_effect("backlash", j) for j in table.joints),
         PayloadMount(),
+        *pointing_flexures(table),  # a telescope mount's TPOINT flexure terms (else none)
     )
     _CATALOGUES[table] = out
     return out

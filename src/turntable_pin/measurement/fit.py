@@ -170,7 +170,8 @@ class OrientationFit:
         )
 
     def to_dict(self) -> dict:
-        """The fit as a JSON-ready dict (the generic result plus effects and sigma in arcsec)."""
+        """The fit as a JSON-ready dict (the generic result plus effects and sigma in arcsec; on a
+        telescope mount also ``pointing_terms``, TPOINT's terms by name)."""
         out = {
             "n_positions": self.data.n_positions,
             "effects": list(self.effect_names),
@@ -181,6 +182,11 @@ class OrientationFit:
             "unobserved_combinations": self.unobserved_combinations(),
         }
         out.update(self.result.to_dict())
+        from .pointing_terms import fitted_pointing_terms
+
+        terms = fitted_pointing_terms(self)
+        if terms is not None:  # a telescope mount: TPOINT's terms by name
+            out["pointing_terms"] = terms
         return out
 
 
