@@ -345,3 +345,14 @@ def test_named_effects_show_determined_parameters():
     assert by_name["c1"]["value"] == pytest.approx(4.0, abs=4 * by_name["c1"]["std"])
     assert all(e["correlation"] < 0.95 and e["determined"] for e in entries)
     assert d["verdict"]["named_undetermined"] == {}
+
+
+def test_data_of_another_table_make_the_first_line_ask_for_the_urdf():
+    from turntable_pin.measurement.data import read_measurements
+    from turntable_pin.report.diagnosis_text import headline
+
+    data = read_measurements(EXAMPLES_DIR / "measurements_vertical_outer.csv")
+    d = diagnose_measurements(data).to_dict()  # forgot --urdf: the paper's table
+    assert headline(d).startswith("Check the table:") and "--urdf" in d["verdict"]["doubt"]
+    clean = diagnose_measurements(read_measurements(EXAMPLES_DIR / "measurements_example.csv"))
+    assert clean.to_dict()["verdict"]["doubt"] is None

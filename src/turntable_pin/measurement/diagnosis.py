@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 
@@ -634,6 +635,7 @@ def diagnose_measurements(
     check_count(data.n_positions, MAX_DIAGNOSED_ROWS, "measurement rows", DIAGNOSIS_ROW_BYTES)
     table = measured_table(turntable)
     diagnosis = _diagnose(data, until_explained, catalogue, table, outliers)
+    diagnosis.doubt = _table_doubt(diagnosis, table)
     if data.sigma_rad is None:
         per_angle = _noise_per_angle(diagnosis)
         if per_angle is not None:
@@ -646,6 +648,30 @@ def diagnose_measurements(
             diagnosis = _diagnose(weighted, until_explained, catalogue, table, outliers)
             diagnosis.warnings.append(note)
     return diagnosis
+
+
+WRONG_TABLE_CHI2_REDUCED = 9.0
+"""With sigma given, a best model (every accepted effect in) still this far from the noise
+(residuals three times the stated sigma) makes the diagnosis ask whether the URDF is the table
+the data were measured on."""
+
+
+def _table_doubt(diagnosis: Diagnosis, table) -> str | None:
+    """Why the table itself is in doubt (the data may come from another table), or None."""
+    best = diagnosis.best_fit.result
+    if not best.sigma_known or best.dof <= 0:
+        return None
+    chi2_reduced = best.rss / best.dof
+    if chi2_reduced <= WRONG_TABLE_CHI2_REDUCED:
+        return None
+    where = getattr(table, "urdf_path", None)
+    urdf = f"the URDF {Path(where).name}" if where is not None else "the default URDF"
+    return (
+        f"with every accepted effect the residuals are still {chi2_reduced**0.5:.1f} times the "
+        f"stated noise (chi2_reduced {chi2_reduced:.3g}): no rigid error set of {urdf} and no "
+        "catalogued effect makes these data; were they measured on another table (--urdf)? "
+        "Or is the stated sigma too small?"
+    )
 
 
 def _diagnose(data, until_explained, catalogue, table, outliers) -> Diagnosis:

@@ -67,6 +67,13 @@ def headline(d: dict) -> str:
     effect) -- ...``; ``Unexplained misfit: ...``; ``The base model fits to the noise -- ...``.
     """
     verdict = d["verdict"]
+    if verdict.get("doubt"):
+        return f"Check the table: {verdict['doubt']} -- {_verdict_headline(d)}"
+    return _verdict_headline(d)
+
+
+def _verdict_headline(d: dict) -> str:
+    verdict = d["verdict"]
     base, best = d["base"], d["best"]
     key = _rms_key(base)
     unit = key[len("rms_") :]

@@ -359,6 +359,8 @@ class Diagnosis:
         unneeded_given_structure: effects the forward selection accepted that the best
             description of the data does not need (:func:`_least_needed`), with what removing
             each cost in BIC (below 6): they are not named.
+        doubt: the caller's doubt about the model family itself (the data may not come from
+            this model at all), said before the verdict; ``None`` when it has none.
     """
 
     family: Any = field(repr=False)
@@ -376,6 +378,7 @@ class Diagnosis:
     outliers: list[dict] = field(default_factory=list)
     outlier_rule: str | None = None
     unneeded_given_structure: dict[str, float] = field(default_factory=dict)
+    doubt: str | None = None
 
     @property
     def missing_effect(self) -> str | None:
@@ -467,6 +470,7 @@ class Diagnosis:
             candidates.append(entry)
         best = self.best_fit
         verdict = {
+            "doubt": self.doubt,
             "missing_effect": self.missing_effect,
             "alternatives": self.alternatives,
             "unexplained": self.unexplained,
