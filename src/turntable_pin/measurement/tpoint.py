@@ -637,8 +637,9 @@ def convert_tpoint(
 
     Raises:
         InputError: refraction requested without temperature and pressure, or at an observed
-            elevation below 0 deg; an observed/raw pair more than the small-error limit (5 deg)
-            apart on the sky (not a pointing error), naming the line.
+            elevation below 0 deg; an observed/raw pair farther apart on the sky than a
+            measurement file may hold (``MAX_MEASURED_ANGLE_ARCSEC``: not a pointing error),
+            naming the line.
     """
     from ..model.chain import compose_rotation
     from ..model.generic_table import GenericTable
