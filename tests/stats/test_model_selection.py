@@ -55,15 +55,15 @@ def test_parameter_determination_is_the_variance_inflation_of_a_full_rank_fit():
     x = np.linspace(0.2, 1.0, 60)
     y = 1.0 + 2.0 * x + rng.normal(0, 1.0, x.size)
     result = fit_least_squares(_Polynomial(x, y, 2))
-    entries = parameter_determination(result, result.parameter_names, result.rank)
+    entries = parameter_determination(result, result.parameter_names, (), 0)
     design = result.jacobian_weighted
     inverse = np.linalg.inv(design.T @ design)
     for i, entry in enumerate(entries):
         # R^2 = 1 - 1/VIF with VIF = (J^T J)^-1_ii |J_i|^2: the textbook multiple correlation.
         vif = inverse[i, i] * float(design[:, i] @ design[:, i])
-        assert entry["correlation"] == pytest.approx(np.sqrt(1.0 - 1.0 / vif), rel=1e-9)
+        assert entry["correlation_all"] == pytest.approx(np.sqrt(1.0 - 1.0 / vif), rel=1e-9)
         assert entry["std"] == pytest.approx(np.sqrt(result.covariance[i, i]), rel=1e-12)
-        assert entry["determined"] == (entry["correlation"] <= 0.95)
+        assert entry["determined"] == (entry["correlation_all"] <= 0.995)
 
 
 def test_an_effect_is_undetermined_when_traded_off_or_insignificant_absorbed_ones_aside():
@@ -73,7 +73,8 @@ def test_an_effect_is_undetermined_when_traded_off_or_insignificant_absorbed_one
         determined = std is not None and correlation <= 0.95
         sigmas = abs(value) / std if std else None
         return {"name": name, "value": value, "std": std, "sigmas": sigmas,
-                "correlation": correlation, "determined": determined}  # fmt: skip
+                "correlation": correlation, "correlation_all": correlation,
+                "determined": determined}  # fmt: skip
 
     # a 1/rev eccentricity: c2, s2 determined to be near zero, c1 significant
     assert undetermined_parameters([entry("c1", 3.0, 0.1, 0.2), entry("c2", 0.05, 0.1, 0.2)]) == []

@@ -48,14 +48,14 @@ def _short(names: list[str]) -> str:
 
 
 def _parameter_words(entry: dict) -> str:
-    """``c1 = -57.3 +- 37.4 arcsec (correlation with the model 0.91)``."""
+    """``c1 = -57.3 +- 37.4 arcsec (correlation with the base errors 0.91)``."""
     name = entry["name"].rsplit(".", 1)[-1]
     if entry["std"] is None:
         return f"{name} not seen on its own (absorbed into the model's errors on these data)"
     mark = "" if entry["determined"] else ", not determined"
     return (
         f"{name} = {entry['value']:.3g} +- {entry['std']:.2g} {entry['unit']} (correlation "
-        f"with the model {entry['correlation']:.2f}{mark})"
+        f"with the base errors {entry['correlation']:.2f}{mark})"
     )
 
 

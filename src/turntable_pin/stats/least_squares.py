@@ -265,6 +265,15 @@ class FitResult:
         return self._jacobian() if callable(self._jacobian) else self._jacobian
 
     @property
+    def determined_jacobian_weighted(self) -> np.ndarray:
+        """The weighted Jacobian along the directions the fit determines, (m, rank): the span
+        the fitted model really has. The full Jacobian at ``params`` can also hold directions
+        the data do not determine at zero that large fitted errors make barely visible at
+        second order (a roll about a telescope's boresight next to a 0.3 deg azimuth offset);
+        projecting residuals on those would credit the model with fits it did not make."""
+        return self.jacobian_weighted @ self.identifiability.basis
+
+    @property
     def n_obs(self) -> int:
         """Number of observations m."""
         return int(self.residuals.size)

@@ -56,6 +56,7 @@ __all__ = [
     "ALTERNATIVE_LEVEL",
     "DETERMINED_SIGMAS",
     "MAX_CORRELATION",
+    "MAX_CORRELATION_ALL",
     "parameter_determination",
     "undetermined_parameters",
     "acceptance_threshold",
@@ -79,7 +80,10 @@ DETERMINED_SIGMAS = 3.0
 errors (:func:`undetermined_parameters`)."""
 
 MAX_CORRELATION = 0.95
-"""A parameter is traded off against the model's others above this multiple correlation."""
+"""A parameter is traded off against the base errors above this multiple correlation."""
+
+MAX_CORRELATION_ALL = 0.995
+"""... and against all the model's other parameters (its own effect's too) above this one."""
 
 
 class ModelFamily(Protocol):
@@ -184,39 +188,48 @@ def undetermined_parameters(entries: Sequence[dict]) -> list[str]:
     return []
 
 
-def parameter_determination(result: FitResult, names: Sequence[str], rank: int) -> list[dict]:
+def parameter_determination(
+    result: FitResult, names: Sequence[str], base_names: Sequence[str], base_rank: int
+) -> list[dict]:
     """Whether the data determine each parameter ``names`` of a fit, in user units.
 
     Each entry: ``name``, ``value``, ``std`` (None when the parameter is not determined on its
     own: it moves along a combination the data cannot see), ``unit``, ``sigmas``
-    (``|value| / std``), ``correlation`` and ``determined``.
+    (``|value| / std``), ``correlation``, ``correlation_all`` and ``determined``.
 
-    ``correlation`` is the parameter's largest correlation with any combination of all the
-    other parameters of the model (the base errors and its own effect's others): the multiple
-    correlation ``|P_others J_i| / |J_i|`` of its weighted Jacobian column with the span of
-    theirs, that span cut to ``rank - 1`` directions (``rank``: the model's rank, so that
-    directions a large error makes barely visible at second order do not count); 1 when not
-    determined alone. A parameter is ``determined`` when that correlation is at most
-    :data:`MAX_CORRELATION`: it is not traded off against the others (the practice of
+    ``correlation`` is the parameter's largest correlation with any combination of the base
+    parameters ``base_names``: the multiple correlation ``|P_base J_i| / |J_i|`` of its
+    weighted Jacobian column with the span of theirs, cut to ``base_rank`` directions (the
+    base model's rank, so that directions a large error makes barely visible at second order
+    do not count); ``correlation_all`` the same with all the other parameters (the effect's own
+    others too, span cut to the fit's rank - 1). Both are 1 when the parameter is not
+    determined alone. A parameter is ``determined`` when ``correlation <=``
+    :data:`MAX_CORRELATION` and ``correlation_all <=`` :data:`MAX_CORRELATION_ALL`: it is not
+    traded off against the base errors, nor hopelessly against its siblings (the practice of
     pointing-model fitting). Whether the effect as a whole is significant is
     :func:`undetermined_parameters`' question.
     """
     table = result.parameter_table()
     index = {n: i for i, n in enumerate(result.parameter_names)}
     jac = result.jacobian_weighted
+
+    def span(columns: list[int], rank: int) -> np.ndarray:
+        u, _, _ = np.linalg.svd(jac[:, columns], full_matrices=False)
+        return u[:, : max(int(rank), 0)]
+
+    base = span([index[n] for n in base_names], base_rank)
     out = []
     for name in names:
         i = index[name]
         entry = table[name]
         std = entry["std"]
-        correlation = 1.0
+        correlation = correlation_all = 1.0
         column = jac[:, i]
         norm = float(np.linalg.norm(column))
         if std is not None and std > 0 and norm > 0:
-            others = np.delete(jac, i, axis=1)
-            u, _, _ = np.linalg.svd(others, full_matrices=False)
-            span = u[:, : max(int(rank) - 1, 0)]
-            correlation = min(float(np.linalg.norm(span.T @ column)) / norm, 1.0)
+            correlation = min(float(np.linalg.norm(base.T @ column)) / norm, 1.0)
+            others = span([k for k in range(jac.shape[1]) if k != i], result.rank - 1)
+            correlation_all = min(float(np.linalg.norm(others.T @ column)) / norm, 1.0)
         out.append(
             {
                 "name": name,
@@ -225,7 +238,12 @@ def parameter_determination(result: FitResult, names: Sequence[str], rank: int) 
                 "unit": entry["unit"],
                 "sigmas": abs(entry["value"]) / std if std else None,
                 "correlation": correlation,
-                "determined": bool(std is not None and correlation <= MAX_CORRELATION),
+                "correlation_all": correlation_all,
+                "determined": bool(
+                    std is not None
+                    and correlation <= MAX_CORRELATION
+                    and correlation_all <= MAX_CORRELATION_ALL
+                ),
             }
         )
     return out
@@ -290,7 +308,9 @@ def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, ca
         c.threshold = threshold
         if c.significant:
             added_names = [n for n in c.fit.result.parameter_names if n not in known_names]
-            c.parameters = parameter_determination(c.fit.result, added_names, c.fit.result.rank)
+            c.parameters = parameter_determination(
+                c.fit.result, added_names, base.parameter_names, base.rank
+            )
     # Best first: the significant effects whose parameters are determined, then the others by
     # delta_bic (a richer effect whose extra parameters the data do not determine is not
     # preferred to the simpler one that explains the signal with determined ones).
@@ -426,13 +446,18 @@ class Diagnosis:
 
     def named_parameters(self) -> dict[str, list[dict]]:
         """``{effect: parameter_determination entries}`` of every named effect in the best fit
-        (values, standard errors, correlations with the other parameters)."""
+        (values, standard errors, correlations with the base errors and with all the others)."""
         result = self.best_fit.result
+        prefixes = tuple(f"{s.added}." for s in self.steps)
+        base = [n for n in result.parameter_names if not n.startswith(prefixes)]
         out = {}
         for step in self.steps:
-            prefix = f"{step.added}."
-            names = [n for n in result.parameter_names if n.startswith(prefix)]
-            out[step.added] = parameter_determination(result, names, result.rank) if names else []
+            names = [n for n in result.parameter_names if n.startswith(f"{step.added}.")]
+            out[step.added] = (
+                parameter_determination(result, names, base, self.base_fit.result.rank)
+                if names
+                else []
+            )
         return out
 
     def _first_threshold(self) -> float:
@@ -631,7 +656,7 @@ def _search(
     result = fit.result
     found = search_structure(
         result.residuals * result.weights,
-        result.jacobian_weighted,
+        result.determined_jacobian_weighted,
         probes,
         noise_variance=known,
         max_terms=max_terms,
@@ -703,7 +728,8 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
         """(rss, rank) of ``fit`` with the probe columns of ``terms`` added."""
         result = fit.result
         by_name = {p.name: p for p in term_probes}
-        columns = [result.jacobian_weighted] + [by_name[t.name].matrix() for t in terms]
+        columns = [result.determined_jacobian_weighted]
+        columns += [by_name[t.name].matrix() for t in terms]
         return _projected_rss(result.residuals * result.weights, columns)
 
     full_rss, full_rank = projected(current_fit, structure, probes)
@@ -744,7 +770,7 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
             own
             and sum(len(t.coefficients) for t in own)
             <= current_fit.result.rank - without.result.rank
-            and not _within(own, own_probes, current_fit.result.jacobian_weighted)
+            and not _within(own, own_probes, current_fit.result.determined_jacobian_weighted)
         ):
             bic_own, fit_own = score(without, own, own_probes)
             if fit_own <= full_fit:
@@ -774,7 +800,8 @@ def _duplicated(full: FitResult, without: FitResult, terms, term_probes) -> bool
         return False
     columns = full.jacobian_weighted[:, own]
     by_name = {p.name: p for p in term_probes}
-    blocks = [without.jacobian_weighted] + [by_name[t.name].matrix() for t in terms]
+    blocks = [without.determined_jacobian_weighted]
+    blocks += [by_name[t.name].matrix() for t in terms]
     outside = _projected_rss(columns, blocks)[0]
     return bool(outside <= OWN_SHAPE_FRACTION**2 * float(np.sum(columns**2)))
 
