@@ -8,6 +8,7 @@ from turntable_pin.core.exceptions import InputError
 from turntable_pin.measurement.data import (
     MAX_COMMANDED_ANGLE_DEG,
     MAX_MEASURED_ANGLE_ARCSEC,
+    MAX_SIGMA_ARCSEC,
     MAX_TIME_S,
     MIN_SIGMA_ARCSEC,
     read_measurements,
@@ -24,7 +25,8 @@ def _file(tmp_path, row: int, column: str, value: str):
 
 
 def test_the_limits():
-    assert MAX_MEASURED_ANGLE_ARCSEC == 18000.0
+    assert MAX_MEASURED_ANGLE_ARCSEC == 108000.0  # 30 deg
+    assert MAX_SIGMA_ARCSEC == 18000.0  # 5 deg
     assert MAX_COMMANDED_ANGLE_DEG == 3600.0
     assert MIN_SIGMA_ARCSEC == 1e-9
     assert MAX_TIME_S == 366 * 86400.0
@@ -33,8 +35,9 @@ def test_the_limits():
 @pytest.mark.parametrize(
     "column, value, fragment",
     [
-        ("dpsi_arcsec", "1e308", "a measured orientation error must be within +-18000 arcsec"),
-        ("dgamma_arcsec", "-18000.5", "a measured orientation error must be within"),
+        ("dpsi_arcsec", "1e308", "a measured orientation error must be within +-108000 arcsec"),
+        ("dgamma_arcsec", "-108000.5", "a measured orientation error must be within"),
+        ("dtheta_arcsec", "144000", "(30 deg; more is no orientation error of the table)"),
         ("phi1_deg", "1e308", "a commanded angle must be within +-3600 deg (ten turns)"),
         ("phi2_deg", "-3600.1", "a commanded angle must be within +-3600 deg"),
         ("sigma_arcsec", "1e-300", "sigma must be at least 1e-09 arcsec"),
@@ -52,9 +55,10 @@ def test_out_of_range_values_are_refused_naming_row_and_column(tmp_path, column,
 
 
 def test_values_at_the_limits_are_read(tmp_path):
-    path = _file(tmp_path, 0, "dpsi_arcsec", "-18000")
+    path = _file(tmp_path, 0, "dpsi_arcsec", "-108000")
     data = read_measurements(path)
     assert data.n_positions == 3
+    read_measurements(_file(tmp_path, 1, "sigma_arcsec", "18000"))
     read_measurements(_file(tmp_path, 2, "phi1_deg", "3600"))
     read_measurements(_file(tmp_path, 2, "sigma_arcsec", "1e-9"))
 
@@ -66,6 +70,6 @@ def test_the_cli_refuses_an_absurd_measurement_in_one_line(tmp_path):
         assert proc.returncode == 2 and proc.stdout == ""
         assert proc.stderr.splitlines() == [
             f"turntable-pin {command}: error: {path}, row 4, column 'dtheta_arcsec': a measured "
-            "orientation error must be within +-18000 arcsec (5 deg; more is not a small error), "
-            "found 1e+308"
+            "orientation error must be within +-108000 arcsec (30 deg; more is no orientation "
+            "error of the table), found 1e+308"
         ]

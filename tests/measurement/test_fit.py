@@ -4,6 +4,7 @@ determine is named."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from conftest import random_errors
 from turntable_pin.measurement.fit import fit_orientation
@@ -46,3 +47,67 @@ def test_filling_the_empty_cells_with_the_fit_changes_nothing():
         assert refit.result.rss == np.float64(partial.result.rss) or np.isclose(
             refit.result.rss, partial.result.rss, rtol=1e-9
         )
+
+
+# ---- large constant offsets (a telescope mount not synced) -------------------------------------
+def _gem_run(offset_deg: float, noise_arcsec: float = 1.0, seed: int = 5):
+    """A German-equatorial run: hour-angle index ``offset_deg`` off, small errors, no roll."""
+    from conftest import REPO_DIR
+    from turntable_pin.measurement.data import OrientationMeasurements
+    from turntable_pin.measurement.effect_model import OrientationModel
+    from turntable_pin.measurement.effects.base import PositionVariables
+    from turntable_pin.model.generic_table import GenericTable
+
+    table = GenericTable(REPO_DIR / "models" / "german_equatorial_mount.urdf")
+    rng = np.random.default_rng(seed)
+    joints = np.stack([rng.uniform(-np.pi, np.pi, 200), rng.uniform(-1.2, 1.4, 200)], axis=1)
+    model = OrientationModel(PositionVariables(joints), [], table)
+    errors = {"hour_angle.position": np.radians(offset_deg), "declination.tilt_a": 1e-4}
+    truth = model.parameter_vector({**errors, "tube_mount.rot_y": 7e-5})
+    sigma = noise_arcsec / 206264.806
+    angles = model.predict(truth) + rng.normal(0.0, sigma, (200, 3))
+    angles[:, 2] = np.nan
+    return table, OrientationMeasurements(joints, angles, np.full(200, sigma))
+
+
+def test_gauss_newton_from_zero_converges_with_a_large_constant_offset(monkeypatch):
+    import turntable_pin.stats.least_squares as least_squares
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the fit fell back to Levenberg-Marquardt")
+
+    monkeypatch.setattr(least_squares, "_levenberg_marquardt", refuse)
+    for offset_deg, most_evaluations in ((0.0, 4), (5.7, 5), (10.0, 6)):
+        table, data = _gem_run(offset_deg)
+        fit = fit_orientation(data, turntable=table)
+        assert fit.result.chi2_reduced == pytest.approx(1.0, abs=0.25)
+        assert fit.result.n_function_evaluations <= most_evaluations
+        position = fit.result.params[0] - fit.result.params[5]  # hour_angle.position - dec.tilt_b
+        assert position == pytest.approx(np.radians(offset_deg), abs=1e-5)
+
+
+def test_a_fit_with_effects_starts_from_the_base_solution_when_offsets_are_large(monkeypatch):
+    from turntable_pin.measurement import fit as fit_module
+    from turntable_pin.measurement.catalogue import resolve_effect
+    from turntable_pin.measurement.table import measured_table
+
+    table, data = _gem_run(1.0)
+    wobble = resolve_effect("wobble_harmonics@declination", measured_table(table), ())
+    base = fit_orientation(data, turntable=table)
+    with_effect = fit_orientation(data, [wobble], turntable=table)
+    assert with_effect.result.rss <= base.result.rss  # it nests the base model
+    # From zero alone, the minimum-norm split of the offset over the wobble's harmonics is no
+    # solution: the fit ends far above the base fit it contains.
+    monkeypatch.setattr(fit_module, "RELINEARISE_RAD", np.inf)
+    from_zero = fit_orientation(data, [wobble], turntable=table)
+    assert from_zero.result.rss > 2.0 * base.result.rss
+
+
+def test_residuals_beyond_five_degrees_are_refused_naming_the_rows():
+    from turntable_pin.core.exceptions import InputError
+
+    table, data = _gem_run(5.7)
+    angles = data.angles_rad.copy()
+    angles[[7, 30], 1] += np.radians(12.0)  # another star
+    with pytest.raises(InputError, match=r"row\(s\) 9, 32 of the data: the best fit of the "):
+        fit_orientation(data.replace(angles_rad=angles), turntable=table)

@@ -36,7 +36,8 @@ def test_the_largest_seed_works():
         ({"effects": {"gravity_sag": {"k": "x"}}}, "must be a number within"),
         ({"schedule": Schedule(90, 90, dwell_s=1e7)},
          "dwell_s 1e+07: the run of 16 measurements would last 1.5e+08 s"),
-        ({"errors": TurntableErrors.from_arcsec(**{n: 17000 for n in ("dphi_y1", "deps_y")})},
+        ({"errors": TurntableErrors.from_user_units({"dphi_y1_deg": 25, "deps_y_deg": 25},
+                                                    max_angle_deg=30)},
          "the simulated orientation errors reach"),
     ],
 )  # fmt: skip

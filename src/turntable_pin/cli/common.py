@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.exceptions import SEED_LIMIT, InputError, one_line
-from ..model.errors import TurntableErrors, parse_error_value
+from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors, parse_error_value
 from ..model.turntable import TurntableModel
 
 __all__ = [
@@ -208,8 +208,9 @@ def generic_table_from_args(args: argparse.Namespace):
 def error_overrides(args: argparse.Namespace, **table_names) -> dict[str, float]:
     """``{name: value in rad or m}`` of the ``--error NAME=VALUE`` options, each name once.
 
-    ``table_names`` (``names``, ``length_names``) are passed to
-    :func:`~turntable_pin.model.errors.parse_error_value` (default: the paper's nine errors).
+    ``table_names`` (``names``, ``length_names``, ``max_angle_deg``) are passed to
+    :func:`~turntable_pin.model.errors.parse_error_value` (default: the paper's nine errors
+    within the small-error limit).
     """
     values: dict[str, float] = {}
     given: dict[str, str] = {}
@@ -228,20 +229,38 @@ def error_overrides(args: argparse.Namespace, **table_names) -> dict[str, float]
     return values
 
 
-def generic_errors_from_args(table, args: argparse.Namespace) -> np.ndarray:
+def generic_errors_from_args(
+    table, args: argparse.Namespace, max_angle_deg: float = MAX_ANGULAR_ERROR_DEG
+) -> np.ndarray:
     """The error vector of ``--errors`` overridden entry by entry by ``--error``, in the generic
-    names of ``table`` (``<joint>.position``, ``<joint>.tilt_a``, ...)."""
-    values = table.errors_from_yaml(args.errors) if args.errors else table.values()
-    overrides = error_overrides(args, names=table.parameter_names, length_names=table.length_names)
+    names of ``table`` (``<joint>.position``, ``<joint>.tilt_a``, ...); angles up to
+    ``max_angle_deg``, degrees."""
+    values = (
+        table.errors_from_yaml(args.errors, max_angle_deg=max_angle_deg)
+        if args.errors
+        else table.values()
+    )
+    overrides = error_overrides(
+        args, names=table.parameter_names, length_names=table.length_names,
+        max_angle_deg=max_angle_deg,
+    )  # fmt: skip
     for name, value in overrides.items():
         values[table.parameter_names.index(name)] = value
     return values
 
 
-def errors_from_args(args: argparse.Namespace) -> TurntableErrors:
-    """The error set of ``--errors`` overridden entry by entry by ``--error``."""
-    base = TurntableErrors.from_yaml(args.errors) if args.errors else TurntableErrors.zero()
-    return TurntableErrors(**{**base.as_dict(), **error_overrides(args)})
+def errors_from_args(
+    args: argparse.Namespace, max_angle_deg: float = MAX_ANGULAR_ERROR_DEG
+) -> TurntableErrors:
+    """The error set of ``--errors`` overridden entry by entry by ``--error`` (angles up to
+    ``max_angle_deg``, degrees)."""
+    base = (
+        TurntableErrors.from_yaml(args.errors, max_angle_deg=max_angle_deg)
+        if args.errors
+        else TurntableErrors.zero()
+    )
+    overrides = error_overrides(args, max_angle_deg=max_angle_deg)
+    return TurntableErrors(**{**base.as_dict(), **overrides})
 
 
 def model_from_args(args: argparse.Namespace) -> TurntableModel:

@@ -8,6 +8,7 @@ from pathlib import Path
 from ..core.exceptions import InputError
 from ..measurement.data import MAX_TIME_S, MIN_SIGMA_ARCSEC, read_measurements
 from ..measurement.effects import EFFECT_NAMES, parse_effect_spec
+from ..model.errors import MAX_ORIENTATION_ERROR_DEG
 from .common import (
     add_error_options,
     add_table_options,
@@ -337,7 +338,9 @@ def run_simulate(args: argparse.Namespace) -> int:
             f"{schedule.duration_s(n_joints):.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
         )
     sim = simulate_measurements(
-        generic_errors_from_args(table, args) if generic else errors_from_args(args),
+        generic_errors_from_args(table, args, MAX_ORIENTATION_ERROR_DEG)
+        if generic
+        else errors_from_args(args, MAX_ORIENTATION_ERROR_DEG),
         effects,
         schedule=schedule,
         noise_arcsec=args.noise_arcsec,

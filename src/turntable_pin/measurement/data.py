@@ -6,8 +6,9 @@ reader's checks (missing columns, non-numbers, NaN), a file is refused, naming r
 
 - a value is outside its valid range: ``|phi1_deg|``, ``|phi2_deg|`` above
   :data:`MAX_COMMANDED_ANGLE_DEG`; ``|dpsi|, |dtheta|, |dgamma|`` above
-  :data:`MAX_MEASURED_ANGLE_ARCSEC` (the small-error limit); a ``sigma_arcsec`` <= 0, below
-  :data:`MIN_SIGMA_ARCSEC` or above the small-error limit; a ``time_s`` negative or above
+  :data:`MAX_MEASURED_ANGLE_ARCSEC` (30 deg: beyond, no orientation error of the table); a
+  ``sigma_arcsec`` <= 0, below :data:`MIN_SIGMA_ARCSEC` or above :data:`MAX_SIGMA_ARCSEC` (the
+  small-error limit); a ``time_s`` negative or above
   :data:`MAX_TIME_S`; a ``dir1``/``dir2`` not +1 or -1;
 - two rows are the same measurement: equal ``phi1_deg, phi2_deg`` and equal values of every
   present ``dir1, dir2, time_s`` column. Repeats of a position are legitimate when they differ in
@@ -35,13 +36,14 @@ from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows
 from ..core.exceptions import InputError
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.angles import ANGLE_NAMES
-from ..model.errors import MAX_ANGULAR_ERROR_DEG
+from ..model.errors import MAX_ANGULAR_ERROR_DEG, MAX_ORIENTATION_ERROR_DEG
 from .effects.base import PositionVariables
 
 __all__ = [
     "ANGLE_NAMES",
     "MAX_COMMANDED_ANGLE_DEG",
     "MAX_MEASURED_ANGLE_ARCSEC",
+    "MAX_SIGMA_ARCSEC",
     "MAX_TIME_S",
     "MIN_SIGMA_ARCSEC",
     "OPTIONAL_COLUMNS",
@@ -58,9 +60,15 @@ also ``sigma_dpsi_arcsec, sigma_dtheta_arcsec, sigma_dgamma_arcsec`` (a sigma pe
 ``dirK`` for joint K of a table with more axes."""
 _RESERVED = frozenset(("sigma_arcsec", "time_s"))
 
-MAX_MEASURED_ANGLE_ARCSEC = MAX_ANGULAR_ERROR_DEG * 3600.0
-"""Largest ``|dpsi|, |dtheta|, |dgamma|`` and ``sigma_arcsec`` of a row, arc seconds (5 deg):
-the model's small-error limit (:data:`~turntable_pin.model.errors.MAX_ANGULAR_ERROR_DEG`)."""
+MAX_MEASURED_ANGLE_ARCSEC = MAX_ORIENTATION_ERROR_DEG * 3600.0
+"""Largest ``|dpsi|, |dtheta|, |dgamma|`` of a row, arc seconds (30 deg,
+:data:`~turntable_pin.model.errors.MAX_ORIENTATION_ERROR_DEG`): the fit is exact, so a constant
+offset of several degrees is an ordinary run; beyond 30 deg a row is no orientation error of the
+table. What the table's errors cannot explain is refused after the base fit
+(:data:`~turntable_pin.measurement.fit.MAX_UNEXPLAINED_ARCSEC`)."""
+MAX_SIGMA_ARCSEC = MAX_ANGULAR_ERROR_DEG * 3600.0
+"""Largest ``sigma_arcsec`` (and ``sigma_<angle>_arcsec``), arc seconds (5 deg): noise is a small
+error (:data:`~turntable_pin.model.errors.MAX_ANGULAR_ERROR_DEG`)."""
 MIN_SIGMA_ARCSEC = 1e-9
 """Smallest ``sigma_arcsec``, arc seconds: five femtoradians, the rounding of a double-precision
 angle; a smaller sigma is no noise level, and its weight 1/sigma^2 would overflow the fit."""
@@ -348,7 +356,7 @@ def read_measurements(
         _check_at_most(
             table, column, limit,
             f"a measured orientation error must be within +-{limit:g} arcsec "
-            f"({MAX_ANGULAR_ERROR_DEG:g} deg; more is not a small error)",
+            f"({MAX_ORIENTATION_ERROR_DEG:g} deg; more is no orientation error of the table)",
         )  # fmt: skip
     for column in joint_columns:
         why = _looks_like_radians(table[column])
@@ -374,8 +382,8 @@ def read_measurements(
             f"sigma must be at least {MIN_SIGMA_ARCSEC:g} arcsec",
         )  # fmt: skip
         _check_at_most(
-            table, column, limit,
-            f"sigma must be at most {limit:g} arcsec ({MAX_ANGULAR_ERROR_DEG:g} deg)",
+            table, column, MAX_SIGMA_ARCSEC,
+            f"sigma must be at most {MAX_SIGMA_ARCSEC:g} arcsec ({MAX_ANGULAR_ERROR_DEG:g} deg)",
         )  # fmt: skip
     sigma = None
     if table.has("sigma_arcsec"):

@@ -22,6 +22,8 @@ from .effect_model import OrientationModel
 from .effects.base import Effect
 
 __all__ = [
+    "MAX_UNEXPLAINED_ARCSEC",
+    "RELINEARISE_RAD",
     "ZERO_POINT_BLOCK",
     "OrientationFit",
     "OrientationFitProblem",
@@ -31,6 +33,22 @@ __all__ = [
 
 ZERO_POINT_BLOCK = 8192
 """Positions per block of :meth:`OrientationFitProblem.zero_point_blocks` (a few MB each)."""
+
+RELINEARISE_RAD = 1e-3
+"""Fitted base errors beyond this (rad, 3.4 arcmin; a constant offset of a mount not synced, an
+encoder index off) make :func:`fit_orientation` fit a model with effects again, from the
+solution of the base errors alone: the fit from zero takes the minimum-norm representative of
+what the data do not determine at zero errors, and with degrees of offset that split (e.g. an
+hour-angle offset shared with an effect's harmonics) is no longer equivalent: a
+German-equatorial mount with a 1 deg hour-angle offset and no roll measured fitted chi2 3273
+with declination wobble against 385 without it; 384 from the base solution. Arc-second tables
+never reach it."""
+
+MAX_UNEXPLAINED_ARCSEC = 18000.0
+"""Largest residual a fit may leave, arc seconds (5 deg, the small-error limit
+``MAX_ANGULAR_ERROR_DEG``): what the fitted errors of the table do not explain is a small error
+(noise, an effect) or no orientation error of the table at all (another star, a wrong sign, a
+unit mix-up); :func:`fit_orientation` refuses the rows beyond it."""
 
 
 class OrientationFitProblem:
@@ -210,15 +228,56 @@ def fit_orientation(
         zero_point: :func:`orientation_zero_point` of these data with these effects and maybe
             more (fits of many effect sets of one data set share it).
 
+    The fit starts from zero errors. With effects, when the fitted base errors exceed
+    :data:`RELINEARISE_RAD` (large constant offsets), the base errors are fitted alone first and
+    the model again from their solution (effects at zero), along the same determined
+    combinations; the better of the two fits is kept.
+
     Raises:
-        InputError: more rows than :data:`~turntable_pin.core.sizes.MAX_FITTED_ROWS`.
+        InputError: more rows than :data:`~turntable_pin.core.sizes.MAX_FITTED_ROWS`; residuals
+            beyond :data:`MAX_UNEXPLAINED_ARCSEC` (naming the rows: no error set of the table
+            explains them).
     """
     check_count(data.n_positions, MAX_FITTED_ROWS, "measurement rows", FIT_ROW_BYTES)
     model = OrientationModel(data.variables(), effects, turntable)
-    result = fit_least_squares(
-        OrientationFitProblem(data, model), noise_variance=noise_variance, zero_point=zero_point
+    problem = OrientationFitProblem(data, model)
+    result = fit_least_squares(problem, noise_variance=noise_variance, zero_point=zero_point)
+    n_base = len(model.base_names)
+    if model.effects and np.max(np.abs(result.params[:n_base]), initial=0.0) > RELINEARISE_RAD:
+        base = fit_orientation(data, (), noise_variance=noise_variance, turntable=turntable)
+        origin = np.zeros(model.n_params)
+        origin[:n_base] = base.result.params
+        refit = fit_least_squares(
+            problem, noise_variance=noise_variance, zero_point=zero_point, origin=origin
+        )
+        if refit.rss < result.rss:
+            result = refit
+    fit = OrientationFit(data, model, result)
+    _refuse_unexplained(fit)
+    return fit
+
+
+def _refuse_unexplained(fit: OrientationFit) -> None:
+    """:class:`InputError` naming the rows whose residual exceeds
+    :data:`MAX_UNEXPLAINED_ARCSEC`."""
+    from ..core.exceptions import InputError
+
+    residual_arcsec = np.abs(fit.residuals_rad) * ARCSEC_PER_RAD
+    bad = np.flatnonzero(np.nanmax(np.where(fit.data.measured, residual_arcsec, 0.0), axis=1)
+                         > MAX_UNEXPLAINED_ARCSEC)  # fmt: skip
+    if not bad.size:
+        return
+    rows = [int(r) for r in fit.data.rows[bad]]
+    shown = ", ".join(str(r) for r in rows[:10]) + (
+        f" and {len(rows) - 10} more" if len(rows) > 10 else ""
     )
-    return OrientationFit(data, model, result)
+    worst = float(np.nanmax(residual_arcsec[bad])) / 3600.0
+    raise InputError(
+        f"row(s) {shown} of {fit.data.source or 'the data'}: the best fit of the table's errors "
+        f"leaves up to {worst:.3g} deg unexplained, beyond {MAX_UNEXPLAINED_ARCSEC / 3600:g} deg: "
+        "no error set of this table explains them (another star, a wrong sign or unit, another "
+        "table?); correct or remove them"
+    )
 
 
 def orientation_zero_point(

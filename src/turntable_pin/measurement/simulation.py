@@ -19,11 +19,12 @@ from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows, 
 from ..core.exceptions import InputError, check_seed
 from ..core.sizes import MAX_SIMULATED_ROWS, check_count, turn_grid_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
-from ..model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
+from ..model.errors import ANGULAR_ERROR_NAMES, MAX_ANGULAR_ERROR_DEG, TurntableErrors
 from .catalogue import resolve_effect
 from .data import (
     MAX_COMMANDED_ANGLE_DEG,
     MAX_MEASURED_ANGLE_ARCSEC,
+    MAX_SIGMA_ARCSEC,
     MAX_TIME_S,
     MIN_SIGMA_ARCSEC,
     OrientationMeasurements,
@@ -49,9 +50,10 @@ ORDERS = ("grid", "random")
 APPROACHES = ("random", "motion", "positive")
 """Approach-direction rules a :class:`Schedule` knows."""
 
-MAX_NOISE_ARCSEC = MAX_MEASURED_ANGLE_ARCSEC / 10.0
-"""Largest simulated noise sigma, arc seconds (1800, half a degree): a tenth of the largest angle
-a measurement file may hold, so that noise alone never makes a file that cannot be read back."""
+MAX_NOISE_ARCSEC = MAX_SIGMA_ARCSEC / 10.0
+"""Largest simulated noise sigma, arc seconds (1800, half a degree): a tenth of the largest sigma
+a measurement file may hold (and of the small-error limit), so that noise alone never makes a file
+that cannot be read back."""
 
 MAX_NOISE_SPREAD = 100.0
 """Largest ``noise_spread`` F: each row's sigma is drawn log-uniform in [sigma/F, sigma*F]."""
@@ -483,13 +485,15 @@ def simulate_measurements(
         seed: seed of every random choice (order, directions, noise): a whole number
             0 <= seed < 2**63.
 
-    Every effect needs at least one parameter, each within ``+-MAX_MEASURED_ANGLE_ARCSEC`` in its
-    user unit; the run may last at most ``MAX_TIME_S`` and the simulated angles must stay within
-    what a measurement file may hold, or :class:`InputError` says which.
+    Every effect needs at least one parameter, each within +-18000 (the small-error limit
+    ``MAX_ANGULAR_ERROR_DEG`` in arcsec) in its user unit; the run may last at most
+    ``MAX_TIME_S`` and the simulated angles must stay within what a measurement file may hold
+    (``MAX_MEASURED_ANGLE_ARCSEC``), or :class:`InputError` says which.
         turntable: the table (``GenericTable``, ``TurntableModel`` or ``None``: the paper's).
         catalogue: effects besides the table's catalogue that ``effects`` may name (the user's).
     """
     limit = MAX_MEASURED_ANGLE_ARCSEC
+    effect_limit = MAX_ANGULAR_ERROR_DEG * 3600.0  # an effect is a small error
     noise = np.atleast_1d(np.asarray(noise_arcsec, dtype=float))
     if noise.size not in (1, 3):
         raise InputError(f"noise_arcsec takes one number or three, got {noise.size}")
@@ -540,10 +544,10 @@ def simulate_measurements(
                 number = float(value)
             except (TypeError, ValueError):
                 number = math.nan
-            if not abs(number) <= limit:
+            if not abs(number) <= effect_limit:
                 raise InputError(
                     f"effect '{name}', parameter '{pname}' = {value!r}: must be a number within "
-                    f"+-{limit:g} (in its user unit: arcsec, arcsec/g or arcsec/h)"
+                    f"+-{effect_limit:g} (in its user unit: arcsec, arcsec/g or arcsec/h)"
                 )
     rng = np.random.default_rng(seed)
     angles_deg = schedule.positions_deg(rng, n_joints)

@@ -3,7 +3,8 @@
 Inside the set, the eight angular errors are radians and the intersection error ``deta`` is
 metres. Readers take user units: arc seconds (or ``_arcmin``, ``_deg``, ``_rad`` suffixes) for
 angles, millimetres (or ``_m``) for ``deta``. Readers refuse values beyond the small-error range
-(:data:`MAX_ANGULAR_ERROR_DEG`, :data:`MAX_DETA_M`).
+(:data:`MAX_ANGULAR_ERROR_DEG`, :data:`MAX_DETA_M`), or, for a simulated measurement run (the
+exact chain), beyond :data:`MAX_ORIENTATION_ERROR_DEG`.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ __all__ = [
     "ERROR_NAMES",
     "MAX_ANGULAR_ERROR_DEG",
     "MAX_DETA_M",
+    "MAX_ORIENTATION_ERROR_DEG",
     "TurntableErrors",
     "parse_error_value",
 ]
@@ -81,6 +83,17 @@ orientation limit (``allocate``). The model is first order in these angles (eq. 
 order angle^2, 0.4 % of the angle at 5 degrees); an error of more than a few degrees is a broken
 or misassembled table, not a small error, and a value beyond this is refused as a typo or a unit
 mix-up (degrees written as arc seconds)."""
+MAX_ORIENTATION_ERROR_DEG = 30.0
+"""Largest orientation error the exact chain takes from a measurement run, degrees: a measured
+``dpsi/dtheta/dgamma`` (``measurement.data``) and an angular error of a simulated run. A run is
+fitted by nonlinear least squares on the exact rotation chain, so a constant offset of several
+degrees (a telescope mount not synced, an encoder index off) is an ordinary first fit, not a
+small-angle violation: Gauss-Newton from zero errors converges on runs whose measured angles
+reach 20 deg, with Levenberg-Marquardt's help up to 30 deg, and lands in wrong minima only
+beyond 40 deg (``tests/measurement/test_fit.py``). The measured angles are entries of ``dR``
+(sines: they cannot exceed 1 rad = 57.3 deg, and at 30 deg one reads the angle 5 % off);
+a third of a turn or more is no orientation error of the table but another star, the other
+pier side or a sign convention."""
 MAX_DETA_M = 0.01
 """Largest intersection error ``|deta|``, metres (10 mm): the axes of a bench-top table are
 centimetres apart at worst; more is a unit mix-up (metres written as millimetres)."""
@@ -104,17 +117,20 @@ def parse_error_value(
     *,
     names: Sequence[str] = ERROR_NAMES,
     length_names: Sequence[str] = ("deta",),
+    max_angle_deg: float = MAX_ANGULAR_ERROR_DEG,
 ) -> tuple[str, float]:
     """Turn one user entry into ``(name, value in rad or m)``.
 
     ``key`` is an error name, optionally with a unit suffix (``dphi_y1_arcmin``, ``deta_m``).
     Without a suffix angles are arc seconds and lengths (``deta``) millimetres. ``names`` and
     ``length_names`` are the table's error names and those of them that are lengths (default:
-    the paper's nine, of which ``deta``).
+    the paper's nine, of which ``deta``). ``max_angle_deg``: the largest angle taken, degrees
+    (:data:`MAX_ANGULAR_ERROR_DEG`, the small-error limit; a simulated measurement run takes
+    :data:`MAX_ORIENTATION_ERROR_DEG`).
 
     Raises:
         InputError: unknown name or unit, a value that is not a finite number, an angle beyond
-            :data:`MAX_ANGULAR_ERROR_DEG` or a ``deta`` beyond :data:`MAX_DETA_M`.
+            ``max_angle_deg`` or a ``deta`` beyond :data:`MAX_DETA_M`.
     """
     key = key.strip()
     name, unit = key, None
@@ -140,10 +156,13 @@ def parse_error_value(
                 f"error '{key}' = {number:g} {unit} is beyond the range of the model: "
                 f"|{name}| must be at most {MAX_DETA_M / M_PER_MM:g} mm"
             )
-    elif not abs(si_value) <= MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD:
+    elif not abs(si_value) <= max_angle_deg / DEG_PER_RAD:
+        what = (
+            "a small error" if max_angle_deg <= MAX_ANGULAR_ERROR_DEG else "an error of the table"
+        )
         raise InputError(
-            f"error '{key}' = {number:g} {unit} is not a small error: an angular error must be "
-            f"at most {MAX_ANGULAR_ERROR_DEG:g} deg ({MAX_ANGULAR_ERROR_DEG * 3600:g} arcsec)"
+            f"error '{key}' = {number:g} {unit} is not {what}: an angular error must be "
+            f"at most {max_angle_deg:g} deg ({max_angle_deg * 3600:g} arcsec)"
         )
     return name, si_value
 
@@ -211,11 +230,14 @@ class TurntableErrors:
         return cls(*values.tolist())
 
     @classmethod
-    def from_user_units(cls, entries: Mapping[str, object]) -> TurntableErrors:
-        """From a mapping ``name[_unit] -> value`` in user units (see :func:`parse_error_value`)."""
+    def from_user_units(
+        cls, entries: Mapping[str, object], *, max_angle_deg: float = MAX_ANGULAR_ERROR_DEG
+    ) -> TurntableErrors:
+        """From a mapping ``name[_unit] -> value`` in user units (see :func:`parse_error_value`;
+        angles up to ``max_angle_deg``, degrees)."""
         values: dict[str, float] = {}
         for key, value in entries.items():
-            name, si_value = parse_error_value(str(key), value)
+            name, si_value = parse_error_value(str(key), value, max_angle_deg=max_angle_deg)
             if name in values:
                 raise InputError(f"error '{name}' is given twice")
             values[name] = si_value
@@ -227,8 +249,11 @@ class TurntableErrors:
         return cls.from_user_units({**angles_arcsec, "deta_mm": deta_mm})
 
     @classmethod
-    def from_yaml(cls, path: str | Path) -> TurntableErrors:
-        """Read a YAML file: a mapping ``name[_unit]: value``, optionally under a key ``errors``.
+    def from_yaml(
+        cls, path: str | Path, *, max_angle_deg: float = MAX_ANGULAR_ERROR_DEG
+    ) -> TurntableErrors:
+        """Read a YAML file: a mapping ``name[_unit]: value``, optionally under a key ``errors``
+        (angles up to ``max_angle_deg``, degrees).
 
         Example::
 
@@ -240,7 +265,7 @@ class TurntableErrors:
         path = Path(path)
         data = read_error_mapping(path)
         try:
-            return cls.from_user_units(data)
+            return cls.from_user_units(data, max_angle_deg=max_angle_deg)
         except InputError as exc:
             raise InputError(exc.detail, path=path) from None
 

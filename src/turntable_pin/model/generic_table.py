@@ -228,31 +228,43 @@ class GenericTable:
         """The parameters that are lengths (the offsets, metres)."""
         return tuple(n for n in self.parameter_names if ".offset_" in n)
 
-    def errors_from_user_units(self, entries: Mapping[str, object]) -> np.ndarray:
+    def errors_from_user_units(
+        self, entries: Mapping[str, object], *, max_angle_deg: float | None = None
+    ) -> np.ndarray:
         """The error vector from ``{name[_unit]: value}`` in user units (arcsec and mm by
         default; ``_arcmin``, ``_deg``, ``_rad``, ``_um``, ``_m`` suffixes), with the ranges of
-        :func:`~turntable_pin.model.errors.parse_error_value`."""
-        from .errors import parse_error_value
+        :func:`~turntable_pin.model.errors.parse_error_value` (angles up to ``max_angle_deg``,
+        degrees; default the small-error limit ``MAX_ANGULAR_ERROR_DEG``)."""
+        from .errors import MAX_ANGULAR_ERROR_DEG, parse_error_value
+
+        if max_angle_deg is None:
+            max_angle_deg = MAX_ANGULAR_ERROR_DEG
 
         out = np.zeros(len(self.parameter_names))
         given: set[str] = set()
         for key, value in entries.items():
             name, si_value = parse_error_value(
-                str(key), value, names=self.parameter_names, length_names=self.length_names
-            )
+                str(key), value, names=self.parameter_names, length_names=self.length_names,
+                max_angle_deg=max_angle_deg,
+            )  # fmt: skip
             if name in given:
                 raise InputError(f"error '{name}' is given twice")
             given.add(name)
             out[self.parameter_names.index(name)] = si_value
         return out
 
-    def errors_from_yaml(self, path: str | Path) -> np.ndarray:
+    def errors_from_yaml(
+        self, path: str | Path, *, max_angle_deg: float | None = None
+    ) -> np.ndarray:
         """The error vector of a YAML file of ``name[_unit]: value`` (optionally under
-        ``errors:``), in this table's names."""
+        ``errors:``), in this table's names (angles up to ``max_angle_deg``, degrees, as in
+        :meth:`errors_from_user_units`)."""
         from .errors import read_error_mapping
 
         try:
-            return self.errors_from_user_units(read_error_mapping(path))
+            return self.errors_from_user_units(
+                read_error_mapping(path), max_angle_deg=max_angle_deg
+            )
         except InputError as exc:
             if exc.path is not None:
                 raise

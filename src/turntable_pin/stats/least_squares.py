@@ -506,10 +506,17 @@ def tall_times(tall: np.ndarray, small: np.ndarray) -> np.ndarray:
     return (small.T @ tall.T).T
 
 
-def _iterate(problem, evaluate, weights, basis, start):
-    """Gauss-Newton, then chord steps, from ``z = 0`` in whitened coordinates.
+def _point(origin: np.ndarray | None, basis: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """The parameters at whitened coordinates ``z``: ``origin + basis @ z`` (``origin`` None:
+    zero)."""
+    return basis @ z if origin is None else origin + basis @ z
 
-    ``start`` is ``(cost, normal matrix, gradient)`` at zero (``jz^T jz`` and ``jz^T r`` for
+
+def _iterate(problem, evaluate, weights, basis, start, origin):
+    """Gauss-Newton, then chord steps, from ``z = 0`` in whitened coordinates (parameters
+    ``_point(origin, basis, z)``).
+
+    ``start`` is ``(cost, normal matrix, gradient)`` at ``z = 0`` (``jz^T jz`` and ``jz^T r`` for
     the weighted Jacobian ``jz`` in these coordinates, orthonormal there). The first step uses
     it; the model's Jacobian is evaluated once, at that first point ``z1``, and every further
     step solves with it against fresh residuals (``predict`` only). Their fixed point differs
@@ -527,7 +534,7 @@ def _iterate(problem, evaluate, weights, basis, start):
     observed = problem.observed
     cost, normal, gradient = start
     z = np.linalg.solve(normal, gradient)
-    predicted, jac = evaluate(basis @ z)
+    predicted, jac = evaluate(_point(origin, basis, z))
     jac *= weights[:, None]
     jz = tall_times(jac, basis)  # d(predicted * weights)/dz = -d(res)/dz
     del jac
@@ -546,7 +553,7 @@ def _iterate(problem, evaluate, weights, basis, start):
             # The residuals after this last, tiny step: linear in it to its size squared times
             # the nonlinearity (< 1e-20 relative), so no further evaluation is needed.
             return z, res - jz @ step, normal, count
-        predicted = problem.predict(basis @ z)
+        predicted = problem.predict(_point(origin, basis, z))
         count += 1
     return None
 
@@ -556,6 +563,7 @@ def fit_least_squares(
     *,
     noise_variance: float | None = None,
     zero_point: ZeroPoint | None = None,
+    origin: np.ndarray | None = None,
 ) -> FitResult:
     """Fit ``problem`` by weighted nonlinear least squares (Gauss-Newton and chord steps, else
     scipy's Levenberg-Marquardt).
@@ -574,6 +582,11 @@ def fit_least_squares(
         zero_point: the reduced Jacobian at zero of a model with these parameters and maybe more
             (:func:`zero_point`): the identifiability and the first step are then read from it
             instead of evaluating the Jacobian at zero (fits of many models of one data set).
+        origin: start from these parameters instead of zero: ``params`` is then ``origin``
+            plus a combination of the directions determined at zero (which also give the
+            identifiability), found from the Jacobian at ``origin``. For a model whose solution
+            is far from zero (large constant offsets), started from a nearby solution (e.g.
+            that of fewer parameters): the minimum-norm representative at zero can miss it.
 
     Raises:
         IdentifiabilityError: no parameter is determined, or no degree of freedom is left.
@@ -615,15 +628,24 @@ def fit_least_squares(
     del j0
     start = (cost0, jz0.T @ jz0, basis.T @ gradient0)
     del jz0
-    solved = _iterate(problem, evaluate, weights, basis, start)
+    if origin is not None:  # the first step from ``origin``, with the Jacobian there
+        origin = np.asarray(origin, dtype=float)
+        predicted1, j1 = evaluate(origin)
+        j1 *= weights[:, None]
+        res1 = (problem.observed - predicted1) * weights
+        jz1 = tall_times(j1, basis)
+        del j1
+        start = (float(res1 @ res1), jz1.T @ jz1, jz1.T @ res1)
+        del jz1
+    solved = _iterate(problem, evaluate, weights, basis, start, origin)
     if solved is None:
-        z, weighted_res, jac_weighted, nfev = _levenberg_marquardt(problem, weights, basis)
+        z, weighted_res, jac_weighted, nfev = _levenberg_marquardt(problem, weights, basis, origin)
         jz = tall_times(jac_weighted, basis)
         normal = jz.T @ jz
         del jac_weighted, jz
     else:
         z, weighted_res, normal, nfev = solved
-    params = basis @ z
+    params = _point(origin, basis, z)
     rss = float(weighted_res @ weighted_res)
     dof = m - ident.rank
     if sigma_known:
@@ -663,21 +685,23 @@ def _weighted_jacobian(problem: FitProblem, params: np.ndarray, weights: np.ndar
     return compute
 
 
-def _levenberg_marquardt(problem: FitProblem, weights: np.ndarray, basis: np.ndarray):
-    """scipy's Levenberg-Marquardt in the coordinates ``basis``: ``(z, weighted residuals,
-    weighted jacobian (m, n), evaluations)``."""
+def _levenberg_marquardt(
+    problem: FitProblem, weights: np.ndarray, basis: np.ndarray, origin: np.ndarray | None
+):
+    """scipy's Levenberg-Marquardt in the coordinates ``basis`` about ``origin``: ``(z,
+    weighted residuals, weighted jacobian (m, n), evaluations)``."""
     from scipy import optimize  # imported on use: keeps the package's import light
 
     def fun(z):
-        return (problem.observed - problem.predict(basis @ z)) * weights
+        return (problem.observed - problem.predict(_point(origin, basis, z))) * weights
 
     def jac(z):
-        return -tall_times(problem.jacobian(basis @ z) * weights[:, None], basis)
+        return -tall_times(problem.jacobian(_point(origin, basis, z)) * weights[:, None], basis)
 
     # The models are nearly linear: one Gauss-Newton step from zero lands close to the optimum.
     rank = basis.shape[1]
     z0 = np.linalg.lstsq(-jac(np.zeros(rank)), -fun(np.zeros(rank)), rcond=None)[0]
     solution = optimize.least_squares(fun, z0, jac=jac, method="lm", xtol=1e-12, ftol=1e-12)
     z = solution.x
-    jac_weighted = problem.jacobian(basis @ z) * weights[:, None]
+    jac_weighted = problem.jacobian(_point(origin, basis, z)) * weights[:, None]
     return z, solution.fun, jac_weighted, solution.nfev
