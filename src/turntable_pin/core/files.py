@@ -9,7 +9,7 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["read_yaml", "write_atomic", "write_bytes_atomic", "write_text_atomic"]
+__all__ = ["read_text_file", "read_yaml", "write_atomic", "write_bytes_atomic", "write_text_atomic"]
 
 
 def write_atomic(path: str | Path, write: Callable[[Path], None]) -> Path:
@@ -60,6 +60,20 @@ def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
     return write_atomic(path, lambda tmp: tmp.write_bytes(data))
 
 
+def read_text_file(path: str | Path, kind: str, encoding: str = "utf-8") -> str:
+    """The text of the file ``path``; an unreadable or non-UTF-8 file is an ``InputError``
+    naming it (``kind``: what the file should be, e.g. ``"YAML"``, for the message)."""
+    from .exceptions import InputError
+
+    path = Path(path)
+    try:
+        return path.read_text(encoding=encoding)
+    except OSError as exc:
+        raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
+    except UnicodeDecodeError:
+        raise InputError(f"not a text (UTF-8) {kind} file", path=path) from None
+
+
 def read_yaml(path: str | Path):
     """Parse a YAML file; an unreadable file or invalid YAML raises :class:`InputError`.
 
@@ -71,12 +85,7 @@ def read_yaml(path: str | Path):
     from .exceptions import InputError
 
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
-    except UnicodeDecodeError:
-        raise InputError("not a text (UTF-8) YAML file", path=path) from None
+    text = read_text_file(path, "YAML")
     try:
         return yaml.load(text, Loader=_unique_key_loader())  # noqa: S506 (a SafeLoader)
     except _DuplicateKey as dup:

@@ -56,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.exceptions import InputError
-from ..core.files import write_text_atomic
+from ..core.files import read_text_file, write_text_atomic
 from ..core.units import ARCSEC_PER_RAD
 from .data import MAX_MEASURED_ANGLE_ARCSEC
 
@@ -332,12 +332,7 @@ def read_tpoint(
             f"azimuth convention '{azimuth_origin}, {azimuth_direction}': expected origin "
             f"{'|'.join(AZIMUTH_ORIGINS)} and direction {'|'.join(AZIMUTH_DIRECTIONS)}"
         )
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except OSError as exc:
-        raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
-    except UnicodeDecodeError:
-        raise InputError("not a text (UTF-8) TPOINT file", path=path) from None
+    text = read_text_file(path, "TPOINT", encoding="utf-8-sig")
 
     caption = None
     options: list[str] = []
@@ -523,25 +518,21 @@ def _check_run_parameters(params: dict, path: Path, line: int) -> None:
 
 def _check_azimuth_notes(notes, origin: str, direction: str, path: Path) -> None:
     """Refuse an azimuth convention that a comment of the file contradicts."""
+    checks = (
+        (_ORIGIN_NOTE, origin, "the azimuth origin is", "origin"),
+        (_DIRECTION_NOTE, direction, "azimuth 90 is", "direction"),
+    )
     for number, text in notes:
-        found = _ORIGIN_NOTE.search(text)
-        if found and found.group(1).lower() != origin:
-            raise InputError(
-                f"the file's comment states '{found.group(0)}', but the azimuth origin is "
-                f"taken as {origin} (--azimuth-origin); give --azimuth-origin "
-                f"{found.group(1).lower()} or correct the comment",
-                path=path,
-                line=number,
-            )
-        found = _DIRECTION_NOTE.search(text)
-        if found and found.group(1).lower() != direction:
-            raise InputError(
-                f"the file's comment states '{found.group(0)}', but azimuth 90 is taken as "
-                f"{direction} (--azimuth-direction); give --azimuth-direction "
-                f"{found.group(1).lower()} or correct the comment",
-                path=path,
-                line=number,
-            )
+        for pattern, taken, what, option in checks:
+            found = pattern.search(text)
+            if found and found.group(1).lower() != taken:
+                raise InputError(
+                    f"the file's comment states '{found.group(0)}', but {what} taken as "
+                    f"{taken} (--azimuth-{option}); give --azimuth-{option} "
+                    f"{found.group(1).lower()} or correct the comment",
+                    path=path,
+                    line=number,
+                )
 
 
 # --- the mount URDFs --------------------------------------------------------------------------
