@@ -137,7 +137,11 @@ class OrientationFamily:
         key = tuple(e.name for e in effects)
         if key not in self._cache:
             self._cache[key] = fit_orientation(
-                self.data, effects, turntable=self.table, zero_point=self._zero_point()
+                self.data,
+                effects,
+                turntable=self.table,
+                zero_point=self._zero_point(),
+                base_fit=self.fit([]) if effects else None,
             )
         return self._cache[key]
 
@@ -635,7 +639,6 @@ def diagnose_measurements(
     check_count(data.n_positions, MAX_DIAGNOSED_ROWS, "measurement rows", DIAGNOSIS_ROW_BYTES)
     table = measured_table(turntable)
     diagnosis = _diagnose(data, until_explained, catalogue, table, outliers)
-    diagnosis.doubt = _table_doubt(diagnosis, table)
     if data.sigma_rad is None:
         per_angle = _noise_per_angle(diagnosis)
         if per_angle is not None:
@@ -647,6 +650,7 @@ def diagnose_measurements(
             diagnosis = None  # free the first one's fits before the second
             diagnosis = _diagnose(weighted, until_explained, catalogue, table, outliers)
             diagnosis.warnings.append(note)
+    diagnosis.doubt = _table_doubt(diagnosis, table)
     return diagnosis
 
 

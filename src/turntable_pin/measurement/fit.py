@@ -215,6 +215,7 @@ def fit_orientation(
     noise_variance: float | None = None,
     turntable=None,
     zero_point: ZeroPoint | None = None,
+    base_fit: OrientationFit | None = None,
 ) -> OrientationFit:
     """Fit the base error model plus ``effects`` to ``data``.
 
@@ -227,6 +228,8 @@ def fit_orientation(
             default: the bundled paper table).
         zero_point: :func:`orientation_zero_point` of these data with these effects and maybe
             more (fits of many effect sets of one data set share it).
+        base_fit: the fit of the base errors alone to these ``data``, when at hand (the start
+            of a fit again from large offsets, below; fitted here when needed and not given).
 
     The fit starts from zero errors. With effects, when the fitted base errors exceed
     :data:`RELINEARISE_RAD` (large constant offsets), the base errors are fitted alone first and
@@ -244,9 +247,10 @@ def fit_orientation(
     result = fit_least_squares(problem, noise_variance=noise_variance, zero_point=zero_point)
     n_base = len(model.base_names)
     if model.effects and np.max(np.abs(result.params[:n_base]), initial=0.0) > RELINEARISE_RAD:
-        base = fit_orientation(data, (), noise_variance=noise_variance, turntable=turntable)
+        if base_fit is None:
+            base_fit = fit_orientation(data, (), noise_variance=noise_variance, turntable=turntable)
         origin = np.zeros(model.n_params)
-        origin[:n_base] = base.result.params
+        origin[:n_base] = base_fit.result.params
         refit = fit_least_squares(
             problem, noise_variance=noise_variance, zero_point=zero_point, origin=origin
         )

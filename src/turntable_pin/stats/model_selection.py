@@ -170,8 +170,8 @@ def undetermined_parameters(entries: Sequence[dict]) -> list[str]:
     undetermined; empty: the effect is determined.
 
     An effect is determined when the data see at least one of its parameters on its own, every
-    such parameter is determined (not traded off against the others, correlation at most
-    :data:`MAX_CORRELATION`) and at least one is significant (``|value| >=``
+    such parameter is determined (not traded off: :func:`parameter_determination`) and at
+    least one is significant (``|value| >=``
     :data:`DETERMINED_SIGMAS` ``std``). Parameters that only move along combinations the data
     cannot see (absorbed into the model's errors, or acting on an angle not measured) count
     neither way; a coefficient determined to be near zero (the 2/rev term of a 1/rev
@@ -513,11 +513,8 @@ class Diagnosis:
         }
         named_parameters = self.named_parameters()
         verdict["named_parameters"] = named_parameters
-        verdict["named_undetermined"] = {
-            name: undetermined_parameters(entries)
-            for name, entries in named_parameters.items()
-            if entries and undetermined_parameters(entries)
-        }
+        loose = {name: undetermined_parameters(e) for name, e in named_parameters.items() if e}
+        verdict["named_undetermined"] = {name: names for name, names in loose.items() if names}
         verdict["not_named_undetermined"] = [
             {
                 "effect": c.effect,
@@ -727,9 +724,7 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
     def projected(fit, terms, term_probes) -> tuple[float, int]:
         """(rss, rank) of ``fit`` with the probe columns of ``terms`` added."""
         result = fit.result
-        by_name = {p.name: p for p in term_probes}
-        columns = [result.determined_jacobian_weighted]
-        columns += [by_name[t.name].matrix() for t in terms]
+        columns = [result.determined_jacobian_weighted, *_term_columns(terms, term_probes)]
         return _projected_rss(result.residuals * result.weights, columns)
 
     full_rss, full_rank = projected(current_fit, structure, probes)
@@ -788,31 +783,37 @@ OWN_SHAPE_FRACTION = 0.05
 lies outside the span of the model with the effect."""
 
 
+def _inside(columns: np.ndarray, blocks: Sequence[np.ndarray]) -> bool:
+    """Whether ``columns`` lie (up to :data:`OWN_SHAPE_FRACTION` of their Frobenius norm) in
+    the span of the tall ``blocks`` side by side."""
+    outside = _projected_rss(columns, blocks)[0]
+    return bool(outside <= OWN_SHAPE_FRACTION**2 * float(np.sum(columns**2)))
+
+
+def _term_columns(terms, term_probes) -> list[np.ndarray]:
+    """The probe columns of the structure ``terms``, one block per term."""
+    by_name = {p.name: p for p in term_probes}
+    return [by_name[t.name].matrix() for t in terms]
+
+
 def _duplicated(full: FitResult, without: FitResult, terms, term_probes) -> bool:
-    """Whether the columns of the effect that ``full`` has and ``without`` lacks lie (up to
-    :data:`OWN_SHAPE_FRACTION`) in the span of ``without``'s Jacobian and the probe columns of
-    the structure ``terms``: the structure then describes the effect's own signal."""
+    """Whether the columns of the effect that ``full`` has and ``without`` lacks lie in the span
+    of ``without``'s Jacobian and the probe columns of the structure ``terms`` (:func:`_inside`):
+    the structure then describes the effect's own signal."""
     if not terms:
         return False
     known = set(without.parameter_names)
     own = [i for i, n in enumerate(full.parameter_names) if n not in known]
     if not own:
         return False
-    columns = full.jacobian_weighted[:, own]
-    by_name = {p.name: p for p in term_probes}
-    blocks = [without.determined_jacobian_weighted]
-    blocks += [by_name[t.name].matrix() for t in terms]
-    outside = _projected_rss(columns, blocks)[0]
-    return bool(outside <= OWN_SHAPE_FRACTION**2 * float(np.sum(columns**2)))
+    blocks = [without.determined_jacobian_weighted, *_term_columns(terms, term_probes)]
+    return _inside(full.jacobian_weighted[:, own], blocks)
 
 
 def _within(terms, term_probes, jacobian_weighted: np.ndarray) -> bool:
-    """Whether the probe columns of ``terms`` lie (up to :data:`OWN_SHAPE_FRACTION`) in the span
-    of ``jacobian_weighted``."""
-    by_name = {p.name: p for p in term_probes}
-    columns = np.concatenate([by_name[t.name].matrix() for t in terms], axis=1)
-    outside = _projected_rss(columns, [jacobian_weighted])[0]
-    return bool(outside <= OWN_SHAPE_FRACTION**2 * float(np.sum(columns**2)))
+    """Whether the probe columns of ``terms`` lie in the span of ``jacobian_weighted``
+    (:func:`_inside`)."""
+    return _inside(np.concatenate(_term_columns(terms, term_probes), axis=1), [jacobian_weighted])
 
 
 def _steps_of(family, effects, base_fit) -> list[Step]:
