@@ -42,7 +42,7 @@ import numpy as np
 
 from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError
-from .least_squares import FitResult, chi2_quantile, chi2_sf
+from .least_squares import FitResult, chi2_quantile, chi2_sf, tall_r_factor
 from .structure_search import (
     BIC_THRESHOLD,
     FoundTerm,
@@ -211,7 +211,9 @@ def parameter_determination(
     """
     table = result.parameter_table()
     index = {n: i for i, n in enumerate(result.parameter_names)}
-    jac = result.jacobian_weighted
+    # Angles between columns are those of the small triangular factor R (J = Q R, Q with
+    # orthonormal columns): every projection below is done on R, not on the tall Jacobian.
+    jac = tall_r_factor(result.jacobian_weighted)
 
     def span(columns: list[int], rank: int) -> np.ndarray:
         u, _, _ = np.linalg.svd(jac[:, columns], full_matrices=False)
