@@ -356,3 +356,42 @@ def test_data_of_another_table_make_the_first_line_ask_for_the_urdf():
     assert headline(d).startswith("Check the table:") and "--urdf" in d["verdict"]["doubt"]
     clean = diagnose_measurements(read_measurements(EXAMPLES_DIR / "measurements_example.csv"))
     assert clean.to_dict()["verdict"]["doubt"] is None
+
+
+def test_with_noise_per_angle_every_model_is_judged_at_its_own_noise():
+    # Issue 17: the second pass took each angle's sigma from the first pass' best model and held
+    # it fixed, so an angle whose effect that model lacked was down-weighted and the effect lost.
+    # Now each model is refitted at the noise it estimates itself: the verdict and the fits do
+    # not depend on the sigmas the second pass starts from.
+    from turntable_pin.measurement.diagnosis import _diagnose
+    from turntable_pin.measurement.simulation import Schedule
+    from turntable_pin.measurement.table import measured_table
+
+    sim = simulate_measurements(
+        random_errors(np.random.default_rng(5)), {"inner_encoder_harmonics": {"c1": 3.0}},
+        schedule=Schedule(30, 30), noise_arcsec=(0.5, 2.0, 1.0), seed=5,
+    )  # fmt: skip
+    data = sim.data.without_sigma()
+    outcomes = []
+    for start in ((0.5, 2.0, 1.0), (20.0, 0.1, 1.0)):  # right, and badly wrong on dpsi
+        sigma = np.broadcast_to(np.array(start) / ARCSEC_PER_RAD, data.angles_rad.shape).copy()
+        start_data = data.replace(sigma_rad=sigma, sigma_relative=True)
+        d = _diagnose(start_data, False, None, measured_table(None), False, noise_per_angle=True)
+        outcomes.append(d)
+    right, wrong = outcomes
+    assert right.missing_effect == wrong.missing_effect == "inner_encoder_harmonics"
+    np.testing.assert_allclose(
+        wrong.best_fit.result.params, right.best_fit.result.params, rtol=0, atol=1e-4 / 206265
+    )
+    variance = np.sum(right.best_fit.residuals_rad**2, axis=0) / 144
+    assert np.sqrt(variance) * ARCSEC_PER_RAD == pytest.approx([0.5, 2.0, 1.0], rel=0.15)
+    # a fixed wrong sigma (the old rule) gives a different fit
+    fixed = fit_orientation(
+        data.replace(
+            sigma_rad=np.broadcast_to(np.array((20.0, 0.1, 1.0)) / ARCSEC_PER_RAD,
+                                      data.angles_rad.shape).copy(),
+            sigma_relative=True,
+        ),
+        [EFFECTS["inner_encoder_harmonics"]],
+    )  # fmt: skip
+    assert np.max(np.abs(fixed.result.params - right.best_fit.result.params)) > 1e-2 / 206265

@@ -208,3 +208,31 @@ def test_chi2_tail_and_quantile_equal_scipy_stats():
         for x in (0.3, 5.0, 40.0, 500.0, 3e5):
             assert chi2_sf(x, dof) == pytest.approx(stats.chi2.sf(x, dof), rel=1e-14, abs=0)
         assert chi2_quantile(0.99, dof) == pytest.approx(stats.chi2.ppf(0.99, dof), rel=1e-14)
+
+
+def test_profiled_rss_is_the_likelihood_with_a_noise_level_per_group(rng):
+    # -2 ln L with each group's variance at its maximum (S_g / n_g) is
+    # sum_g n_g ln(S_g / n_g) + m (1 + ln 2 pi): the differences of two fits' m ln(profiled_rss)
+    # must be the differences of that, computed here from the residuals directly.
+    from dataclasses import replace
+
+    x = np.linspace(-1, 1, 60)
+    groups = np.repeat([0, 1, 2], 20)
+    y = 1.0 + 3.0 * x + rng.normal(0, 1.0, x.size) * np.array([0.5, 2.0, 1.0])[groups]
+    results = []
+    for truncate in (False, True):
+        toy = LinearToy(x, y, None)
+        if truncate:  # a worse model: no x^2 and no slope
+            toy.design = toy.design[:, :1] * np.ones((1, 4))
+        results.append(replace(fit_least_squares(toy), noise_groups=groups))
+
+    def minus_two_log_likelihood(result):
+        s = np.array([np.sum(result.residuals[groups == g] ** 2) for g in range(3)])
+        return float(np.sum(20 * np.log(s / 20)))
+
+    good, bad = results
+    m = x.size
+    got = m * (np.log(bad.profiled_rss) - np.log(good.profiled_rss))
+    assert got == pytest.approx(minus_two_log_likelihood(bad) - minus_two_log_likelihood(good))
+    assert replace(good, noise_groups=None).profiled_rss == good.rss
+    assert good.group_rss.sum() == pytest.approx(np.sum(good.residuals**2))

@@ -105,6 +105,11 @@ class OrientationFamily:
         turntable: the table (see :func:`~turntable_pin.measurement.table.measured_table`).
         left_out_rad: the measured values (N, 3) of the angles left out of ``data`` as
             outliers, NaN elsewhere (shown in the plots, never fitted), or ``None``.
+        noise_per_angle: sigma unknown and the angles' noise differ: every model is fitted
+            with a noise level per measured angle estimated with that model (iteratively
+            reweighted to the maximum of its likelihood), and scored with each level profiled
+            (``FitResult.profiled_rss``), so that each comparison is made at each model's own
+            noise. ``data``'s relative sigmas are only the first weights.
     """
 
     record_label = "positions"
@@ -116,8 +121,10 @@ class OrientationFamily:
         catalogue: Sequence[Effect] | None = None,
         turntable=None,
         left_out_rad: np.ndarray | None = None,
+        noise_per_angle: bool = False,
     ) -> None:
         self.data = data
+        self.noise_per_angle = noise_per_angle
         self.left_out_rad = left_out_rad
         self.table = measured_table(turntable)
         self.turntable = self.table
@@ -136,14 +143,41 @@ class OrientationFamily:
         """The fit of the base errors plus ``effects`` (cached per effect list)."""
         key = tuple(e.name for e in effects)
         if key not in self._cache:
-            self._cache[key] = fit_orientation(
+            fit = fit_orientation(
                 self.data,
                 effects,
                 turntable=self.table,
                 zero_point=self._zero_point(),
                 base_fit=self.fit([]) if effects else None,
             )
+            self._cache[key] = self._own_noise(fit) if self.noise_per_angle else fit
         return self._cache[key]
+
+    def _own_noise(self, fit: OrientationFit) -> OrientationFit:
+        """``fit`` refitted with the per-angle noise levels it estimates itself, until they
+        stop moving (:data:`NOISE_RTOL`, at most :data:`NOISE_ITERATIONS` refits); its result
+        carries the angle of each observation as its noise group."""
+        data = self.data
+        sigma = None
+        for _ in range(NOISE_ITERATIONS):
+            variance, counts, _ = _angle_variances(fit)
+            measured = counts > 0
+            new = np.sqrt(np.where(measured, variance, np.mean(variance[measured])))
+            if sigma is not None and np.all(np.abs(new - sigma) <= NOISE_RTOL * sigma):
+                break
+            sigma = new
+            weighted = data.replace(
+                sigma_rad=np.broadcast_to(sigma, data.angles_rad.shape).copy(),
+                sigma_relative=True,
+            )
+            fit = fit_orientation(
+                weighted,
+                fit.model.effects,
+                turntable=self.table,
+                base_fit=self.fit([]) if fit.model.effects else None,
+            )
+        groups = np.broadcast_to(np.arange(3), data.angles_rad.shape)[data.measured]
+        return dataclasses.replace(fit, result=dataclasses.replace(fit.result, noise_groups=groups))
 
     def _zero_point(self):
         """The reduced Jacobian at zero of the base and every testable catalogued effect, shared
@@ -444,11 +478,19 @@ class OrientationFamily:
         return [p for p in self.probes(fit) if not of_angles(p)]
 
     def _dense_variables(self) -> PositionVariables:
-        """A dense design over every axis (15-degree grid; 30 degrees for three axes), with a
+        """A dense design over every axis (15-degree grid; 30 degrees for three axes; as many
+        angles within the limits of a joint that does not turn all the way round), with a
         random time order and random approach directions where the data have them."""
         step = 30.0 if self.data.n_joints > 2 else 15.0
+        count = int(round(360.0 / step))
         g = np.radians(np.arange(0.0, 360.0, step))
-        grids = np.meshgrid(*([g] * self.data.n_joints), indexing="ij")
+        # Within a joint's limits, the same number of angles at the centres of equal cells
+        # (the ends, where a term such as cot(elevation) may be infinite, are not positions).
+        axes = [
+            g if limits is None else limits[0] + (np.arange(count) + 0.5) * np.ptp(limits) / count
+            for limits in self.table.joint_limits_rad
+        ]
+        grids = np.meshgrid(*axes, indexing="ij")
         joints = np.stack([x.ravel() for x in grids], axis=1)
         n = joints.shape[0]
         rng = np.random.default_rng(0)
@@ -473,9 +515,18 @@ class OrientationFamily:
             variables.dirs, dict(variables.extra), source="dense design",
         )  # fmt: skip
         base_effects = [e for e in a_effects if e is not a]
-        misfit = fit_orientation(dense, [*base_effects, effect_b], turntable=self.table)
-        chi2 = misfit.result.rss
         grid = "30-degree" if self.data.n_joints > 2 else "15-degree"
+        if any(limits is not None for limits in self.table.joint_limits_rad):
+            grid += " (within the joints' limits)"
+        try:
+            misfit = fit_orientation(dense, [*base_effects, effect_b], turntable=self.table)
+        except InputError as exc:  # B cannot be evaluated everywhere (cot E at the horizon)
+            return (
+                f"{effect_b.name} cannot be compared with {a.name} on a dense {grid} grid "
+                f"({exc.detail}); an independent measurement tells them apart. For {a.name}: "
+                f"{a.confirm} For {effect_b.name}: {effect_b.confirm}"
+            )
+        chi2 = misfit.result.rss
         if chi2 > SEPARATION_CHI2:
             return (
                 f"{effect_b.name} mimics {a.name} on these positions only: on a {grid} grid "
@@ -571,18 +622,32 @@ NOISE_PER_ANGLE_ALPHA = 0.01
 variances rejects equal noise at this level (over the pairs, Bonferroni)."""
 
 
+def _angle_variances(fit: OrientationFit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(variance rad^2, counts, degrees of freedom)`` of each measured angle's residuals
+    under ``fit``, the fit's degrees of freedom shared out by the angles' counts."""
+    residuals = fit.residuals_rad  # NaN where not measured or left out
+    counts = np.sum(np.isfinite(residuals), axis=0)
+    share = fit.result.dof / max(fit.result.n_obs, 1)
+    dof = counts * share
+    return np.nansum(residuals**2, axis=0) / np.maximum(dof, 1.0), counts, dof
+
+
+NOISE_ITERATIONS = 20
+"""Most refits of a model with its own per-angle noise (:meth:`OrientationFamily.fit`)."""
+
+NOISE_RTOL = 1e-3
+"""The per-angle noise levels of a model have converged when none moves by more than this
+fraction (the profiled likelihood is stationary there: what is left changes a score by its
+square)."""
+
+
 def _noise_per_angle(diagnosis: Diagnosis) -> tuple[np.ndarray, str] | None:
     """Without sigmas: the residual rms of each measured angle under the best model (rad) and a
     sentence, when the angles' noise differ (F test at :data:`NOISE_PER_ANGLE_ALPHA`), else None.
     """
     from scipy import special
 
-    fit = diagnosis.best_fit
-    residuals = fit.residuals_rad  # NaN where not measured or left out
-    counts = np.sum(np.isfinite(residuals), axis=0)
-    share = fit.result.dof / max(fit.result.n_obs, 1)  # the degrees of freedom, shared out
-    dof = counts * share
-    variance = np.nansum(residuals**2, axis=0) / np.maximum(dof, 1.0)
+    variance, counts, dof = _angle_variances(diagnosis.best_fit)
     present = [a for a in range(3) if counts[a] >= 10]
     if len(present) < 2:
         return None
@@ -648,8 +713,10 @@ def diagnose_measurements(
                 sigma_relative=True,
             )
             diagnosis = None  # free the first one's fits before the second
-            diagnosis = _diagnose(weighted, until_explained, catalogue, table, outliers)
-            diagnosis.warnings.append(note)
+            diagnosis = _diagnose(
+                weighted, until_explained, catalogue, table, outliers, noise_per_angle=True
+            )
+            diagnosis.warnings.append(_per_angle_note(diagnosis, note))
     diagnosis.doubt = _table_doubt(diagnosis, table)
     return diagnosis
 
@@ -678,12 +745,32 @@ def _table_doubt(diagnosis: Diagnosis, table) -> str | None:
     )
 
 
-def _diagnose(data, until_explained, catalogue, table, outliers) -> Diagnosis:
-    """The diagnosis of ``data`` with the outlier rule (or without it)."""
+def _per_angle_note(diagnosis: Diagnosis, found: str) -> str:
+    """The warning of a diagnosis made with each model's own per-angle noise: why (``found``,
+    the first pass' sentence) and the best model's levels."""
+    variance, counts, _ = _angle_variances(diagnosis.best_fit)
+    words = ", ".join(
+        f"{ANGLE_NAMES[a]} {np.sqrt(variance[a]) * ARCSEC_PER_RAD:.3g}"
+        for a in range(3)
+        if counts[a]
+    )
+    return (
+        f"{found}; every model was fitted and compared at its own per-angle noise (the best "
+        f"model's: {words} arcsec)"
+    )
+
+
+def _diagnose(
+    data, until_explained, catalogue, table, outliers, noise_per_angle: bool = False
+) -> Diagnosis:
+    """The diagnosis of ``data`` with the outlier rule (or without it); ``noise_per_angle``:
+    see :class:`OrientationFamily`."""
 
     def run(cells):
         left_out = np.where(cells, data.angles_rad, np.nan)
-        family = OrientationFamily(_without(data, cells), catalogue, table, left_out)
+        family = OrientationFamily(
+            _without(data, cells), catalogue, table, left_out, noise_per_angle
+        )
         return diagnose(family, until_explained=until_explained)
 
     if not outliers:

@@ -84,6 +84,12 @@ class MeasuredTable:
         q = [np.asarray(joint_rad, dtype=float)[:, k] for k in range(self.n_joints)]
         return compose_rotation(self.chain.placements(), q)
 
+    @property
+    def joint_limits_rad(self) -> tuple[tuple[float, float] | None, ...]:
+        """Each joint's ``(lower, upper)`` when its URDF limits span less than a full turn,
+        radians, else ``None`` (see :class:`~turntable_pin.model.chain.ChainLink`)."""
+        return tuple(link.limits_rad for link in self.chain.joints)
+
     def angle_label(self, k: int) -> str:
         """``phiK``, the name of joint K's angle in data files and reports."""
         return f"phi{k}"

@@ -76,6 +76,9 @@ class ChainLink:
         axis: unit rotation axis of a revolute joint in its own frame; ``None`` for a fixed link.
         q_index: index of the joint's value in Pinocchio's configuration vector (-1 when fixed).
         unbounded: a continuous joint: Pinocchio holds ``(cos q, sin q)`` at ``q_index``.
+        limits_rad: ``(lower, upper)`` of a revolute joint whose URDF ``<limit>`` spans less
+            than a full turn, radians; ``None`` for a fixed link, a continuous joint or one
+            that may turn all the way round.
     """
 
     name: str
@@ -84,6 +87,7 @@ class ChainLink:
     axis: np.ndarray | None
     q_index: int = -1
     unbounded: bool = False
+    limits_rad: tuple[float, float] | None = None
 
     @property
     def is_joint(self) -> bool:
@@ -129,6 +133,19 @@ def joint_axis(model, joint_id: int) -> np.ndarray:
         raise ModelError(f"joint '{model.names[joint_id]}' is {short}, not a revolute joint")
     axis = subspace[3:, 0]
     return axis / np.linalg.norm(axis)
+
+
+def _limits(model, joint_id: int) -> tuple[float, float] | None:
+    """``(lower, upper)`` of a bounded revolute joint turning less than a full turn, radians,
+    else ``None`` (continuous joints, full-turn limits)."""
+    joint = model.joints[joint_id]
+    if joint.nq != 1:
+        return None
+    lower = float(model.lowerPositionLimit[joint.idx_q])
+    upper = float(model.upperPositionLimit[joint.idx_q])
+    if not (np.isfinite(lower) and np.isfinite(upper)) or upper - lower >= 2 * np.pi - 1e-9:
+        return None
+    return lower, upper
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:
@@ -225,6 +242,7 @@ class ErrorChain:
                     _readonly(joint_axis(model, jid)),
                     model.joints[jid].idx_q,
                     model.joints[jid].nq == 2,
+                    _limits(model, jid),
                 )
             )
         previous = np.eye(4)  # frame placements are relative to the parent joint's frame

@@ -238,6 +238,9 @@ class FitResult:
             sigmas are given).
         sigma_known: whether sigmas were given (then chi2 has a p-value).
         identifiability: see :class:`Identifiability`.
+        noise_groups: with sigma unknown, the group (an integer) of each observation when every
+            group has a noise level of its own, estimated with this model (the fit is then
+            weighted by them); ``None``: one noise level (see :attr:`profiled_rss`).
     """
 
     parameter_names: tuple[str, ...]
@@ -257,6 +260,7 @@ class FitResult:
     _jacobian: Any = field(repr=False)  # (m, n) array, or a function computing it on first use
     n_function_evaluations: int = 0
     observation_unit: str = ""
+    noise_groups: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def jacobian_weighted(self) -> np.ndarray:
@@ -272,6 +276,28 @@ class FitResult:
         second order (a roll about a telescope's boresight next to a 0.3 deg azimuth offset);
         projecting residuals on those would credit the model with fits it did not make."""
         return self.jacobian_weighted @ self.identifiability.basis
+
+    @property
+    def group_rss(self) -> np.ndarray:
+        """Unweighted residual sum of squares of each noise group (of :attr:`noise_groups`, in
+        group order; one group when there are none), internal units squared."""
+        if self.noise_groups is None:
+            return np.array([float(self.residuals @ self.residuals)])
+        _, inverse = np.unique(self.noise_groups, return_inverse=True)
+        return np.bincount(inverse, weights=self.residuals**2)
+
+    @property
+    def profiled_rss(self) -> float:
+        """The rss the likelihood with the noise profiled out depends on: :attr:`rss` with one
+        noise level; with a noise level per group (:attr:`noise_groups`), each profiled, the
+        weighted geometric mean ``exp(sum_g (n_g / m) ln S_g)`` of the groups' unweighted rss
+        ``S_g``, so that ``m ln(profiled_rss) = sum_g n_g ln S_g`` (minus two log-likelihood,
+        up to a constant): ratios of it compare two models each at its own noise levels."""
+        if self.noise_groups is None:
+            return self.rss
+        _, counts = np.unique(self.noise_groups, return_counts=True)
+        logs = np.log(np.maximum(self.group_rss, 1e-300))
+        return float(np.exp(np.sum(counts * logs) / self.n_obs))
 
     @property
     def n_obs(self) -> int:

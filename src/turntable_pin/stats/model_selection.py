@@ -41,7 +41,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from ..core.blas_threads import one_blas_thread
-from ..core.exceptions import IdentifiabilityError
+from ..core.exceptions import IdentifiabilityError, InputError
 from .least_squares import FitResult, chi2_quantile, chi2_sf, tall_r_factor
 from .structure_search import (
     BIC_THRESHOLD,
@@ -258,12 +258,26 @@ def acceptance_threshold(n_testable: int) -> float:
     return BIC_THRESHOLD - 2.0 * math.log(max(n_testable, 1))
 
 
-def _chi2(result: FitResult, noise_variance: float) -> float:
+def _chi2(result: FitResult, noise_variance: float, group_variance=None) -> float:
+    """chi2 of ``result`` with the unit-weight ``noise_variance``; with the best model's noise
+    per group (``group_variance``, :func:`_group_variance`) for a fit with noise groups, the
+    groups' unweighted rss over those variances (every model judged at one noise)."""
+    if group_variance is not None and result.noise_groups is not None:
+        return float(np.sum(result.group_rss / group_variance))
     return result.rss / noise_variance
 
 
-def _summary(result: FitResult, noise_variance: float) -> dict:
-    chi2 = _chi2(result, noise_variance)
+def _group_variance(best: FitResult) -> np.ndarray | None:
+    """The best model's noise variance per group (its degrees of freedom shared out by the
+    groups' sizes), or None without noise groups (or with sigma given)."""
+    if best.sigma_known or best.noise_groups is None:
+        return None
+    _, counts = np.unique(best.noise_groups, return_counts=True)
+    return best.group_rss / np.maximum(counts * best.dof / best.n_obs, 1.0)
+
+
+def _summary(result: FitResult, noise_variance: float, group_variance=None) -> dict:
+    chi2 = _chi2(result, noise_variance, group_variance)
     return {
         result.rms_key: result.rms_user,
         "chi2_reduced": chi2 / result.dof if result.dof > 0 else None,
@@ -286,7 +300,7 @@ def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, ca
             continue
         try:
             fit = family.fit([*current, effect])
-        except IdentifiabilityError as exc:
+        except (IdentifiabilityError, InputError) as exc:  # InputError: not defined here
             out.append(Candidate(effect.name, False, f"cannot be fitted on these data: {exc}"))
             continue
         added = fit.result.rank - base.rank
@@ -302,7 +316,7 @@ def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, ca
                 )
             )
             continue
-        dbic = delta_bic(fit.result.rss, base.rss, added, m, known, fit.result.rank)
+        dbic = delta_bic(_rss(fit.result), _rss(base), added, m, known, fit.result.rank)
         out.append(Candidate(effect.name, True, None, fit, added, float(dbic)))
     threshold = acceptance_threshold(sum(c.testable for c in out))
     known_names = set(base.parameter_names)
@@ -326,20 +340,28 @@ def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, ca
     return out
 
 
+def _rss(result: FitResult) -> float:
+    """The rss a score compares: the weighted rss with sigma given; with the noise profiled, the
+    one of :attr:`FitResult.profiled_rss` (per noise group, each model at its own noise)."""
+    return result.rss if result.sigma_known else result.profiled_rss
+
+
 def _noise_variance(best: FitResult) -> float:
     """Unit-weight noise variance used to report chi2: 1 if sigma given, else the best model's."""
     return 1.0 if best.sigma_known else best.rss / best.dof
 
 
-def _mark_alternatives(candidates: list[Candidate], noise_variance: float) -> None:
+def _mark_alternatives(
+    candidates: list[Candidate], noise_variance: float, group_variance=None
+) -> None:
     accepted = [c for c in candidates if c.significant]
     for a in accepted:
-        chi2_a = _chi2(a.fit.result, noise_variance)
+        chi2_a = _chi2(a.fit.result, noise_variance, group_variance)
         a.alternatives = [
             b.effect
             for b in accepted
             if b is not a
-            and abs(_chi2(b.fit.result, noise_variance) - chi2_a)
+            and abs(_chi2(b.fit.result, noise_variance, group_variance) - chi2_a)
             <= chi2_quantile(ALTERNATIVE_LEVEL, max(a.added_rank, b.added_rank, 1))
         ]
 
@@ -383,6 +405,8 @@ class Diagnosis:
             each cost in BIC (below 6): they are not named.
         doubt: the caller's doubt about the model family itself (the data may not come from
             this model at all), said before the verdict; ``None`` when it has none.
+        group_variance: with a noise level per group estimated with each model, the best
+            model's (:func:`_group_variance`): every fit's chi2 is reported at it.
     """
 
     family: Any = field(repr=False)
@@ -401,6 +425,7 @@ class Diagnosis:
     outlier_rule: str | None = None
     unneeded_given_structure: dict[str, float] = field(default_factory=dict)
     doubt: str | None = None
+    group_variance: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def missing_effect(self) -> str | None:
@@ -446,6 +471,16 @@ class Diagnosis:
         """Whether the observations' sigmas were given (not estimated)."""
         return self.base_fit.result.sigma_known
 
+    def _sigma_user(self) -> float:
+        """The noise the verdict uses, in user units: the unit-weight noise times the family's
+        typical sigma; with a noise level per group, their rms over the observations."""
+        if self.group_variance is None:
+            return float(math.sqrt(self.noise_variance) * self.family.sigma_scale)
+        best = self.best_fit.result
+        _, counts = np.unique(best.noise_groups, return_counts=True)
+        pooled = float(np.sum(counts * self.group_variance) / best.n_obs)
+        return math.sqrt(pooled) * best.user_unit_scale
+
     def named_parameters(self) -> dict[str, list[dict]]:
         """``{effect: parameter_determination entries}`` of every named effect in the best fit
         (values, standard errors, correlations with the base errors and with all the others)."""
@@ -468,11 +503,11 @@ class Diagnosis:
 
     def summary(self, fit) -> dict:
         """rms, chi2_reduced, rank and p-value of ``fit`` judged with this noise variance."""
-        return _summary(fit.result, self.noise_variance)
+        return _summary(fit.result, self.noise_variance, self.group_variance)
 
     def to_dict(self) -> dict:
         """The spec's diagnosis JSON (plus steps, structure and per-effect explanations)."""
-        nv = self.noise_variance
+        nv, gv = self.noise_variance, self.group_variance
         named = {s.added for s in self.steps}
         candidates = []
         for c in self.candidates:
@@ -481,7 +516,7 @@ class Diagnosis:
                 "testable": c.testable,
                 "delta_bic": c.delta_bic,
                 self.base_fit.result.rms_key: c.fit.result.rms_user if c.fit is not None else None,
-                "chi2_reduced": _summary(c.fit.result, nv)["chi2_reduced"] if c.fit else None,
+                "chi2_reduced": (_summary(c.fit.result, nv, gv)["chi2_reduced"] if c.fit else None),
                 "added_rank": c.added_rank,
                 "significant": c.significant,
                 "alternatives": list(c.alternatives),
@@ -534,18 +569,18 @@ class Diagnosis:
             f"n_{self.family.record_label}": self.family.n_records,
             "n_observations": self.base_fit.result.n_obs,
             "sigma_source": "column" if self.sigma_known else "estimated",
-            f"sigma_{unit}" if unit else "sigma": float(math.sqrt(nv) * self.family.sigma_scale),
-            "base": _summary(self.base_fit.result, nv),
+            f"sigma_{unit}" if unit else "sigma": self._sigma_user(),
+            "base": _summary(self.base_fit.result, nv, gv),
             "candidates": candidates,
             "steps": [
                 {
                     "added": s.added,
                     "delta_bic": s.delta_bic,
-                    **_summary(s.fit.result, nv),
+                    **_summary(s.fit.result, nv, gv),
                 }
                 for s in self.steps
             ],
-            "best": {"effects": [s.added for s in self.steps], **_summary(best.result, nv)},
+            "best": {"effects": [s.added for s in self.steps], **_summary(best.result, nv, gv)},
             "verdict": verdict,
             "warnings": list(self.warnings),
             "outliers": [dict(o) for o in self.outliers],
@@ -613,7 +648,8 @@ def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
         steps = _steps_of(family, current, base_fit)
     best = current_fit.result
     noise_variance = _noise_variance(best)
-    _mark_alternatives(candidates, noise_variance)
+    group_variance = _group_variance(best)
+    _mark_alternatives(candidates, noise_variance, group_variance)
     fails = bool(best.sigma_known and best.dof > 0 and best.p_value < FIT_TEST_ALPHA)
     separations = {}
     if steps:
@@ -635,6 +671,7 @@ def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
         after_first=after_first,
         warnings=list(family.design_warnings(base_fit)),
         unneeded_given_structure=unneeded,
+        group_variance=group_variance,
     )
 
 
@@ -722,24 +759,39 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
     """
     m = current_fit.result.n_obs
     penalty = 2.0 * math.log(max(len(probes), 1))
+    # With a noise level per group estimated with each model, the fits carry different
+    # weights: they are all judged in the weights of the best description (its own noise
+    # levels, unit variance there), as with sigma given.
+    reference = None
+    score_known = known
+    if known is None and current_fit.result.noise_groups is not None:
+        reference, score_known = current_fit.result.weights, 1.0
 
-    def projected(fit, terms, term_probes) -> tuple[float, int]:
-        """(rss, rank) of ``fit`` with the probe columns of ``terms`` added."""
+    def projected(fit, terms, term_probes, own_probes=False) -> tuple[float, int]:
+        """(rss, rank) of ``fit`` with the probe columns of ``terms`` added (``own_probes``:
+        the probes were weighted like ``fit``, not like the best description)."""
         result = fit.result
         columns = [result.determined_jacobian_weighted, *_term_columns(terms, term_probes)]
-        return _projected_rss(result.residuals * result.weights, columns)
+        if reference is None:
+            return _projected_rss(result.residuals * result.weights, columns)
+        scale = (reference / result.weights)[:, None]
+        columns = [c * scale if k == 0 or own_probes else c for k, c in enumerate(columns)]
+        return _projected_rss(result.residuals * reference, columns)
 
     full_rss, full_rank = projected(current_fit, structure, probes)
     # With the variance profiled, ln(rss) weighs as in delta_bic, with the residual degrees of
     # freedom of the best description (the larger model of each comparison).
     weight = profiled_weight(m, full_rank, 2)
 
-    def score(fit, terms, term_probes) -> tuple[float, float]:
+    def score(fit, terms, term_probes, own_probes=False) -> tuple[float, float]:
         """(BIC, its fit part) of ``fit`` with the probe columns of ``terms`` added."""
-        return bic(*projected(fit, terms, term_probes), len(terms))
+        return bic(*projected(fit, terms, term_probes, own_probes), len(terms))
 
     def bic(rss: float, rank: int, n_terms: int) -> tuple[float, float]:
-        fit_term = rss / known if known is not None else weight * math.log(max(rss, 1e-300))
+        if score_known is not None:
+            fit_term = rss / score_known
+        else:
+            fit_term = weight * math.log(max(rss, 1e-300))
         return fit_term + rank * math.log(m) + penalty * n_terms, fit_term
 
     full, full_fit = bic(full_rss, full_rank, len(structure))
@@ -769,7 +821,7 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
             <= current_fit.result.rank - without.result.rank
             and not _within(own, own_probes, current_fit.result.determined_jacobian_weighted)
         ):
-            bic_own, fit_own = score(without, own, own_probes)
+            bic_own, fit_own = score(without, own, own_probes, own_probes=True)
             if fit_own <= full_fit:
                 costs.append(bic_own - full)
         if not costs:
@@ -828,7 +880,9 @@ def _steps_of(family, effects, base_fit) -> list[Step]:
         fit = family.fit(effects[: k + 1])
         added = fit.result.rank - previous.result.rank
         result = fit.result
-        dbic = delta_bic(result.rss, previous.result.rss, added, result.n_obs, known, result.rank)
+        dbic = delta_bic(
+            _rss(result), _rss(previous.result), added, result.n_obs, known, result.rank
+        )
         steps.append(Step(effects[k].name, float(dbic), fit, []))
         previous = fit
     return steps
