@@ -395,3 +395,21 @@ def test_with_noise_per_angle_every_model_is_judged_at_its_own_noise():
         [EFFECTS["inner_encoder_harmonics"]],
     )  # fmt: skip
     assert np.max(np.abs(fixed.result.params - right.best_fit.result.params)) > 1e-2 / 206265
+
+
+@pytest.mark.parametrize("hidden", ["dphi_y1", "deps_y"])
+def test_a_structure_finding_names_every_error_it_cannot_tell_apart_the_physical_first(hidden):
+    # Issue 17: a 4/rev term hidden on dphi_y1 was reported as "a 4/rev term in phi1 of deps_y",
+    # though the data see only their combination; an orthogonality has no reason to vary.
+    from turntable_pin.measurement.user_effects import inline_effect
+
+    term = inline_effect(f"{hidden}~h4(phi1)")
+    sim = simulate_measurements(
+        random_errors(np.random.default_rng(0)), {term.name: {"c4": 3.0, "s4": -2.0}},
+        seed=0, catalogue=[term],
+    )  # fmt: skip
+    d = diagnose_measurements(sim.data).to_dict()
+    [found, *_] = d["verdict"]["remaining_structure"]
+    assert found["term"] == "dphi_y1 4/rev in phi1"
+    assert found["effect_spec"] == "dphi_y1~h4(phi1)"
+    assert "or of deps_y" in found["description"]

@@ -368,27 +368,71 @@ class OrientationFamily:
         return probes
 
     def _error_probes(
-        self, directions, shape: str, text: str, plot: tuple, spec: str, unseen=frozenset()
+        self,
+        directions,
+        shape: str,
+        text: str,
+        plot: tuple,
+        spec: str,
+        unseen=frozenset(),
+        alike=None,
     ) -> list[Probe]:
         """One probe per base error: its derivative (the direction it enters the angles,
         ``directions[e]``, shared by the probes of every shape) times the shape ``plot``
         (variable, values, functions, value scale, unit); none for the errors
         ``unseen`` (those the measured angles do not see to first order: their derivative at the
-        fitted errors is a second-order remainder, and a shape along it is no finding)."""
+        fitted errors is a second-order remainder, and a shape along it is no finding).
+
+        ``alike`` (:meth:`_alike_errors`): errors that enter the measured angles alike give the
+        same probe, so a shape found along them is named after the most physical of them and
+        says which others it cannot be told from."""
         probes = []
         var, values, functions, scale, unit = plot
         basis = functions(values)
-        for e, name in enumerate(self.table.base_names):
+        names = self.table.base_names
+        for e, name in enumerate(names):
             if name in unseen:
                 continue
+            group = (alike or {}).get(e, [e])
+            lead = names[group[0]]
             factors = ProbeFactors(
                 var, values, functions, directions[e], scale, unit, self._observed
             )
-            description = f"a {text} of {name} ({self.table.descriptions.get(name, name)})"
+            description = f"a {text} of {lead} ({self.table.descriptions.get(lead, lead)})"
+            if len(group) > 1:
+                others = " or ".join(names[k] for k in group[1:])
+                description += (
+                    f", or of {others}: they enter the measured angles alike on these data, "
+                    "which see only their combination"
+                )
             probes.append(
-                self._probe(f"{name} {shape}", description, factors, f"{name}~{spec}", basis)
+                self._probe(f"{lead} {shape}", description, factors, f"{lead}~{spec}", basis)
             )
         return probes
+
+    def _alike_errors(self, jac: np.ndarray, w: np.ndarray, unseen) -> dict[int, list[int]]:
+        """``{error index: the errors entering the measured angles alike, most physical first}``
+        for the base errors whose weighted derivatives ``jac[:, :, e] * w`` are parallel (the
+        data see only a combination of them): position errors (a k/rev term of an encoder)
+        before tilts (a wobble), before the rest (an orthogonality or a mount error, which has
+        no reason to vary with an angle)."""
+        names = self.table.base_names
+        positions = {j.position for j in self.table.joints}
+        tilts = {t for j in self.table.joints for t in j.tilts}
+        live = [e for e, n in enumerate(names) if n not in unseen]
+        if len(live) < 2:
+            return {}
+        vectors = np.stack([(jac[:, :, e] * w).reshape(-1) for e in live])
+        norms = np.linalg.norm(vectors, axis=1)
+        unit = vectors / np.where(norms > 0, norms, 1.0)[:, None]
+        parallel = np.abs(unit @ unit.T) > 1.0 - 1e-9
+        rank = {e: (0 if names[e] in positions else 1 if names[e] in tilts else 2) for e in live}
+        out = {}
+        for i, e in enumerate(live):
+            group = [live[k] for k in np.flatnonzero(parallel[i]) if norms[k] > 0]
+            if len(group) > 1:
+                out[e] = sorted(group, key=lambda k: (rank[k], k))
+        return out
 
     def probes(self, fit: OrientationFit) -> list[Probe]:
         """The structure-search probes, weighted like the residuals of ``fit`` (see the module)."""
@@ -397,6 +441,7 @@ class OrientationFamily:
         jac = fit.model.jacobian(fit.result.params)  # (N, 3, n)
         unseen = set(fit.result.identifiability.unresponsive)
         along = [_along_error(jac, w, e) for e in range(len(self.table.base_names))]
+        alike = self._alike_errors(jac, w, unseen)
         on_angle = [_one_angle(w, a) for a in range(len(ANGLE_NAMES))]  # a term on one angle
         probes = []
         labels = [self.table.angle_label(k) for k in range(1, data.n_joints + 1)]
@@ -406,7 +451,7 @@ class OrientationFamily:
                 shape = f"{k}/rev in {var}"
                 spec = f"h{k}({var})"
                 probes += self._error_probes(
-                    along, shape, f"{k}/rev term in {var}", plot, spec, unseen
+                    along, shape, f"{k}/rev term in {var}", plot, spec, unseen, alike
                 )
                 probes += self._measured_angle_probes(
                     shape, f"a {k}/rev term in {var} of {{angle}} itself", plot, on_angle, spec
@@ -454,7 +499,7 @@ class OrientationFamily:
             plot = (column, values, _polynomial(values), 1.0, "")
             text = f"term linear and quadratic in {column}"
             spec = f"poly2({column})"
-            probes += self._error_probes(along, f"in {column}", text, plot, spec, unseen)
+            probes += self._error_probes(along, f"in {column}", text, plot, spec, unseen, alike)
             probes += self._measured_angle_probes(
                 f"in {column}", f"a {text} of {{angle}}", plot, on_angle, spec
             )
