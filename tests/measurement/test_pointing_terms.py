@@ -345,6 +345,10 @@ def test_mmt_diagnosis_names_the_tube_flexure_with_determined_parameters(mmt_run
     # the richer explanations that fit as well are stated, not named: their parameters trade off
     passed = {e["effect"] for e in out["verdict"]["not_named_undetermined"]}
     assert {"encoder_harmonics@elevation", "gravity_sag"} <= passed
+    # ... with whether positions within the limits would separate them, and what would
+    alias = out["verdict"]["separations"]["encoder_harmonics@elevation"]
+    assert "no set of positions separates them" in alias and "within the joints' limits" in alias
+    assert "an independent measurement" in alias and "tube's balance or mass" in alias
 
 
 @pytest.mark.parametrize("start_arcsec", [(2.67, 0.584, 1.0), (0.3, 3.0, 1.0)])

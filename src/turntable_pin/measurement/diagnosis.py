@@ -560,27 +560,27 @@ class OrientationFamily:
             variables.dirs, dict(variables.extra), source="dense design",
         )  # fmt: skip
         base_effects = [e for e in a_effects if e is not a]
-        grid = "30-degree" if self.data.n_joints > 2 else "15-degree"
+        grid = ("30-degree" if self.data.n_joints > 2 else "15-degree") + " grid"
         if any(limits is not None for limits in self.table.joint_limits_rad):
-            grid += " (within the joints' limits)"
+            grid += " within the joints' limits"
         try:
             misfit = fit_orientation(dense, [*base_effects, effect_b], turntable=self.table)
         except InputError as exc:  # B cannot be evaluated everywhere (cot E at the horizon)
             return (
-                f"{effect_b.name} cannot be compared with {a.name} on a dense {grid} grid "
+                f"{effect_b.name} cannot be compared with {a.name} on a dense {grid} "
                 f"({exc.detail}); an independent measurement tells them apart. For {a.name}: "
                 f"{a.confirm} For {effect_b.name}: {effect_b.confirm}"
             )
         chi2 = misfit.result.rss
         if chi2 > SEPARATION_CHI2:
             return (
-                f"{effect_b.name} mimics {a.name} on these positions only: on a {grid} grid "
+                f"{effect_b.name} mimics {a.name} on these positions only: on a {grid} "
                 f"({variables.n} positions, random time order) it would leave chi2 = {chi2:.0f} "
                 f"of misfit at the same noise, so measuring more angles separates them"
             )
         return (
             f"{effect_b.name} reproduces the fitted {a.name} at every turntable position "
-            f"(noise-free misfit chi2 = {chi2:.2g} on a {grid} grid), so no set of positions "
+            f"(noise-free misfit chi2 = {chi2:.2g} on a {grid}), so no set of positions "
             f"separates them; an independent measurement does. For {a.name}: {a.confirm} "
             f"For {effect_b.name}: {effect_b.confirm}"
         )

@@ -196,8 +196,9 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
             + ", ".join(verdict["also_significant"])
             + " (--until-explained names every step)"
         )
-    for name, text in verdict["separations"].items():
-        lines.append(f"  alternative {name}: {text}")
+    for name in verdict.get("alternatives", []):
+        if name in verdict["separations"]:
+            lines.append(f"  alternative {name}: {verdict['separations'][name]}")
     kept = (
         "the effect named, whose parameters are determined, is kept"
         if d["steps"] and not verdict.get("named_undetermined")
@@ -210,6 +211,8 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
             f"(correlation > 0.95 with the model's other parameters, or none reaches 3 sigma); "
             f"{kept}"
         )
+        if entry["effect"] in verdict["separations"]:
+            lines.append(f"  {entry['effect']}: {verdict['separations'][entry['effect']]}")
     for entry in verdict.get("unneeded_given_structure", []):
         lines.append(
             f"not named: {entry['effect']} was significant on its own, but the best description "

@@ -654,7 +654,15 @@ def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
     separations = {}
     if steps:
         first = next(c for c in candidates if c.effect == steps[0].added)
-        for name in first.alternatives:
+        named = {s.added for s in steps}
+        # The equally good alternatives, and the significant candidates not named because
+        # their parameters are not determined: each may be the same signal under another name.
+        passed_over = [
+            c.effect
+            for c in candidates
+            if c.significant and not c.determined and c.effect not in named
+        ]
+        for name in dict.fromkeys([*first.alternatives, *passed_over]):
             effect = next(e for e in family.catalogue if e.name == name)
             separations[name] = family.separation(first.fit, effect)
     return Diagnosis(
