@@ -413,3 +413,26 @@ def test_a_structure_finding_names_every_error_it_cannot_tell_apart_the_physical
     assert found["term"] == "dphi_y1 4/rev in phi1"
     assert found["effect_spec"] == "dphi_y1~h4(phi1)"
     assert "or of deps_y" in found["description"]
+
+
+def test_the_final_model_never_fits_worse_than_a_candidate_it_passed_over(monkeypatch):
+    # Issue 17: on a real run the final model (66 arcsec) fitted worse than the best candidate
+    # alone (53 arcsec). Whatever the earn-its-place rule sets aside, a determined candidate that
+    # alone fits better than all that was kept is put back, and the steps say so.
+    from turntable_pin.stats import model_selection
+
+    sim = simulate_measurements(
+        random_errors(np.random.default_rng(2)), {"inner_encoder_harmonics": {"c1": 4.0}}, seed=2
+    )
+    calls = []
+
+    def wrongly_unneeded(family, current, *args):
+        calls.append([e.name for e in current])
+        return (current[0].name, -50.0) if len(calls) == 1 else None
+
+    monkeypatch.setattr(model_selection, "_least_needed", wrongly_unneeded)
+    d = diagnose_measurements(sim.data, outliers=False).to_dict()
+    assert calls and calls[0][0] == "inner_encoder_harmonics"
+    assert d["verdict"]["missing_effect"] == "inner_encoder_harmonics"
+    assert d["best"]["effects"][0] == "inner_encoder_harmonics"
+    assert d["best"]["chi2_reduced"] < 1.3

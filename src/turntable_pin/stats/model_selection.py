@@ -346,6 +346,17 @@ def _rss(result: FitResult) -> float:
     return result.rss if result.sigma_known else result.profiled_rss
 
 
+def _described_rss(result: FitResult, structure, probes) -> float | None:
+    """The rss (as :func:`_rss` compares) of ``result`` with the probe columns of the structure
+    found added, or None when not comparable (a noise level per group and structure found)."""
+    if not structure:
+        return _rss(result)
+    if result.noise_groups is not None and not result.sigma_known:
+        return None
+    columns = [result.determined_jacobian_weighted, *_term_columns(structure, probes)]
+    return _projected_rss(result.residuals * result.weights, columns)[0]
+
+
 def _noise_variance(best: FitResult) -> float:
     """Unit-weight noise variance used to report chi2: 1 if sigma given, else the best model's."""
     return 1.0 if best.sigma_known else best.rss / best.dof
@@ -645,6 +656,26 @@ def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
         current_fit = family.fit(current)
         structure, probes = _search(family, current_fit, known)
     if unneeded:
+        # The final description (the effects kept and the structure found) never fits worse
+        # than a determined candidate it passed over: one that alone leaves less misfit is put
+        # back first.
+        kept = {e.name for e in current}
+        described = _described_rss(current_fit.result, structure, probes)
+        better = [
+            c
+            for c in candidates
+            if c.significant
+            and c.determined
+            and c.effect not in kept
+            and described is not None
+            and _rss(c.fit.result) < described
+        ]
+        if better:
+            restored = better[0].effect
+            unneeded.pop(restored, None)
+            current = [next(e for e in family.catalogue if e.name == restored), *current]
+            current_fit = family.fit(current)
+            structure, probes = _search(family, current_fit, known)
         steps = _steps_of(family, current, base_fit)
     best = current_fit.result
     noise_variance = _noise_variance(best)
