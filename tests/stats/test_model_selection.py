@@ -88,3 +88,65 @@ def test_an_effect_is_undetermined_when_traded_off_or_insignificant_absorbed_one
     assert undetermined_parameters([entry("k_xx", 0.0, None, 1.0), entry("k", 9, 1, 0.5)]) == []
     # nothing seen at all: undetermined
     assert undetermined_parameters([entry("a", 1.0, None, 1.0)]) == ["a"]
+
+
+class _Columns:
+    """y = the named columns times their parameters (a linear toy of the model family)."""
+
+    user_unit_scale = 1.0
+    observation_unit = ""
+
+    def __init__(self, y, columns: dict):
+        self.observed, self.sigma = y, np.full(y.size, 0.1)
+        self.parameter_names = tuple(columns)
+        self.design = np.stack(list(columns.values()), axis=1)
+        self.parameter_units = ("u",) * len(columns)
+        self.per_user_unit = np.ones(len(columns))
+
+    def predict(self, p):
+        return self.design @ p
+
+    def jacobian(self, p):
+        return self.design
+
+
+def _toy_family(x, y, effects: dict):
+    from types import SimpleNamespace
+
+    from turntable_pin.stats.least_squares import fit_least_squares
+
+    base = {"base.a": np.ones_like(x)}
+
+    def fit(chosen):
+        columns = dict(base)
+        for e in chosen:
+            columns.update(effects[e.name])
+        return SimpleNamespace(result=fit_least_squares(_Columns(y, columns)))
+
+    catalogue = tuple(SimpleNamespace(name=n) for n in effects)
+    return SimpleNamespace(fit=fit, untestable_reason=lambda e: None, catalogue=catalogue)
+
+
+def test_a_determined_effect_with_a_small_gain_is_not_put_before_one_that_explains_much_more():
+    # Issue 17: "never headline an effect whose rms gain is negligible while another candidate
+    # halves it", even when the better one's parameters trade off against each other.
+    from turntable_pin.stats.model_selection import compare_effects
+
+    rng = np.random.default_rng(1)
+    x = np.linspace(0.2, 1.0, 200)
+    y = 1.0 + 3.0 * x + 0.3 * np.sin(20 * x) + rng.normal(0, 0.1, x.size)
+    effects = {
+        "small": {"small.s": np.sin(20 * x)},  # real, determined, small
+        "big": {"big.b1": x, "big.b2": x + 1e-3 * x**2},  # the slope, in two traded-off columns
+    }
+    family = _toy_family(x, y, effects)
+    ranked = compare_effects(family, [], family.fit([]), family.catalogue)
+    by_name = {c.effect: c for c in ranked}
+    assert by_name["small"].significant and by_name["small"].determined
+    assert by_name["big"].significant and not by_name["big"].determined
+    assert ranked[0].effect == "big"
+    # with a determined effect explaining most of it, the determined one comes first
+    effects["small"] = {"small.s": x}
+    family = _toy_family(x, y, effects)
+    ranked = compare_effects(family, [], family.fit([]), family.catalogue)
+    assert ranked[0].effect == "small" and ranked[0].determined

@@ -57,6 +57,7 @@ __all__ = [
     "DETERMINED_SIGMAS",
     "MAX_CORRELATION",
     "MAX_CORRELATION_ALL",
+    "UNDETERMINED_GAIN_RATIO",
     "parameter_determination",
     "undetermined_parameters",
     "acceptance_threshold",
@@ -78,6 +79,10 @@ ALTERNATIVE_LEVEL = 0.99
 DETERMINED_SIGMAS = 3.0
 """An effect is significant in its values when one of its parameters reaches this many standard
 errors (:func:`undetermined_parameters`)."""
+
+UNDETERMINED_GAIN_RATIO = 2.0
+"""A significant undetermined effect still ranks first when it lowers the misfit (rss) by more
+than this many times what the best determined one does."""
 
 MAX_CORRELATION = 0.95
 """A parameter is traded off against the base errors above this multiple correlation."""
@@ -329,11 +334,23 @@ def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, ca
             )
     # Best first: the significant effects whose parameters are determined, then the others by
     # delta_bic (a richer effect whose extra parameters the data do not determine is not
-    # preferred to the simpler one that explains the signal with determined ones).
+    # preferred to the simpler one that explains the signal with determined ones) -- unless the
+    # undetermined one explains more than twice as much: a determined effect whose gain is
+    # small beside it is not the same signal, and is not put first.
+    base_rss = _rss(base)
+
+    def gain(c: Candidate) -> float:
+        return base_rss - _rss(c.fit.result)
+
+    lead = max((gain(c) for c in out if c.significant and c.determined), default=0.0)
+
+    def preferred(c: Candidate) -> bool:
+        return c.significant and (c.determined or gain(c) > UNDETERMINED_GAIN_RATIO * lead)
+
     out.sort(
         key=lambda c: (
             not c.testable,
-            not (c.significant and c.determined),
+            not preferred(c),
             c.delta_bic if c.delta_bic is not None else 0.0,
         )
     )
