@@ -125,7 +125,7 @@ def test_outputs_may_not_be_the_input(tmp_path):
             "--write-urdf",
             str(tmp_path / "a.csv"),
         ),  # fmt: skip
-        "it is -o",
+        "they are one file",
     )
     assert run.read_bytes() == MMT.read_bytes()
     _one_line_exit_2(cli("import-tpoint", str(tmp_path / "nope.dat"), "-o", "x.csv"), "cannot read")

@@ -15,6 +15,7 @@ ERRORS = EXAMPLES_DIR / "errors_example.yaml"
 DATA = EXAMPLES_DIR / "measurements_example.csv"
 BOUNDS = EXAMPLES_DIR.parent / "manufacturing_lower_bounds.yaml"
 URDF = EXAMPLES_DIR.parent / "turntable.urdf"
+MMT = EXAMPLES_DIR / "mmt_pointing" / "k_and_e.dat"
 
 
 def _copy(tmp_path, source):
@@ -32,6 +33,9 @@ WRITERS = [
     (["simulate", "--urdf", "{in}", "-o", "{in}"], URDF),
     (["report", "{in}", "-o", "{in}"], DATA),
     (["fit", "{in}", "--plots", "{in}"], DATA),
+    (["fit", "{in}", "--write-urdf", "{in}"], DATA),  # the data were lost to a URDF
+    (["fit", DATA.as_posix(), "--urdf", "{in}", "--write-urdf", "{in}"], URDF),
+    (["import-tpoint", "{in}", "-o", "out.csv", "--write-urdf", "{in}"], MMT),
     (["diagnose", "{in}", "--plots", "{in}"], DATA),
     (["allocate", "--lower-bounds", "{in}", "--plots", "{in}"], BOUNDS),
     (["montecarlo", "-n", "10", "--lower-bounds", "{in}", "--plots", "{in}"], BOUNDS),

@@ -293,7 +293,7 @@ def print_json(payload: dict) -> None:
     sys.stdout.write("\n")
 
 
-OUTPUT_OPTIONS: tuple[str, ...] = ("output", "plots")
+OUTPUT_OPTIONS: tuple[str, ...] = ("output", "plots", "write_urdf")
 """Destinations of the options through which a command writes (a file, or a folder of files)."""
 
 
@@ -305,10 +305,12 @@ def _same_path(a: Path, b: Path) -> bool:
 
 
 def refuse_inputs_as_outputs(args: argparse.Namespace) -> None:
-    """Refuse a command whose output path is one of its inputs (every other path option).
+    """Refuse a command whose output path is one of its inputs (every other path option), or
+    another of its outputs.
 
     An output file may not be an input file (nor the same file under another name: links count);
-    a plots folder may not be an input file either. Raises :class:`InputError` naming both.
+    a plots folder may not be an input file either; two outputs may not be one file. Raises
+    :class:`InputError` naming both.
     """
     inputs: list[tuple[str, Path]] = []
     for dest, value in vars(args).items():
@@ -324,7 +326,17 @@ def refuse_inputs_as_outputs(args: argparse.Namespace) -> None:
         for name, item in inputs:
             if output.resolve() == item.resolve() or _same_path(output, item):
                 option = "the data file" if name == "data" else f"--{name.replace('_', '-')}"
+                flag = dest.replace("_", "-")
                 raise InputError(
-                    f"refusing to write --{dest} {output}: it is {option} {item}, an input of "
+                    f"refusing to write --{flag} {output}: it is {option} {item}, an input of "
                     "this command (choose another output name)"
+                )
+    outputs = [(d, getattr(args, d, None)) for d in OUTPUT_OPTIONS]
+    outputs = [(d, v) for d, v in outputs if isinstance(v, Path)]
+    for i, (dest, output) in enumerate(outputs):
+        for other, path in outputs[i + 1 :]:
+            if output.resolve() == path.resolve() or _same_path(output, path):
+                raise InputError(
+                    f"refusing to write --{dest} {output} and --{other.replace('_', '-')} {path}: "
+                    "they are one file (choose two output names)"
                 )

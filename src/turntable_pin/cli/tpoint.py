@@ -4,7 +4,6 @@ CSV of the bundled mount URDFs."""
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
 
 from ..core.exceptions import InputError
@@ -62,9 +61,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="on which side the file's azimuth 90 lies (default east, TPOINT's); north,east is "
         "the common north-through-east azimuth (converted as 180 - az)",
     )
-    # A str, not a Path: the shared input guard would take a Path option for an input file.
     p.add_argument(
         "--write-urdf",
+        type=Path,
         metavar="OUT.urdf",
         help="write the mount's URDF the CSV belongs to (required for an equatorial run: a copy "
         "of the bundled one with its polar axis tilted to the run's latitude)",
@@ -72,29 +71,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run_import_tpoint)
 
 
-def _same(a: Path, b: Path) -> bool:
-    """Whether ``a`` and ``b`` are one file (same path, or a link to it)."""
-    if a.resolve() == b.resolve():
-        return True
-    try:
-        return a.exists() and b.exists() and os.path.samefile(a, b)
-    except OSError:
-        return False
-
-
 def run_import_tpoint(args: argparse.Namespace) -> int:
     import dataclasses
 
     from ..measurement.tpoint import EQUATORIAL, convert_tpoint, read_tpoint
 
-    urdf_out = Path(args.write_urdf) if args.write_urdf else None
-    if urdf_out is not None:
-        for other, what in ((args.data, "the TPOINT file"), (args.output, "-o")):
-            if _same(urdf_out, other):
-                raise InputError(
-                    f"refusing to write --write-urdf {urdf_out}: it is {what} {other} (choose "
-                    "another output name)"
-                )
+    urdf_out = args.write_urdf  # never an input nor -o: the commands' shared output guard
     run = read_tpoint(
         args.data,
         mount=args.mount,
