@@ -22,7 +22,7 @@ import numpy as np
 from ..core.exceptions import IdentifiabilityError, InputError
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
-from ..stats.least_squares import RANK_RTOL
+from ..stats.least_squares import RANK_RTOL, fit_least_squares
 from ..stats.model_selection import Diagnosis, diagnose
 from ..stats.structure_search import Probe, ProbeFactors
 from .catalogue import catalogue as table_catalogue
@@ -30,7 +30,13 @@ from .catalogue import resolve_effect
 from .data import ANGLE_NAMES, OrientationMeasurements
 from .effect_model import OrientationModel
 from .effects.base import Effect, PositionVariables
-from .fit import OrientationFit, fit_orientation, orientation_zero_point
+from .fit import (
+    RELINEARISE_RAD,
+    OrientationFit,
+    OrientationFitProblem,
+    fit_orientation,
+    orientation_zero_point,
+)
 from .residuals import ResidualSet, orientation_residuals
 from .table import measured_table
 
@@ -158,7 +164,8 @@ class OrientationFamily:
         stop moving (:data:`NOISE_RTOL`, at most :data:`NOISE_ITERATIONS` refits); its result
         carries the angle of each observation as its noise group."""
         data = self.data
-        sigma = None
+        # the levels ``fit`` was weighted with (the family's data: the first pass' estimate)
+        sigma = None if data.sigma_rad is None else np.nanmedian(data.sigma_rad, axis=0)
         for _ in range(NOISE_ITERATIONS):
             variance, counts, _ = _angle_variances(fit)
             measured = counts > 0
@@ -170,12 +177,7 @@ class OrientationFamily:
                 sigma_rad=np.broadcast_to(sigma, data.angles_rad.shape).copy(),
                 sigma_relative=True,
             )
-            fit = fit_orientation(
-                weighted,
-                fit.model.effects,
-                turntable=self.table,
-                base_fit=self.fit([]) if fit.model.effects else None,
-            )
+            fit = _refit(fit, weighted)
         groups = np.broadcast_to(np.arange(3), data.angles_rad.shape)[data.measured]
         return dataclasses.replace(fit, result=dataclasses.replace(fit.result, noise_groups=groups))
 
@@ -667,6 +669,17 @@ NOISE_PER_ANGLE_ALPHA = 0.01
 variances rejects equal noise at this level (over the pairs, Bonferroni)."""
 
 
+def _refit(fit: OrientationFit, data: OrientationMeasurements) -> OrientationFit:
+    """``fit``'s model fitted again to ``data`` (the same positions, other weights): from zero
+    errors, or from ``fit``'s solution when its base errors are large offsets
+    (:data:`~.fit.RELINEARISE_RAD`, as :func:`~.fit.fit_orientation` restarts)."""
+    n_base = len(fit.model.base_names)
+    large = np.max(np.abs(fit.result.params[:n_base]), initial=0.0) > RELINEARISE_RAD
+    problem = OrientationFitProblem(data, fit.model)
+    result = fit_least_squares(problem, origin=fit.result.params if large else None)
+    return OrientationFit(data, fit.model, result)
+
+
 def _angle_variances(fit: OrientationFit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(variance rad^2, counts, degrees of freedom)`` of each measured angle's residuals
     under ``fit``, the fit's degrees of freedom shared out by the angles' counts."""
@@ -680,7 +693,7 @@ def _angle_variances(fit: OrientationFit) -> tuple[np.ndarray, np.ndarray, np.nd
 NOISE_ITERATIONS = 20
 """Most refits of a model with its own per-angle noise (:meth:`OrientationFamily.fit`)."""
 
-NOISE_RTOL = 1e-3
+NOISE_RTOL = 1e-2
 """The per-angle noise levels of a model have converged when none moves by more than this
 fraction (the profiled likelihood is stationary there: what is left changes a score by its
 square)."""
