@@ -77,7 +77,20 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
-__version__ = "0.1.0"
+
+
+def _version() -> str:
+    """The installed distribution's version (one version: ``pyproject.toml``'s, read from the
+    metadata at run time)."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("turntable-pin")
+    except metadata.PackageNotFoundError:  # a source tree on the path, not installed
+        return "0+unknown"
+
+
+__version__ = _version()
 
 if TYPE_CHECKING:  # names for static checkers; nothing is imported at run time
     from .allocation.capability import ManufacturingCapability  # noqa: F401

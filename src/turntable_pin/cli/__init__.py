@@ -89,6 +89,7 @@ def _parser(wanted: set[str]) -> argparse.ArgumentParser:
         "for inertial-instrument calibration, from its URDF (one to three revolute axes, --urdf; "
         "the paper's two-axis table is bundled and the default).",
     )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     subparsers.required = True
     registrar = _Subcommands(subparsers)
@@ -101,6 +102,13 @@ def _parser(wanted: set[str]) -> argparse.ArgumentParser:
         else:  # listed with its help; its options are read only when it is the command
             subparsers.add_parser(name, help=text, add_help=False)
     return parser
+
+
+def _version() -> str:
+    """The installed version (from the package's metadata; no heavy import)."""
+    from .. import __version__
+
+    return __version__
 
 
 def _command(argv: list[str]) -> str | None:

@@ -28,6 +28,7 @@ from .common import (
     bounded_float,
     finite_float,
     generic_table_from_args,
+    input_path,
     latitude_deg,
     one_line_errors,
     paper_table_requested,
@@ -114,7 +115,7 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--lower-bounds",
-        type=Path,
+        type=input_path,
         metavar="FILE.yaml",
         help="manufacturing lower bounds (default: the bundled "
         "models/manufacturing_lower_bounds.yaml; a table given by --urdf: its error names, "

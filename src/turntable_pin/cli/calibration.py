@@ -19,6 +19,7 @@ from .common import (
     add_table_options,
     bounded_float,
     generic_table_from_args,
+    input_path,
     latitude_deg,
     one_line_errors,
     paper_table_requested,
@@ -45,7 +46,7 @@ def _add_setup_options(parser: argparse.ArgumentParser, *, positions: bool = Tru
 
 def _add_model_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "--gyrowheel", type=Path, metavar="FILE.yaml",
+        "--gyrowheel", type=input_path, metavar="FILE.yaml",
         help="drift coefficients {x: {DF, x, y, z, xx, zz, xy}, y: {...}} (default: Table 1)",
     )  # fmt: skip
     parser.add_argument(
@@ -99,7 +100,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "position.",
     )
     one_line_errors(c)
-    c.add_argument("run", type=Path, metavar="RUN.csv")
+    c.add_argument("run", type=input_path, metavar="RUN.csv")
     _add_setup_options(c, positions=False)
     c.add_argument("--json", action="store_true", help="print one JSON object")
     c.set_defaults(func=run_calibrate)

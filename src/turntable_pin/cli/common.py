@@ -16,6 +16,7 @@ from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors, parse_error_v
 from ..model.turntable import TurntableModel
 
 __all__ = [
+    "input_path",
     "OUTPUT_OPTIONS",
     "accuracy_dph",
     "add_error_options",
@@ -144,11 +145,34 @@ def one_line_errors(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
     return parser
 
 
+def input_path(value: str) -> Path:
+    """A file a command reads (an argparse ``type``): the path as given when something is there;
+    else the bundled file of that name, so that an installed package runs its examples from any
+    folder: ``altaz_mount.urdf`` or ``altaz_mount`` (a bundled table),
+    ``measurements_example.csv`` or ``mmt_pointing/k_and_e.dat`` (a bundled example), or a
+    repository path ``models/...``. A name that is neither is returned as given (the command
+    then says it is missing)."""
+    path = Path(value)
+    if path.exists():
+        return path
+    from ..core.resources import models_dir
+
+    root = models_dir()
+    parts = path.parts
+    name = Path(*parts[1:]) if len(parts) > 1 and parts[0] == "models" else path
+    candidates = [root / name, root / "examples" / name]
+    if not name.suffix:
+        candidates.append(root / name.with_suffix(".urdf"))
+    return next((c for c in candidates if c.is_file()), path)
+
+
 def add_table_options(parser: argparse.ArgumentParser) -> None:
     """``--urdf FILE`` and ``--payload-frame NAME``: the table (default: the paper's)."""
     parser.add_argument(
-        "--urdf", type=Path, metavar="FILE.urdf",
-        help="the turntable's URDF: 1 to 3 revolute joints in a chain (default: the paper's)",
+        "--urdf", type=input_path, metavar="FILE.urdf",
+        help="the turntable's URDF: 1 to 3 revolute joints in a chain (default: the paper's); "
+        "a bundled table by name: altaz_mount, german_equatorial_mount, two_axis_vertical_outer, "
+        "three_axis_imu_table, single_axis_rate_table",
     )  # fmt: skip
     parser.add_argument(
         "--payload-frame",
@@ -168,7 +192,7 @@ def add_error_options(parser: argparse.ArgumentParser) -> None:
         "(a unit suffix such as dphi_y1_arcmin=0.1 or deta_m=2e-4 is also understood); repeatable",
     )
     parser.add_argument(
-        "--errors", type=Path, metavar="FILE.yaml", help="YAML file of turntable errors"
+        "--errors", type=input_path, metavar="FILE.yaml", help="YAML file of turntable errors"
     )
     add_table_options(parser)
 

@@ -4,9 +4,8 @@ parameters, required columns, definition and title."""
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from .common import one_line_errors, print_json
+from .common import input_path, one_line_errors, print_json
 
 __all__ = ["register"]
 
@@ -21,9 +20,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "columns, definition and title.",
     )
     one_line_errors(p)
-    p.add_argument("--urdf", type=Path, metavar="FILE.urdf", help="the table (default: bundled)")
+    p.add_argument(
+        "--urdf", type=input_path, metavar="FILE.urdf", help="the table (default: bundled)"
+    )
     p.add_argument("--payload-frame", metavar="NAME", help="the payload frame of the URDF")
-    p.add_argument("--catalogue", action="append", default=[], type=Path, metavar="FILE",
+    p.add_argument("--catalogue", action="append", default=[], type=input_path, metavar="FILE",
                    help="your effects (.yaml effect file or .py module); repeatable")  # fmt: skip
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run_effects)

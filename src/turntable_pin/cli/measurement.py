@@ -15,6 +15,7 @@ from .common import (
     bounded_float,
     errors_from_args,
     generic_errors_from_args,
+    input_path,
     one_line_errors,
     positive_float,
     positive_int,
@@ -74,7 +75,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         s.add_argument(f"--phi{k}-start-deg", type=start, default=0.0,
                        help=f"first grid angle of phi{k}; a sweep holds phi{k} here")  # fmt: skip
     design = s.add_mutually_exclusive_group()
-    design.add_argument("--positions", type=Path, metavar="FILE.csv",
+    design.add_argument("--positions", type=input_path, metavar="FILE.csv",
                         help="measure these positions in the file's order (columns phi1_deg.. "
                         "or <joint>_deg, optional dir1.. and time_s)")  # fmt: skip
     design.add_argument("--sweep", metavar="AXES",
@@ -155,7 +156,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "parameters; plots embedded.",
     )
     one_line_errors(r)
-    r.add_argument("data", type=Path, metavar="DATA.csv")
+    r.add_argument("data", type=input_path, metavar="DATA.csv")
     add_table_options(r)
     r.add_argument("--ignore-sigma", action="store_true")
     r.add_argument("--until-explained", action="store_true")
@@ -210,7 +211,7 @@ def _add_outlier_option(p: argparse.ArgumentParser) -> None:
 
 
 def _add_catalogue_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--catalogue", action="append", default=[], type=Path, metavar="FILE",
+    p.add_argument("--catalogue", action="append", default=[], type=input_path, metavar="FILE",
                    help="your effects (a .yaml effect file or a .py module) join the candidates; "
                    "repeatable")  # fmt: skip
 
@@ -226,7 +227,7 @@ def _user_catalogue(args: argparse.Namespace, table=None):
 
 
 def _add_data_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("data", type=Path, metavar="DATA.csv")
+    p.add_argument("data", type=input_path, metavar="DATA.csv")
     add_table_options(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument(

@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from ..core.exceptions import InputError
-from .common import latitude_deg, one_line_errors
+from .common import input_path, latitude_deg, one_line_errors
 
 __all__ = ["register"]
 
@@ -28,7 +28,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "docs/measurements.md, 'Pointing runs (TPOINT files)'.",
     )
     one_line_errors(p)
-    p.add_argument("data", type=Path, metavar="RUN.dat", help="the TPOINT file")
+    p.add_argument("data", type=input_path, metavar="RUN.dat", help="the TPOINT file")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.csv")
     p.add_argument(
         "--mount",

@@ -19,6 +19,7 @@ from .common import (
     finite_float,
     generic_errors_from_args,
     generic_table_from_args,
+    input_path,
     paper_table_requested,
     positive_int,
     print_json,
@@ -72,7 +73,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     v.add_argument(
         "--positions",
-        type=Path,
+        type=input_path,
         metavar="FILE.csv",
         help="schedule for --animate: a CSV with columns phi1_deg, phi2_deg (any table: "
         "phi1_deg .. phiN_deg or <joint>_deg; default every joint through 0, 90, 180, 270 deg)",

@@ -1,13 +1,13 @@
 """Where the bundled files are: the models folder and the files in it.
 
 ``$TURNTABLE_PIN_MODELS`` if set; else the repository's ``models/`` (a source checkout or an
-editable install); else the copy a wheel installs under ``<prefix>/share/turntable-pin/models``.
+editable install); else the package data ``turntable_pin/models`` of an installed wheel (read
+with ``importlib.resources``; ``setup.py`` maps the repository's ``models/`` there).
 """
 
 from __future__ import annotations
 
 import os
-import sys
 from pathlib import Path
 
 __all__ = [
@@ -25,9 +25,11 @@ def models_dir() -> Path:
     if env:
         return Path(env)
     checkout = Path(__file__).resolve().parents[3] / "models"
-    if checkout.is_dir():
+    if checkout.is_dir() and (checkout / "turntable.urdf").is_file():
         return checkout
-    return Path(sys.prefix) / "share" / "turntable-pin" / "models"
+    from importlib import resources
+
+    return Path(str(resources.files("turntable_pin") / "models"))
 
 
 def examples_dir() -> Path:
