@@ -63,7 +63,7 @@ def data_figure(data) -> bytes:
     panel per angle, coloured by the first joint's (phi1); one joint: against phi1."""
     plt = pyplot()
 
-    fig, axes = plt.subplots(1, 3, figsize=(14, 3.4))
+    fig, axes = plt.subplots(1, 3, figsize=(14, 3.6), layout="constrained")
     last = data.n_joints
     x = data.joint_rad[:, last - 1] * DEG_PER_RAD
     colour = data.joint_rad[:, 0] * DEG_PER_RAD

@@ -82,14 +82,17 @@ def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
                     ax.plot(x[pick], shown[pick, i], "x", ms=6, mew=1.4, color="black",
                             label="outlier (left out)" if i == 0 else None)  # fmt: skip
             if direction is not None:
-                ax.text(0.01, 0.02, "filled up-triangles: approached forward (dir +1); open "
-                        "down-triangles: backward (dir -1)", transform=ax.transAxes,
+                ax.text(0.01, 0.02, "filled up-triangles: approached forward (dir +1)\n"
+                        "open down-triangles: backward (dir -1)", transform=ax.transAxes,
                         fontsize=6.5, color="#555")  # fmt: skip
             if np.isfinite(sigma) and sigma > 0:
                 for s in (-k_sigma * sigma, k_sigma * sigma):
                     ax.axhline(s, color="grey", lw=0.7, ls="--")
             ax.axhline(0, color="black", lw=0.5)
             ax.set_ylim(-limit, limit)
+            if name.startswith("dir"):  # an approach direction: two values, +-1
+                ax.set_xticks([-1, 1], ["-1 (backward)", "+1 (forward)"])
+                ax.set_xlim(-1.6, 1.6)
             ax.set_xlabel("position (measurement order)" if name == "position" else name)
             ax.set_ylabel(f"residual ({rs.unit})")
             if row == 0:
@@ -185,7 +188,7 @@ def residual_map_figure(sets: Sequence[ResidualSet], limit: float | None = None)
             ax.set_aspect("equal")
             ax.set_xlabel(names[0].replace("_deg", " (deg)"))
             ax.set_ylabel(names[1].replace("_deg", " (deg)"))
-            ax.set_title(f"{comp} residual, {rs.label}", fontsize=9, color=COLOURS[i])
+            ax.set_title(f"{comp} residual\n{rs.label}", fontsize=9, color=COLOURS[i])
     fig.subplots_adjust(wspace=0.35, hspace=0.3)
     fig.colorbar(image, ax=axes.ravel().tolist(), label=f"residual ({sets[0].unit})",
                  shrink=0.85 if len(sets) == 1 else 0.6)  # fmt: skip

@@ -67,6 +67,8 @@ def plot_figure4(result: OrientationRequirement, path: str | Path, *, points: in
     plt = pyplot()
     u, v, gamma1, gamma2 = _surfaces(result, points)
 
+    from matplotlib.ticker import MaxNLocator
+
     fig = plt.figure(figsize=(15, 9))
     fig.suptitle("Figure 4: rate-sensing errors against the orientation error\n" + _title(result))
     for index, (values, names, axis) in enumerate(
@@ -77,9 +79,12 @@ def plot_figure4(result: OrientationRequirement, path: str | Path, *, points: in
         ax.plot_surface(
             u, v, np.full(u.shape, result.accuracy_dph), color="red", alpha=0.25, linewidth=0
         )
-        ax.set_xlabel(_LABELS[names[0]])
-        ax.set_ylabel(_LABELS[names[1]])
-        ax.set_zlabel(rf"$\Delta\omega_{axis}$ (deg/h)")
+        ax.set_xlabel(_LABELS[names[0]], labelpad=12)
+        ax.set_ylabel(_LABELS[names[1]], labelpad=12)
+        ax.set_zlabel(rf"$\Delta\omega_{axis}$ (deg/h)", labelpad=14)
+        ax.tick_params(labelsize=7)
+        for axis3d in (ax.xaxis, ax.yaxis, ax.zaxis):
+            axis3d.set_major_locator(MaxNLocator(4))
         ax.set_title(
             f"({'ab'[index]}) $\\Gamma_{index + 1}$: $\\Delta\\omega_{axis}$, plane $\\omega_m$"
         )
@@ -103,6 +108,7 @@ def plot_figure4(result: OrientationRequirement, path: str | Path, *, points: in
         ax.axhline(result.accuracy_dph, color="red", lw=0.8, ls="--", label=r"$\omega_m$")
         ax.set_xlabel(_LABELS[along_name])
         ax.set_ylabel(rf"$\Delta\omega_{'xy'[column]}$ (deg/h)")
+        ax.xaxis.set_major_locator(MaxNLocator(6))
         ax.set_title(f"({letter}) $\\Delta\\omega_{'xy'[column]}$ against $\\Delta\\{along_name}$")
         ax.legend(fontsize=7)
         ax.grid(alpha=0.3)
