@@ -111,3 +111,19 @@ def test_residuals_beyond_five_degrees_are_refused_naming_the_rows():
     angles[[7, 30], 1] += np.radians(12.0)  # another star
     with pytest.raises(InputError, match=r"row\(s\) 9, 32 of the data: the best fit of the "):
         fit_orientation(data.replace(angles_rad=angles), turntable=table)
+
+
+def test_the_same_shape_given_twice_is_refused_naming_both():
+    # Issue 21: a catalogue name and an inline term of the same shape showed a lower rank silently.
+    from conftest import EXAMPLES_DIR
+    from turntable_pin.core.exceptions import InputError
+    from turntable_pin.measurement.data import read_measurements
+    from turntable_pin.measurement.fit import refuse_repeated_shapes
+    from turntable_pin.measurement.user_effects import resolve_effects
+
+    data = read_measurements(EXAMPLES_DIR / "measurements_example.csv")
+    twice = resolve_effects(["inner_encoder_harmonics", "dphi_z2~h1(phi2)"])
+    with pytest.raises(InputError, match="dphi_z2~h1\\(phi2\\).*inner_encoder_harmonics"):
+        refuse_repeated_shapes(data, twice)
+    refuse_repeated_shapes(data, resolve_effects(["inner_encoder_harmonics", "dphi_z2~h3(phi2)"]))
+    refuse_repeated_shapes(data, resolve_effects(["inner_encoder_harmonics", "backlash"]))

@@ -365,7 +365,7 @@ def _fit_line(label: str, summary: dict) -> str:
 
 
 def run_fit(args: argparse.Namespace) -> int:
-    from ..measurement.fit import fit_orientation
+    from ..measurement.fit import fit_orientation, refuse_repeated_shapes
     from ..measurement.residuals import analyse_residuals, orientation_residuals
     from ..measurement.user_effects import load_effects_module, resolve_effects
     from ..report.measurement_figures import write_residual_plots
@@ -374,6 +374,7 @@ def run_fit(args: argparse.Namespace) -> int:
     data = _read(args, table)
     modules = [e for path in args.effects_module for e in load_effects_module(path)]
     effects = resolve_effects(args.effects, table, modules)
+    refuse_repeated_shapes(data, effects, turntable=table)
     after = fit_orientation(data, effects, turntable=table)
     before = fit_orientation(data, turntable=table) if effects else after
     # With sigma estimated, both fits are judged with the noise of the fuller model.

@@ -29,6 +29,7 @@ __all__ = [
     "OrientationFitProblem",
     "fit_orientation",
     "orientation_zero_point",
+    "refuse_repeated_shapes",
 ]
 
 ZERO_POINT_BLOCK = 8192
@@ -259,6 +260,49 @@ def fit_orientation(
     fit = OrientationFit(data, model, result)
     _refuse_unexplained(fit)
     return fit
+
+
+def refuse_repeated_shapes(data: OrientationMeasurements, effects, turntable=None) -> None:
+    """:class:`InputError` when one of ``effects`` adds nothing the others do not already add on
+    these data (its Jacobian columns, beyond the base errors, lie in the span of another's:
+    ``inner_encoder_harmonics`` and ``dphi_z2~h1(phi2)`` together), naming both; a fit would
+    otherwise show a lower rank and split the shape between them silently."""
+    from ..core.exceptions import InputError
+    from ..stats.least_squares import RANK_RTOL
+
+    if len(effects) < 2:
+        return
+    model = OrientationModel(data.variables(), effects, turntable)
+    jac = model.jacobian(np.zeros(model.n_params)).reshape(-1, model.n_params)
+    jac = jac[data.measured.reshape(-1)]
+    n_base = len(model.base_names)
+
+    def span(columns: np.ndarray) -> np.ndarray:
+        u, s, _ = np.linalg.svd(columns, full_matrices=False)
+        return u[:, s > RANK_RTOL * (s[0] if s.size else 1.0)]
+
+    base = span(jac[:, :n_base])
+    blocks = []
+    start = n_base
+    for effect in effects:
+        count = len(effect.parameters(data.variables()))
+        block = jac[:, start : start + count]
+        blocks.append(block - base @ (base.T @ block))
+        start += count
+    for i, a in enumerate(effects):
+        own = blocks[i]
+        if not np.linalg.norm(own) > 0:
+            continue
+        for j, b in enumerate(effects):
+            if i == j or not np.linalg.norm(blocks[j]) > 0:
+                continue
+            other = span(blocks[j])
+            left = own - other @ (other.T @ own)
+            if np.linalg.norm(left) <= 1e-6 * np.linalg.norm(own):
+                raise InputError(
+                    f"effect '{a.name}' adds nothing that '{b.name}' does not already add on "
+                    "these data (the same shape given twice); give it once"
+                )
 
 
 def _refuse_unexplained(fit: OrientationFit) -> None:
