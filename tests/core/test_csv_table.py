@@ -133,3 +133,20 @@ def test_the_header_read_alone_agrees_with_the_whole_reading(tmp_path):
     assert read_header(path) == (table.header, table.header_row) == (("a", "b", "c"), 4)
     assert read_header(tmp_path / "absent.csv") == ((), 0)
     assert read_header(write_file(tmp_path, "# only a comment\n", "empty.csv")) == ((), 0)
+
+
+def test_a_missing_column_error_names_the_header_row_and_the_closest_column(tmp_path):
+    from turntable_pin.core.csv_table import closest_column_hint
+    from turntable_pin.measurement.data import read_measurements
+
+    assert "'dteta_arcsec'" in closest_column_hint("dtheta_arcsec", ["phi1_deg", "dteta_arcsec"])
+    assert closest_column_hint("dtheta_arcsec", ["phi1_deg", "temperature_c"]) == ""
+    path = tmp_path / "m.csv"
+    path.write_text(
+        "# a comment line first\nphi1_deg,phi_2deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec\n"
+        "0,0,1,1,1\n"
+    )
+    with pytest.raises(InputError) as caught:
+        read_measurements(path)
+    message = str(caught.value)
+    assert "row 2" in message and "is 'phi_2deg' a misspelling" in message

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.csv_table import read_csv_table
+from ..core.csv_table import closest_column_hint, read_csv_table
 from ..core.exceptions import InputError
 from ..core.sizes import MAX_POSITIONS, check_count, turn_grid_count
 from ..core.units import deg_to_rad, rad_to_deg
@@ -255,9 +255,12 @@ def angle_columns(
         found = [c for c in (f"phi{k}_deg", f"{joint}_deg" if joint else None) if c in header]
         if not found:
             spelled = f"'phi{k}_deg'" + (f" or '{joint}_deg'" if joint else "")
+            hint = closest_column_hint(f"phi{k}_deg", header) or (
+                closest_column_hint(f"{joint}_deg", header) if joint else ""
+            )
             raise InputError(
                 f"missing required column {spelled} (the commanded angle of joint {k}"
-                f"{' ' + joint if joint else ''}); the header has {', '.join(header)}",
+                f"{' ' + joint if joint else ''}){hint}; the header has {', '.join(header)}",
                 path=path, row=header_row,
             )  # fmt: skip
         if len(found) > 1:

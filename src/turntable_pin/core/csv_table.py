@@ -16,7 +16,14 @@ import numpy as np
 
 from .exceptions import InputError
 
-__all__ = ["CsvTable", "read_csv_table", "read_header", "refuse_repeated_rows", "write_csv_table"]
+__all__ = [
+    "CsvTable",
+    "closest_column_hint",
+    "read_csv_table",
+    "read_header",
+    "refuse_repeated_rows",
+    "write_csv_table",
+]
 
 
 @dataclass(frozen=True)
@@ -60,6 +67,15 @@ class CsvTable:
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.columns[name]
+
+
+def closest_column_hint(name: str, header) -> str:
+    """`` (is 'X' a misspelling of it?)`` for the header column most like ``name``, or ``""``
+    when none is close (difflib's ratio at least 0.6)."""
+    import difflib
+
+    close = difflib.get_close_matches(name, [h for h in header if h != name], n=1, cutoff=0.6)
+    return f" (is '{close[0]}' a misspelling of it?)" if close else ""
 
 
 def read_header(path: str | Path) -> tuple[tuple[str, ...], int]:
@@ -135,7 +151,7 @@ def read_csv_table(
             if close:
                 hints.append(f"'{name}' (found {', '.join(repr(c) for c in close)})")
             else:
-                hints.append(f"'{name}'")
+                hints.append(f"'{name}'" + closest_column_hint(name, header))
         raise InputError(
             f"missing required column(s) {', '.join(hints)}; the header has {', '.join(header)}",
             path=path,
