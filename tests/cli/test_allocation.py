@@ -114,3 +114,19 @@ def test_parse_limits_one_number_for_all():
     assert limits == pytest.approx({"psi": 1.5, "theta": 1.5, "gamma": 1.5})
     with pytest.raises(InputError, match="twice"):
         parse_limits("psi=1,psi=2,theta=1,gamma=1", "deg")
+
+
+@pytest.mark.parametrize("table", [[], ["--urdf", "two_axis_vertical_outer"]])
+def test_the_text_says_what_holds_for_the_final_bounds(table):
+    # Issue 18: "dpsi limit 0.6'  worst case 0.3031' ... active: first-order max |dpsi| = limit"
+    # showed a line of the psi sub-problem as if it held for the result.
+    args = [*table, "--limits-arcmin", "psi=0.6,theta=0.25,gamma=0.45"]
+    text = cli("allocate", *args).stdout
+    out = json.loads(cli("allocate", *args, "--json").stdout)
+    for name in ("psi", "theta", "gamma"):
+        limit = {"psi": 0.6, "theta": 0.25, "gamma": 0.45}[name]
+        worst = out["worst_case_arcmin"][name]
+        line = next(x for x in text.splitlines() if x.startswith(f"d{name} ") and "limit" in x)
+        state = "(at the limit)" if worst >= limit * (1 - 1e-6) else f"({worst / limit:.0%} of"
+        assert state in line, line
+    assert "active in it:" in text and "active: " not in text

@@ -164,15 +164,21 @@ def render_allocation_report(
         )
     lines.append("")
     limits_arcmin = limits.to_dict()
+    lines.append(
+        "with every error at its final upper bound (the smallest of the three sub-problems'):"
+    )
     for k, name in enumerate(ORIENTATION_ANGLES):
+        limit = limits_arcmin[name]
+        worst = worst_case_rad[k] * ARCMIN_PER_RAD
+        share = worst / limit if limit > 0 else float("nan")
+        state = "at the limit" if share >= 1.0 - 1e-6 else f"{share:.0%} of the limit"
+        lines.append(f"d{name:6s} limit {limit:.4f}'  worst case {worst:.4f}'  ({state})")
+    lines.append("each angle's own sub-problem (its bounds before the minimum over the angles):")
+    for name in ORIENTATION_ANGLES:
         sub = subproblems[name]
-        lines.append(
-            f"d{name:6s} limit {limits_arcmin[name]:.4f}'  worst case "
-            f"{worst_case_rad[k] * ARCMIN_PER_RAD:.4f}'  J = {sub.J:.6g} /arcmin^2  "
-            f"[{method_note(sub)}]"
-        )
+        lines.append(f"d{name:6s} J = {sub.J:.6g} /arcmin^2  [{method_note(sub)}]")
         for item in sub.active:
-            lines.append(f"         active: {item}")
+            lines.append(f"         active in it: {item}")
     return "\n".join(lines)
 
 
