@@ -142,3 +142,61 @@ def test_a_full_grid_gets_no_design_warning():
 
     out = json.loads(cli("diagnose", str(DATA), "--json").stdout)
     assert out["warnings"] == []
+
+
+def _command_actions(command: str):
+    """The argparse actions of ``command``'s own parser."""
+    import argparse
+
+    from turntable_pin.cli import build_parser
+
+    parser = build_parser(command)
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return sub.choices[command]._actions
+
+
+def _guard_cases():
+    """(command, output option, input option or positional) for every command's parser."""
+    from pathlib import Path
+
+    from turntable_pin.cli import COMMANDS
+    from turntable_pin.cli.common import OUTPUT_OPTIONS, input_path
+
+    cases = []
+    for command in COMMANDS:
+        actions = _command_actions(command)
+        outputs = [a for a in actions if a.dest in OUTPUT_OPTIONS]
+        inputs = [a for a in actions if a.dest not in OUTPUT_OPTIONS
+                  and a.type in (Path, input_path)]  # fmt: skip
+        cases += [(command, o.dest, i.dest) for o in outputs for i in inputs]
+    return cases
+
+
+@pytest.mark.parametrize("command, output, source", _guard_cases())
+def test_every_output_option_of_every_command_refuses_every_input(
+    tmp_path, command, output, source
+):
+    # Issue 18: one guard for every command, every output option against every input option.
+    import contextlib
+    import io
+
+    from turntable_pin.cli import main
+
+    target = tmp_path / "file.txt"
+    target.write_text("an input that must survive\n")
+    argv = [command]
+    for action in _command_actions(command):
+        flag = action.option_strings[-1] if action.option_strings else None
+        if action.dest in (output, source):
+            argv += [flag, str(target)] if flag else [str(target)]
+        elif flag is None and action.dest not in ("help",):  # another positional: a file
+            argv.append(str(tmp_path / f"other_{action.dest}.csv"))
+        elif action.required:
+            value = action.choices[0] if action.choices else str(tmp_path / f"{action.dest}.out")
+            argv += [flag, str(value)]
+    stderr = io.StringIO()
+    with contextlib.redirect_stderr(stderr):
+        status = main(argv)
+    assert status == 2, (argv, stderr.getvalue())
+    assert "refusing to write" in stderr.getvalue(), stderr.getvalue()
+    assert target.read_text() == "an input that must survive\n"
