@@ -198,26 +198,20 @@ def add_error_options(parser: argparse.ArgumentParser) -> None:
 
 
 def table_from_args(args: argparse.Namespace):
-    """The table of ``--urdf``/``--payload-frame`` for the measurement layer: ``None`` (the
-    bundled paper table), a ``TurntableModel`` (a URDF with the paper's joints: the paper's
-    names) or a ``GenericTable`` (any other table: generic names)."""
-    if paper_table_requested(args):
-        return TurntableModel(urdf_path=args.urdf) if args.urdf else None
-    return generic_table_from_args(args)
+    """The table of ``--urdf``/``--payload-frame``: a
+    :class:`~turntable_pin.model.generic_table.GenericTable` in the paper's names (the bundled
+    table, or a URDF with the paper's joints and payload) or in the generic ones (any other)."""
+    from ..model.paper_table import table_of
+
+    return table_of(args.urdf, getattr(args, "payload_frame", None))
 
 
 def paper_table_requested(args: argparse.Namespace) -> bool:
     """Whether the paper's model (its nine named errors) applies: the bundled table, or a URDF
     with the paper's joints and payload, and no ``--payload-frame`` naming another frame."""
-    from ..model.paper_table import INNER_JOINT, OUTER_JOINT, PAYLOAD_FRAME
+    from ..model.paper_table import PAPER_LAYOUT
 
-    frame = getattr(args, "payload_frame", None)
-    if frame not in (None, PAYLOAD_FRAME):
-        return False
-    if args.urdf is None:
-        return True
-    table = generic_table_from_args(args)
-    return table.joint_names == (OUTER_JOINT, INNER_JOINT) and table.payload_frame == PAYLOAD_FRAME
+    return table_from_args(args).layout is PAPER_LAYOUT
 
 
 def generic_table_from_args(args: argparse.Namespace):

@@ -34,18 +34,9 @@ def run_effects(args: argparse.Namespace) -> int:
     from ..measurement.catalogue import catalogue
     from ..measurement.table import measured_table
     from ..measurement.user_effects import describe_effects, load_catalogue
+    from .common import table_from_args
 
-    table = None
-    if args.urdf is not None or args.payload_frame is not None:
-        from .common import generic_table_from_args, paper_table_requested
-
-        if paper_table_requested(args):
-            from ..model.turntable import TurntableModel
-
-            table = measured_table(TurntableModel(urdf_path=args.urdf))
-        else:
-            table = measured_table(generic_table_from_args(args))
-    table = measured_table(table)
+    table = measured_table(table_from_args(args))
     effects = (*catalogue(table), *load_catalogue(args.catalogue, table))
     listing = describe_effects(effects, table)
     if args.json:

@@ -13,6 +13,7 @@ Its candidate effects are in :mod:`turntable_pin.measurement.catalogue`.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -95,54 +96,28 @@ class MeasuredTable:
         return f"phi{k}"
 
 
-def _paper(turntable) -> MeasuredTable:
-    from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_DESCRIPTIONS
-    from ..model.paper_table import JOINT_ERRORS
-
-    chain = turntable.chain
-    joints = [
-        JointErrors(name, k, JOINT_ERRORS[name][0], JOINT_ERRORS[name][1:])
-        for k, name in enumerate(chain.joint_names, start=1)
-    ]
-    table = MeasuredTable(
-        chain, joints, {n: ERROR_DESCRIPTIONS[n] for n in ANGULAR_ERROR_NAMES}, label="paper",
-        paper=True, urdf_path=turntable.urdf_path,
-    )  # fmt: skip
-    return table
-
-
-def _generic(table) -> MeasuredTable:
-    joints = [
-        JointErrors(name, k, f"{name}.position", (f"{name}.tilt_a", f"{name}.tilt_b"))
-        for k, name in enumerate(table.joint_names, start=1)
-    ]
-    return MeasuredTable(
-        table.chain, joints, table.descriptions, label=str(table.urdf_path),
-        urdf_path=table.urdf_path,
-    )  # fmt: skip
+_MEASURED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+"""The :class:`MeasuredTable` of each table in use (built once per table; gone with it)."""
 
 
 def measured_table(turntable=None) -> MeasuredTable:
     """The :class:`MeasuredTable` of ``turntable``: ``None`` (the bundled paper table), a
-    :class:`~turntable_pin.model.turntable.TurntableModel` (the paper's names), a
-    :class:`~turntable_pin.model.generic_table.GenericTable` (generic names), or a
-    :class:`MeasuredTable` (returned as it is)."""
+    :class:`~turntable_pin.model.generic_table.GenericTable` (in its layout's names: the paper's
+    on the paper's table), a :class:`~turntable_pin.model.turntable.TurntableModel` (its table)
+    or a :class:`MeasuredTable` (returned as it is)."""
+    from ..model.paper_table import PAPER_LAYOUT, paper_table
+
     if isinstance(turntable, MeasuredTable):
         return turntable
-    if turntable is None:
-        return _default_paper()
-    if hasattr(turntable, "parameter_names") and hasattr(turntable, "identifiable"):
-        return _generic(turntable)
-    return _paper(turntable)
-
-
-_DEFAULT: list[MeasuredTable] = []
-
-
-def _default_paper() -> MeasuredTable:
-    """The bundled paper table (built once per process: reading the URDF costs ~10 ms)."""
-    if not _DEFAULT:
-        from ..model.turntable import TurntableModel
-
-        _DEFAULT.append(_paper(TurntableModel()))
-    return _DEFAULT[0]
+    table = paper_table() if turntable is None else getattr(turntable, "table", turntable)
+    cached = _MEASURED.get(table)
+    if cached is None:
+        joints = [
+            JointErrors(name, k, errors[0], tuple(errors[1:]))
+            for k, (name, errors) in enumerate(table.layout.joint_errors.items(), start=1)
+        ]
+        cached = _MEASURED[table] = MeasuredTable(
+            table.chain, joints, table.descriptions, label=table.label,
+            paper=table.layout is PAPER_LAYOUT, urdf_path=table.urdf_path,
+        )  # fmt: skip
+    return cached

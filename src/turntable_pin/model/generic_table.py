@@ -15,8 +15,12 @@ The rule that places the errors (stated once, here):
 
 Angles are radians, offsets metres. Which combinations orientation data determine is found
 numerically (:meth:`GenericTable.identifiable`: QR with column pivoting of the orientation
-regressor on generic positions); no combination is hard-coded. The paper's table is this model
-too, under other names (see ``tests/model/test_generic_table.py``).
+regressor on generic positions); no combination is hard-coded.
+
+A table may instead bring its own :class:`ErrorLayout` (which error factors sit in which
+placement, in which order, under which names): the paper's table is this class given the URDF
+``models/turntable.urdf`` and the layout of its Table 3 (:data:`~.paper_table.PAPER_LAYOUT`), so
+every layer written for a ``GenericTable`` reproduces the paper when given the paper's table.
 """
 
 from __future__ import annotations
@@ -41,8 +45,10 @@ from .chain import (
 
 __all__ = [
     "MAX_JOINTS",
+    "ErrorLayout",
     "GenericTable",
     "Identifiable",
+    "OrientationError",
     "perpendicular_directions",
 ]
 
@@ -106,6 +112,88 @@ def _payload_frame(model, path: Path, payload_frame: str | None) -> str:
     return leaves[0]
 
 
+@dataclass(frozen=True, eq=False)
+class ErrorLayout:
+    """Where a table's errors sit and what they are called: the table-specific part as data.
+
+    Attributes:
+        factors: ``{placement (joint or fixed joint): ((kind, axis, error name), ...)}``, the
+            elementary motions after each nominal ``<origin>``, in order (see
+            :class:`~turntable_pin.model.chain.ErrorChain`).
+        names: every error, in the order of error vectors.
+        descriptions: ``{error: what it is}``.
+        joint_errors: ``{joint: (position error, tilt a, tilt b)}``, from the base.
+        label: how reports name the table (``None``: its URDF file).
+        payload_frame: the payload frame the layout is written for (``None``: any).
+    """
+
+    factors: Mapping[str, tuple[tuple, ...]]
+    names: tuple[str, ...]
+    descriptions: Mapping[str, str]
+    joint_errors: Mapping[str, tuple[str, str, str]]
+    label: str | None = None
+    payload_frame: str | None = None
+
+    @property
+    def length_names(self) -> tuple[str, ...]:
+        """The errors that are lengths (translation factors, metres)."""
+        lengths = {f[2] for fs in self.factors.values() for f in fs if f[0] == TRANSLATION}
+        return tuple(n for n in self.names if n in lengths)
+
+    @property
+    def angular_names(self) -> tuple[str, ...]:
+        """The errors that are angles (rotation factors, radians), in :attr:`names` order."""
+        return tuple(n for n in self.names if n not in self.length_names)
+
+
+def generic_layout(chain: ErrorChain, mount: str) -> ErrorLayout:
+    """The layout of the module docstring's rule for the joints of ``chain`` and payload mount
+    ``mount``: per joint ``position``, ``tilt_a``, ``tilt_b``, ``offset_a``, ``offset_b``; then
+    the mount's ``rot_x``, ``rot_y``, ``rot_z``."""
+    factors: dict[str, tuple[tuple, ...]] = {}
+    names: list[str] = []
+    descriptions: dict[str, str] = {}
+    joint_errors: dict[str, tuple[str, str, str]] = {}
+    for link in chain.joints:
+        a = link.axis / np.linalg.norm(link.axis)
+        u, v = perpendicular_directions(a)
+        j = link.name
+        entries = [
+            (ROTATION, a, "position", f"position error of {j} (about its axis)"),
+            (ROTATION, u, "tilt_a", f"tilt of {j}'s axis about u = {_vec(u)}"),
+            (ROTATION, v, "tilt_b", f"tilt of {j}'s axis about v = {_vec(v)}"),
+            (TRANSLATION, u, "offset_a", f"offset of {j}'s axis along u (m)"),
+            (TRANSLATION, v, "offset_b", f"offset of {j}'s axis along v (m)"),
+        ]
+        factors[j] = tuple((kind, tuple(axis), f"{j}.{short}") for kind, axis, short, _ in entries)
+        for _, _, short, text in entries:
+            names.append(f"{j}.{short}")
+            descriptions[f"{j}.{short}"] = text
+        joint_errors[j] = (f"{j}.position", f"{j}.tilt_a", f"{j}.tilt_b")
+    factors[mount] = tuple((ROTATION, ax, f"{mount}.rot_{ax}") for ax in ("x", "y", "z"))
+    for ax in ("x", "y", "z"):
+        names.append(f"{mount}.rot_{ax}")
+        descriptions[f"{mount}.rot_{ax}"] = f"payload mount rotation about its {ax} axis"
+    return ErrorLayout(factors, tuple(names), descriptions, joint_errors)
+
+
+@dataclass(frozen=True)
+class OrientationError:
+    """The orientation error of the payload at one position.
+
+    Attributes:
+        dR: ``Rd^T Rt`` (eq. 23), 3x3.
+        dpsi_rad, dtheta_rad, dgamma_rad: ``dR[0,2]``, ``dR[1,0]``, ``dR[2,1]`` (eq. 24), radians.
+        payload_origin_m: payload origin in the base frame, metres (zero for a perfect table).
+    """
+
+    dR: np.ndarray
+    dpsi_rad: float
+    dtheta_rad: float
+    dgamma_rad: float
+    payload_origin_m: np.ndarray
+
+
 @dataclass(frozen=True)
 class Identifiable:
     """What orientation data determine, found on generic positions.
@@ -138,7 +226,12 @@ class GenericTable:
             ``.offset_b`` per joint from the base, then ``<mount>.rot_x``, ``.rot_y``, ``.rot_z``.
     """
 
-    def __init__(self, urdf_path: str | Path, payload_frame: str | None = None) -> None:
+    def __init__(
+        self,
+        urdf_path: str | Path,
+        payload_frame: str | None = None,
+        layout: ErrorLayout | None = None,
+    ) -> None:
         import pinocchio as pin
 
         path = Path(urdf_path)
@@ -149,6 +242,8 @@ class GenericTable:
             model = pin.buildModelFromUrdf(str(path))
         except (RuntimeError, ValueError) as exc:
             raise ModelError(f"{path}: Pinocchio cannot read this URDF: {exc}") from None
+        if payload_frame is None and layout is not None:
+            payload_frame = layout.payload_frame
         frame = _payload_frame(model, path, payload_frame)
         chain_joints = []
         jid = model.frames[model.getFrameId(frame)].parentJoint
@@ -177,33 +272,20 @@ class GenericTable:
         self.payload_frame = frame
         self.nominal_pin_model = model
         probe = ErrorChain.from_pinocchio(model, frame, {}, ())
-        factors: dict[str, list[tuple]] = {}
-        names: list[str] = []
-        descriptions: dict[str, str] = {}
-        for link in probe.joints:
-            a = link.axis / np.linalg.norm(link.axis)
-            u, v = perpendicular_directions(a)
-            j = link.name
-            entries = [
-                (ROTATION, a, "position", f"position error of {j} (about its axis)"),
-                (ROTATION, u, "tilt_a", f"tilt of {j}'s axis about u = {_vec(u)}"),
-                (ROTATION, v, "tilt_b", f"tilt of {j}'s axis about v = {_vec(v)}"),
-                (TRANSLATION, u, "offset_a", f"offset of {j}'s axis along u (m)"),
-                (TRANSLATION, v, "offset_b", f"offset of {j}'s axis along v (m)"),
-            ]
-            factors[j] = [(kind, tuple(axis), f"{j}.{short}") for kind, axis, short, _ in entries]
-            for _, _, short, text in entries:
-                names.append(f"{j}.{short}")
-                descriptions[f"{j}.{short}"] = text
-        mount = next((link.name for link in probe.links if not link.is_joint), frame)
-        factors[mount] = [(ROTATION, ax, f"{mount}.rot_{ax}") for ax in ("x", "y", "z")]
-        for ax in ("x", "y", "z"):
-            names.append(f"{mount}.rot_{ax}")
-            descriptions[f"{mount}.rot_{ax}"] = f"payload mount rotation about its {ax} axis"
-        self.mount = mount
-        self.parameter_names = tuple(names)
-        self.descriptions = descriptions
-        self.chain = ErrorChain.from_pinocchio(model, frame, factors, names)
+        self.mount = next((link.name for link in probe.links if not link.is_joint), frame)
+        if layout is None:
+            layout = generic_layout(probe, self.mount)
+        elif tuple(layout.joint_errors) != probe.joint_names:
+            raise ModelError(
+                f"{path}: the error layout is written for joints "
+                f"{', '.join(layout.joint_errors)}; this URDF's chain to '{frame}' has "
+                f"{', '.join(probe.joint_names)}"
+            )
+        self.layout = layout
+        self.parameter_names = layout.names
+        self.descriptions = dict(layout.descriptions)
+        self.chain = ErrorChain.from_pinocchio(model, frame, layout.factors, layout.names)
+        self._pinocchio: dict[bytes, tuple] = {}
 
     # ---- values ---------------------------------------------------------------------------
     @property
@@ -225,8 +307,18 @@ class GenericTable:
 
     @property
     def length_names(self) -> tuple[str, ...]:
-        """The parameters that are lengths (the offsets, metres)."""
-        return tuple(n for n in self.parameter_names if ".offset_" in n)
+        """The parameters that are lengths (translation errors: offsets, metres)."""
+        return self.layout.length_names
+
+    @property
+    def angular_names(self) -> tuple[str, ...]:
+        """The parameters that are angles (rotation errors, radians)."""
+        return self.layout.angular_names
+
+    @property
+    def label(self) -> str:
+        """How reports name the table: the layout's label (``paper``) or the URDF file."""
+        return self.layout.label or str(self.urdf_path)
 
     def errors_from_user_units(
         self, entries: Mapping[str, object], *, max_angle_deg: float | None = None
@@ -283,14 +375,38 @@ class GenericTable:
                 out[f"{name}_arcsec"] = float(value) * ARCSEC_PER_RAD
         return out
 
-    def payload_origin_m(self, error_values, angles_rad: Sequence[float]) -> np.ndarray:
-        """The payload origin in the base frame with these errors (Pinocchio), metres."""
+    def payload_pose(self, error_values, angles_rad: Sequence[float]):
+        """The payload pose in the base frame (a ``pinocchio.SE3``) at joint angles (chain
+        order, radians): Pinocchio forward kinematics of the table with these errors in its
+        placements (``None``: the nominal model, the ideal pose)."""
         import pinocchio as pin
 
-        model = self.pinocchio_model(error_values)
-        data = model.createData()
+        key = b"" if error_values is None else np.asarray(error_values, float).tobytes()
+        cached = self._pinocchio.get(key)
+        if cached is None:
+            if len(self._pinocchio) >= 8:  # a few error sets in use at a time
+                self._pinocchio.pop(next(iter(self._pinocchio)))
+            model = self.nominal_pin_model if not key else self.pinocchio_model(error_values)
+            frame_id = model.getFrameId(self.payload_frame)
+            cached = self._pinocchio[key] = (model, model.createData(), frame_id)
+        model, data, frame_id = cached
         pin.framesForwardKinematics(model, data, self.chain.joint_vector(*angles_rad))
-        return np.array(data.oMf[model.getFrameId(self.payload_frame)].translation)
+        return data.oMf[frame_id].copy()
+
+    def payload_origin_m(self, error_values, angles_rad: Sequence[float]) -> np.ndarray:
+        """The payload origin in the base frame with these errors (Pinocchio), metres."""
+        return np.array(self.payload_pose(error_values, angles_rad).translation)
+
+    def orientation_error(self, error_values, angles_rad: Sequence[float]) -> OrientationError:
+        """``dR = Rd^T Rt`` and the three error angles at joint angles (chain order, radians),
+        by Pinocchio forward kinematics of the nominal model and the model with errors."""
+        for value in angles_rad:
+            if not np.isfinite(value):
+                raise InputError(f"rotation angles must be finite numbers, got {value!r}")
+        actual = self.payload_pose(error_values, angles_rad)
+        dR = self.payload_pose(None, angles_rad).rotation.T @ actual.rotation
+        dpsi, dtheta, dgamma = (float(dR[i, j]) for i, j in ANGLE_ENTRIES)
+        return OrientationError(dR, dpsi, dtheta, dgamma, np.array(actual.translation))
 
     def _angles(self, angles_rad: Sequence) -> list[np.ndarray]:
         if len(angles_rad) != len(self.joint_names):

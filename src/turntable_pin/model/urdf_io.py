@@ -14,7 +14,6 @@ import numpy as np
 from ..core.exceptions import InputError, ModelError
 from ..core.files import write_atomic
 from .chain import ErrorChain
-from .paper_table import INNER_JOINT, OUTER_JOINT, PAYLOAD_FRAME, PAYLOAD_MOUNT
 
 __all__ = ["YourdfpyTurntable", "write_error_urdf"]
 
@@ -63,30 +62,39 @@ class YourdfpyTurntable:
 
     Args:
         urdf_path: the URDF with errors in its placements.
-        nominal_urdf_path: the URDF giving the ideal orientation (default: the same joints with
-            identity error, i.e. ``urdf_path`` is compared with the bundled nominal file).
+        nominal_urdf_path: the URDF giving the ideal orientation (default: the bundled nominal
+            file, ``models/turntable.urdf``).
+        joints: the revolute joints from the base (default the paper's ``outer_axis``,
+            ``inner_axis``); payload_frame: the payload frame (default ``gyrowheel``).
     """
 
-    def __init__(self, urdf_path: str | Path, nominal_urdf_path: str | Path | None = None) -> None:
+    def __init__(
+        self,
+        urdf_path: str | Path,
+        nominal_urdf_path: str | Path | None = None,
+        joints: tuple[str, ...] = ("outer_axis", "inner_axis"),
+        payload_frame: str = "gyrowheel",
+    ) -> None:
         from ..core.resources import default_urdf_path
 
+        self.joints, self.payload_frame = tuple(joints), payload_frame
         self.actual = _load_yourdfpy(urdf_path)
         self.nominal = _load_yourdfpy(nominal_urdf_path or default_urdf_path())
         for urdf in (self.actual, self.nominal):
-            for joint in (OUTER_JOINT, INNER_JOINT, PAYLOAD_MOUNT):
+            for joint in self.joints:
                 if joint not in urdf.joint_map:
                     raise ModelError(f"URDF has no joint '{joint}'")
 
-    def _pose(self, urdf, phi1_rad: float, phi2_rad: float) -> np.ndarray:
-        urdf.update_cfg({OUTER_JOINT: phi1_rad, INNER_JOINT: phi2_rad})
-        return urdf.get_transform(PAYLOAD_FRAME, urdf.base_link)
+    def _pose(self, urdf, angles_rad) -> np.ndarray:
+        urdf.update_cfg(dict(zip(self.joints, angles_rad, strict=True)))
+        return urdf.get_transform(self.payload_frame, urdf.base_link)
 
-    def orientation_error_matrix(self, phi1_rad: float, phi2_rad: float) -> np.ndarray:
-        """``dR = Rd^T Rt`` at (phi1, phi2), radians."""
-        rt = self._pose(self.actual, phi1_rad, phi2_rad)[:3, :3]
-        rd = self._pose(self.nominal, phi1_rad, phi2_rad)[:3, :3]
+    def orientation_error_matrix(self, *angles_rad: float) -> np.ndarray:
+        """``dR = Rd^T Rt`` at joint angles (from the base), radians."""
+        rt = self._pose(self.actual, angles_rad)[:3, :3]
+        rd = self._pose(self.nominal, angles_rad)[:3, :3]
         return rd.T @ rt
 
-    def payload_origin_m(self, phi1_rad: float, phi2_rad: float) -> np.ndarray:
+    def payload_origin_m(self, *angles_rad: float) -> np.ndarray:
         """Actual payload origin in the base frame, metres."""
-        return self._pose(self.actual, phi1_rad, phi2_rad)[:3, 3].copy()
+        return self._pose(self.actual, angles_rad)[:3, 3].copy()
