@@ -10,8 +10,12 @@
 Which entries of ``K`` and which base axes are kept is found like the base errors: QR with column
 pivoting of the effect's columns, after projecting out the base errors, on generic positions.
 
-On the paper's table the catalogue is the paper's nine effects, and the per-joint names are
-aliases of them (``encoder_harmonics@outer_axis`` is ``outer_encoder_harmonics``).
+The paper's table has the same catalogue under the paper's nine names
+(:data:`~.effects.paper_names.PAPER_EFFECTS`: ``outer_encoder_harmonics`` is
+``encoder_harmonics@outer_axis``; ``backlash`` is the backlash of both joints; ``gravity_sag`` is
+``K`` with ``k_xy = -k``, ``k_yx = k``; ``base_tilt`` is about x and z), and ``<kind>@<joint>``
+names the effect of that kind on that joint (``encoder_harmonics@outer_axis`` is
+``outer_encoder_harmonics``).
 """
 
 from __future__ import annotations
@@ -23,22 +27,22 @@ import numpy as np
 
 from ..core.exceptions import InputError
 from .effect_model import OrientationModel
+from .effects.backlash import Backlash
 from .effects.base import Effect, PositionVariables
+from .effects.base_rotation import BaseRotation
+from .effects.encoder_harmonics import EncoderHarmonics
+from .effects.gravity_compliance import GravityCompliance
+from .effects.paper_names import PAPER_EFFECTS, NamedEffect
+from .effects.payload_mount import PayloadMount
+from .effects.thermal_drift import ThermalDrift
+from .effects.wobble_harmonics import WobbleHarmonics
 from .table import JointErrors, MeasuredTable, measured_table
 
-__all__ = ["PAPER_ALIASES", "PER_JOINT_EFFECTS", "catalogue", "joint_effect", "resolve_effect"]
+__all__ = ["PER_JOINT_EFFECTS", "catalogue", "joint_effect", "resolve_effect"]
 
 PER_JOINT_EFFECTS = ("encoder_harmonics", "wobble_harmonics", "backlash")
 """The kinds of per-joint effects, named ``<kind>@<joint>``."""
 _PER_JOINT_TEXT = ", ".join(f"{k}@<joint>" for k in PER_JOINT_EFFECTS)
-
-PAPER_ALIASES = {
-    "encoder_harmonics@outer_axis": "outer_encoder_harmonics",
-    "encoder_harmonics@inner_axis": "inner_encoder_harmonics",
-    "wobble_harmonics@outer_axis": "outer_wobble_harmonics",
-    "wobble_harmonics@inner_axis": "inner_wobble_harmonics",
-}
-"""The paper's catalogue names of per-joint effects on its table."""
 
 _CATALOGUES: weakref.WeakKeyDictionary[MeasuredTable, tuple[Effect, ...]] = (
     weakref.WeakKeyDictionary()
@@ -48,52 +52,81 @@ _CATALOGUES: weakref.WeakKeyDictionary[MeasuredTable, tuple[Effect, ...]] = (
 
 def catalogue(turntable=None) -> tuple[Effect, ...]:
     """The candidate effects of a table, in catalogue order (module docstring)."""
-    from .effects import EFFECTS
-    from .effects.base_rotation import BaseRotation
-    from .effects.gravity_compliance import GravityCompliance
-    from .effects.payload_mount import PayloadMount
     from .effects.pointing_flexure import pointing_flexures
-    from .effects.thermal_drift import ThermalDrift
 
     table = measured_table(turntable)
-    if table.paper:
-        return tuple(EFFECTS.values())
     cached = _CATALOGUES.get(table)
     if cached is not None:
         return cached
-    # Keep the parameters the data determine; when none is, keep the whole effect, so that the
-    # diagnosis says it is absorbed by the base errors (a base tilt by the first joint's tilts).
-    sag = GravityCompliance(table.rotation)
-    sag = GravityCompliance(table.rotation, _determined(table, sag) or sag.entries)
-    tilt = BaseRotation()
-    tilt = BaseRotation(tuple(name[1] for name in _determined(table, tilt)) or tilt.axes)
-    out = (
-        *(joint_effect("encoder_harmonics", j) for j in table.joints),
-        *(joint_effect("wobble_harmonics", j) for j in table.joints),
-        sag,
-        tilt,
-        ThermalDrift(),
-        *(joint_effect("backlash", j) for j in table.joints),
-        PayloadMount(),
-        *pointing_flexures(table),  # a telescope mount's TPOINT flexure terms (else none)
+    names = PAPER_EFFECTS if table.paper else ()
+    slots = (
+        *(("encoder_harmonics", j) for j in table.joints),
+        *(("wobble_harmonics", j) for j in table.joints),
+        ("gravity_sag", None),
+        ("base_tilt", None),
+        ("thermal_drift", None),
+        *(("backlash", j) for j in table.joints),
+        ("payload_mount", None),
     )
-    _CATALOGUES[table] = out
-    return out
+    out: list[Effect] = []
+    for kind, joint in slots:
+        named = next(
+            (n for n in names if n.kind == kind and (joint is None or joint.joint in n.joints)),
+            None,
+        )
+        if named is None:
+            out.append(_effect(table, kind, (joint,) if joint else ()))
+        elif all(e.name != named.name for e in out):  # one effect of several joints: once
+            out.append(_effect(table, kind, (), named))
+    out.extend(pointing_flexures(table))  # a telescope mount's TPOINT flexure terms (else none)
+    _CATALOGUES[table] = tuple(out)
+    return _CATALOGUES[table]
 
 
 def joint_effect(kind: str, joint: JointErrors) -> Effect:
     """The per-joint effect ``kind`` of ``joint``, named ``<kind>@<joint>``."""
-    from .effects.encoder_harmonics import EncoderHarmonics
-    from .effects.joint_backlash import JointBacklash
-    from .effects.wobble_harmonics import WobbleHarmonics
+    if kind not in PER_JOINT_EFFECTS:
+        raise InputError(f"no per-joint effect '{kind}'; per-joint effects: {_PER_JOINT_TEXT}")
+    return _effect(None, kind, (joint,))
 
+
+def _effect(
+    table: MeasuredTable | None,
+    kind: str,
+    joints: Sequence[JointErrors],
+    named: NamedEffect | None = None,
+) -> Effect:
+    """The generic effect ``kind`` of ``joints`` on ``table``, or as ``named`` says (its joints,
+    name, parameters and story)."""
+    story, labelled = {}, {}
+    if named is not None:
+        by_name = {j.joint: j for j in table.joints}
+        joints = tuple(by_name[n] for n in named.joints)
+        story = {"name": named.name, "text": named.text}
+        labelled = {**story, "labels": named.labels}
     if kind == "encoder_harmonics":
-        return EncoderHarmonics(joint.joint, joint.index, joint.position)
+        return EncoderHarmonics(*joints, **labelled)
     if kind == "wobble_harmonics":
-        return WobbleHarmonics(joint.joint, joint.index, joint.tilts)
+        return WobbleHarmonics(*joints, **labelled)
     if kind == "backlash":
-        return JointBacklash(joint.joint, joint.index, joint.position)
-    raise InputError(f"no per-joint effect '{kind}'; per-joint effects: {_PER_JOINT_TEXT}")
+        return Backlash(joints, **labelled)
+    if kind == "thermal_drift":
+        return ThermalDrift(**story)
+    if kind == "payload_mount":
+        return PayloadMount(**story)
+    # Keep the parameters the data determine; when none is, keep the whole effect, so that the
+    # diagnosis says it is absorbed by the base errors (a base tilt by the first joint's tilts).
+    if kind == "gravity_sag":
+        if named is not None:
+            return GravityCompliance(table.rotation, named.tied, **labelled)
+        sag = GravityCompliance(table.rotation)
+        return GravityCompliance(table.rotation, _determined(table, sag) or sag.entries)
+    if kind == "base_tilt":
+        if named is not None:
+            return BaseRotation(named.axes, **labelled)
+        axes = tuple(name[1] for name in _determined(table, BaseRotation()))
+        return BaseRotation(axes or "xyz")
+    raise ValueError(f"no effect of kind '{kind}'")
 
 
 def _determined(table: MeasuredTable, effect: Effect) -> tuple[str, ...]:
@@ -127,7 +160,8 @@ def _determined(table: MeasuredTable, effect: Effect) -> tuple[str, ...]:
 
 def resolve_effect(name: str, turntable=None, extra: Sequence[Effect] = ()) -> Effect:
     """The effect called ``name`` on a table: in ``extra`` (the caller's, first), the table's
-    catalogue, a paper alias, or a per-joint ``<kind>@<joint>``.
+    catalogue, or a per-joint ``<kind>@<joint>`` (the catalogue's effect of that kind on that
+    joint alone, whatever the table names it, else a new one).
 
     Raises:
         InputError: an unknown name, listing the known ones.
@@ -146,11 +180,9 @@ def resolve_effect(name: str, turntable=None, extra: Sequence[Effect] = ()) -> E
                 f"unknown joint '{joint_name}' in effect '{name}'; this table's joints: "
                 f"{', '.join(table.joint_names)}"
             )
-        alias = PAPER_ALIASES.get(name) if table.paper else None
-        if alias:
-            return resolve_effect(alias, table)
         if kind in PER_JOINT_EFFECTS:
-            return joint_effect(kind, joint)
+            same = (e for e in catalogue(table) if e.kind == kind and e.joints == (joint.joint,))
+            return next(same, None) or joint_effect(kind, joint)
     raise InputError(
         f"unknown effect '{name}'; effects of this table: {', '.join(e.name for e in known)} "
         f"(and {_PER_JOINT_TEXT} for joints {', '.join(table.joint_names)})"

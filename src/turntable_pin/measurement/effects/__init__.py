@@ -1,8 +1,9 @@
-"""The catalogue of candidate physical effects for orientation data (``docs/measurements.md``).
+"""The candidate physical effects for orientation data (``docs/measurements.md``).
 
-Each effect is one module holding one :class:`Effect` subclass. Adding an effect is a new module
-and one line in :data:`_REGISTRY`; nothing else changes. :func:`parse_effect_spec` reads the
-``NAME:P=V,...`` form the simulator takes.
+Each physical effect is one module holding one :class:`Effect` subclass, for any table; a table's
+catalogue of them is :func:`turntable_pin.measurement.catalogue.catalogue`. :data:`EFFECTS` is the
+paper's table's catalogue by the paper's names (:mod:`.paper_names`). :func:`parse_effect_spec`
+reads the ``NAME:P=V,...`` form the simulator takes.
 """
 
 from __future__ import annotations
@@ -12,40 +13,37 @@ import math
 import numpy as np
 
 from ...core.exceptions import InputError
-from .backlash import Backlash
-from .base import ChainTerm, Effect, ParameterSpec, PositionVariables
-from .base_tilt import BaseTilt
-from .gravity_sag import GravitySag
-from .inner_encoder_harmonics import InnerEncoderHarmonics
-from .inner_wobble_harmonics import InnerWobbleHarmonics
-from .outer_encoder_harmonics import OuterEncoderHarmonics
-from .outer_wobble_harmonics import OuterWobbleHarmonics
-from .payload_mount import PayloadMount
-from .thermal_drift import ThermalDrift
+from .base import ChainTerm, Effect, EffectText, ParameterSpec, PositionVariables
+from .paper_names import PAPER_EFFECTS
 
-_REGISTRY: tuple[type[Effect], ...] = (
-    OuterEncoderHarmonics,
-    InnerEncoderHarmonics,
-    OuterWobbleHarmonics,
-    InnerWobbleHarmonics,
-    GravitySag,
-    BaseTilt,
-    ThermalDrift,
-    Backlash,
-    PayloadMount,
-)
+EFFECT_NAMES: tuple[str, ...] = tuple(e.name for e in PAPER_EFFECTS)
+"""The paper's table's catalogue names, in catalogue order."""
 
-EFFECTS: dict[str, Effect] = {cls.name: cls() for cls in _REGISTRY}
-"""Every catalogued effect by its catalogue name, in catalogue order."""
 
-EFFECT_NAMES: tuple[str, ...] = tuple(EFFECTS)
-"""The catalogue names, in catalogue order."""
+def _paper_effects() -> dict[str, Effect]:
+    """:data:`EFFECTS`, built on first use (it reads the paper's table)."""
+    if "EFFECTS" not in globals():
+        from ..catalogue import catalogue
+
+        globals()["EFFECTS"] = {e.name: e for e in catalogue()}
+    return globals()["EFFECTS"]
+
+
+def __getattr__(name: str):
+    if name == "EFFECTS":
+        return _paper_effects()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+EFFECTS: dict[str, Effect]
+"""The paper's table's catalogue by name, in catalogue order (:data:`EFFECT_NAMES`)."""
 
 
 def get_effect(name: str) -> Effect:
-    """The catalogued effect ``name``; :class:`InputError` listing the known names otherwise."""
+    """The paper's catalogued effect ``name``; :class:`InputError` listing the known names
+    otherwise."""
     try:
-        return EFFECTS[name.strip()]
+        return _paper_effects()[name.strip()]
     except KeyError:
         raise InputError(
             f"unknown effect '{name}'; catalogued effects: {', '.join(EFFECT_NAMES)}"
@@ -111,6 +109,7 @@ __all__ = [
     "EFFECT_NAMES",
     "ChainTerm",
     "Effect",
+    "EffectText",
     "ParameterSpec",
     "PositionVariables",
     "get_effect",

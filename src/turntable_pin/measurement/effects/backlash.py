@@ -1,48 +1,82 @@
-"""``backlash``: the position depends on the direction the axis approached it from."""
+"""``backlash@<joint>``: the position of a joint depends on the direction it came from."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
-from .base import ARCSEC, ChainTerm, Effect, ParameterSpec, PositionVariables
+from .base import ARCSEC, ChainTerm, Effect, EffectText, ParameterSpec, PositionVariables
 
 __all__ = ["Backlash"]
 
 
 class Backlash(Effect):
-    """Approach-direction dependence: half the backlash ``b`` (arcsec) times ``dir``, per axis."""
+    """Approach-direction dependence of one or more joints: half each one's backlash (arcsec)
+    times its ``dirK``. Of several joints, the parameters of the ``dirK`` columns present are
+    fitted (one column suffices).
 
-    name = "backlash"
-    title = "backlash (approach-direction dependence)"
-    definition = "dphi_y1 += b1 dir1 / 2, dphi_z2 += b2 dir2 / 2"
-    explanation = (
-        "Gears, couplings and the servo's dead band let an axis stop a little short of the "
-        "commanded angle, on the side it came from: the position error differs by b between "
-        "approaches from below (dir = +1) and from above (dir = -1). Only one of dir1 / dir2 is "
-        "needed; the parameter of an absent column is not fitted."
-    )
-    confirm = (
-        "Approach a few positions alternately from both directions (or always from the same side) "
-        "and compare: a backlash flips sign with the approach direction; a unidirectional "
-        "approach removes it."
-    )
-    required_columns = ("dir1", "dir2")
+    Args:
+        joints: the joints' errors (:class:`~turntable_pin.measurement.table.JointErrors`: name,
+            place from the base K of ``dirK``, position error).
+        name, text: the table's name and story of it (default ``backlash@<joint>``, one joint).
+        labels: ``(parameter, description)`` of each joint (default ``b`` for one joint, ``bK``
+            for several; ``"backlash of <joint>"``).
+    """
+
+    kind = "backlash"
     any_column = True
 
+    def __init__(
+        self,
+        joints: Sequence,
+        *,
+        name: str | None = None,
+        text: EffectText | None = None,
+        labels: tuple[tuple[str, str], ...] = (),
+    ) -> None:
+        self.joints = tuple(j.joint for j in joints)
+        self.sites = tuple(j.position for j in joints)
+        self.required_columns = tuple(f"dir{j.index}" for j in joints)
+        self.labels = tuple(labels) or tuple(
+            ("b" if len(joints) == 1 else f"b{j.index}", f"backlash of {j.joint}") for j in joints
+        )
+        columns = self.required_columns
+        changes = (
+            f"{site} += {b} {column} / 2"
+            for site, (b, _), column in zip(self.sites, self.labels, columns, strict=True)
+        )
+        joint, column = " and ".join(self.joints), " / ".join(columns)
+        super().__init__(
+            name or f"{self.kind}@{'+'.join(self.joints)}",
+            text
+            or EffectText(
+                title=f"backlash of {joint} (approach-direction dependence)",
+                definition=", ".join(changes),
+                explanation="Gears, couplings and the servo's dead band let "
+                f"{joint} stop a little short of the commanded angle, on the side it came "
+                "from: its position error differs by b between approaches from below "
+                f"({column} = +1) and from above ({column} = -1).",
+                confirm="Approach a few positions alternately from both directions and compare: "
+                "a backlash flips sign with the approach direction; a unidirectional approach "
+                "removes it.",
+            ),
+        )
+
     def parameters(self, variables: PositionVariables):
-        """``b1`` and/or ``b2`` (arcsec), for each of ``dir1``/``dir2`` the data have."""
-        out = []
-        if variables.has("dir1"):
-            out.append(ParameterSpec("b1", "arcsec", ARCSEC, "outer-axis backlash"))
-        if variables.has("dir2"):
-            out.append(ParameterSpec("b2", "arcsec", ARCSEC, "inner-axis backlash"))
-        return tuple(out)
+        """The backlash of each joint whose ``dirK`` the data have, arcsec."""
+        return tuple(
+            ParameterSpec(b, "arcsec", ARCSEC, description)
+            for (b, description), column in zip(self.labels, self.required_columns, strict=True)
+            if variables.has(column)
+        )
 
     def chain_terms(self, variables: PositionVariables):
-        """``b1 dir1 / 2`` added to ``dphi_y1`` and ``b2 dir2 / 2`` to ``dphi_z2``."""
-        terms = []
-        if variables.has("dir1"):
-            terms.append(ChainTerm("dphi_y1", None, {"b1": 0.5 * np.asarray(variables.dir1)}))
-        if variables.has("dir2"):
-            terms.append(ChainTerm("dphi_z2", None, {"b2": 0.5 * np.asarray(variables.dir2)}))
-        return tuple(terms)
+        """``b dirK / 2`` added to each joint's position error."""
+        return tuple(
+            ChainTerm(site, None, {b: 0.5 * np.asarray(variables.column(column))})
+            for site, (b, _), column in zip(
+                self.sites, self.labels, self.required_columns, strict=True
+            )
+            if variables.has(column)
+        )

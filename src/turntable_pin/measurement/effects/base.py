@@ -34,6 +34,7 @@ __all__ = [
     "PRE",
     "ChainTerm",
     "Effect",
+    "EffectText",
     "ParameterSpec",
     "PositionVariables",
     "harmonic_parameters",
@@ -216,14 +217,31 @@ def harmonic_parameters(prefix: str, what: str, angle: str) -> tuple[ParameterSp
     )
 
 
+@dataclass(frozen=True)
+class EffectText:
+    """An effect's story as the reports tell it (the attributes of :class:`Effect` of the same
+    names): a table may tell an effect in its own words (the paper's, :mod:`.paper_names`)."""
+
+    title: str
+    definition: str
+    explanation: str
+    confirm: str
+
+
 class Effect:
     """Base class of a candidate physical effect (a plug-in of
     :mod:`turntable_pin.measurement.effects`).
 
     Subclasses set the class attributes and implement :meth:`parameters` and :meth:`chain_terms`.
 
+    Args:
+        name, text: the name and story a table gives this effect instead of the class's.
+
     Attributes:
         name: the catalogue name (``inner_encoder_harmonics``; ``docs/measurements.md``, section 4).
+        kind: the physical effect (``encoder_harmonics``...); a per-joint one is named
+            ``<kind>@<joint>`` unless its table names it otherwise.
+        joints: the joints it is an effect of (per-joint kinds; empty for table-wide ones).
         title: a few words for people.
         definition: how it changes the chain, as ``docs/measurements.md`` defines it.
         explanation: one paragraph of physics.
@@ -232,12 +250,21 @@ class Effect:
     """
 
     name: str = ""
+    kind: str = ""
+    joints: tuple[str, ...] = ()
     title: str = ""
     definition: str = ""
     explanation: str = ""
     confirm: str = ""
     required_columns: tuple[str, ...] = ()
     any_column: bool = False
+
+    def __init__(self, name: str | None = None, text: EffectText | None = None) -> None:
+        if name:
+            self.name = name
+        if text is not None:
+            self.title, self.definition = text.title, text.definition
+            self.explanation, self.confirm = text.explanation, text.confirm
 
     def missing_columns(self, variables: PositionVariables) -> tuple[str, ...]:
         """The required data columns ``variables`` lacks (empty when the effect can be tested)."""

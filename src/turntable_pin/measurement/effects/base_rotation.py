@@ -1,4 +1,4 @@
-"""``base_tilt`` on any table: the base rotated with respect to the measurement reference."""
+"""``base_tilt``: the base rotated with respect to the measurement reference, on any table."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .base import ARCSEC, PRE, ChainTerm, Effect, ParameterSpec, PositionVariables
+from .base import ARCSEC, PRE, ChainTerm, Effect, EffectText, ParameterSpec, PositionVariables
 
 __all__ = ["BaseRotation"]
 
@@ -18,33 +18,50 @@ class BaseRotation(Effect):
         axes: the base axes kept (default all three; the table's catalogue keeps those that
             orientation data tell apart from the base errors: a rotation about the first joint's
             axis is that joint's position error).
+        name, text: the table's name and story of it (default ``base_tilt``).
+        labels: ``(parameter, description)`` of each kept axis (default ``tx``...,
+            ``"rotation of the base about x"``...).
     """
 
     kind = "base_tilt"
 
-    def __init__(self, axes: Sequence[str] = ("x", "y", "z")) -> None:
+    def __init__(
+        self,
+        axes: Sequence[str] = ("x", "y", "z"),
+        *,
+        name: str | None = None,
+        text: EffectText | None = None,
+        labels: tuple[tuple[str, str], ...] = (),
+    ) -> None:
         self.axes = tuple(a for a in "xyz" if a in axes)
-        self.name = self.kind
-        self.title = "base not level with the reference"
-        self.definition = "Rt -> " + " ".join(f"R{a}(t{a})" for a in self.axes) + " Rt (base frame)"
-        self.explanation = (
-            "The table stands on a floor or a pier that is not exactly level, or the reference the "
-            "orientation is measured against is rotated with respect to the base: the whole "
-            "table is rotated by small constant angles before anything turns."
+        self.labels = tuple(labels) or tuple(
+            (f"t{a}", f"rotation of the base about {a}") for a in self.axes
         )
-        self.confirm = (
-            "Put a precision level (or electronic inclinometer) on the base mounting surface, or "
-            "re-measure the reference direction; re-level the table and repeat a few positions."
+        super().__init__(
+            name or self.kind,
+            text
+            or EffectText(
+                title="base not level with the reference",
+                definition="Rt -> "
+                + " ".join(f"R{a}({t})" for a, (t, _) in zip(self.axes, self.labels, strict=True))
+                + " Rt (base frame)",
+                explanation="The table stands on a floor or a pier that is not exactly level, "
+                "or the reference the orientation is measured against is rotated with respect "
+                "to the base: the whole table is rotated by small constant angles before "
+                "anything turns.",
+                confirm="Put a precision level (or electronic inclinometer) on the base mounting "
+                "surface, or re-measure the reference direction; re-level the table and repeat "
+                "a few positions.",
+            ),
         )
 
     def parameters(self, variables: PositionVariables):
-        """``tx``, ``ty``, ``tz`` (those kept), arcsec."""
-        return tuple(
-            ParameterSpec(f"t{a}", "arcsec", ARCSEC, f"rotation of the base about {a}")
-            for a in self.axes
-        )
+        """One angle per kept axis (``tx``, ``ty``, ``tz``), arcsec."""
+        return tuple(ParameterSpec(t, "arcsec", ARCSEC, what) for t, what in self.labels)
 
     def chain_terms(self, variables: PositionVariables):
         """Constant rotations about the kept base axes, before ``Rt``."""
         one = np.ones(variables.n)
-        return tuple(ChainTerm(PRE, a, {f"t{a}": one}) for a in self.axes)
+        return tuple(
+            ChainTerm(PRE, a, {t: one}) for a, (t, _) in zip(self.axes, self.labels, strict=True)
+        )

@@ -1,4 +1,4 @@
-"""``payload_mount``: the instrument is mounted askew on the inner frame."""
+"""``payload_mount``: the instrument is mounted askew on the frame that carries it."""
 
 from __future__ import annotations
 
@@ -10,22 +10,25 @@ __all__ = ["PayloadMount"]
 
 
 class PayloadMount(Effect):
-    """Payload mounted askew: a constant rotation after ``Rt`` (same as inner-frame errors)."""
+    """Payload mounted askew: a constant rotation after ``Rt`` (same as the rotation errors of
+    the placement that carries the payload)."""
 
-    name = "payload_mount"
+    name = kind = "payload_mount"
     title = "payload mounted askew"
     definition = "Rt -> Rt Rz(mz) Ry(my) Rx(mx)"
     explanation = (
-        "The instrument sits on the inner frame through a fixture whose faces are not exactly "
-        "square to the inner frame, so the payload frame is rotated by small constant angles "
+        "The instrument sits on the table's last frame through a fixture whose faces are not "
+        "exactly square to that frame, so the payload frame is rotated by small constant angles "
         "with respect to it. Orientation measurements of the payload cannot tell this from the "
-        "inner-frame errors dalpha_y2, dphi_z2, dalpha_x2, which are also a constant rotation at "
-        "the same place of the chain: the three together absorb any mount rotation exactly."
+        "table's rotation errors of the placement that carries the payload, which are also a "
+        "constant rotation at the same place of the chain: three of them together absorb any "
+        "mount rotation exactly."
     )
     confirm = (
-        "Measure the fixture against the inner frame directly (autocollimator on the mounting "
-        "face and on the instrument's reference mirror), or remount the instrument rotated by "
-        "180 deg about its axis: a mount error changes sign, a turntable error does not."
+        "Measure the fixture against the frame that carries it directly (autocollimator on the "
+        "mounting face and on the instrument's reference mirror), or remount the instrument "
+        "rotated by 180 deg about its axis: a mount error changes sign, a turntable error does "
+        "not."
     )
 
     def parameters(self, variables: PositionVariables):

@@ -14,7 +14,7 @@ __all__ = ["ThermalDrift"]
 class ThermalDrift(Effect):
     """Slow thermal drift: a payload rotation growing linearly with ``time_s`` (arcsec/h)."""
 
-    name = "thermal_drift"
+    name = kind = "thermal_drift"
     title = "slow thermal drift of the payload"
     definition = "Rt -> Rt Rz(rz t) Ry(ry t) Rx(rx t), t = time_s"
     explanation = (
