@@ -31,7 +31,7 @@ from .effects.backlash import Backlash
 from .effects.base import Effect, PositionVariables
 from .effects.base_rotation import BaseRotation
 from .effects.encoder_harmonics import EncoderHarmonics
-from .effects.gravity_compliance import GravityCompliance
+from .effects.gravity_compliance import COMPLIANCE_ENTRIES, GravityCompliance
 from .effects.paper_names import PAPER_EFFECTS, NamedEffect
 from .effects.payload_mount import PayloadMount
 from .effects.thermal_drift import ThermalDrift
@@ -77,7 +77,7 @@ def catalogue(turntable=None) -> tuple[Effect, ...]:
         if named is None:
             out.append(_effect(table, kind, (joint,) if joint else ()))
         elif all(e.name != named.name for e in out):  # one effect of several joints: once
-            out.append(_effect(table, kind, (), named))
+            out.append(_effect(table, kind, named=named))
     out.extend(pointing_flexures(table))  # a telescope mount's TPOINT flexure terms (else none)
     _CATALOGUES[table] = tuple(out)
     return _CATALOGUES[table]
@@ -90,13 +90,9 @@ def joint_effect(kind: str, joint: JointErrors) -> Effect:
     return _effect(None, kind, (joint,))
 
 
-def _effect(
-    table: MeasuredTable | None,
-    kind: str,
-    joints: Sequence[JointErrors],
-    named: NamedEffect | None = None,
-) -> Effect:
-    """The generic effect ``kind`` of ``joints`` on ``table``, or as ``named`` says (its joints,
+def _effect(table, kind: str, joints=(), named: NamedEffect | None = None) -> Effect:
+    """The generic effect ``kind`` of ``joints`` (:class:`JointErrors`) on ``table`` (a
+    :class:`MeasuredTable`; ``None`` for per-joint kinds), or as ``named`` says (its joints,
     name, parameters and story)."""
     story, labelled = {}, {}
     if named is not None:
@@ -117,15 +113,11 @@ def _effect(
     # Keep the parameters the data determine; when none is, keep the whole effect, so that the
     # diagnosis says it is absorbed by the base errors (a base tilt by the first joint's tilts).
     if kind == "gravity_sag":
-        if named is not None:
-            return GravityCompliance(table.rotation, named.tied, **labelled)
-        sag = GravityCompliance(table.rotation)
-        return GravityCompliance(table.rotation, _determined(table, sag) or sag.entries)
+        kept = named.tied if named else _determined(table, GravityCompliance(table.rotation))
+        return GravityCompliance(table.rotation, kept or COMPLIANCE_ENTRIES, **labelled)
     if kind == "base_tilt":
-        if named is not None:
-            return BaseRotation(named.axes, **labelled)
-        axes = tuple(name[1] for name in _determined(table, BaseRotation()))
-        return BaseRotation(axes or "xyz")
+        kept = named.axes if named else [t[1] for t in _determined(table, BaseRotation())]
+        return BaseRotation(kept or "xyz", **labelled)
     raise ValueError(f"no effect of kind '{kind}'")
 
 

@@ -6,7 +6,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .base import ARCSEC, ChainTerm, Effect, EffectText, ParameterSpec, PositionVariables
+from .base import ARCSEC, ChainTerm, Effect, EffectText, Labels, ParameterSpec, PositionVariables
 
 __all__ = ["Backlash"]
 
@@ -27,32 +27,23 @@ class Backlash(Effect):
     kind = "backlash"
     any_column = True
 
-    def __init__(
-        self,
-        joints: Sequence,
-        *,
-        name: str | None = None,
-        text: EffectText | None = None,
-        labels: tuple[tuple[str, str], ...] = (),
-    ) -> None:
+    def __init__(self, joints: Sequence, *, name=None, text=None, labels: Labels = ()) -> None:
         self.joints = tuple(j.joint for j in joints)
-        self.sites = tuple(j.position for j in joints)
         self.required_columns = tuple(f"dir{j.index}" for j in joints)
-        self.labels = tuple(labels) or tuple(
+        labels = tuple(labels) or tuple(
             ("b" if len(joints) == 1 else f"b{j.index}", f"backlash of {j.joint}") for j in joints
         )
-        columns = self.required_columns
-        changes = (
-            f"{site} += {b} {column} / 2"
-            for site, (b, _), column in zip(self.sites, self.labels, columns, strict=True)
+        self.each = tuple(  # (position error, parameter, description, dirK) of each joint
+            (j.position, b, what, f"dir{j.index}")
+            for j, (b, what) in zip(joints, labels, strict=True)
         )
-        joint, column = " and ".join(self.joints), " / ".join(columns)
+        joint, column = " and ".join(self.joints), " / ".join(self.required_columns)
         super().__init__(
             name or f"{self.kind}@{'+'.join(self.joints)}",
-            text
-            or EffectText(
+            text,
+            EffectText(
                 title=f"backlash of {joint} (approach-direction dependence)",
-                definition=", ".join(changes),
+                definition=", ".join(f"{s} += {b} {c} / 2" for s, b, _, c in self.each),
                 explanation="Gears, couplings and the servo's dead band let "
                 f"{joint} stop a little short of the commanded angle, on the side it came "
                 "from: its position error differs by b between approaches from below "
@@ -66,8 +57,8 @@ class Backlash(Effect):
     def parameters(self, variables: PositionVariables):
         """The backlash of each joint whose ``dirK`` the data have, arcsec."""
         return tuple(
-            ParameterSpec(b, "arcsec", ARCSEC, description)
-            for (b, description), column in zip(self.labels, self.required_columns, strict=True)
+            ParameterSpec(b, "arcsec", ARCSEC, what)
+            for _, b, what, column in self.each
             if variables.has(column)
         )
 
@@ -75,8 +66,6 @@ class Backlash(Effect):
         """``b dirK / 2`` added to each joint's position error."""
         return tuple(
             ChainTerm(site, None, {b: 0.5 * np.asarray(variables.column(column))})
-            for site, (b, _), column in zip(
-                self.sites, self.labels, self.required_columns, strict=True
-            )
+            for site, b, _, column in self.each
             if variables.has(column)
         )

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
@@ -35,6 +35,7 @@ __all__ = [
     "ChainTerm",
     "Effect",
     "EffectText",
+    "Labels",
     "ParameterSpec",
     "PositionVariables",
     "harmonic_parameters",
@@ -220,12 +221,18 @@ def harmonic_parameters(prefix: str, what: str, angle: str) -> tuple[ParameterSp
 @dataclass(frozen=True)
 class EffectText:
     """An effect's story as the reports tell it (the attributes of :class:`Effect` of the same
-    names): a table may tell an effect in its own words (the paper's, :mod:`.paper_names`)."""
+    names); a table may tell an effect in its own words (the paper's, :mod:`.paper_names`): what
+    it leaves ``None`` stays as the effect's class tells it."""
 
-    title: str
-    definition: str
-    explanation: str
-    confirm: str
+    title: str | None = None
+    definition: str | None = None
+    explanation: str | None = None
+    confirm: str | None = None
+
+
+Labels = tuple[tuple[str, str], ...]
+"""``(parameter name or prefix of a harmonic series, description)`` of each parameter (or series)
+of an effect, as a table names them (the paper's, :mod:`.paper_names`)."""
 
 
 class Effect:
@@ -236,6 +243,7 @@ class Effect:
 
     Args:
         name, text: the name and story a table gives this effect instead of the class's.
+        default: the class's story (the class attributes otherwise).
 
     Attributes:
         name: the catalogue name (``inner_encoder_harmonics``; ``docs/measurements.md``, section 4).
@@ -259,12 +267,12 @@ class Effect:
     required_columns: tuple[str, ...] = ()
     any_column: bool = False
 
-    def __init__(self, name: str | None = None, text: EffectText | None = None) -> None:
-        if name:
-            self.name = name
-        if text is not None:
-            self.title, self.definition = text.title, text.definition
-            self.explanation, self.confirm = text.explanation, text.confirm
+    def __init__(self, name=None, text: EffectText | None = None, default=None) -> None:
+        self.name = name or self.name
+        for story in (default, text):
+            for key, value in asdict(story or EffectText()).items():
+                if value is not None:
+                    setattr(self, key, value)
 
     def missing_columns(self, variables: PositionVariables) -> tuple[str, ...]:
         """The required data columns ``variables`` lacks (empty when the effect can be tested)."""

@@ -6,7 +6,16 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .base import ARCSEC, PRE, ChainTerm, Effect, EffectText, ParameterSpec, PositionVariables
+from .base import (
+    ARCSEC,
+    PRE,
+    ChainTerm,
+    Effect,
+    EffectText,
+    Labels,
+    ParameterSpec,
+    PositionVariables,
+)
 
 __all__ = ["BaseRotation"]
 
@@ -25,22 +34,15 @@ class BaseRotation(Effect):
 
     kind = "base_tilt"
 
-    def __init__(
-        self,
-        axes: Sequence[str] = ("x", "y", "z"),
-        *,
-        name: str | None = None,
-        text: EffectText | None = None,
-        labels: tuple[tuple[str, str], ...] = (),
-    ) -> None:
+    def __init__(self, axes: Sequence[str] = "xyz", *, name=None, text=None, labels: Labels = ()):
         self.axes = tuple(a for a in "xyz" if a in axes)
         self.labels = tuple(labels) or tuple(
             (f"t{a}", f"rotation of the base about {a}") for a in self.axes
         )
         super().__init__(
             name or self.kind,
-            text
-            or EffectText(
+            text,
+            EffectText(
                 title="base not level with the reference",
                 definition="Rt -> "
                 + " ".join(f"R{a}({t})" for a, (t, _) in zip(self.axes, self.labels, strict=True))

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from .base import ChainTerm, Effect, ParameterSpec, PositionVariables
+from .base import ChainTerm, Effect, EffectText, ParameterSpec, PositionVariables
 
 __all__ = ["DeclaredEffect"]
 
@@ -33,13 +33,9 @@ class DeclaredEffect(Effect):
         confirm: str = "",
         source: str = "",
     ) -> None:
-        self.name = name
-        self.terms = tuple(terms)
-        self.definition = "; ".join(t.definition() for t in self.terms)
-        self.title = title or self.definition
-        self.explanation = explanation
-        self.confirm = confirm
-        self.source = source
+        self.terms, self.source = tuple(terms), source
+        definition = "; ".join(t.definition() for t in self.terms)
+        super().__init__(name, EffectText(title or definition, definition, explanation, confirm))
         self.required_columns = tuple(
             dict.fromkeys(c for t in self.terms for c in t.required_columns())
         )

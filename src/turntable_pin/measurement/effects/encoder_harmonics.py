@@ -6,6 +6,7 @@ from .base import (
     ChainTerm,
     Effect,
     EffectText,
+    Labels,
     PositionVariables,
     harmonic_parameters,
     harmonic_weights,
@@ -28,22 +29,15 @@ class EncoderHarmonics(Effect):
 
     kind = "encoder_harmonics"
 
-    def __init__(
-        self,
-        joint,
-        *,
-        name: str | None = None,
-        text: EffectText | None = None,
-        labels: tuple[tuple[str, str], ...] = (),
-    ) -> None:
+    def __init__(self, joint, *, name=None, text=None, labels: Labels = ()) -> None:
         self.joint, self.index, self.site = joint.joint, int(joint.index), joint.position
         self.joints = (self.joint,)
         ((self.prefix, self.what),) = labels or (("", f"{self.joint} position error"),)
         phi, site = f"phi{self.index}", self.site
         super().__init__(
             name or f"{self.kind}@{self.joint}",
-            text
-            or EffectText(
+            text,
+            EffectText(
                 title=f"encoder eccentricity and ellipticity of {self.joint}",
                 definition=f"{site} -> {site} + h({phi}), "
                 "h(a) = c1 cos a + s1 sin a + c2 cos 2a + s2 sin 2a",

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -35,15 +35,7 @@ class GravityCompliance(Effect):
 
     kind = "gravity_sag"
 
-    def __init__(
-        self,
-        rotation,
-        entries: Sequence[str] | Mapping[str, Mapping[str, float]] = COMPLIANCE_ENTRIES,
-        *,
-        name: str | None = None,
-        text: EffectText | None = None,
-        labels: tuple[tuple[str, str], ...] = (),
-    ) -> None:
+    def __init__(self, rotation, entries=COMPLIANCE_ENTRIES, *, name=None, text=None, labels=()):
         if not isinstance(entries, Mapping):
             entries = {e: {e: 1.0} for e in COMPLIANCE_ENTRIES if e in entries}
         self.tied = {p: dict(combination) for p, combination in entries.items()}
@@ -60,8 +52,8 @@ class GravityCompliance(Effect):
             raise ValueError(f"labels {self.labels} do not name the parameters {list(self.tied)}")
         super().__init__(
             name or self.kind,
-            text
-            or EffectText(
+            text,
+            EffectText(
                 title="payload sag under gravity",
                 definition="Rt -> Rt Rx(t_x) Ry(t_y) Rz(t_z), t = K a, a = Rd^T e_z (specific "
                 f"force in the payload frame, g); entries fitted: {', '.join(self.entries)}",

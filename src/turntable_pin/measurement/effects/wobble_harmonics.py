@@ -6,6 +6,7 @@ from .base import (
     ChainTerm,
     Effect,
     EffectText,
+    Labels,
     PositionVariables,
     harmonic_parameters,
     harmonic_weights,
@@ -27,29 +28,21 @@ class WobbleHarmonics(Effect):
 
     kind = "wobble_harmonics"
 
-    def __init__(
-        self,
-        joint,
-        *,
-        name: str | None = None,
-        text: EffectText | None = None,
-        labels: tuple[tuple[str, str], ...] = (),
-    ) -> None:
+    def __init__(self, joint, *, name=None, text=None, labels: Labels = ()) -> None:
         self.joint, self.index, self.tilts = joint.joint, int(joint.index), tuple(joint.tilts)
         self.joints = (self.joint,)
-        self.labels = tuple(labels) or tuple(
-            (prefix, f"{self.joint} wobble ({tilt})")
-            for prefix, tilt in zip(("a_", "b_"), self.tilts, strict=True)
+        labels = labels or tuple(
+            (p, f"{self.joint} wobble ({t})") for p, t in zip(("a_", "b_"), self.tilts, strict=True)
+        )
+        self.series = tuple(  # (tilt error, parameter prefix, description) of each tilt
+            (tilt, prefix, what) for tilt, (prefix, what) in zip(self.tilts, labels, strict=True)
         )
         phi = f"phi{self.index}"
-        series = (
-            f"{t} -> {t} + h_{p.rstrip('_')}({phi})"
-            for t, (p, _) in zip(self.tilts, self.labels, strict=True)
-        )
+        series = (f"{t} -> {t} + h_{p.rstrip('_')}({phi})" for t, p, _ in self.series)
         super().__init__(
             name or f"{self.kind}@{self.joint}",
-            text
-            or EffectText(
+            text,
+            EffectText(
                 title=f"angle-dependent wobble of {self.joint}",
                 definition=", ".join(series) + " (two harmonic series of degree 2)",
                 explanation="A real bearing does not turn about a fixed line: ball or race "
@@ -65,14 +58,9 @@ class WobbleHarmonics(Effect):
     def parameters(self, variables: PositionVariables):
         """Harmonic coefficients of each tilt (``a_c1 ... a_s2``, ``b_c1 ... b_s2``), arcsec."""
         phi = f"phi{self.index}"
-        return tuple(
-            spec for prefix, what in self.labels for spec in harmonic_parameters(prefix, what, phi)
-        )
+        return tuple(s for _, p, what in self.series for s in harmonic_parameters(p, what, phi))
 
     def chain_terms(self, variables: PositionVariables):
         """A harmonic series in the joint's angle added to each of its two tilts."""
         angle = variables.angle(self.index)
-        return tuple(
-            ChainTerm(tilt, None, harmonic_weights(angle, prefix))
-            for tilt, (prefix, _) in zip(self.tilts, self.labels, strict=True)
-        )
+        return tuple(ChainTerm(t, None, harmonic_weights(angle, p)) for t, p, _ in self.series)
