@@ -64,11 +64,10 @@ GENERIC = {
 
 
 def _variables(rng, n=50):
-    return PositionVariables.of(
-        rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n),
-        time_s=rng.uniform(0, 7200, n),
-        dirs=(rng.choice([-1.0, 1.0], n), rng.choice([-1.0, 1.0], n)),
-    )  # fmt: skip
+    """Random positions of the two axes, each with a time and both approach directions."""
+    phi = rng.uniform(-np.pi, np.pi, (2, n))
+    dirs = tuple(rng.choice([-1.0, 1.0], (2, n)))
+    return PositionVariables.of(*phi, time_s=rng.uniform(0, 7200, n), dirs=dirs)
 
 
 @pytest.mark.parametrize("name", EFFECT_NAMES)
