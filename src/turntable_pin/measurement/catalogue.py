@@ -10,11 +10,9 @@
 Which entries of ``K`` and which base axes are kept is found like the base errors: QR with column
 pivoting of the effect's columns, after projecting out the base errors, on generic positions.
 
-The paper's table has the same catalogue under the paper's nine names
-(:data:`~.effects.paper_names.PAPER_EFFECTS`: ``outer_encoder_harmonics`` is
-``encoder_harmonics@outer_axis``; ``backlash`` is the backlash of both joints; ``gravity_sag`` is
-``K`` with ``k_xy = -k``, ``k_yx = k``; ``base_tilt`` is about x and z), and ``<kind>@<joint>``
-names the effect of that kind on that joint (``encoder_harmonics@outer_axis`` is
+The paper's table has the same catalogue under the paper's nine names (data:
+:data:`~.effects.paper_names.PAPER_EFFECTS`); on any table ``<kind>@<joint>`` is the catalogue's
+effect of that kind on that joint alone (``encoder_harmonics@outer_axis`` is
 ``outer_encoder_harmonics``).
 """
 
