@@ -13,7 +13,6 @@ import numpy as np
 
 from ..core.exceptions import SEED_LIMIT, InputError, one_line
 from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors, parse_error_value
-from ..model.turntable import TurntableModel
 
 __all__ = [
     "input_path",
@@ -22,14 +21,13 @@ __all__ = [
     "add_error_options",
     "add_table_options",
     "bounded_float",
-    "error_overrides",
+    "error_values_from_args",
     "errors_from_args",
     "finite_float",
     "generic_errors_from_args",
     "generic_table_from_args",
     "paper_table_requested",
     "latitude_deg",
-    "model_from_args",
     "one_line_errors",
     "positive_float",
     "positive_int",
@@ -223,67 +221,50 @@ def generic_table_from_args(args: argparse.Namespace):
     return GenericTable(args.urdf or default_urdf_path(), getattr(args, "payload_frame", None))
 
 
-def error_overrides(args: argparse.Namespace, **table_names) -> dict[str, float]:
-    """``{name: value in rad or m}`` of the ``--error NAME=VALUE`` options, each name once.
-
-    ``table_names`` (``names``, ``length_names``, ``max_angle_deg``) are passed to
-    :func:`~turntable_pin.model.errors.parse_error_value` (default: the paper's nine errors
-    within the small-error limit).
-    """
-    values: dict[str, float] = {}
+def error_values_from_args(
+    table, args: argparse.Namespace, max_angle_deg: float = MAX_ANGULAR_ERROR_DEG
+) -> np.ndarray:
+    """The error vector (rad, m) of ``--errors FILE.yaml`` overridden entry by entry by
+    ``--error NAME=VALUE``, in the names of ``table`` (the paper's nine on the paper's table,
+    ``<joint>.position``, ... on any other): arc seconds and millimetres unless a unit suffix
+    says otherwise, angles up to ``max_angle_deg``, degrees; each name once among the
+    ``--error`` options."""
+    values = (
+        table.errors_from_yaml(args.errors, max_angle_deg=max_angle_deg)
+        if args.errors
+        else table.values()
+    )
     given: dict[str, str] = {}
     for item in args.error:
         if "=" not in item:
             raise InputError(f"--error '{item}': expected NAME=VALUE")
         key, _, text = item.partition("=")
         try:
-            name, value = parse_error_value(key, text, **table_names)
+            name, value = parse_error_value(
+                key, text, names=table.parameter_names, length_names=table.length_names,
+                max_angle_deg=max_angle_deg,
+            )  # fmt: skip
         except InputError as exc:
             raise InputError(f"--error '{item}': {exc.detail}") from None
         if name in given:
             raise InputError(f"--error '{item}': {name} is given twice (also '{given[name]}')")
         given[name] = item
-        values[name] = value
-    return values
-
-
-def generic_errors_from_args(
-    table, args: argparse.Namespace, max_angle_deg: float = MAX_ANGULAR_ERROR_DEG
-) -> np.ndarray:
-    """The error vector of ``--errors`` overridden entry by entry by ``--error``, in the generic
-    names of ``table`` (``<joint>.position``, ``<joint>.tilt_a``, ...); angles up to
-    ``max_angle_deg``, degrees."""
-    values = (
-        table.errors_from_yaml(args.errors, max_angle_deg=max_angle_deg)
-        if args.errors
-        else table.values()
-    )
-    overrides = error_overrides(
-        args, names=table.parameter_names, length_names=table.length_names,
-        max_angle_deg=max_angle_deg,
-    )  # fmt: skip
-    for name, value in overrides.items():
         values[table.parameter_names.index(name)] = value
     return values
+
+
+generic_errors_from_args = error_values_from_args
+"""The former name of :func:`error_values_from_args` (kept for its callers)."""
 
 
 def errors_from_args(
     args: argparse.Namespace, max_angle_deg: float = MAX_ANGULAR_ERROR_DEG
 ) -> TurntableErrors:
-    """The error set of ``--errors`` overridden entry by entry by ``--error`` (angles up to
-    ``max_angle_deg``, degrees)."""
-    base = (
-        TurntableErrors.from_yaml(args.errors, max_angle_deg=max_angle_deg)
-        if args.errors
-        else TurntableErrors.zero()
-    )
-    overrides = error_overrides(args, max_angle_deg=max_angle_deg)
-    return TurntableErrors(**{**base.as_dict(), **overrides})
+    """The paper's error set of the options: :func:`error_values_from_args` on the paper's
+    table as a :class:`TurntableErrors` (kept for its callers)."""
+    from ..model.paper_table import paper_table
 
-
-def model_from_args(args: argparse.Namespace) -> TurntableModel:
-    """The :class:`TurntableModel` of ``--urdf`` with the errors of the arguments."""
-    return TurntableModel(errors_from_args(args), urdf_path=args.urdf)
+    return TurntableErrors.from_array(error_values_from_args(paper_table(), args, max_angle_deg))
 
 
 def _jsonable(value):

@@ -1,4 +1,5 @@
-"""``turntable-pin orientation`` and ``turntable-pin urdf``: the error model at one position."""
+"""``turntable-pin orientation`` and ``turntable-pin urdf``: the error model of a table (the paper's
+or any URDF's, in its own error names) at one position."""
 
 from __future__ import annotations
 
@@ -10,20 +11,24 @@ import numpy as np
 from ..calibration.positions import MAX_COMMANDED_ANGLE_DEG
 from ..core.exceptions import InputError
 from ..core.units import M_PER_MM, deg_to_rad, rad_to_arcsec
-from ..model.angles import ANGLE_ENTRIES, ANGLE_NAMES
+from ..model.angles import ANGLE_NAMES
 from ..model.small_angle import small_angle_orientation_error
 from .common import (
     add_error_options,
     bounded_float,
-    generic_errors_from_args,
-    generic_table_from_args,
-    model_from_args,
+    error_values_from_args,
     one_line_errors,
-    paper_table_requested,
     print_json,
+    table_from_args,
 )
 
-__all__ = ["register"]
+__all__ = [
+    "joint_angles_deg",
+    "orientation_report",
+    "position_fields",
+    "position_text",
+    "register",
+]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -59,28 +64,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     u.set_defaults(func=run_urdf)
 
 
-def orientation_report(model, phi1_deg: float, phi2_deg: float) -> dict:
-    """The dictionary the ``orientation`` command prints (units in the key names)."""
-    phi1_rad, phi2_rad = deg_to_rad(phi1_deg), deg_to_rad(phi2_deg)
-    result = model.orientation_error(phi1_rad, phi2_rad)
-    small = small_angle_orientation_error(model.errors, phi2_rad)
-    return {
-        "phi1_deg": phi1_deg,
-        "phi2_deg": phi2_deg,
-        "dR": result.dR,
-        "dpsi_arcsec": rad_to_arcsec(result.dpsi_rad),
-        "dtheta_arcsec": rad_to_arcsec(result.dtheta_rad),
-        "dgamma_arcsec": rad_to_arcsec(result.dgamma_rad),
-        "dpsi_small_angle_arcsec": rad_to_arcsec(float(small[0])),
-        "dtheta_small_angle_arcsec": rad_to_arcsec(float(small[1])),
-        "dgamma_small_angle_arcsec": rad_to_arcsec(float(small[2])),
-        "payload_origin_mm": np.asarray(result.payload_origin_m) / M_PER_MM,
-        "errors": model.errors.to_user_units(),
-    }
-
-
-def _joint_angles_deg(args: argparse.Namespace, n_joints: int) -> list[float]:
-    """The joint angles of ``--angles-deg`` or ``--phi1-deg/--phi2-deg`` (0 where not given)."""
+def joint_angles_deg(
+    args: argparse.Namespace, n_joints: int, defaults_deg=(0.0, 0.0, 0.0)
+) -> list[float]:
+    """The joint angles (chain order, degrees) of ``--angles-deg`` or ``--phi1-deg/--phi2-deg``
+    (a two-joint table), ``defaults_deg`` where not given."""
     two = (args.phi1_deg, args.phi2_deg)
     if args.angles_deg is not None:
         if any(v is not None for v in two):
@@ -100,75 +88,94 @@ def _joint_angles_deg(args: argparse.Namespace, n_joints: int) -> list[float]:
         return angles
     if n_joints != 2 and any(v is not None for v in two):
         raise InputError(f"this table has {n_joints} joint(s): give --angles-deg")
-    return [0.0 if v is None else v for v in two[:n_joints]] + [0.0] * max(0, n_joints - 2)
+    given = [*two, None][:n_joints]
+    return [d if v is None else v for v, d in zip(given, defaults_deg, strict=False)]
 
 
-def generic_orientation_report(table, error_values, angles_deg: list[float]) -> dict:
-    """The ``orientation`` dictionary of any table (generic error names; units in the keys)."""
-    angles_rad = [deg_to_rad(a) for a in angles_deg]
-    dR = table.rotation_error(error_values, angles_rad)
-    first = table.regressor([np.array([a]) for a in angles_rad])[0] @ error_values
-    report = {
+def _paper_names(table) -> bool:
+    """Whether reports use the paper's names on ``table`` (its Table 2 errors, angles phi1,
+    phi2 and eq. 26): the paper's table."""
+    from ..model.paper_table import PAPER_LAYOUT
+
+    return table.layout is PAPER_LAYOUT
+
+
+def position_fields(table, angles_deg) -> dict:
+    """How a command's JSON names the table and its position: on the paper's table its angles
+    ``phi1_deg``, ``phi2_deg`` (the table implied); on any other its URDF, payload frame and
+    ``angles_deg``, ``{joint: degrees}``."""
+    angles = [float(a) for a in angles_deg]
+    if _paper_names(table):
+        return {f"phi{k}_deg": a for k, a in enumerate(angles, start=1)}
+    return {
         "urdf": str(table.urdf_path),
         "payload_frame": table.payload_frame,
-        "angles_deg": dict(zip(table.joint_names, angles_deg, strict=True)),
-        "dR": dR,
+        "angles_deg": dict(zip(table.joint_names, angles, strict=True)),
     }
-    for k, (name, (i, j)) in enumerate(zip(ANGLE_NAMES, ANGLE_ENTRIES, strict=True)):
-        report[f"{name}_arcsec"] = rad_to_arcsec(float(dR[i, j]))
-        report[f"{name}_first_order_arcsec"] = rad_to_arcsec(float(first[k]))
-    report["payload_origin_mm"] = table.payload_origin_m(error_values, angles_rad) / M_PER_MM
-    report["errors"] = {k: v for k, v in table.to_user_units(error_values).items() if v != 0.0}
+
+
+def position_text(fields: dict) -> str:
+    """The position of :func:`position_fields` in words (``phi1 = 30 deg, ...``)."""
+    angles = fields.get("angles_deg") or {
+        k.removesuffix("_deg"): v for k, v in fields.items() if k.startswith("phi")
+    }
+    text = ", ".join(f"{j} = {a:g} deg" for j, a in angles.items())
+    frame = fields.get("payload_frame")
+    return text if frame is None else f"{text} (payload frame {frame})"
+
+
+def _first_order(table, error_values, angles_rad) -> tuple[str, str, np.ndarray]:
+    """``(key, label, [dpsi, dtheta, dgamma] in rad)`` of the table's first-order model: on the
+    paper's table eq. 26 in closed form (exact zeros where its matrix has them), else the exact
+    regressor at zero errors times the errors (the same numbers to rounding on the paper's)."""
+    if _paper_names(table):
+        return "small_angle", "eq. 26", small_angle_orientation_error(error_values, angles_rad[1])
+    first = table.regressor([np.array([a]) for a in angles_rad])[0] @ error_values
+    return "first_order", "first order", first
+
+
+def orientation_report(table, error_values, angles_deg) -> dict:
+    """The dictionary the ``orientation`` command prints (units in the key names): the exact
+    angles (Pinocchio) beside the first-order ones, the payload origin and the errors."""
+    angles_rad = [deg_to_rad(a) for a in angles_deg]
+    result = table.orientation_error(error_values, angles_rad)
+    key, _, first = _first_order(table, error_values, angles_rad)
+    report = {**position_fields(table, angles_deg), "dR": result.dR}
+    for name, value in zip(ANGLE_NAMES, (result.dpsi_rad, result.dtheta_rad, result.dgamma_rad),
+                           strict=True):  # fmt: skip
+        report[f"{name}_arcsec"] = rad_to_arcsec(value)
+    for name, value in zip(ANGLE_NAMES, first, strict=True):
+        report[f"{name}_{key}_arcsec"] = rad_to_arcsec(float(value))
+    report["payload_origin_mm"] = np.asarray(result.payload_origin_m) / M_PER_MM
+    report["errors"] = table.to_user_units(error_values)
     return report
 
 
-def _print_report(report: dict, position: str, approx_key: str, approx_label: str) -> None:
-    """The text form of an ``orientation`` report: dR, the exact angles beside their
-    approximation (``<angle>_<approx_key>_arcsec``), the payload origin."""
-    print(f"position: {position}")
-    print("dR = Rd^T Rt:")
-    for row in report["dR"]:
-        print("  [" + "  ".join(f"{v: .12f}" for v in row) + "]")
-    label = f"{approx_label} (arcsec)"
-    print(f"{'':8s}{'exact (arcsec)':>16s}{label:>{len(label) + 3}s}")
-    for name in ANGLE_NAMES:
-        exact, approx = report[f"{name}_arcsec"], report[f"{name}_{approx_key}_arcsec"]
-        print(f"{name:8s}{exact:16.6f}{approx:{len(label) + 3}.6f}")
-    x, y, z = report["payload_origin_mm"]
-    print(f"payload origin (mm): x = {x:.6f}, y = {y:.6f}, z = {z:.6f}")
-
-
 def run_orientation(args: argparse.Namespace) -> int:
-    if not paper_table_requested(args):
-        return _run_generic_orientation(args)
-    phi1, phi2 = _joint_angles_deg(args, 2)
-    report = orientation_report(model_from_args(args), phi1, phi2)
-    if args.json:
-        print_json(report)
-    else:
-        _print_report(report, f"phi1 = {phi1:g} deg, phi2 = {phi2:g} deg", "small_angle", "eq. 26")
-    return 0
-
-
-def _run_generic_orientation(args: argparse.Namespace) -> int:
-    table = generic_table_from_args(args)
-    angles = _joint_angles_deg(args, len(table.joint_names))
-    report = generic_orientation_report(table, generic_errors_from_args(table, args), angles)
+    table = table_from_args(args)
+    angles = joint_angles_deg(args, len(table.joint_names))
+    values = error_values_from_args(table, args)
+    report = orientation_report(table, values, angles)
     if args.json:
         print_json(report)
         return 0
-    where = ", ".join(f"{j} = {a:g} deg" for j, a in report["angles_deg"].items())
-    position = f"{where} (payload frame {table.payload_frame})"
-    _print_report(report, position, "first_order", "first order")
+    key, label, _ = _first_order(table, values, [deg_to_rad(a) for a in angles])
+    print(f"position: {position_text(report)}")
+    print("dR = Rd^T Rt:")
+    for row in report["dR"]:
+        print("  [" + "  ".join(f"{v: .12f}" for v in row) + "]")
+    label = f"{label} (arcsec)"
+    print(f"{'':8s}{'exact (arcsec)':>16s}{label:>{len(label) + 3}s}")
+    for name in ANGLE_NAMES:
+        exact, approx = report[f"{name}_arcsec"], report[f"{name}_{key}_arcsec"]
+        print(f"{name:8s}{exact:16.6f}{approx:{len(label) + 3}.6f}")
+    x, y, z = report["payload_origin_mm"]
+    print(f"payload origin (mm): x = {x:.6f}, y = {y:.6f}, z = {z:.6f}")
     return 0
 
 
 def run_urdf(args: argparse.Namespace) -> int:
-    if not paper_table_requested(args):
-        table = generic_table_from_args(args)
-        path = table.write_urdf(generic_errors_from_args(table, args), args.output)
-        print(f"wrote {path}")
-        return 0
-    path = model_from_args(args).write_urdf(args.output)
+    table = table_from_args(args)
+    path = table.write_urdf(error_values_from_args(table, args), args.output)
     print(f"wrote {path}")
     return 0

@@ -1,4 +1,4 @@
-"""``turntable-pin view`` and ``turntable-pin snapshot``: the setup in 3-D, live or as a PNG."""
+"""``turntable-pin view`` and ``turntable-pin snapshot``: a table in 3-D, live or as a PNG."""
 
 from __future__ import annotations
 
@@ -9,21 +9,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.csv_table import read_csv_table
 from ..core.exceptions import InputError
 from ..core.units import deg_to_rad
 from ..viewer.scene import Exaggeration, SetupScene, animation_frames_rad, default_positions_deg
 from .common import (
     add_error_options,
-    errors_from_args,
+    error_values_from_args,
     finite_float,
-    generic_errors_from_args,
-    generic_table_from_args,
     input_path,
-    paper_table_requested,
     positive_int,
     print_json,
+    table_from_args,
 )
+from .orientation import joint_angles_deg, position_fields, position_text
 
 __all__ = ["register"]
 
@@ -62,7 +60,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     v = subparsers.add_parser(
         "view",
         description="Serve a meshcat 3-D view of the turntable URDF with its errors magnified, "
-        "the ideal and the actual payload frames as triads and the ideal and actual inner axis. "
+        "the ideal and the actual payload frames as triads and the ideal and actual axis of the "
+        "last joint (the paper's inner axis). "
         "Prints the URL and serves until Ctrl-C (or --duration). Needs the extra 'viz' (meshcat).",
     )
     _add_scene_options(v)
@@ -109,74 +108,39 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 _DEFAULT_ANGLES_DEG = (30.0, 45.0, 60.0)
 
 
-def _table(args: argparse.Namespace):
-    """The :class:`GenericTable` of ``--urdf``, or None for the paper's table."""
-    if paper_table_requested(args):
-        return None
-    return generic_table_from_args(args)
-
-
-def _angles_deg(args: argparse.Namespace, table) -> list[float]:
-    """The joint angles of the options (chain order, degrees)."""
-    from .orientation import _joint_angles_deg
-
-    n = len(table.joint_names)
-    if args.angles_deg is None and args.phi1_deg is None and args.phi2_deg is None:
-        return list(_DEFAULT_ANGLES_DEG[:n])
-    return _joint_angles_deg(args, n)
-
-
-def table_scene_from_args(args: argparse.Namespace, table):
-    """The :class:`~turntable_pin.viewer.table_scene.TableScene` of the options for ``table``."""
-    from ..viewer.table_scene import TableScene, table_exaggeration
-
-    values = generic_errors_from_args(table, args)
-    exaggeration = table_exaggeration(table, values, args.exaggerate, args.exaggerate_deta)
-    scene = TableScene(table, values, exaggeration=exaggeration)
+def scene_from_args(args: argparse.Namespace) -> tuple[SetupScene, list[float]]:
+    """The :class:`SetupScene` of the table, error and magnification options (warnings on
+    stderr), and the joint angles of the options (chain order, degrees)."""
+    table = table_from_args(args)
+    angles_deg = joint_angles_deg(args, len(table.joint_names), _DEFAULT_ANGLES_DEG)
+    values = error_values_from_args(table, args)
+    exaggeration = Exaggeration.for_errors(
+        values, args.exaggerate, args.exaggerate_deta, table=table
+    )
+    scene = SetupScene(values, table=table, exaggeration=exaggeration)
     for line in scene.warnings:
         print(f"turntable-pin {args.command}: warning: {line}", file=sys.stderr)
-    return scene
+    return scene, angles_deg
 
 
-def _table_schedule_rad(args: argparse.Namespace, table) -> np.ndarray:
-    """Animation frames (F, J) of any table: through ``--positions`` or a 90-degree grid."""
-    from ..calibration.table_positions import JointPositions
-
+def _schedule_rad(args: argparse.Namespace, table) -> np.ndarray:
+    """Animation frames (F, J): through ``--positions`` or every joint through 0, 90, 180,
+    270 deg."""
     if args.positions is not None:
+        from ..calibration.table_positions import JointPositions
+
         positions = np.degrees(JointPositions.from_csv(table, args.positions).angles_rad)
     else:
-        positions = np.degrees(JointPositions.grid(table, 90.0).angles_rad)
-    return animation_frames_rad(positions, args.frames_per_move)
-
-
-def scene_from_args(args: argparse.Namespace) -> SetupScene:
-    """The :class:`SetupScene` of the error and magnification options."""
-    errors = errors_from_args(args)
-    exaggeration = Exaggeration.for_errors(errors, args.exaggerate, args.exaggerate_deta)
-    return SetupScene(errors, urdf_path=args.urdf, exaggeration=exaggeration)
-
-
-def _schedule_rad(args: argparse.Namespace) -> np.ndarray:
-    if args.positions is not None:
-        table = read_csv_table(args.positions, required=("phi1_deg", "phi2_deg"))
-        positions = np.column_stack([table["phi1_deg"], table["phi2_deg"]])
-    else:
-        positions = default_positions_deg()
+        positions = default_positions_deg(len(table.joint_names))
     return animation_frames_rad(positions, args.frames_per_move)
 
 
 def run_view(args: argparse.Namespace) -> int:
     from ..viewer.meshcat_server import MeshcatServer
 
-    table = _table(args)
-    if table is None:
-        scene = scene_from_args(args)
-        angles_rad = [deg_to_rad(v) for v in _paper_angles_deg(args)]
-        frames = _schedule_rad(args) if args.animate else None
-    else:
-        scene = table_scene_from_args(args, table)
-        angles_rad = [deg_to_rad(v) for v in _angles_deg(args, table)]
-        frames = _table_schedule_rad(args, table) if args.animate else None
+    scene, angles_deg = scene_from_args(args)
+    angles_rad = [deg_to_rad(v) for v in angles_deg]
+    frames = _schedule_rad(args, scene.table) if args.animate else None
     if args.frame_seconds <= 0:
         raise InputError(f"--frame-seconds must be > 0, got {args.frame_seconds:g}")
     if args.duration is not None and args.duration < 0:
@@ -204,40 +168,11 @@ def run_view(args: argparse.Namespace) -> int:
     return 0
 
 
-def _paper_angles_deg(args: argparse.Namespace) -> tuple[float, float]:
-    """(phi1, phi2) of the paper's table, degrees (default 30, 45; or ``--angles-deg``)."""
-    if args.angles_deg is not None:
-        from .orientation import _joint_angles_deg
+def run_snapshot(args: argparse.Namespace) -> int:
+    from ..viewer.snapshot import render_snapshot
 
-        phi1, phi2 = _joint_angles_deg(args, 2)
-        return phi1, phi2
-    phi1 = _DEFAULT_ANGLES_DEG[0] if args.phi1_deg is None else args.phi1_deg
-    phi2 = _DEFAULT_ANGLES_DEG[1] if args.phi2_deg is None else args.phi2_deg
-    return phi1, phi2
-
-
-def _print_snapshot(args: argparse.Namespace, scene, result, where: str, lengths: str) -> int:
-    """Say what ``snapshot`` wrote: one JSON object (``--json``) or one line; ``where`` is the
-    position's text ("" or ending "; "), ``lengths`` the name of the magnified lengths."""
-    if args.json:
-        print_json({**result.to_dict(), **scene.to_dict()})
-    else:
-        k = scene.exaggeration
-        print(
-            f"wrote {result.path} ({result.width}x{result.height} px; {where}errors magnified "
-            f"x{k.angle_factor:.4g}, {lengths} x{k.length_factor:.4g}; "
-            f"{result.scene_seconds + result.browser_seconds:.1f} s)"
-        )
-    return 0
-
-
-def _run_table_snapshot(args: argparse.Namespace, table) -> int:
-    """``snapshot`` of a table given by ``--urdf`` (or ``--angles-deg``)."""
-    from ..viewer.snapshot import render_table_snapshot
-
-    angles_deg = _angles_deg(args, table)
-    scene = table_scene_from_args(args, table)
-    result = render_table_snapshot(
+    scene, angles_deg = scene_from_args(args)
+    result = render_snapshot(
         scene,
         [deg_to_rad(a) for a in angles_deg],
         args.output,
@@ -245,25 +180,14 @@ def _run_table_snapshot(args: argparse.Namespace, table) -> int:
         height=args.height,
         legend=not args.no_legend,
     )
-    where = ", ".join(f"{j} = {a:g} deg" for j, a in result.angles_deg.items())
-    return _print_snapshot(args, scene, result, f"{where}; ", "offsets")
-
-
-def run_snapshot(args: argparse.Namespace) -> int:
-    from ..viewer.snapshot import render_snapshot
-
-    table = _table(args)
-    if table is not None:
-        return _run_table_snapshot(args, table)
-    phi1_deg, phi2_deg = _paper_angles_deg(args)
-    scene = scene_from_args(args)
-    result = render_snapshot(
-        scene,
-        deg_to_rad(phi1_deg),
-        deg_to_rad(phi2_deg),
-        args.output,
-        width=args.width,
-        height=args.height,
-        legend=not args.no_legend,
+    position = position_fields(scene.table, angles_deg)
+    if args.json:
+        print_json({**result.to_dict(position), **scene.to_dict()})
+        return 0
+    k = scene.exaggeration
+    print(
+        f"wrote {result.path} ({result.width}x{result.height} px; {position_text(position)}; "
+        f"errors magnified x{k.angle_factor:.4g}, {scene.length_label} x{k.length_factor:.4g}; "
+        f"{result.scene_seconds + result.browser_seconds:.1f} s)"
     )
-    return _print_snapshot(args, scene, result, "", "deta")
+    return 0

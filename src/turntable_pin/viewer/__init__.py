@@ -1,11 +1,9 @@
-"""The meshcat viewer: the 3-D setup scene, the meshcat server, headless Chromium and PNG
-snapshots."""
+"""The meshcat viewer: the 3-D setup scene of any table, the meshcat server, headless Chromium
+and PNG snapshots."""
 
 from ..core.lazy import lazy_exports
 
 _EXPORTS = {
-    "TableScene": "table_scene",
-    "render_table_snapshot": "snapshot",
     "Exaggeration": "scene",
     "SetupScene": "scene",
     "render_snapshot": "snapshot",

@@ -1,42 +1,48 @@
-"""The 3-D scene of the setup: the turntable URDF's primitives, errors magnified, in meshcat.
+"""The 3-D scene of a table (the paper's or any URDF's, 1 to 3 joints), errors magnified, meshcat.
 
 Arc-second errors are invisible at true size, so the scene is built from the errors magnified
-(angles by K, ``deta`` by its own factor, see :class:`Exaggeration`): a :class:`TurntableModel`
-whose joint placements carry the magnified errors, drawn by Pinocchio's ``MeshcatVisualizer``
-from the URDF's visual primitives. Default magnification: K makes the largest angular error
-:data:`DEFAULT_DISPLAY_ANGLE_RAD` (3 degrees; 2700 for 4 arcsec); ``deta`` gets the same factor
-but no more than shows it as :data:`DEFAULT_DISPLAY_OFFSET_M` (30 mm, a sixth of the table's
-radius) -- a 0.2 mm offset times 2700 would put the inner axis half a metre off the table.
+(angles by K, lengths by their own factor, see :class:`Exaggeration`): the table's Pinocchio model
+whose joint placements carry the magnified errors (:meth:`GenericTable.pinocchio_model`), drawn by
+Pinocchio's ``MeshcatVisualizer`` from the URDF's visuals. Default magnification: K makes the
+largest angular error :data:`DEFAULT_DISPLAY_ANGLE_RAD` (3 degrees; 2700 for 4 arcsec); the lengths
+(the paper's ``deta``, a generic table's offsets) get the same factor but no more than shows the
+largest as :data:`DEFAULT_DISPLAY_OFFSET_M` (30 mm, a sixth of the paper table's radius) -- a
+0.2 mm offset times 2700 would put the inner axis half a metre off the table.
 
 Besides the machine the scene shows the ideal payload frame ``Rd`` (thin dark triad) and the actual
-one ``Rt`` (red/green/blue triad, x/y/z), and the ideal (dark) and actual (magenta) inner rotation
-axis, so wobble and orthogonality errors (the axis tilts), the intersection error (the axis moves)
-and the mount errors (the triads part) can be told apart.
+one ``Rt`` (red/green/blue triad, x/y/z), and the ideal (dark) and actual (magenta) axis of the last
+joint (the paper's inner axis), so wobble and orthogonality errors (the axis tilts), the
+intersection error (the axis moves) and the mount errors (the triads part) can be told apart.
+
+The paper's table is :func:`~turntable_pin.model.paper_table.paper_table` given to the same class
+(the default). A ``<mesh>`` visual whose file cannot be found is drawn as a 5 cm box
+(:func:`primitive_urdf`); :attr:`SetupScene.warnings` says which, for the command line to print.
 """
 
 from __future__ import annotations
 
 import math
+import re
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pinocchio as pin
 
-from ..core.exceptions import InputError
+from ..core.exceptions import InputError, ModelError
+from ..core.interrupts import temporary_folder
 from ..core.rotations import rot_x, rot_z
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD, M_PER_MM
-from ..model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
-from ..model.turntable import INNER_JOINT, TurntableModel
+from ..model.errors import TurntableErrors
 
 __all__ = [
     "ACTUAL_AXIS_COLOR",
     "ACTUAL_TRIAD_COLORS",
     "AXIS_LENGTH_M",
     "CAMERA_OFFSET_M",
-    "CAMERA_TARGET_M",
     "DEFAULT_DISPLAY_ANGLE_RAD",
     "DEFAULT_DISPLAY_OFFSET_M",
+    "FALLBACK_BOX_M",
     "IDEAL_COLOR",
     "ROOT",
     "TRIAD_LENGTH_M",
@@ -45,33 +51,57 @@ __all__ = [
     "SetupScene",
     "animation_frames_rad",
     "default_positions_deg",
+    "missing_meshes",
+    "primitive_urdf",
 ]
 
 DEFAULT_DISPLAY_ANGLE_RAD = math.radians(3.0)
 """The largest angular error is magnified to this angle by default."""
 DEFAULT_DISPLAY_OFFSET_M = 0.03
-"""The intersection error is magnified to at most this length by default."""
+"""The largest length error is magnified to at most this length by default."""
 
 ROOT = "turntable_pin"
 """The meshcat path under which the scene draws everything."""
 TRIAD_LENGTH_M = 0.3
 """Length of the payload-frame triads, metres."""
 AXIS_LENGTH_M = 0.7
-"""Length of the inner-axis rods, metres."""
+"""Length of the axis rods, metres."""
 ACTUAL_TRIAD_COLORS = (0xD62728, 0x2CA02C, 0x1F77B4)  # x, y, z
 """Colours (RGB) of the actual triad's x, y, z axes: red, green, blue."""
 IDEAL_COLOR = 0x303030
-"""Colour (RGB) of the ideal triad and the ideal inner axis: dark grey."""
+"""Colour (RGB) of the ideal triad and the ideal axis: dark grey."""
 ACTUAL_AXIS_COLOR = 0xC000C0
-"""Colour (RGB) of the actual inner axis: magenta."""
-# Camera: look at the table centre from north-east and above (base frame x north, y west, z up).
-CAMERA_TARGET_M = (0.0, 0.0, -0.2)
+"""Colour (RGB) of the actual axis: magenta."""
+# The camera looks from north-east and above (base frame x north, y west, z up); its distance is
+# the diagonal of the table's bounding box (the paper's table: this offset, 1.11 m).
 CAMERA_OFFSET_M = (0.84, -0.64, 0.34)
+"""The eye's offset from the table's centre for the paper's table, metres (base frame)."""
+FALLBACK_BOX_M = 0.05
+"""Edge of the box drawn in place of a mesh whose file is missing, metres."""
+
+
+def _paper_table():
+    from ..model.paper_table import paper_table
+
+    return paper_table()
+
+
+def _error_vector(table, errors) -> np.ndarray:
+    """``errors`` (a :class:`TurntableErrors`, a vector in the table's order, or None) as the
+    table's error vector (rad, m)."""
+    n = len(table.parameter_names)
+    if errors is None:
+        return np.zeros(n)
+    values = errors.as_array() if isinstance(errors, TurntableErrors) else errors
+    values = np.array(values, dtype=float)
+    if values.shape != (n,):
+        raise InputError(f"expected {n} error values, got shape {values.shape}")
+    return values
 
 
 @dataclass(frozen=True)
 class Exaggeration:
-    """How the scene magnifies errors: angles by ``angle_factor``, deta by ``length_factor``."""
+    """How the scene magnifies errors: angles by ``angle_factor``, lengths by ``length_factor``."""
 
     angle_factor: float
     length_factor: float
@@ -86,46 +116,62 @@ class Exaggeration:
     @classmethod
     def for_errors(
         cls,
-        errors: TurntableErrors,
+        errors,
         angle_factor: float | None = None,
         length_factor: float | None = None,
         display_angle_rad: float = DEFAULT_DISPLAY_ANGLE_RAD,
         display_offset_m: float = DEFAULT_DISPLAY_OFFSET_M,
+        *,
+        table=None,
     ) -> Exaggeration:
-        """The default magnification of ``errors`` (see the module docstring); either factor given
-        is used as is. A perfect table is shown at true size; a table whose only error is deta
-        shows it as ``display_offset_m``."""
-        largest = float(np.max(np.abs(errors.angular_array_rad())))
+        """The default magnification of ``errors`` (a :class:`TurntableErrors` or the error
+        vector of ``table``, default the paper's; see the module docstring); either factor given
+        is used as is. A perfect table is shown at true size; a table whose only errors are
+        lengths shows the largest as ``display_offset_m``."""
+        table = table if table is not None else _paper_table()
+        values = np.abs(_error_vector(table, errors))
+        is_length = _is_length(table)
+        largest = float(np.max(values[~is_length], initial=0.0))
+        offset = float(np.max(values[is_length], initial=0.0))
         angle_given = angle_factor is not None
         if angle_factor is None:
             angle_factor = display_angle_rad / largest if largest > 0.0 else 1.0
         if length_factor is None:
             length_factor = angle_factor
-            if errors.deta != 0.0:
-                to_display = display_offset_m / abs(errors.deta)
-                # With no angular error to take the factor from, deta alone sets it.
+            if offset > 0.0:
+                to_display = display_offset_m / offset
+                # With no angular error to take the factor from, the lengths alone set it.
                 own = angle_given or largest > 0.0
                 length_factor = min(angle_factor, to_display) if own else to_display
         return cls(angle_factor, length_factor)
 
-    def apply(self, errors: TurntableErrors) -> TurntableErrors:
-        """The magnified error set the scene's model carries."""
-        values = errors.as_array()
-        values[: len(ANGULAR_ERROR_NAMES)] *= self.angle_factor
-        values[len(ANGULAR_ERROR_NAMES) :] *= self.length_factor
-        return TurntableErrors.from_array(values)
+    def factors(self, table) -> np.ndarray:
+        """The factor of each error of ``table``, in its order."""
+        return np.where(_is_length(table), self.length_factor, self.angle_factor)
+
+    def apply(self, errors, table=None):
+        """The magnified errors: a :class:`TurntableErrors` for one, else the vector of
+        ``table`` (default the paper's)."""
+        if isinstance(errors, TurntableErrors):
+            return TurntableErrors.from_array(self.apply(errors.as_array()))
+        table = table if table is not None else _paper_table()
+        return _error_vector(table, errors) * self.factors(table)
 
     def to_dict(self) -> dict:
         """Both factors as a dict."""
         return {"angle_factor": self.angle_factor, "length_factor": self.length_factor}
 
 
+def _is_length(table) -> np.ndarray:
+    return np.array([n in table.length_names for n in table.parameter_names], dtype=bool)
+
+
 @dataclass(frozen=True)
 class ScenePoses:
     """Base-frame poses (4x4) of the scene's markers at one position of the magnified model.
 
-    The inner-axis poses are the inner joint's frame (after its rotation phi2): the rod is drawn
-    along its z axis, the inner rotation axis.
+    The axis poses are the last joint's frame (after its rotation) turned so that their z axis is
+    the joint's axis, along which the rod is drawn (the paper's inner axis: the joint frame).
     """
 
     actual_payload: np.ndarray
@@ -150,75 +196,234 @@ def _rotation(matrix: np.ndarray) -> np.ndarray:
 _Y_ONTO = (_rotation(rot_z(-math.pi / 2)), np.eye(4), _rotation(rot_x(math.pi / 2)))
 
 
+def _z_onto(axis) -> np.ndarray:
+    """A 4x4 rotation taking z onto the unit ``axis`` (z itself for the z axis)."""
+    from ..model.generic_table import perpendicular_directions
+
+    a = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    u, _ = perpendicular_directions(a)
+    y_onto_axis = _rotation(np.column_stack([u, a, np.cross(u, a)]))
+    return y_onto_axis @ _Y_ONTO[2].T
+
+
+# ---- visuals of a URDF ---------------------------------------------------------------------------
+def _mesh_file(filename: str, urdf_dir: Path) -> Path | None:
+    """The file a URDF mesh ``filename`` names, if it exists (relative to the URDF's folder;
+    ``package://PKG/REST`` looked up as ``PKG/REST`` or ``REST`` in the URDF's folder and its
+    parents; ``file://`` stripped)."""
+    text = filename.strip()
+    if text.startswith("file://"):
+        text = text[len("file://") :]
+    candidates: list[Path] = []
+    if text.startswith("package://"):
+        rest = text[len("package://") :]
+        tail = rest.split("/", 1)[1] if "/" in rest else rest
+        for folder in (urdf_dir, *urdf_dir.parents):
+            candidates += [folder / rest, folder / tail]
+    else:
+        path = Path(text)
+        candidates.append(path if path.is_absolute() else urdf_dir / path)
+    return next((c for c in candidates if c.is_file()), None)
+
+
+def missing_meshes(urdf_path: str | Path) -> list[str]:
+    """The ``<mesh filename>``s of the URDF's visuals whose files cannot be found."""
+    path = Path(urdf_path)
+    root = ET.parse(path).getroot()
+    out = []
+    for visual in root.iter("visual"):
+        for mesh in visual.iter("mesh"):
+            name = mesh.get("filename", "")
+            if _mesh_file(name, path.parent) is None:
+                out.append(name)
+    return out
+
+
+def primitive_urdf(urdf_path: str | Path, output: str | Path) -> Path:
+    """Write the URDF with every visual mesh whose file is missing replaced by a box of edge
+    :data:`FALLBACK_BOX_M`; other meshes get their absolute path. Returns ``output``."""
+    path = Path(urdf_path)
+    tree = ET.parse(path)
+    for visual in tree.getroot().iter("visual"):
+        geometry = visual.find("geometry")
+        if geometry is None:
+            continue
+        for mesh in list(geometry.iter("mesh")):
+            found = _mesh_file(mesh.get("filename", ""), path.parent)
+            if found is not None:
+                mesh.set("filename", str(found.resolve()))
+                continue
+            geometry.remove(mesh)
+            ET.SubElement(geometry, "box", size=" ".join([f"{FALLBACK_BOX_M:g}"] * 3))
+    output = Path(output)
+    tree.write(output, encoding="unicode")
+    return output
+
+
+def _visual_model(table, pin_model, warnings: list[str]):
+    """The URDF's visual geometry on ``pin_model``, a missing mesh drawn as a box (and said in
+    ``warnings``)."""
+    import pinocchio as pin
+
+    missing = missing_meshes(table.urdf_path)
+    try:
+        if not missing:
+            return pin.buildGeomFromUrdf(pin_model, str(table.urdf_path), pin.GeometryType.VISUAL)
+        warnings.append(
+            f"{table.urdf_path}: mesh file(s) not found, drawn as {FALLBACK_BOX_M * 100:g} cm "
+            f"boxes: {', '.join(missing)}"
+        )
+        with temporary_folder("turntable-pin-urdf-") as tmp:
+            urdf = primitive_urdf(table.urdf_path, tmp / table.urdf_path.name)
+            return pin.buildGeomFromUrdf(pin_model, str(urdf), pin.GeometryType.VISUAL)
+    except (RuntimeError, ValueError) as exc:
+        message = re.sub(r"\s+", " ", str(exc)).strip()
+        raise ModelError(f"{table.urdf_path}: its visuals cannot be loaded: {message}") from None
+
+
+def _camera(table, visual_model) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """Camera target and eye offset (base frame, metres) framing the whole table: the direction
+    of :data:`CAMERA_OFFSET_M`, aimed at the centre of the visuals' bounding box at zero angles,
+    from a distance equal to its diagonal (the paper's table: 5 mm from its hand-set view)."""
+    import pinocchio as pin
+
+    model = table.nominal_pin_model
+    data, geometry_data = model.createData(), pin.GeometryData(visual_model)
+    q = table.chain.joint_vector(*[0.0] * len(table.joint_names))
+    pin.updateGeometryPlacements(model, data, visual_model, geometry_data, q)
+    points = [np.zeros(3)]
+    for index, item in enumerate(visual_model.geometryObjects):
+        placement = geometry_data.oMg[index]
+        try:
+            item.geometry.computeLocalAABB()
+            box = item.geometry.aabb_local
+            corners = np.array(np.meshgrid(*zip(box.min_, box.max_, strict=True))).reshape(3, -1).T
+        except (AttributeError, RuntimeError):  # a geometry without a box: its origin
+            corners = np.zeros((1, 3))
+        points += [placement.act(np.asarray(c, dtype=float)) for c in corners]
+    points = np.array(points)
+    low, high = points.min(axis=0), points.max(axis=0)
+    offset = np.asarray(CAMERA_OFFSET_M, dtype=float)
+    scale = max(float(np.linalg.norm(high - low)), 0.1) / float(np.linalg.norm(offset))
+    return tuple(float(v) for v in 0.5 * (low + high)), tuple(float(v) for v in offset * scale)
+
+
+# ---- the scene -----------------------------------------------------------------------------------
 class SetupScene:
-    """The turntable with magnified errors, ready to be drawn into a meshcat visualizer.
+    """A table with magnified errors, ready to be drawn into a meshcat visualizer.
 
     Args:
-        errors: the true error set (default: none).
-        urdf_path: the nominal URDF (default: the bundled one).
+        errors: the true errors: a :class:`TurntableErrors` (the paper's table) or the table's
+            error vector (rad, m); default none.
+        table: a :class:`~turntable_pin.model.generic_table.GenericTable` (default: the paper's,
+            :func:`~turntable_pin.model.paper_table.paper_table`).
         exaggeration: the magnification (default: :meth:`Exaggeration.for_errors`).
         camera_target_m, camera_offset_m: where the camera looks (base frame, metres) and its
-            eye's offset from there (default: the whole machine from north-east and above).
+            eye's offset from there (default: the whole table from north-east and above).
+
+    The angles of :meth:`poses`, :meth:`legend` and :meth:`set_position` are the joint angles in
+    chain order, radians, one per joint (the paper's table: phi1, phi2).
+
+    Attributes:
+        table, error_values, exaggeration, display_values (the magnified errors);
+        pin_model: the table's Pinocchio model with the magnified errors; visual_model: its
+        visuals; warnings: what the command line should say (missing meshes).
     """
 
     def __init__(
         self,
-        errors: TurntableErrors | None = None,
+        errors=None,
         *,
-        urdf_path: str | Path | None = None,
+        table=None,
         exaggeration: Exaggeration | None = None,
-        camera_target_m=CAMERA_TARGET_M,
-        camera_offset_m=CAMERA_OFFSET_M,
+        camera_target_m=None,
+        camera_offset_m=None,
     ) -> None:
-        self.camera_target_m = tuple(float(v) for v in camera_target_m)
-        self.camera_offset_m = tuple(float(v) for v in camera_offset_m)
-        self.errors = errors if errors is not None else TurntableErrors.zero()
-        self.exaggeration = exaggeration or Exaggeration.for_errors(self.errors)
-        self.display_errors = self.exaggeration.apply(self.errors)
-        self.model = TurntableModel(self.display_errors, urdf_path)
-        # Built against the magnified model: the payload's visuals hang on the fixed mount, and
-        # Pinocchio folds that mount's (magnified) error into their placements.
-        self.visual_model = pin.buildGeomFromUrdf(
-            self.model.pin_model, str(self.model.urdf_path), pin.GeometryType.VISUAL
+        self.table = table if table is not None else _paper_table()
+        self.error_values = _error_vector(self.table, errors)
+        self.exaggeration = exaggeration or Exaggeration.for_errors(
+            self.error_values, table=self.table
         )
-        self._true_model = TurntableModel(self.errors, self.model.urdf_path)
+        self.display_values = self.exaggeration.apply(self.error_values, self.table)
+        # The visuals are built against the magnified model: the payload's visuals hang on the
+        # fixed mount, and Pinocchio folds that mount's (magnified) error into their placements.
+        self.pin_model = self.table.pinocchio_model(self.display_values)
+        self.warnings: list[str] = []
+        self.visual_model = _visual_model(self.table, self.pin_model, self.warnings)
+        target, offset = _camera(self.table, self.visual_model)
+        target = target if camera_target_m is None else camera_target_m
+        offset = offset if camera_offset_m is None else camera_offset_m
+        self.camera_target_m = tuple(float(v) for v in target)
+        self.camera_offset_m = tuple(float(v) for v in offset)
         self._viz = None
         self._vis = None
 
     # ---- geometry (no meshcat needed) ---------------------------------------------------------
-    def poses(self, phi1_rad: float, phi2_rad: float) -> ScenePoses:
-        """Poses of the triads and inner-axis rods at commanded angles (phi1, phi2), radians."""
-        actual = self.model.payload_pose(phi1_rad, phi2_rad).homogeneous
-        ideal = self.model.ideal_pose(phi1_rad, phi2_rad).homogeneous
-        q = self.model.joint_vector(phi1_rad, phi2_rad)
-        axes = []
-        for model in (self.model.pin_model, self.model.nominal_pin_model):
-            data = model.createData()
-            pin.forwardKinematics(model, data, q)
-            axes.append(data.oMi[model.getJointId(INNER_JOINT)].homogeneous)
-        return ScenePoses(actual, ideal, axes[0], axes[1])
+    def _q(self, angles_rad) -> np.ndarray:
+        joints = self.table.joint_names
+        if len(angles_rad) != len(joints):
+            raise InputError(
+                f"expected {len(joints)} joint angle(s) ({', '.join(joints)}), "
+                f"got {len(angles_rad)}"
+            )
+        return self.table.chain.joint_vector(*[float(a) for a in angles_rad])
 
-    def legend(self, phi1_rad: float, phi2_rad: float) -> list[str]:
+    def poses(self, *angles_rad: float) -> ScenePoses:
+        """Poses of the triads and the last joint's axis rods at the joint angles, radians."""
+        import pinocchio as pin
+
+        q = self._q(angles_rad)
+        last = self.table.chain.joints[-1]
+        onto_axis = _z_onto(last.axis)
+        out = []
+        for model in (self.pin_model, self.table.nominal_pin_model):
+            data = model.createData()
+            pin.framesForwardKinematics(model, data, q)
+            payload = data.oMf[model.getFrameId(self.table.payload_frame)].homogeneous
+            joint = data.oMi[model.getJointId(last.name)].homogeneous
+            out.append((payload, joint @ onto_axis))
+        return ScenePoses(out[0][0], out[1][0], out[0][1], out[1][1])
+
+    @property
+    def length_label(self) -> str:
+        """What the magnified lengths are called: the one length's name (the paper's ``deta``)
+        or ``offsets``."""
+        lengths = self.table.length_names
+        return lengths[0] if len(lengths) == 1 else "offsets"
+
+    def legend(self, *angles_rad: float) -> list[str]:
         """Lines saying what the picture shows: position, magnification, true error angles."""
-        true = self._true_model.orientation_error(phi1_rad, phi2_rad)
-        k = self.exaggeration
+        true = self.table.orientation_error(self.error_values, [float(a) for a in angles_rad])
+        table, k = self.table, self.exaggeration
+        where = ", ".join(
+            f"phi{i} = {a * DEG_PER_RAD:g} deg ({j})"
+            for i, (j, a) in enumerate(zip(table.joint_names, angles_rad, strict=True), start=1)
+        )
+        lengths = self.error_values[_is_length(table)] / M_PER_MM
+        if len(lengths) == 1:
+            shown = f"{self.length_label} {lengths[0]:g} mm"
+        else:
+            shown = f"offsets, largest {np.max(np.abs(lengths), initial=0.0):g} mm"
+        last = table.joint_names[-1]
+        axis = last if last.endswith("axis") else f"{last} axis"
         return [
-            f"phi1 = {phi1_rad * DEG_PER_RAD:g} deg, phi2 = {phi2_rad * DEG_PER_RAD:g} deg",
-            f"errors magnified x{k.angle_factor:.4g} (angles), x{k.length_factor:.4g} (deta "
-            f"{self.errors.deta / M_PER_MM:g} mm)",
+            where,
+            f"errors magnified x{k.angle_factor:.4g} (angles), x{k.length_factor:.4g} ({shown})",
             f'true dpsi = {true.dpsi_rad * ARCSEC_PER_RAD:.2f}", dtheta = '
             f'{true.dtheta_rad * ARCSEC_PER_RAD:.2f}", dgamma = '
             f'{true.dgamma_rad * ARCSEC_PER_RAD:.2f}"',
             "colour triad: actual payload frame (x red, y green, z blue); dark: ideal",
-            "magenta rod: actual inner axis; dark rod: ideal inner axis",
+            f"magenta rod: actual {axis}; dark rod: ideal {axis}",
         ]
 
     def to_dict(self) -> dict:
-        """True errors (arcsec, mm), magnification and URDF path, as a JSON-ready dict."""
+        """True errors (arcsec, mm), magnification and table, as a JSON-ready dict."""
         return {
-            "errors": self.errors.to_user_units(),
+            "errors": self.table.to_user_units(self.error_values),
             "exaggeration": self.exaggeration.to_dict(),
-            "urdf": str(self.model.urdf_path),
+            "urdf": str(self.table.urdf_path),
+            "payload_frame": self.table.payload_frame,
+            "joints": list(self.table.joint_names),
         }
 
     # ---- meshcat ------------------------------------------------------------------------------
@@ -228,7 +433,7 @@ class SetupScene:
         from pinocchio.visualize import MeshcatVisualizer
 
         self._vis = visualizer
-        viz = MeshcatVisualizer(self.model.pin_model, None, self.visual_model)
+        viz = MeshcatVisualizer(self.pin_model, None, self.visual_model)
         viz.initViewer(viewer=visualizer)
         viz.loadViewerModel(rootNodeName=f"{ROOT}/machine")
         self._viz = viz
@@ -257,12 +462,12 @@ class SetupScene:
         visualizer["/Background"].set_property("bottom_color", [0.74, 0.76, 0.80])
         self.set_camera()
 
-    def set_position(self, phi1_rad: float, phi2_rad: float) -> ScenePoses:
-        """Move the drawn scene to commanded angles (phi1, phi2), radians."""
+    def set_position(self, *angles_rad: float) -> ScenePoses:
+        """Move the drawn scene to the joint angles, radians (chain order)."""
         if self._viz is None:
             raise RuntimeError("draw() the scene into a visualizer first")
-        self._viz.display(self.model.joint_vector(phi1_rad, phi2_rad))
-        poses = self.poses(phi1_rad, phi2_rad)
+        self._viz.display(self._q(angles_rad))
+        poses = self.poses(*angles_rad)
         self._vis[f"{ROOT}/actual_triad"].set_transform(poses.actual_payload)
         self._vis[f"{ROOT}/ideal_triad"].set_transform(poses.ideal_payload)
         self._vis[f"{ROOT}/actual_inner_axis"].set_transform(poses.actual_inner_axis)
@@ -283,20 +488,23 @@ class SetupScene:
         self._vis["/Cameras/default/rotated/<object>"].set_property("position", [dx, dz, -dy])
 
 
-def default_positions_deg() -> np.ndarray:
-    """A 16-position tumble (phi1, phi2 in 0/90/180/270 deg, inner axis serpentine), (16, 2)."""
-    rows = []
-    for i, phi1 in enumerate((0.0, 90.0, 180.0, 270.0)):
-        inner = (0.0, 90.0, 180.0, 270.0)
-        for phi2 in inner if i % 2 == 0 else inner[::-1]:
-            rows.append((phi1, phi2))
+# ---- animation -----------------------------------------------------------------------------------
+def default_positions_deg(n_joints: int = 2) -> np.ndarray:
+    """A tumble of every joint through 0, 90, 180 and 270 deg, each joint serpentine (reversed
+    on every other pass of the joints before it, so no move turns more than one joint):
+    (4**n_joints, n_joints); the paper's table: 16 positions (phi1, phi2)."""
+    steps = (0.0, 90.0, 180.0, 270.0)
+    rows: list[tuple[float, ...]] = [()]
+    for _ in range(n_joints):
+        rows = [
+            (*row, a) for i, row in enumerate(rows) for a in (steps if i % 2 == 0 else steps[::-1])
+        ]
     return np.array(rows)
 
 
 def animation_frames_rad(positions_deg, frames_per_move: int = 12) -> np.ndarray:
-    """Frames (phi1, phi2) in radians moving linearly through ``positions_deg`` (N, 2) and back
-    to the first, ``frames_per_move`` frames per move: shape (N * frames_per_move, 2). Any table:
-    ``positions_deg`` (N, J) of J joint angles gives frames (N * frames_per_move, J)."""
+    """Frames in radians moving linearly through ``positions_deg`` (N, J) of J joint angles and
+    back to the first, ``frames_per_move`` frames per move: shape (N * frames_per_move, J)."""
     positions = np.asarray(positions_deg, dtype=float)
     width = positions.shape[1] if positions.ndim == 2 else 2
     positions = np.radians(positions.reshape(-1, width))
