@@ -1,4 +1,6 @@
-"""The command line: JSON output and clear errors (exit 2, no traceback) on bad input."""
+"""``orientation`` and ``urdf``: JSON output against the library and plain Pinocchio on the paper's
+table and on the bundled one-, two- and three-axis tables (their generic error names), and clear
+errors (one line, exit 2, no traceback) on bad input."""
 
 import json
 
@@ -6,10 +8,11 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import cli
+from conftest import REPO_DIR, cli
 from turntable_pin import TurntableErrors, TurntableModel
 from turntable_pin.cli import main
-from turntable_pin.core.units import ARCSEC_PER_RAD
+from turntable_pin.core.units import ARCSEC_PER_RAD, arcsec_to_rad
+from turntable_pin.model.generic_table import GenericTable
 
 
 def test_orientation_json_matches_the_library():
@@ -74,3 +77,90 @@ def test_unreadable_yaml(tmp_path):
     assert proc.returncode == 2
     assert "errors.yaml" in proc.stderr and "YAML" in proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+# ---- any table --------------------------------------------------------------------------------
+MODELS = REPO_DIR / "models"
+CASES = [
+    ("single_axis_rate_table.urdf", "90", ["spindle.tilt_b=60", "gyro_mount.rot_z=5"]),
+    ("two_axis_vertical_outer.urdf", "30,-20", ["azimuth_axis.tilt_a=4", "tilt_axis.position=-3"]),
+    ("three_axis_imu_table.urdf", "10,20,30",
+     ["outer_gimbal.tilt_a=5", "inner_gimbal.tilt_b=-2", "middle_gimbal.offset_a_mm=0.2"]),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("urdf, angles, errors", CASES)
+def test_orientation_of_each_bundled_table(urdf, angles, errors):
+    argv = ["orientation", "--urdf", str(MODELS / urdf), "--angles-deg", angles, "--json"]
+    for e in errors:
+        argv += ["--error", e]
+    proc = cli(*argv)
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    table = GenericTable(MODELS / urdf)
+    values = table.values()
+    for e in errors:
+        name, value = e.split("=")
+        if name.endswith("_mm"):
+            values[table.parameter_names.index(name[:-3])] = float(value) * 1e-3
+        else:
+            values[table.parameter_names.index(name)] = arcsec_to_rad(float(value))
+    angles_rad = np.radians([float(a) for a in angles.split(",")])
+    np.testing.assert_allclose(out["dR"], table.rotation_error(values, angles_rad), atol=1e-15)
+    for name in ("dpsi", "dtheta", "dgamma"):  # first order is exact to second order
+        assert abs(out[f"{name}_arcsec"] - out[f"{name}_first_order_arcsec"]) < 1e-3
+    assert list(out["angles_deg"]) == list(table.joint_names)
+
+
+def test_urdf_of_a_generic_table_reproduces_it_in_plain_pinocchio(tmp_path):
+    urdf = MODELS / "three_axis_imu_table.urdf"
+    out = tmp_path / "with_errors.urdf"
+    proc = cli("urdf", "--urdf", str(urdf), "--error", "outer_gimbal.tilt_a=30",
+               "--error", "imu_mount.rot_y_arcmin=1", "-o", str(out))  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    table = GenericTable(urdf)
+    values = table.errors_from_user_units({"outer_gimbal.tilt_a": 30, "imu_mount.rot_y_arcmin": 1})
+    plain, nominal = pin.buildModelFromUrdf(str(out)), table.nominal_pin_model
+    angles = np.radians([40.0, -10.0, 75.0])
+    q = table.chain.joint_vector(*angles)
+    rotations = []
+    for m in (plain, nominal):
+        data = m.createData()
+        pin.framesForwardKinematics(m, data, q)
+        rotations.append(data.oMf[m.getFrameId("imu")].rotation)
+    np.testing.assert_allclose(
+        rotations[1].T @ rotations[0], table.rotation_error(values, angles), atol=1e-12
+    )
+
+
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["--angles-deg", "1,2"], "this table has 3 joint(s), got 2 angle(s)"),
+        (["--phi1-deg", "3"], "give --angles-deg"),
+        (["--angles-deg", "1,x,3"], "--angles-deg '1,x,3'"),
+        (["--error", "dphi_y1=3", "--angles-deg", "1,2,3"], "unknown error name 'dphi_y1'"),
+        (["--payload-frame", "nowhere", "--angles-deg", "1,2,3"], "no frame 'nowhere'"),
+    ],
+)
+def test_bad_use_on_a_generic_table_is_one_line_exit_2(argv, fragment):
+    proc = cli("orientation", "--urdf", str(MODELS / "three_axis_imu_table.urdf"), *argv)
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1 and fragment in proc.stderr
+
+
+def test_a_mimic_joint_is_refused_in_one_line(tmp_path):
+    text = (MODELS / "two_axis_vertical_outer.urdf").read_text()
+    bad = tmp_path / "mimic.urdf"
+    joint = '<joint name="tilt_axis" type="revolute">'
+    bad.write_text(text.replace(joint, joint + '<mimic joint="azimuth_axis"/>'))
+    proc = cli("orientation", "--urdf", str(bad), "--angles-deg", "1,2")
+    assert proc.returncode == 2 and "mimic joint" in proc.stderr
+
+
+def test_the_paper_table_keeps_its_names_with_angles_deg():
+    a = json.loads(cli("orientation", "--angles-deg", "30,45", "--error", "dphi_y1=3",
+                       "--json").stdout)  # fmt: skip
+    b = json.loads(cli("orientation", "--phi1-deg", "30", "--phi2-deg", "45", "--error",
+                       "dphi_y1=3", "--json").stdout)  # fmt: skip
+    assert a == b and "dpsi_small_angle_arcsec" in a

@@ -79,6 +79,15 @@ def test_view_animates_a_positions_file_for_a_while(tmp_path):
     assert len(watch.server_pids) == 1 and watch.survivors() == []
 
 
+def test_view_of_the_paper_table_takes_joint_named_positions(tmp_path):
+    positions = tmp_path / "positions.csv"
+    positions.write_text("outer_axis_deg,inner_axis_deg\n0,0\n90,0\n")
+    proc = cli("view", "--animate", "--positions", str(positions), "--angles-deg", "10,20",
+               "--error", "deps_x=4", "--duration", "0")  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "magenta rod: actual inner_axis" in proc.stdout
+
+
 def test_view_names_the_bad_cell_of_a_positions_file(tmp_path):
     positions = tmp_path / "positions.csv"
     positions.write_text("phi1_deg,phi2_deg\n0,0\n90,abc\n")

@@ -157,6 +157,17 @@ def test_animation_frames_visit_every_position_and_close_the_loop():
         animation_frames_rad(positions, frames_per_move=0)
 
 
+@pytest.mark.parametrize("n_joints", [1, 2, 3])
+def test_the_default_tumble_turns_one_joint_per_move(n_joints):
+    positions = default_positions_deg(n_joints)
+    assert positions.shape == (4**n_joints, n_joints)
+    assert len({tuple(p) for p in positions}) == 4**n_joints
+    assert set(positions.ravel()) == {0.0, 90.0, 180.0, 270.0}
+    moves = np.diff(positions, axis=0)
+    assert np.all(np.count_nonzero(moves, axis=1) == 1)  # serpentine: one joint at a time
+    assert np.abs(moves).max() == 90.0
+
+
 def test_meshcat_receives_the_poses_of_the_model():
     scene = SetupScene(EXAMPLE)
     phi1, phi2 = 0.7, 2.1
@@ -331,3 +342,24 @@ def test_a_snapshot_of_the_three_axis_table_is_a_real_picture(tmp_path):
     assert result.to_dict()["angles_deg"] == {
         "outer_gimbal": 30.0, "middle_gimbal": 45.0, "inner_gimbal": 60.0,
     }  # fmt: skip
+
+
+def test_the_paper_table_gets_the_any_table_features(tmp_path):
+    """The paper's table is the same scene: a mesh missing from a URDF with its joints is drawn
+    as a box with a warning too, and the scene's table keeps the paper's names."""
+    from turntable_pin.model.paper_table import paper_table
+
+    text = (MODELS / "turntable.urdf").read_text()
+    first_box = re.search(r'<box size="[^"]*"/>', text).group(0)
+    urdf = tmp_path / "paper_meshy.urdf"
+    urdf.write_text(text.replace(first_box, '<mesh filename="base.stl"/>', 1))
+    scene = SetupScene(EXAMPLE, table=paper_table(urdf))
+    assert scene.table.parameter_names[-1] == "deta" and len(scene.warnings) == 1
+    assert len(scene.visual_model.geometryObjects) == len(
+        SetupScene(EXAMPLE).visual_model.geometryObjects
+    )
+    np.testing.assert_allclose(
+        scene.poses(0.3, 1.2).actual_payload, SetupScene(EXAMPLE).poses(0.3, 1.2).actual_payload,
+        atol=1e-15,
+    )  # fmt: skip
+    assert scene.to_dict()["errors"] == EXAMPLE.to_user_units()
