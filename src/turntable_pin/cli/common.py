@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.exceptions import SEED_LIMIT, InputError, one_line
-from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors, parse_error_value
+from ..model.errors import MAX_ANGULAR_ERROR_DEG, parse_error_value
 
 __all__ = [
     "input_path",
@@ -22,9 +22,7 @@ __all__ = [
     "add_table_options",
     "bounded_float",
     "error_values_from_args",
-    "errors_from_args",
     "finite_float",
-    "generic_errors_from_args",
     "generic_table_from_args",
     "paper_table_requested",
     "latitude_deg",
@@ -251,20 +249,6 @@ def error_values_from_args(
         given[name] = item
         values[table.parameter_names.index(name)] = value
     return values
-
-
-generic_errors_from_args = error_values_from_args
-"""The former name of :func:`error_values_from_args` (kept for its callers)."""
-
-
-def errors_from_args(
-    args: argparse.Namespace, max_angle_deg: float = MAX_ANGULAR_ERROR_DEG
-) -> TurntableErrors:
-    """The paper's error set of the options: :func:`error_values_from_args` on the paper's
-    table as a :class:`TurntableErrors` (kept for its callers)."""
-    from ..model.paper_table import paper_table
-
-    return TurntableErrors.from_array(error_values_from_args(paper_table(), args, max_angle_deg))
 
 
 def _jsonable(value):

@@ -13,8 +13,7 @@ from .common import (
     add_error_options,
     add_table_options,
     bounded_float,
-    errors_from_args,
-    generic_errors_from_args,
+    error_values_from_args,
     input_path,
     one_line_errors,
     positive_float,
@@ -281,7 +280,6 @@ def run_simulate(args: argparse.Namespace) -> int:
 
     table = table_from_args(args)
     joints = _generic_joints(table)
-    generic = joints is not None
     user = load_catalogue(args.catalogue, table)
     effects = _parse_effect_options(args.effect, table, user)
     user = (*user, *(inline_effect(name, table) for name in effects if "~" in name))
@@ -332,16 +330,14 @@ def run_simulate(args: argparse.Namespace) -> int:
         passes=args.passes,
         **design,
     )
-    n_joints = len(joints) if generic else 2
+    n_joints = len(table.joint_names)
     if schedule.duration_s(n_joints) > MAX_TIME_S:
         raise InputError(
             f"--dwell-s {args.dwell_s:g}: the run would last "
             f"{schedule.duration_s(n_joints):.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
         )
     sim = simulate_measurements(
-        generic_errors_from_args(table, args, MAX_ORIENTATION_ERROR_DEG)
-        if generic
-        else errors_from_args(args, MAX_ORIENTATION_ERROR_DEG),
+        error_values_from_args(table, args, MAX_ORIENTATION_ERROR_DEG),
         effects,
         schedule=schedule,
         noise_arcsec=args.noise_arcsec,

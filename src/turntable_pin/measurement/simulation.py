@@ -19,7 +19,8 @@ from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows, 
 from ..core.exceptions import InputError, check_seed
 from ..core.sizes import MAX_SIMULATED_ROWS, check_count, turn_grid_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
-from ..model.errors import ANGULAR_ERROR_NAMES, MAX_ANGULAR_ERROR_DEG, TurntableErrors
+from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors
+from ..model.paper_table import paper_table
 from .catalogue import resolve_effect
 from .data import (
     MAX_COMMANDED_ANGLE_DEG,
@@ -393,8 +394,8 @@ class SimulatedMeasurements:
 
     Attributes:
         data: the measurements (with sigma, time and directions).
-        errors: the turntable errors used (the paper's ``TurntableErrors``, or ``{name: value in
-            user units}`` of another table: ``<error>_arcsec``, ``<offset>_mm``).
+        errors: the turntable errors used, ``{name_unit: value}`` in user units
+            (``<error>_arcsec``, ``<length>_mm``: what ``GenericTable.to_user_units`` gives).
         effects: ``{effect: {parameter: value in user units}}`` hidden in the data.
         noise_arcsec: the noise sigma (one number, or ``(dpsi, dtheta, dgamma)``).
         seed: the random seed.
@@ -404,7 +405,7 @@ class SimulatedMeasurements:
     """
 
     data: OrientationMeasurements
-    errors: TurntableErrors | dict[str, float]
+    errors: dict[str, float]
     effects: dict[str, dict[str, float]]
     noise_arcsec: float | tuple[float, float, float]
     seed: int
@@ -418,8 +419,7 @@ class SimulatedMeasurements:
         With ``hide_truth`` only the seed, noise and schedule are written, not the errors and the
         hidden effects, so that the file can be used to rehearse a blind diagnosis.
         """
-        user = self.errors.to_user_units() if hasattr(self.errors, "to_user_units") else self.errors
-        errors = ", ".join(f"{k}={v:.6g}" for k, v in user.items() if not k.endswith("_mm"))
+        errors = ", ".join(f"{k}={v:.6g}" for k, v in self.errors.items() if not k.endswith("_mm"))
         effects = "; ".join(
             f"{name}: " + ", ".join(f"{p}={v:.6g}" for p, v in params.items())
             for name, params in self.effects.items()
@@ -471,8 +471,8 @@ def simulate_measurements(
     """Simulate a measurement run.
 
     Args:
-        errors: turntable errors (default none): the paper's ``TurntableErrors``, or for another
-            table its error vector (rad, m) in ``GenericTable.parameter_names`` order.
+        errors: turntable errors (default none): the table's error vector (rad, m) in its
+            ``parameter_names`` order (the paper's ``TurntableErrors`` on the paper's table).
         effects: ``{effect name: {parameter name: value in user units}}`` (parameters not given
             are zero; units are the effect's, e.g. arcsec, arcsec/g, arcsec/h).
         schedule: positions, order, time and approach directions (default: 30-degree grid).
@@ -516,19 +516,17 @@ def simulate_measurements(
             f"{MAX_NOISE_ARCSEC:g}] arcsec (noise_arcsec / spread .. noise_arcsec * spread)"
         )
     seed = check_seed(seed)
-    table = measured_table(turntable)
+    source = paper_table() if turntable is None else getattr(turntable, "table", turntable)
+    table = measured_table(source)
     n_joints = table.n_joints
-    if table.paper:
-        errors = errors or TurntableErrors.zero()
-        base_values = dict(zip(ANGULAR_ERROR_NAMES, errors.angular_array_rad(), strict=True))
-    else:
-        vector = np.zeros(len(turntable.parameter_names)) if errors is None else errors
-        vector = np.asarray(vector, dtype=float)
-        errors = turntable.to_user_units(vector)
-        base_values = {
-            n: v for n, v in zip(turntable.parameter_names, vector, strict=True)
-            if n in table.base_names
-        }  # fmt: skip
+    if isinstance(errors, TurntableErrors):
+        errors = errors.as_array()
+    vector = np.zeros(len(source.parameter_names)) if errors is None else errors
+    vector = np.asarray(vector, dtype=float)
+    errors = source.to_user_units(vector)
+    base_values = {
+        n: v for n, v in zip(source.parameter_names, vector, strict=True) if n in table.base_names
+    }
     schedule = schedule or Schedule()
     check_count(schedule.count(n_joints), MAX_SIMULATED_ROWS, "rows of simulated measurements",
                 ROW_BYTES)  # fmt: skip
