@@ -29,6 +29,7 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
 from ..model.angles import ANGLE_SYMBOLS
+from .drift_fit import require_identifiable
 from .gyrowheel import GyroWheelModel
 from .positions import PositionInputs, PositionSet, position_inputs
 from .rate_error import DEFINITIONS, orientation_error_rotation, rate_errors_dph
@@ -371,9 +372,9 @@ def orientation_requirement(
     Args:
         accuracy_dph: required calibration accuracy ``w_m``, deg/h (in
             :data:`ACCURACY_RANGE_DPH`).
-        positions: the test positions (a :class:`PositionSet` of the paper's table, or the
-            :class:`~turntable_pin.calibration.table_positions.JointPositions` of any table,
-            which must determine the drift coefficients: else :class:`IdentifiabilityError`).
+        positions: the test positions of a table; they must turn gravity through all three
+            payload axes, else :class:`IdentifiabilityError` (see
+            :func:`~turntable_pin.calibration.drift_fit.require_identifiable`).
         latitude_rad: latitude of the test site, radians.
         gyrowheel: the drift coefficients (default: paper Table 1).
         exact: exact rotation for ``dR`` instead of eq. 7.
@@ -391,10 +392,7 @@ def orientation_requirement(
         raise InputError(f"unknown rate-error definition '{definition}'; expected {DEFINITIONS}")
     gyrowheel = gyrowheel if gyrowheel is not None else GyroWheelModel.nominal()
     inputs = position_inputs(positions, latitude_rad)
-    if hasattr(positions, "nominal_rotations"):  # any table: its positions may not suffice
-        from .drift_fit import require_identifiable
-
-        require_identifiable(inputs)
+    require_identifiable(inputs, every_coefficient=False)
     fx = PlaneRateError("psi_theta", gyrowheel, inputs, exact=exact, definition=definition)
     fy = PlaneRateError("theta_gamma", gyrowheel, inputs, exact=exact, definition=definition)
     rect_x = largest_rectangle(fx, accuracy_dph)
