@@ -41,6 +41,7 @@ __all__ = [
     "orientation_error_rotation",
     "rate_error",
     "rate_error_vectors_dph",
+    "rate_errors_at_angles_dph",
     "rate_errors_dph",
 ]
 
@@ -154,6 +155,21 @@ def rate_errors_dph(
     """
     dw = rate_error_vectors_dph(gyrowheel, inputs, rotations, definition=definition)
     return np.max(np.abs(dw), axis=-2)
+
+
+def rate_errors_at_angles_dph(
+    gyrowheel, inputs, angles_rad, *, exact=False, definition=DEFINITIONS[0]
+):
+    """:func:`rate_errors_dph` (the (M, 2) array ``[dwx, dwy]``, deg/h) at (M, 3) orientation
+    errors ``(dpsi, dtheta, dgamma)``, radians, 4096 at a time (bounded memory)."""
+    angles = np.asarray(angles_rad, dtype=float).reshape(-1, 3)
+    out = np.empty((angles.shape[0], 2))
+    for start in range(0, angles.shape[0], 4096):
+        rotations = orientation_error_rotation(*angles[start : start + 4096].T, exact=exact)
+        out[start : start + 4096] = rate_errors_dph(
+            gyrowheel, inputs, rotations, definition=definition
+        )
+    return out
 
 
 def rate_error_vectors_dph(

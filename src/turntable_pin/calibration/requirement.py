@@ -32,7 +32,7 @@ from ..model.angles import ANGLE_SYMBOLS
 from .drift_fit import require_identifiable
 from .gyrowheel import GyroWheelModel
 from .positions import PositionInputs, PositionSet, position_inputs
-from .rate_error import DEFINITIONS, orientation_error_rotation, rate_errors_dph
+from .rate_error import DEFINITIONS, rate_errors_at_angles_dph
 
 __all__ = [
     "ACCURACY_RANGE_DPH",
@@ -95,16 +95,10 @@ class PlaneRateError:
         angles = np.zeros(u.shape + (3,))
         angles[..., self.indices[0]] = u
         angles[..., self.indices[1]] = v
-        flat = angles.reshape(-1, 3)
-        out = np.empty(flat.shape[0])
-        column = 0 if self.axis == "x" else 1
-        for start in range(0, flat.shape[0], 4096):  # bounded memory for large surfaces
-            chunk = flat[start : start + 4096]
-            rotations = orientation_error_rotation(*chunk.T, exact=self.exact)
-            out[start : start + 4096] = rate_errors_dph(
-                self.gyrowheel, self.inputs, rotations, definition=self.definition
-            )[:, column]
-        return out.reshape(u.shape)
+        out = rate_errors_at_angles_dph(
+            self.gyrowheel, self.inputs, angles, exact=self.exact, definition=self.definition
+        )
+        return out[:, 0 if self.axis == "x" else 1].reshape(u.shape)
 
     def __call__(self, u_rad, v_rad) -> np.ndarray:
         u, v = np.broadcast_arrays(np.asarray(u_rad, float), np.asarray(v_rad, float))
@@ -417,10 +411,9 @@ def orientation_requirement(
         psi, theta = _settle(fx, psi, theta, accuracy_dph)
     signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
     corners = signs * np.array([psi, theta, gamma])
-    box = rate_errors_dph(
-        gyrowheel, inputs, orientation_error_rotation(*corners.T, exact=exact),
-        definition=definition,
-    ).max(axis=0)  # fmt: skip
+    box = rate_errors_at_angles_dph(
+        gyrowheel, inputs, corners, exact=exact, definition=definition
+    ).max(axis=0)
     return OrientationRequirement(
         accuracy_dph=float(accuracy_dph),
         psi_rad=float(psi),

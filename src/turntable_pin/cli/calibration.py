@@ -93,10 +93,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     c = subparsers.add_parser(
         "calibrate",
-        description="Least-squares calibration of a run CSV (phi1_deg, phi2_deg, out_x_dph, "
-        "out_y_dph[, sigma_dph, time_s]; with --urdf one angle column per joint: phi1_deg .. "
-        "phiN_deg in chain order or <joint>_deg): coefficients, standard errors, residuals per "
-        "position.",
+        description="Least-squares calibration of a run CSV (one angle column per joint: "
+        "phi1_deg .. phiN_deg in chain order or <joint>_deg, phi1_deg, phi2_deg on the paper's "
+        "table; out_x_dph, out_y_dph[, sigma_dph, time_s]): coefficients, standard errors, "
+        "residuals per position.",
     )
     one_line_errors(c)
     c.add_argument("run", type=input_path, metavar="RUN.csv")
