@@ -315,7 +315,7 @@ class PositionInputs:
         return len(self.positions)
 
 
-def check_commanded_angles(table, columns=("phi1_deg", "phi2_deg")) -> None:
+def check_commanded_angles(table, columns: Sequence[str]) -> None:
     """Refuse a commanded angle beyond :data:`MAX_COMMANDED_ANGLE_DEG` in a :class:`CsvTable`,
     naming the file, row and column."""
     for column in columns:
