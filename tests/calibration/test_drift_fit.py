@@ -150,6 +150,20 @@ def test_run_file_problems_are_named(tmp_path):
         calibrate_run(sigma, LAT_RAD)
 
 
+def test_a_run_of_the_paper_table_by_joint_name_is_the_same_run(tmp_path):
+    # One rule for every table's angle columns: phiK_deg or <joint>_deg, also on the paper's.
+    text = EXAMPLE.read_text().replace("phi1_deg,phi2_deg", "outer_axis_deg,inner_axis_deg")
+    named = tmp_path / "named.csv"
+    named.write_text(text)
+    a, b = calibrate_run(EXAMPLE, LAT_RAD), calibrate_run(named, LAT_RAD)
+    np.testing.assert_array_equal(a.x.coefficients_dph, b.x.coefficients_dph)
+    assert a.to_dict()["residuals"] == b.to_dict()["residuals"]  # reported as phi1_deg, phi2_deg
+    extra = tmp_path / "extra.csv"
+    extra.write_text("phi1_deg,phi2_deg,phi3_deg,out_x_dph,out_y_dph\n0,0,0,1,2\n")
+    with pytest.raises(InputError, match="phi3_deg is the angle of a joint this table does not"):
+        calibrate_run(extra, LAT_RAD)
+
+
 def test_a_barely_identifying_position_set_still_has_real_standard_errors():
     """17 positions within about 0.04 deg of one another identify the seven coefficients with a
     condition number near 1e11; the inverse of the normal matrix then had negative variances

@@ -200,3 +200,26 @@ def test_eq13_on_a_rank_deficient_grid_by_hand(psi, theta, gamma):
         beta2 = np.linalg.lstsq(A2, b1 - (w @ d)[:, k], rcond=None)[0]
         expected = np.max(np.abs(b1 - A @ beta2 - (w @ d)[:, k]))
         assert getattr(result, f"dw{axis}_dph") == pytest.approx(expected, rel=1e-6, abs=1e-10)
+
+
+def test_one_rule_for_every_table_gravity_through_all_three_payload_axes():
+    # The paper's grid:90 leaves ax ay unexcited (beta1 undetermined) and is taken; so is the
+    # three-axis table's grid:90, which turns gravity through the same six directions.
+    from conftest import REPO_DIR
+    from turntable_pin.calibration.requirement import orientation_requirement
+    from turntable_pin.model.generic_table import GenericTable
+
+    three = GenericTable(REPO_DIR / "models" / "three_axis_imu_table.urdf")
+    inputs = position_inputs(PositionSet.parse("grid:90", three), LAT_RAD)
+    result = rate_error(GYRO, inputs, 1e-4, 0, 0)
+    assert result.beta1["x"] is None
+    assert result.dwx_dph == pytest.approx(rate_error(GYRO, INPUTS["grid:90"], 1e-4, 0, 0).dwx_dph)
+    a = orientation_requirement(0.01, PositionSet.parse("grid:90", three), LAT_RAD)
+    b = orientation_requirement(0.01, PositionSet.parse("grid:90"), LAT_RAD)
+    np.testing.assert_allclose(a.limits_rad, b.limits_rad, rtol=1e-9)
+    # Positions of the paper's table that keep gravity on one line are refused, as on any table.
+    line = PositionSet(np.zeros(12), np.radians(np.arange(0, 360, 30)), name="phi2 only")
+    with pytest.raises(IdentifiabilityError, match="phi2 only: too few distinct gravity"):
+        rate_error(GYRO, position_inputs(line, LAT_RAD), 1e-4, 0, 0)
+    with pytest.raises(IdentifiabilityError, match="too few distinct gravity"):
+        orientation_requirement(0.01, line, LAT_RAD)

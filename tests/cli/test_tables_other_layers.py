@@ -12,9 +12,8 @@ from turntable_pin.allocation.solver import OrientationLimits
 from turntable_pin.allocation.table_allocation import allocate_table_tolerances, angular_names
 from turntable_pin.calibration.drift_fit import simulate_run
 from turntable_pin.calibration.gyrowheel import GyroWheelModel
-from turntable_pin.calibration.positions import position_inputs
+from turntable_pin.calibration.positions import PositionSet, position_inputs
 from turntable_pin.calibration.rate_error import rate_error
-from turntable_pin.calibration.table_positions import JointPositions
 from turntable_pin.core.csv_table import write_csv_table
 from turntable_pin.model.generic_table import GenericTable
 
@@ -43,7 +42,7 @@ def test_rate_error_of_the_three_axis_table_equals_the_library():
     out = _json("rate-error", "--urdf", THREE, "--positions", "grid:90x45x45",
                 "--dpsi-deg", "0.01", "--dgamma-deg", "-0.02", "--latitude-deg", "40")  # fmt: skip
     table = GenericTable(THREE)
-    inputs = position_inputs(JointPositions.parse(table, "grid:90x45x45"), np.radians(40.0))
+    inputs = position_inputs(PositionSet.parse("grid:90x45x45", table), np.radians(40.0))
     expected = rate_error(
         GyroWheelModel.nominal(), inputs, np.radians(0.01), 0.0, np.radians(-0.02)
     )
@@ -61,7 +60,7 @@ def test_requirement_of_the_three_axis_table_in_text():
 
 def test_calibrate_a_run_with_joint_named_columns(tmp_path):
     table = GenericTable(THREE)
-    inputs = position_inputs(JointPositions.parse(table, "grid:90x45x45"), np.radians(45.75))
+    inputs = position_inputs(PositionSet.parse("grid:90x45x45", table), np.radians(45.75))
     truth = GyroWheelModel.nominal()
     columns = simulate_run(truth, inputs, noise_dph=0.0, seed=0)
     named = {

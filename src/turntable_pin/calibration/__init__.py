@@ -6,7 +6,7 @@ the orientation requirement (eq. 16).
 from ..core.lazy import lazy_exports
 
 _EXPORTS = {
-    "JointPositions": "table_positions",
+    "JointPositions": "positions",
     "CalibrationResult": "drift_fit",
     "GyroWheelModel": "gyrowheel",
     "OrientationRequirement": "requirement",

@@ -6,13 +6,15 @@ reports the coefficients, their standard errors, the residual per position and t
 number of ``A``; a position set that cannot determine all seven coefficients raises
 :class:`IdentifiabilityError` naming why.
 
-Calibration run files (CSV, one row per position): ``phi1_deg, phi2_deg, out_x_dph, out_y_dph``
-and optionally ``sigma_dph`` (1-sigma output noise of the row) and ``time_s``; the latitude is a
-parameter of the run. A run is refused, naming file, row and column, when an output or a
-``sigma_dph`` is beyond :data:`MAX_RUN_OUTPUT_DPH`, a ``sigma_dph`` is <= 0 or below
-:data:`MIN_RUN_SIGMA_DPH`, a ``time_s`` is negative, a commanded angle is beyond
-``MAX_COMMANDED_ANGLE_DEG``, or two rows are the same measurement (equal ``phi1_deg, phi2_deg``
-and, when present, ``time_s``: a copied row), as the measurement reader does (positions too few to
+Calibration run files (CSV, one row per position): one angle column per joint of the table
+(``phi1_deg .. phiN_deg`` in chain order or ``<joint>_deg``, see
+:mod:`~turntable_pin.calibration.positions`: ``phi1_deg, phi2_deg`` on the paper's table),
+``out_x_dph, out_y_dph`` and optionally ``sigma_dph`` (1-sigma output noise of the row) and
+``time_s``; the latitude is a parameter of the run. A run is refused, naming file, row and
+column, when an output or a ``sigma_dph`` is beyond :data:`MAX_RUN_OUTPUT_DPH`, a ``sigma_dph``
+is <= 0 or below :data:`MIN_RUN_SIGMA_DPH`, a ``time_s`` is negative, a commanded angle is beyond
+``MAX_COMMANDED_ANGLE_DEG``, or two rows are the same measurement (equal angles and, when
+present, ``time_s``: a copied row), as the measurement reader does (positions too few to
 determine the coefficients are reported before a copied row).
 """
 
@@ -25,7 +27,8 @@ import numpy as np
 
 from ..core.csv_table import read_csv_table, refuse_repeated_rows, write_csv_table
 from ..core.exceptions import IdentifiabilityError, InputError, check_seed
-from ..core.units import deg_to_rad, rad_to_deg
+from ..core.units import rad_to_deg
+from ..model.paper_table import paper_table
 from .gyrowheel import (
     AXES,
     N_COEFFICIENTS,
@@ -34,7 +37,7 @@ from .gyrowheel import (
     GyroWheelModel,
     regressor_matrix,
 )
-from .positions import PositionInputs, PositionSet, check_commanded_angles, position_inputs
+from .positions import PositionInputs, PositionSet, position_inputs
 
 __all__ = [
     "MAX_RUN_OUTPUT_DPH",
@@ -52,8 +55,8 @@ __all__ = [
     "write_simulated_run",
 ]
 
-RUN_REQUIRED_COLUMNS: tuple[str, ...] = ("phi1_deg", "phi2_deg", "out_x_dph", "out_y_dph")
-"""Columns every calibration run CSV must have (angles in degrees, outputs in deg/h)."""
+RUN_REQUIRED_COLUMNS: tuple[str, ...] = ("out_x_dph", "out_y_dph")
+"""Columns every calibration run CSV must have besides the angle of each joint (deg/h)."""
 RUN_OPTIONAL_COLUMNS: tuple[str, ...] = ("sigma_dph", "time_s")
 """Columns read when present: 1-sigma output noise (deg/h) and time (s)."""
 MAX_RUN_OUTPUT_DPH = 1e6
@@ -136,28 +139,6 @@ class CalibrationResult:
     def to_dict(self) -> dict:
         """Both fits and the residual per position as a JSON-ready dict (degrees, deg/h)."""
         positions = self.inputs.positions
-        if hasattr(positions, "column_names"):  # any table: the angles under <joint>_deg
-            return {
-                "positions": positions.name,
-                "n_positions": len(positions),
-                "joints": list(positions.joint_names),
-                "latitude_deg": float(rad_to_deg(self.inputs.latitude_rad)),
-                "x": self.x.to_dict(),
-                "y": self.y.to_dict(),
-                "residuals": [
-                    {
-                        **dict(zip(positions.column_names, map(float, angles), strict=True)),
-                        "residual_x_dph": float(rx),
-                        "residual_y_dph": float(ry),
-                    }
-                    for angles, rx, ry in zip(
-                        rad_to_deg(positions.angles_rad),
-                        self.x.residuals_dph,
-                        self.y.residuals_dph,
-                        strict=True,
-                    )
-                ],
-            }
         return {
             "positions": positions.name,
             "n_positions": len(positions),
@@ -166,14 +147,12 @@ class CalibrationResult:
             "y": self.y.to_dict(),
             "residuals": [
                 {
-                    "phi1_deg": float(p1),
-                    "phi2_deg": float(p2),
+                    **dict(zip(positions.column_names, map(float, angles), strict=True)),
                     "residual_x_dph": float(rx),
                     "residual_y_dph": float(ry),
                 }
-                for p1, p2, rx, ry in zip(
-                    rad_to_deg(positions.phi1_rad),
-                    rad_to_deg(positions.phi2_rad),
+                for angles, rx, ry in zip(
+                    rad_to_deg(positions.angles_rad),
                     self.x.residuals_dph,
                     self.y.residuals_dph,
                     strict=True,
@@ -197,7 +176,7 @@ class CalibrationResult:
                 fit.names, fit.coefficients_dph, fit.standard_errors_dph, strict=True
             ):
                 lines.append(f"  D{axis}{name:3s} = {value:12.6f} +- {error:.3g}")
-        angle_keys = getattr(self.inputs.positions, "column_names", ("phi1_deg", "phi2_deg"))
+        angle_keys = self.inputs.positions.column_names
         width = max(9, *(len(k) for k in angle_keys))
         lines.append(
             " ".join(f"{k:>{width}s}" for k in angle_keys)
@@ -315,47 +294,56 @@ def calibrate(
     )
 
 
-def require_identifiable(inputs: PositionInputs) -> None:
+def require_identifiable(inputs: PositionInputs, *, every_coefficient: bool = True) -> None:
     """Raise :class:`IdentifiabilityError` (naming the positions) unless the positions of
     ``inputs`` determine the seven drift coefficients of both axes (see
-    :func:`check_identifiable`)."""
+    :func:`check_identifiable`).
+
+    ``every_coefficient=False`` asks only what a rate-error analysis (eqs. 7-16) needs: that the
+    positions turn gravity through all three payload axes. They may then leave a coefficient
+    they never excite undetermined (``ax ay`` on a 90-degree grid: eq. 6's ``beta1`` is reported
+    as undetermined), on any table; gravity kept in a plane or on a line is refused as above.
+    """
+    if not every_coefficient and np.linalg.matrix_rank(inputs.specific_force_g) == 3:
+        return
     for axis in AXES:
         design = regressor_matrix(axis, inputs.specific_force_g)
         try:
             check_identifiable(design, axis, inputs.positions)
         except IdentifiabilityError as exc:
-            raise IdentifiabilityError(f"positions {inputs.positions.name}: {exc}") from None
+            name = inputs.positions.name
+            raise IdentifiabilityError(f"positions{' ' + name if name else ''}: {exc}") from None
 
 
 def calibrate_run(path: str | Path, latitude_rad: float, table=None) -> CalibrationResult:
     """Read a calibration run CSV and fit it (see the module docstring for the format).
 
-    ``table``: a :class:`~turntable_pin.model.generic_table.GenericTable` whose run this is (its
-    angle columns ``phi1_deg .. phiN_deg`` in chain order or ``<joint>_deg``, see
-    :mod:`~turntable_pin.calibration.table_positions`); default the paper's table
-    (``phi1_deg, phi2_deg``).
+    ``table``: the :class:`~turntable_pin.model.generic_table.GenericTable` whose run this is
+    (default the paper's table).
     """
-    if table is not None:
-        return _calibrate_table_run(Path(path), latitude_rad, table)
-    table = read_csv_table(path, RUN_REQUIRED_COLUMNS, RUN_OPTIONAL_COLUMNS)
-    check_commanded_angles(table)
-    _check_run_values(path, table)
-    positions = PositionSet(
-        deg_to_rad(table["phi1_deg"]), deg_to_rad(table["phi2_deg"]), name=str(path)
-    )
-    return _fit_run(path, table, position_inputs(positions, latitude_rad), ("phi1_deg", "phi2_deg"))
-
-
-def _calibrate_table_run(path: Path, latitude_rad: float, table) -> CalibrationResult:
-    """:func:`calibrate_run` on a run of any table (its angle columns, chain order)."""
-    from .table_positions import JointPositions
-
-    optional = JointPositions.candidate_columns(table) + RUN_OPTIONAL_COLUMNS
-    csv = read_csv_table(path, RUN_REQUIRED_COLUMNS[2:], optional)
-    columns = JointPositions.columns_of(table, csv)
-    positions = JointPositions.from_table(table, csv, columns, str(path))
+    table = paper_table() if table is None else table
+    optional = PositionSet.candidate_columns(table) + RUN_OPTIONAL_COLUMNS
+    csv = read_csv_table(path, RUN_REQUIRED_COLUMNS, optional)
+    columns = PositionSet.columns_of(csv, table)
+    positions = PositionSet.from_csv_table(csv, columns, table, str(path))
     _check_run_values(path, csv)
-    return _fit_run(path, csv, position_inputs(positions, latitude_rad), columns)
+    inputs = position_inputs(positions, latitude_rad)
+    try:
+        result = calibrate(
+            inputs,
+            csv["out_x_dph"],
+            csv["out_y_dph"],
+            csv["sigma_dph"] if csv.has("sigma_dph") else None,
+        )
+    except IdentifiabilityError as exc:
+        raise IdentifiabilityError(f"{path}: {exc}") from None
+    # After the fit: positions that cannot determine the coefficients are the first problem.
+    refuse_repeated_rows(
+        csv,
+        (*columns, "time_s"),
+        "a copied row counts one measurement twice (repeats must differ in time_s)",
+    )
+    return result
 
 
 def _check_run_values(path, table) -> None:
@@ -388,26 +376,6 @@ def _check_run_values(path, table) -> None:
         table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
 
 
-def _fit_run(path, table, inputs: PositionInputs, angle_columns) -> CalibrationResult:
-    """Fit the outputs of a read run at ``inputs``; refuse copied rows after the fit."""
-    try:
-        result = calibrate(
-            inputs,
-            table["out_x_dph"],
-            table["out_y_dph"],
-            table["sigma_dph"] if table.has("sigma_dph") else None,
-        )
-    except IdentifiabilityError as exc:
-        raise IdentifiabilityError(f"{path}: {exc}") from None
-    # After the fit: positions that cannot determine the coefficients are the first problem.
-    refuse_repeated_rows(
-        table,
-        (*angle_columns, "time_s"),
-        "a copied row counts one measurement twice (repeats must differ in time_s)",
-    )
-    return result
-
-
 def simulate_run(
     gyrowheel: GyroWheelModel,
     inputs: PositionInputs,
@@ -427,18 +395,9 @@ def simulate_run(
     rng = np.random.default_rng(check_seed(seed))
     outputs = gyrowheel.outputs_dph(inputs.specific_force_g, inputs.earth_rate_dph)
     outputs = outputs + rng.normal(0.0, noise_dph, size=outputs.shape)
-    positions = inputs.positions
-    if hasattr(positions, "angles_rad"):  # any table: phi1_deg .. phiN_deg in chain order
-        columns = {f"phi{i + 1}_deg": rad_to_deg(a) for i, a in enumerate(positions.angles_rad.T)}
-    else:
-        columns = {
-            "phi1_deg": rad_to_deg(positions.phi1_rad),
-            "phi2_deg": rad_to_deg(positions.phi2_rad),
-        }
-    columns |= {
-        "out_x_dph": outputs[:, 0],
-        "out_y_dph": outputs[:, 1],
-    }
+    angles = rad_to_deg(inputs.positions.angles_rad).T
+    columns = {f"phi{i + 1}_deg": a for i, a in enumerate(angles)}  # chain order, any table
+    columns |= {"out_x_dph": outputs[:, 0], "out_y_dph": outputs[:, 1]}
     if noise_dph > 0:
         columns["sigma_dph"] = np.full(len(inputs), float(noise_dph))
     return columns

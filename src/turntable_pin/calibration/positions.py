@@ -1,17 +1,22 @@
-"""Test positions of a multi-position calibration and the inputs the GyroWheel senses at each.
+"""Test positions of a multi-position calibration on any table, and the inputs the GyroWheel
+senses at each.
 
-A position is a pair of commanded turntable angles (phi1 about the outer axis y, phi2 about the
-inner axis z). A position set comes from a scheme name or a CSV file:
+A position is a tuple of commanded joint angles in chain order from the base (the order of
+:attr:`~turntable_pin.model.generic_table.GenericTable.joint_names`); on the paper's table, the
+default, these are phi1 about the outer axis y and phi2 about the inner axis z. A position set
+comes from a scheme name or a CSV file:
 
-- ``grid:STEP``: phi1 and phi2 each in {0, STEP, ..., < 360} degrees, all pairs;
-- ``grid:STEP1xSTEP2``: the same with separate steps for phi1 and phi2;
-- a CSV file with columns ``phi1_deg, phi2_deg``.
+- ``grid:STEP``: every joint in {0, STEP, ..., < 360} degrees, every combination (12 positions
+  for one joint at 30 degrees, 144 for two, 1728 for three);
+- ``grid:S1xS2[xS3]``: the same with one step per joint, in chain order;
+- a CSV file with one angle column per joint: ``phi1_deg .. phiN_deg`` (chain order) or
+  ``<joint>_deg`` (the joint names); other columns are ignored.
 
-The specific force and the earth rate along the payload axes come from the payload orientation
-``Rd`` of the Pinocchio model (:class:`TurntableModel`): in the base frame F0 (x north, y west,
-z up) the specific force of a resting body is ``+e_z`` (1 g up) and the earth rate is
-``we (cos lat, 0, sin lat)``; along the payload axes they are ``Rd^T`` times these, which is the
-closed form of paper eq. 3.
+The specific force and the earth rate along the payload axes are ``Rd^T`` times their base-frame
+values: in the base frame F0 (x north, y west, z up) the specific force of a resting body is
+``+e_z`` (1 g up) and the earth rate is ``we (cos lat, 0, sin lat)``; ``Rd`` is the nominal
+payload orientation of the table's Pinocchio model (forward kinematics of its URDF). On the
+paper's table this is the closed form of paper eq. 3.
 """
 
 from __future__ import annotations
@@ -23,16 +28,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.csv_table import closest_column_hint, read_csv_table
+from ..core.csv_table import CsvTable, closest_column_hint, read_csv_table
 from ..core.exceptions import InputError
 from ..core.sizes import MAX_POSITIONS, check_count, turn_grid_count
 from ..core.units import deg_to_rad, rad_to_deg
-from ..model.turntable import TurntableModel
+from ..model.paper_table import PAPER_LAYOUT, paper_table
 from .site import DEFAULT_LATITUDE_DEG, MAX_LATITUDE_DEG  # noqa: F401  (re-exported)
 
 __all__ = [
     "DEFAULT_LATITUDE_DEG",
     "EARTH_RATE_DPH",
+    "JointPositions",
     "MAX_COMMANDED_ANGLE_DEG",
     "POSITION_BYTES",
     "PositionInputs",
@@ -42,6 +48,7 @@ __all__ = [
     "check_commanded_angles",
     "grid_angles_deg",
     "grid_steps",
+    "is_paper_table",
     "position_inputs",
 ]
 
@@ -49,7 +56,7 @@ EARTH_RATE_DPH = 15.041067
 """Earth rotation rate used by the paper (eq. 3), deg/h."""
 
 MAX_COMMANDED_ANGLE_DEG = 3600.0
-"""Largest ``|phi1|``, ``|phi2|`` a position may command, degrees (ten turns either way): angles
+"""Largest ``|angle|`` a position may command of any joint, degrees (ten turns either way): angles
 are taken as written (a table may log its turns), but beyond ten turns a value is a unit mix-up
 or a typo, and trigonometry of huge angles only returns rounding noise."""
 
@@ -101,94 +108,189 @@ def grid_angles_deg(steps_deg: Sequence[float]) -> tuple[np.ndarray, str]:
     return np.stack([m.ravel() for m in mesh], axis=1), name
 
 
-@dataclass(frozen=True)
+def is_paper_table(table) -> bool:
+    """Whether ``table`` is the paper's (under its layout, so its angles go by the paper's names
+    phi1, phi2 in reports and its reports carry no table keys)."""
+    return table.layout is PAPER_LAYOUT
+
+
+@dataclass(frozen=True, init=False)
 class PositionSet:
-    """Commanded turntable positions.
+    """Commanded positions of a table with 1 to 3 joints.
+
+    ``PositionSet(*angles_rad, table=None, name="")`` takes one (N,) array per joint in chain
+    order (``PositionSet(phi1_rad, phi2_rad)`` on the paper's table) or one (N, J) array.
 
     Attributes:
-        phi1_rad, phi2_rad: outer- and inner-axis angles, radians, shape (N,).
+        angles_rad: (N, J) joint angles in chain order, radians (read-only).
+        table: the :class:`~turntable_pin.model.generic_table.GenericTable` they command
+            (default: the paper's, :func:`~turntable_pin.model.paper_table.paper_table`).
         name: the scheme name or file the positions came from.
     """
 
-    phi1_rad: np.ndarray
-    phi2_rad: np.ndarray
+    angles_rad: np.ndarray
+    table: object = field(repr=False, compare=False)
     name: str = ""
 
-    def __post_init__(self) -> None:
-        phi1 = np.array(self.phi1_rad, dtype=float).reshape(-1)
-        phi2 = np.array(self.phi2_rad, dtype=float).reshape(-1)
-        if phi1.shape != phi2.shape:
-            raise InputError(f"positions: {phi1.size} phi1 values but {phi2.size} phi2 values")
-        if phi1.size == 0:
+    def __init__(self, *angles_rad, table=None, name: str = "") -> None:
+        table = paper_table() if table is None else table
+        n_joints = len(table.joint_names)
+        if len(angles_rad) == 1 and np.ndim(angles_rad[0]) == 2:
+            angles = np.array(angles_rad[0], dtype=float)
+        else:
+            columns = [np.array(a, dtype=float).reshape(-1) for a in angles_rad]
+            if len({c.size for c in columns}) > 1:
+                sizes = " and ".join(str(c.size) for c in columns)
+                raise InputError(f"positions: {sizes} angles of the {len(columns)} joints")
+            angles = np.stack(columns, axis=1) if columns else np.zeros((0, 0))
+        if angles.shape[1] != n_joints:
+            raise InputError(
+                f"positions: expected {n_joints} angle(s) per position "
+                f"({', '.join(table.joint_names)}), got {angles.shape[1]}"
+            )
+        if angles.shape[0] == 0:
             raise InputError("positions: the set is empty")
-        check_count(phi1.size, MAX_POSITIONS, "positions", POSITION_BYTES)
-        if not (np.all(np.isfinite(phi1)) and np.all(np.isfinite(phi2))):
+        check_count(angles.shape[0], MAX_POSITIONS, "positions", POSITION_BYTES)
+        if not np.all(np.isfinite(angles)):
             raise InputError("positions: angles must be finite numbers")
-        largest = float(max(np.max(np.abs(phi1)), np.max(np.abs(phi2))))
+        largest = float(np.max(np.abs(angles)))
         if largest > deg_to_rad(MAX_COMMANDED_ANGLE_DEG):
             raise InputError(
                 f"positions: an angle of {rad_to_deg(largest):g} deg; commanded angles must be "
                 f"within +-{MAX_COMMANDED_ANGLE_DEG:g} deg"
             )
-        phi1.setflags(write=False)
-        phi2.setflags(write=False)
-        object.__setattr__(self, "phi1_rad", phi1)
-        object.__setattr__(self, "phi2_rad", phi2)
+        angles.setflags(write=False)
+        object.__setattr__(self, "angles_rad", angles)
+        object.__setattr__(self, "table", table)
+        object.__setattr__(self, "name", name)
 
     def __len__(self) -> int:
-        return int(self.phi1_rad.size)
+        return int(self.angles_rad.shape[0])
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The joints, in the order of the columns of :attr:`angles_rad`."""
+        return tuple(self.table.joint_names)
+
+    @property
+    def column_names(self) -> tuple[str, ...]:
+        """The key of each joint's angle (degrees) in reports: the paper's ``phi1_deg,
+        phi2_deg`` on its table, ``<joint>_deg`` on any other."""
+        if is_paper_table(self.table):
+            return tuple(f"phi{k + 1}_deg" for k in range(len(self.joint_names)))
+        return tuple(f"{j}_deg" for j in self.joint_names)
+
+    @property
+    def phi1_rad(self) -> np.ndarray:
+        """The angles of the first joint (the paper's phi1, outer axis), radians."""
+        return self.angles_rad[:, 0]
+
+    @property
+    def phi2_rad(self) -> np.ndarray:
+        """The angles of the second joint (the paper's phi2, inner axis), radians."""
+        return self.angles_rad[:, 1]
+
+    # ---- construction -------------------------------------------------------------------------
+    @classmethod
+    def grid(cls, *steps_deg: float, table=None) -> PositionSet:
+        """Every joint in {0, step, ..., < 360} degrees, every combination (one step for all
+        joints, or one per joint in chain order)."""
+        table = paper_table() if table is None else table
+        n_joints = len(table.joint_names)
+        if len(steps_deg) not in (1, n_joints):
+            which = "the paper's table" if is_paper_table(table) else "a table"
+            raise InputError(
+                f"grid: {len(steps_deg)} steps for {which} of {n_joints} "
+                f"joint{'s' if n_joints > 1 else ''} ({', '.join(table.joint_names)}); give one "
+                "step, or one per joint"
+            )
+        angles, name = grid_angles_deg(list(steps_deg) * (n_joints // len(steps_deg)))
+        return cls(deg_to_rad(angles), table=table, name=name)
 
     @classmethod
-    def grid(cls, step1_deg: float, step2_deg: float | None = None) -> PositionSet:
-        """phi1 in {0, step1, ... < 360} and phi2 in {0, step2, ... < 360} degrees, all pairs."""
-        step2_deg = step1_deg if step2_deg is None else step2_deg
-        angles, name = grid_angles_deg([step1_deg, step2_deg])
-        return cls(deg_to_rad(angles[:, 0]), deg_to_rad(angles[:, 1]), name)
+    def from_csv(cls, path: str | Path, table=None) -> PositionSet:
+        """Read the angle columns (``phi1_deg .. phiN_deg`` or ``<joint>_deg``) of a CSV file."""
+        table = paper_table() if table is None else table
+        csv = read_csv_table(path, (), cls.candidate_columns(table))
+        return cls.from_csv_table(csv, cls.columns_of(csv, table), table, str(path))
 
     @classmethod
-    def from_csv(cls, path: str | Path) -> PositionSet:
-        """Read columns ``phi1_deg, phi2_deg`` (other columns are ignored)."""
-        table = read_csv_table(path, ("phi1_deg", "phi2_deg"))
-        check_commanded_angles(table)
-        return cls(deg_to_rad(table["phi1_deg"]), deg_to_rad(table["phi2_deg"]), str(path))
+    def from_csv_table(
+        cls, csv: CsvTable, columns: tuple[str, ...], table, name: str
+    ) -> PositionSet:
+        """The positions of the angle ``columns`` (degrees) of a read :class:`CsvTable`."""
+        check_commanded_angles(csv, columns)
+        angles = np.stack([csv[c] for c in columns], axis=1)
+        return cls(deg_to_rad(angles), table=table, name=name)
+
+    @staticmethod
+    def candidate_columns(table) -> tuple[str, ...]:
+        """Every column name an angle may have for ``table`` (numbered, then by joint name)."""
+        n = len(table.joint_names)
+        names = [f"phi{i + 1}_deg" for i in range(n)] + [f"{j}_deg" for j in table.joint_names]
+        return tuple(dict.fromkeys(names))
+
+    @staticmethod
+    def columns_of(csv: CsvTable, table) -> tuple[str, ...]:
+        """The angle columns present in ``csv`` for ``table``, or :class:`InputError`."""
+        return angle_columns(csv.header, table.joint_names, csv.path, csv.header_row)
 
     @classmethod
-    def parse(cls, spec: str) -> PositionSet:
-        """A scheme name (``grid:STEP``, ``grid:STEP1xSTEP2``) or the path of a CSV file."""
+    def parse(cls, spec: str, table=None) -> PositionSet:
+        """A scheme name (``grid:STEP``, ``grid:S1xS2[xS3]``) or the path of a CSV file."""
         text = str(spec).strip()
         steps = grid_steps(text)
         if steps is not None:
-            if len(steps) > 2:
-                raise InputError(
-                    f"grid: {len(steps)} steps for the paper's table of 2 joints; give one "
-                    "step, or one per joint"
-                )
-            return cls.grid(*steps)
+            return cls.grid(*steps, table=table)
         path = Path(text)
         if not path.exists():
             raise InputError(
                 f"positions '{text}': neither a scheme (grid:STEP) nor an existing CSV file"
             )
-        return cls.from_csv(path)
+        return cls.from_csv(path, table)
+
+    # ---- what the payload sees ----------------------------------------------------------------
+    def nominal_rotations(self) -> np.ndarray:
+        """(N, 3, 3) nominal payload orientations ``Rd`` (base <- payload): Pinocchio forward
+        kinematics of the table's URDF."""
+        pose = self.table.payload_pose
+        return np.array([pose(None, angles).rotation for angles in self.angles_rad])
 
     def distinct_count(self, decimals: int = 9) -> int:
-        """Number of distinct payload orientations (angles taken modulo 360 degrees)."""
-        wrapped = (
-            np.round(
-                np.mod(rad_to_deg(np.stack([self.phi1_rad, self.phi2_rad], 1)), 360.0), decimals
-            )
-            % 360.0
-        )
+        """Number of distinct commanded positions (angles taken modulo 360 degrees)."""
+        wrapped = np.round(np.mod(rad_to_deg(self.angles_rad), 360.0), decimals) % 360.0
         return int(np.unique(wrapped, axis=0).shape[0])
 
     def to_dict(self) -> dict:
-        """Name, count and the angles in degrees, as a dict."""
-        return {
-            "name": self.name,
-            "n_positions": len(self),
-            "phi1_deg": rad_to_deg(self.phi1_rad),
-            "phi2_deg": rad_to_deg(self.phi2_rad),
-        }
+        """Name, count, joint names and the angles in degrees per joint, as a dict."""
+        out = {"name": self.name, "n_positions": len(self), "joints": list(self.joint_names)}
+        for column, values in zip(self.column_names, rad_to_deg(self.angles_rad).T, strict=True):
+            out[column] = values
+        return out
+
+
+class JointPositions:
+    """The earlier name of :class:`PositionSet` for a given table, the table first
+    (``JointPositions.parse(table, spec)`` is ``PositionSet.parse(spec, table)``); kept for
+    scripts."""
+
+    def __new__(cls, angles_rad, table, name: str = "") -> PositionSet:  # type: ignore[misc]
+        return PositionSet(angles_rad, table=table, name=name)
+
+    @staticmethod
+    def grid(table, *steps_deg: float) -> PositionSet:
+        """:meth:`PositionSet.grid` of ``table``."""
+        return PositionSet.grid(*steps_deg, table=table)
+
+    @staticmethod
+    def parse(table, spec: str) -> PositionSet:
+        """:meth:`PositionSet.parse` of ``table``."""
+        return PositionSet.parse(spec, table)
+
+    @staticmethod
+    def from_csv(table, path: str | Path) -> PositionSet:
+        """:meth:`PositionSet.from_csv` of ``table``."""
+        return PositionSet.from_csv(path, table)
 
 
 @dataclass(frozen=True)
@@ -213,7 +315,7 @@ class PositionInputs:
         return len(self.positions)
 
 
-def check_commanded_angles(table, columns=("phi1_deg", "phi2_deg")) -> None:
+def check_commanded_angles(table, columns: Sequence[str]) -> None:
     """Refuse a commanded angle beyond :data:`MAX_COMMANDED_ANGLE_DEG` in a :class:`CsvTable`,
     naming the file, row and column."""
     for column in columns:
@@ -285,18 +387,13 @@ def base_frame_inputs(latitude_rad: float) -> tuple[np.ndarray, np.ndarray]:
     return force, rate
 
 
-def position_inputs(
-    positions: PositionSet, latitude_rad: float, model: TurntableModel | None = None
-) -> PositionInputs:
+def position_inputs(positions: PositionSet, latitude_rad: float) -> PositionInputs:
     """Specific force and earth rate along the payload axes at each position (eq. 3).
 
     Args:
-        positions: the commanded angles: a :class:`PositionSet` of the paper's table, or a
-            :class:`~turntable_pin.calibration.table_positions.JointPositions` of any table
-            (whose nominal chain then gives ``Rd``; ``model`` is not used).
+        positions: the commanded angles of a table; its *ideal* (nominal) payload orientation
+            is used: orientation errors enter later (eq. 8), not here.
         latitude_rad: latitude of the test site, radians (|lat| <= pi/2).
-        model: the turntable whose *ideal* (nominal) payload orientation is used; default the
-            bundled URDF. Orientation errors enter later (eq. 8), not here.
     """
     largest = deg_to_rad(MAX_LATITUDE_DEG) + 1e-12
     if not (np.isfinite(latitude_rad) and abs(latitude_rad) <= largest):
@@ -304,16 +401,7 @@ def position_inputs(
             f"latitude must be within +-{MAX_LATITUDE_DEG:g} degrees, got "
             f"{rad_to_deg(latitude_rad)!r}"
         )
-    if hasattr(positions, "nominal_rotations"):  # any table's positions (table_positions)
-        rotations = positions.nominal_rotations()
-    else:
-        model = model if model is not None else TurntableModel()
-        rotations = np.array(
-            [
-                model.ideal_pose(p1, p2).rotation
-                for p1, p2 in zip(positions.phi1_rad, positions.phi2_rad, strict=True)
-            ]
-        )
+    rotations = positions.nominal_rotations()
     force, rate = base_frame_inputs(latitude_rad)
     # Rd maps payload to base coordinates, so payload components are Rd^T v (row vector v Rd).
     return PositionInputs(

@@ -31,6 +31,7 @@ from ..core.exceptions import IdentifiabilityError, InputError
 from ..core.units import DEG_PER_RAD, rad_to_arcsec
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from ..model.small_angle import small_angle_rotation
+from .drift_fit import require_identifiable
 from .gyrowheel import AXES, N_COEFFICIENTS, GyroWheelModel, regressor_matrix
 from .positions import PositionInputs
 
@@ -40,6 +41,7 @@ __all__ = [
     "orientation_error_rotation",
     "rate_error",
     "rate_error_vectors_dph",
+    "rate_errors_at_angles_dph",
     "rate_errors_dph",
 ]
 
@@ -153,6 +155,21 @@ def rate_errors_dph(
     """
     dw = rate_error_vectors_dph(gyrowheel, inputs, rotations, definition=definition)
     return np.max(np.abs(dw), axis=-2)
+
+
+def rate_errors_at_angles_dph(
+    gyrowheel, inputs, angles_rad, *, exact=False, definition=DEFINITIONS[0]
+):
+    """:func:`rate_errors_dph` (the (M, 2) array ``[dwx, dwy]``, deg/h) at (M, 3) orientation
+    errors ``(dpsi, dtheta, dgamma)``, radians, 4096 at a time (bounded memory)."""
+    angles = np.asarray(angles_rad, dtype=float).reshape(-1, 3)
+    out = np.empty((angles.shape[0], 2))
+    for start in range(0, angles.shape[0], 4096):
+        rotations = orientation_error_rotation(*angles[start : start + 4096].T, exact=exact)
+        out[start : start + 4096] = rate_errors_dph(
+            gyrowheel, inputs, rotations, definition=definition
+        )
+    return out
 
 
 def rate_error_vectors_dph(
@@ -269,7 +286,9 @@ def rate_error(
     """Eqs. 7-14 for one orientation error, with beta1 and beta2 reported.
 
     Each angle must be finite and at most ``MAX_ANGULAR_ERROR_DEG`` (5 deg) in magnitude: the
-    model is one of small orientation errors.
+    model is one of small orientation errors. The positions must turn gravity through all three
+    payload axes (else :class:`IdentifiabilityError`, see
+    :func:`~turntable_pin.calibration.drift_fit.require_identifiable`).
     """
     for name, value in (("dpsi", dpsi_rad), ("dtheta", dtheta_rad), ("dgamma", dgamma_rad)):
         if not np.isfinite(value):
@@ -279,6 +298,7 @@ def rate_error(
                 f"{name} = {value:g} rad is not a small orientation error: it must be within "
                 f"+-{MAX_ANGULAR_ERROR_DEG:g} deg ({MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD:.6g} rad)"
             )
+    require_identifiable(inputs, every_coefficient=False)
     rotation = orientation_error_rotation(dpsi_rad, dtheta_rad, dgamma_rad, exact=exact)
     dw = rate_error_vectors_dph(gyrowheel, inputs, rotation[None], definition=definition)
     norms = np.max(np.abs(dw), axis=-2)

@@ -29,9 +29,10 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
 from ..model.angles import ANGLE_SYMBOLS
+from .drift_fit import require_identifiable
 from .gyrowheel import GyroWheelModel
 from .positions import PositionInputs, PositionSet, position_inputs
-from .rate_error import DEFINITIONS, orientation_error_rotation, rate_errors_dph
+from .rate_error import DEFINITIONS, rate_errors_at_angles_dph
 
 __all__ = [
     "ACCURACY_RANGE_DPH",
@@ -94,16 +95,10 @@ class PlaneRateError:
         angles = np.zeros(u.shape + (3,))
         angles[..., self.indices[0]] = u
         angles[..., self.indices[1]] = v
-        flat = angles.reshape(-1, 3)
-        out = np.empty(flat.shape[0])
-        column = 0 if self.axis == "x" else 1
-        for start in range(0, flat.shape[0], 4096):  # bounded memory for large surfaces
-            chunk = flat[start : start + 4096]
-            rotations = orientation_error_rotation(*chunk.T, exact=self.exact)
-            out[start : start + 4096] = rate_errors_dph(
-                self.gyrowheel, self.inputs, rotations, definition=self.definition
-            )[:, column]
-        return out.reshape(u.shape)
+        out = rate_errors_at_angles_dph(
+            self.gyrowheel, self.inputs, angles, exact=self.exact, definition=self.definition
+        )
+        return out[:, 0 if self.axis == "x" else 1].reshape(u.shape)
 
     def __call__(self, u_rad, v_rad) -> np.ndarray:
         u, v = np.broadcast_arrays(np.asarray(u_rad, float), np.asarray(v_rad, float))
@@ -371,9 +366,9 @@ def orientation_requirement(
     Args:
         accuracy_dph: required calibration accuracy ``w_m``, deg/h (in
             :data:`ACCURACY_RANGE_DPH`).
-        positions: the test positions (a :class:`PositionSet` of the paper's table, or the
-            :class:`~turntable_pin.calibration.table_positions.JointPositions` of any table,
-            which must determine the drift coefficients: else :class:`IdentifiabilityError`).
+        positions: the test positions of a table; they must turn gravity through all three
+            payload axes, else :class:`IdentifiabilityError` (see
+            :func:`~turntable_pin.calibration.drift_fit.require_identifiable`).
         latitude_rad: latitude of the test site, radians.
         gyrowheel: the drift coefficients (default: paper Table 1).
         exact: exact rotation for ``dR`` instead of eq. 7.
@@ -391,10 +386,7 @@ def orientation_requirement(
         raise InputError(f"unknown rate-error definition '{definition}'; expected {DEFINITIONS}")
     gyrowheel = gyrowheel if gyrowheel is not None else GyroWheelModel.nominal()
     inputs = position_inputs(positions, latitude_rad)
-    if hasattr(positions, "nominal_rotations"):  # any table: its positions may not suffice
-        from .drift_fit import require_identifiable
-
-        require_identifiable(inputs)
+    require_identifiable(inputs, every_coefficient=False)
     fx = PlaneRateError("psi_theta", gyrowheel, inputs, exact=exact, definition=definition)
     fy = PlaneRateError("theta_gamma", gyrowheel, inputs, exact=exact, definition=definition)
     rect_x = largest_rectangle(fx, accuracy_dph)
@@ -419,10 +411,9 @@ def orientation_requirement(
         psi, theta = _settle(fx, psi, theta, accuracy_dph)
     signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
     corners = signs * np.array([psi, theta, gamma])
-    box = rate_errors_dph(
-        gyrowheel, inputs, orientation_error_rotation(*corners.T, exact=exact),
-        definition=definition,
-    ).max(axis=0)  # fmt: skip
+    box = rate_errors_at_angles_dph(
+        gyrowheel, inputs, corners, exact=exact, definition=definition
+    ).max(axis=0)
     return OrientationRequirement(
         accuracy_dph=float(accuracy_dph),
         psi_rad=float(psi),

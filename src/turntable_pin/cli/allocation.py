@@ -185,8 +185,8 @@ def _limits_from_args(args: argparse.Namespace, table=None) -> tuple[Orientation
     if table is None:
         limits = default_orientation_limits(args.accuracy_dph, args.positions, args.latitude_deg)
         return limits, given
+    from ..calibration.positions import JointPositions
     from ..calibration.requirement import orientation_requirement
-    from ..calibration.table_positions import JointPositions
     from ..core.exceptions import IdentifiabilityError
     from ..core.units import deg_to_rad
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..calibration.drift_fit import calibrate_run
 from ..calibration.gyrowheel import GyroWheelModel
-from ..calibration.positions import PositionSet, position_inputs
+from ..calibration.positions import PositionSet, is_paper_table, position_inputs
 from ..calibration.rate_error import DEFINITIONS, rate_error
 from ..calibration.requirement import orientation_requirement
 from ..calibration.site import DEFAULT_LATITUDE_DEG
@@ -18,12 +18,11 @@ from .common import (
     accuracy_dph,
     add_table_options,
     bounded_float,
-    generic_table_from_args,
     input_path,
     latitude_deg,
     one_line_errors,
-    paper_table_requested,
     print_json,
+    table_from_args,
 )
 
 __all__ = ["register"]
@@ -34,8 +33,8 @@ def _add_setup_options(parser: argparse.ArgumentParser, *, positions: bool = Tru
         parser.add_argument(
             "--positions", default="grid:30", metavar="SCHEME|FILE.csv",
             help="test positions: grid:STEP (every joint in 0, STEP, ... < 360 deg, every "
-            "combination), grid:STEP1xSTEP2[xSTEP3] (one step per joint), or a CSV with "
-            "phi1_deg, phi2_deg (any table: phi1_deg .. phiN_deg or <joint>_deg) (default grid:30)",
+            "combination), grid:STEP1xSTEP2[xSTEP3] (one step per joint), or a CSV with one angle "
+            "column per joint: phi1_deg .. phiN_deg (chain order) or <joint>_deg (default grid:30)",
         )  # fmt: skip
     add_table_options(parser)
     parser.add_argument(
@@ -94,10 +93,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     c = subparsers.add_parser(
         "calibrate",
-        description="Least-squares calibration of a run CSV (phi1_deg, phi2_deg, out_x_dph, "
-        "out_y_dph[, sigma_dph, time_s]; with --urdf one angle column per joint: phi1_deg .. "
-        "phiN_deg in chain order or <joint>_deg): coefficients, standard errors, residuals per "
-        "position.",
+        description="Least-squares calibration of a run CSV (one angle column per joint: "
+        "phi1_deg .. phiN_deg in chain order or <joint>_deg, phi1_deg, phi2_deg on the paper's "
+        "table; out_x_dph, out_y_dph[, sigma_dph, time_s]): coefficients, standard errors, "
+        "residuals per position.",
     )
     one_line_errors(c)
     c.add_argument("run", type=input_path, metavar="RUN.csv")
@@ -106,23 +105,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     c.set_defaults(func=run_calibrate)
 
 
-def _table(args: argparse.Namespace):
-    """The :class:`GenericTable` of ``--urdf``, or None for the paper's table."""
-    return None if paper_table_requested(args) else generic_table_from_args(args)
-
-
-def _positions(args: argparse.Namespace, table):
-    """The positions of ``--positions`` for the paper's table (``table`` None) or ``table``."""
-    if table is None:
-        return PositionSet.parse(args.positions)
-    from ..calibration.table_positions import JointPositions
-
-    return JointPositions.parse(table, args.positions)
-
-
 def _table_keys(table) -> dict:
-    """What a report of any table adds: the URDF, the payload frame and the joints."""
-    if table is None:
+    """What a report of a table other than the paper's adds: URDF, payload frame and joints."""
+    if is_paper_table(table):
         return {}
     return {
         "urdf": str(table.urdf_path),
@@ -131,17 +116,20 @@ def _table_keys(table) -> dict:
     }
 
 
+def _print_table(table) -> None:
+    """The line naming a table other than the paper's in a text report."""
+    if not is_paper_table(table):
+        print(f"table {table.urdf_path.name}: joints {', '.join(table.joint_names)}")
+
+
 def _gyrowheel(args: argparse.Namespace) -> GyroWheelModel:
     return GyroWheelModel.from_yaml(args.gyrowheel) if args.gyrowheel else GyroWheelModel.nominal()
 
 
 def run_rate_error(args: argparse.Namespace) -> int:
-    table = _table(args)
-    inputs = position_inputs(_positions(args, table), deg_to_rad(args.latitude_deg))
-    if table is not None:  # positions of another table may not determine the coefficients
-        from ..calibration.drift_fit import require_identifiable
-
-        require_identifiable(inputs)
+    table = table_from_args(args)
+    positions = PositionSet.parse(args.positions, table)
+    inputs = position_inputs(positions, deg_to_rad(args.latitude_deg))
     result = rate_error(
         _gyrowheel(args), inputs,
         deg_to_rad(args.dpsi_deg), deg_to_rad(args.dtheta_deg), deg_to_rad(args.dgamma_deg),
@@ -151,8 +139,7 @@ def run_rate_error(args: argparse.Namespace) -> int:
     if args.json:
         print_json(report)
         return 0
-    if table is not None:
-        print(f"table {table.urdf_path.name}: joints {', '.join(table.joint_names)}")
+    _print_table(table)
     print(
         f"positions {report['positions']} ({report['n_positions']}), latitude "
         f"{report['latitude_deg']:g} deg, {'exact rotation' if args.exact else 'eq. 7 dR'}, "
@@ -164,9 +151,9 @@ def run_rate_error(args: argparse.Namespace) -> int:
 
 
 def run_requirement(args: argparse.Namespace) -> int:
-    table = _table(args)
+    table = table_from_args(args)
     result = orientation_requirement(
-        args.accuracy_dph, _positions(args, table), deg_to_rad(args.latitude_deg),
+        args.accuracy_dph, PositionSet.parse(args.positions, table), deg_to_rad(args.latitude_deg),
         gyrowheel=_gyrowheel(args), exact=args.exact, definition=args.definition,
     )  # fmt: skip
     report = {**result.to_dict(), **_table_keys(table)}
@@ -177,8 +164,7 @@ def run_requirement(args: argparse.Namespace) -> int:
     if args.json:
         print_json(report)
         return 0
-    if table is not None:
-        print(f"table {table.urdf_path.name}: joints {', '.join(table.joint_names)}")
+    _print_table(table)
     print(
         f"accuracy {args.accuracy_dph:g} deg/h, positions {report['positions']} "
         f"({report['n_positions']}), latitude {report['latitude_deg']:g} deg, "
@@ -205,7 +191,7 @@ def run_requirement(args: argparse.Namespace) -> int:
 
 
 def run_calibrate(args: argparse.Namespace) -> int:
-    table = _table(args)
+    table = table_from_args(args)
     result = calibrate_run(args.run, deg_to_rad(args.latitude_deg), table)
     if args.json:
         print_json({**result.to_dict(), **_table_keys(table)})

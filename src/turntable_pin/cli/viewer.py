@@ -127,9 +127,9 @@ def _schedule_rad(args: argparse.Namespace, table) -> np.ndarray:
     """Animation frames (F, J): through ``--positions`` or every joint through 0, 90, 180,
     270 deg."""
     if args.positions is not None:
-        from ..calibration.table_positions import JointPositions
+        from ..calibration.positions import PositionSet
 
-        positions = np.degrees(JointPositions.from_csv(table, args.positions).angles_rad)
+        positions = np.degrees(PositionSet.from_csv(args.positions, table).angles_rad)
     else:
         positions = default_positions_deg(len(table.joint_names))
     return animation_frames_rad(positions, args.frames_per_move)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..calibration.rate_error import orientation_error_rotation, rate_errors_dph
+from ..calibration.rate_error import rate_errors_at_angles_dph
 from ..calibration.requirement import MAX_ANGLE_RAD, OrientationRequirement
 from ..core.units import deg_to_rad, rad_to_deg
 from .figures import pyplot, save_png
@@ -32,14 +32,10 @@ def plot_span_deg(result: OrientationRequirement) -> float:
 
 def _rate_errors(result: OrientationRequirement, angles_rad: np.ndarray) -> np.ndarray:
     """``[dwx, dwy]`` (deg/h) at (M, 3) angle triples."""
-    out = np.empty((angles_rad.shape[0], 2))
-    for start in range(0, angles_rad.shape[0], 4096):
-        chunk = angles_rad[start : start + 4096]
-        rotations = orientation_error_rotation(*chunk.T, exact=result.exact)
-        out[start : start + 4096] = rate_errors_dph(
-            result.gyrowheel, result.inputs, rotations, definition=result.definition
-        )
-    return out
+    return rate_errors_at_angles_dph(
+        result.gyrowheel, result.inputs, angles_rad, exact=result.exact,
+        definition=result.definition,
+    )  # fmt: skip
 
 
 def _title(result: OrientationRequirement) -> str:
