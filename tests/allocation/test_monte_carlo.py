@@ -91,7 +91,7 @@ def test_phi1_drops_out_and_the_phi1_path_gives_the_same(allocation, monkeypatch
     assert plain.max_phi1_dependence < 1e-15
     assert plain.phi1_evaluated_deg == (0.0,)
     # Force the phi1 grid (as an angle-dependent effect would): same worst values.
-    monkeypatch.setattr(mc, "PHI1_TOLERANCE", -1.0)
+    monkeypatch.setattr(mc, "DEPENDENCE_TOLERANCE", -1.0)
     forced = run(allocation, n=500, seed=2, phi2_step_deg=5.0, phi1_step_deg=30.0)
     assert len(forced.phi1_evaluated_deg) == 12
     np.testing.assert_allclose(forced.worst_rad, plain.worst_rad, rtol=0, atol=1e-15)

@@ -12,7 +12,7 @@ from turntable_pin.allocation.table_allocation import (
     angular_names,
     grid_angles_rad,
 )
-from turntable_pin.allocation.table_monte_carlo import run_table_monte_carlo, sample_table_errors
+from turntable_pin.allocation.monte_carlo import run_table_monte_carlo, sample_table_errors
 from turntable_pin.core.exceptions import InputError
 from turntable_pin.model.angles import ANGLE_ENTRIES
 from turntable_pin.model.generic_table import GenericTable

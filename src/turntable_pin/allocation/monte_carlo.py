@@ -1,22 +1,23 @@
-"""Monte Carlo check of an allocation with the exact Pinocchio chain (paper Figure 9).
+"""Monte Carlo check of an allocation on any table, with its exact chain (paper Figure 9).
 
-N random turntables are drawn inside the allocated box: each angular error gets a magnitude uniform
-in ``[LB_i, UB_i]`` and a random sign (the intersection error is left at 0: it moves the payload
-origin, never its orientation). Each turntable's exact ``dR`` is evaluated on a dense grid of phi2
-through :class:`OrientationErrorField` (coefficients read off the Pinocchio placements). With the
-errors of Table 2 ``dR`` does not depend on phi1 at all; the run checks that on every chunk (the
-phi1 harmonics of the coefficients) and, should some effect make it depend on phi1, evaluates a phi1
-grid as well. The result keeps each turntable's largest ``|dpsi|, |dtheta|, |dgamma|``.
+N random tables are drawn inside the allocated box: each of the table's angular errors gets a
+magnitude uniform in ``[LB_i, UB_i]`` and a random sign (the other errors -- the paper's
+intersection error ``deta``, a table's axis offsets -- stay 0: they move the payload origin, never
+its orientation). Each table's exact ``dR`` over a full grid of joint angles comes from the
+trigonometric coefficients of :class:`~turntable_pin.model.batch_field.ChainExpansion` (one batch
+of tables at a time: their coefficients, then the grid one joint at a time); the run keeps each
+table's largest ``|dpsi|, |dtheta|, |dgamma|``. A joint whose angle no drawn table's ``dR``
+depends on (the paper's outer axis phi1 with the errors of its Table 2: every harmonic of phi1 is
+zero) is evaluated at 0 only; :data:`DEPENDENCE_TOLERANCE` says what zero is.
+
+:func:`run_chain_monte_carlo` is the run, for any :class:`~turntable_pin.model.chain.ErrorChain`;
+:func:`run_monte_carlo` gives it the paper's table (a phi2 grid, phi1 checked) and
+:func:`run_table_monte_carlo` a table read from a URDF (the same grid over every joint).
 
 Chunks draw their samples from ``SeedSequence(seed).spawn(...)``, so the result depends on the seed
 only, not on the number of worker processes. Worker processes never outlive the run: on an error or
 an interruption (SIGINT, SIGTERM) they are killed at once, not waited for; Ctrl-C, which reaches
 the whole process group, is left to the parent.
-
-The run's machinery is shared with the Monte Carlo of any table (:mod:`.table_monte_carlo`):
-:func:`check_run` (the box, the count, the seed), :func:`signed_magnitudes` (the draw),
-:func:`chunk_plan` (chunks and their seeds), :func:`run_chunks` (the workers) and
-:class:`MonteCarloSummary` (the verdict and its JSON form).
 """
 
 from __future__ import annotations
@@ -25,44 +26,50 @@ import os
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
-from functools import lru_cache
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from ..core.blas_threads import blas_thread_controls, one_blas_thread
 from ..core.exceptions import InputError, check_seed
 from ..core.interrupts import deferred, register_cleanup, signals_blocked, worker_initializer
 from ..core.progress import Progress
-from ..core.sizes import MAX_MONTE_CARLO_TURNTABLES, check_count
+from ..core.sizes import MAX_MONTE_CARLO_TURNTABLES, check_count, turn_grid_count
 from ..core.units import DEG_PER_RAD, arcmin_by_name
-from ..model.batch_field import ANGLE_ENTRIES, OrientationErrorField
+from ..model.batch_field import ChainExpansion, joint_dependence, max_abs_on_grid
 from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES
 from ..model.turntable import TurntableModel
 from .solver import ORIENTATION_ANGLES, OrientationLimits
+from .table_allocation import angular_names, default_grid_step_deg, grid_angles_rad
 
 __all__ = [
-    "TURNTABLE_BYTES",
     "CHUNK_SIZE",
-    "PHI1_TOLERANCE",
+    "DEPENDENCE_TOLERANCE",
+    "TABLE_CHUNK_SIZE",
+    "TURNTABLE_BYTES",
     "MonteCarloResult",
-    "MonteCarloSummary",
-    "check_run",
-    "chunk_plan",
-    "phi1_dependence",
-    "run_chunks",
+    "PaperMonteCarloResult",
+    "run_chain_monte_carlo",
     "run_monte_carlo",
+    "run_table_monte_carlo",
     "sample_errors",
+    "sample_table_errors",
     "signed_magnitudes",
 ]
 
-CHUNK_SIZE = 2000  # turntables per block: the (chunk, 3, 360) intermediates stay small
+CHUNK_SIZE = 2000
+"""Tables drawn from one spawned seed (one task) in a run on the paper's table."""
+
+TABLE_CHUNK_SIZE = 500
+"""Tables drawn from one spawned seed in a run on a table given by URDF. The two sizes are part
+of what a seed means (they fix which tables it draws), kept as they were."""
 
 TURNTABLE_BYTES = 64
 """Memory a turntable of the run keeps (its three worst angles, its share of the tasks), bytes."""
 
-# Relative size of phi1 harmonics in dR below which phi1 is taken to drop out (rounding of the
-# 5x5 trigonometric fit is ~1e-16 of the largest coefficient, which is ~1).
-PHI1_TOLERANCE = 1e-12
+DEPENDENCE_TOLERANCE = 1e-12
+"""Largest harmonic of a joint's angle in ``dpsi, dtheta, dgamma`` below which the joint is taken
+to drop out (rounding of the coefficients is about 1e-16)."""
 
 
 def signed_magnitudes(
@@ -78,73 +85,47 @@ def signed_magnitudes(
 
 
 def sample_errors(
-    rng: np.random.Generator, n: int, upper_bounds_rad, lower_bounds_rad
+    rng: np.random.Generator,
+    n: int,
+    upper_bounds_rad,
+    lower_bounds_rad,
+    error_names=ERROR_NAMES,
+    drawn_names=ANGULAR_ERROR_NAMES,
 ) -> np.ndarray:
-    """(n, 9) error sets: magnitudes uniform in [LB, UB], random signs, deta = 0."""
-    drawn = signed_magnitudes(rng, n, upper_bounds_rad, lower_bounds_rad)
-    values = np.zeros((n, len(ERROR_NAMES)))
-    values[:, : drawn.shape[1]] = drawn
+    """(n, E) error vectors in ``error_names`` order: the ``drawn_names`` (the order of the
+    bounds) drawn by :func:`signed_magnitudes`, every other error 0. Default: the paper's nine
+    errors, ``deta = 0``."""
+    values = np.zeros((n, len(error_names)))
+    columns = [list(error_names).index(name) for name in drawn_names]
+    values[:, columns] = signed_magnitudes(rng, n, upper_bounds_rad, lower_bounds_rad)
     return values
 
 
-def check_run(
-    upper_bounds_rad, lower_bounds_rad, n: int, seed, size: int, size_message: str, *, finite=False
-) -> tuple[np.ndarray, np.ndarray, int]:
-    """The box ``(upper, lower)`` (lower default 0) and the seed of a run, checked.
-
-    Raises:
-        InputError: not ``size`` bounds each (``size_message``), an upper bound not finite (when
-            ``finite``), a lower bound outside ``[0, upper]``, fewer than 1 or too many tables,
-            a bad seed.
-    """
-    upper = np.asarray(upper_bounds_rad, dtype=float).reshape(-1)
-    lower = (
-        np.zeros_like(upper) if lower_bounds_rad is None else np.asarray(lower_bounds_rad, float)
+def sample_table_errors(table, rng: np.random.Generator, n: int, upper_rad, lower_rad):
+    """:func:`sample_errors` for a :class:`~turntable_pin.model.generic_table.GenericTable`."""
+    return sample_errors(
+        rng, n, upper_rad, lower_rad, table.chain.error_names, angular_names(table)
     )
-    if upper.size != size or lower.shape != upper.shape:
-        raise InputError(size_message)
-    if finite and not np.all(np.isfinite(upper)):
-        raise InputError("every upper bound must be a finite number")
-    if np.any(lower > upper) or np.any(lower < 0.0):
-        raise InputError("every lower bound must be between 0 and its upper bound")
-    if n < 1:
-        raise InputError(f"the number of turntables must be at least 1, got {n}")
-    check_count(n, MAX_MONTE_CARLO_TURNTABLES, "random turntables", TURNTABLE_BYTES)
-    return upper, lower, check_seed(seed)
 
 
-def chunk_plan(n: int, chunk_size: int, seed: int) -> tuple[list[int], list]:
-    """The sizes of the chunks of ``n`` tables (``chunk_size`` each, the rest last) and each
-    chunk's ``SeedSequence`` (spawned from ``seed``: the result depends on the seed only)."""
-    sizes = [chunk_size] * (n // chunk_size) + ([n % chunk_size] if n % chunk_size else [])
-    return sizes, np.random.SeedSequence(seed).spawn(len(sizes))
+def _run_chunk(task) -> tuple[np.ndarray, np.ndarray]:
+    """Worker: draw one chunk of tables; each one's max |angle| over the grid (n, 3) and the
+    chunk's largest harmonic of each joint."""
+    seed_seq, n, expansion, names, upper, lower, grids, tolerance = task
+    values = sample_errors(np.random.default_rng(seed_seq), n, upper, lower, *names)
+    coefficients = expansion.coefficients(values)
+    dependence = joint_dependence(coefficients, expansion.n_joints)
+    grids = [g if d > tolerance else g[:1] for g, d in zip(grids, dependence, strict=True)]
+    return max_abs_on_grid(coefficients, grids), dependence
 
 
-def phi1_dependence(field: OrientationErrorField) -> float:
-    """Largest coefficient of a phi1 harmonic in dpsi, dtheta, dgamma (0 when phi1 drops out)."""
-    c = field.coefficients
-    return float(max(np.abs(c[:, i, j, 1:, :]).max() for i, j in ANGLE_ENTRIES))
-
-
-@lru_cache(maxsize=4)
-def _nominal_model(urdf_path: str | None) -> TurntableModel:
-    """One nominal model per process and URDF (chunks only read its placements)."""
-    return TurntableModel(urdf_path=urdf_path)
-
-
-def _run_chunk(args) -> tuple[np.ndarray, float]:
-    """Worker: sample one chunk and return each turntable's max |angle| (n, 3) and phi1 check."""
-    seed_seq, n, upper, lower, phi2_grid_rad, phi1_grid_rad, urdf_path = args
-    rng = np.random.default_rng(seed_seq)
-    values = sample_errors(rng, n, upper, lower)
-    field = OrientationErrorField.from_error_values(values, _nominal_model(urdf_path))
-    dependence = phi1_dependence(field)
-    phi1_values = [0.0] if dependence <= PHI1_TOLERANCE else phi1_grid_rad
-    worst = np.zeros((n, 3))
-    for phi1 in phi1_values:
-        angles = field.angles_on_phi2_grid(phi1, phi2_grid_rad)  # (n, 3, M)
-        np.maximum(worst, np.maximum(angles.max(axis=2), -angles.min(axis=2)), out=worst)
-    return worst, dependence
+def _start_worker() -> None:
+    """Pool initializer: the interruption handling of every worker, and one BLAS thread for
+    the worker's life (a product split over threads on cores the other workers use was 3 to 6
+    times slower)."""
+    worker_initializer()
+    for set_threads, _ in blas_thread_controls():
+        set_threads(1)
 
 
 def _stop_workers(pools: list[ProcessPoolExecutor], kill: bool = True) -> None:
@@ -171,9 +152,9 @@ def _stop_workers(pools: list[ProcessPoolExecutor], kill: bool = True) -> None:
         pools.clear()
 
 
-def _chunk_results(worker, tasks, sizes, workers: int, progress: bool):
-    """Yield ``worker(task)`` of every task in order, in this process (``workers == 1``) or in
-    a pool of ``workers`` processes, reporting the turntables done (``sizes``) on stderr.
+def _chunk_results(tasks, sizes, workers: int, progress: bool):
+    """Yield ``_run_chunk(task)`` of every task in order, in this process (``workers == 1``) or
+    in a pool of ``workers`` processes, reporting the turntables done (``sizes``) on stderr.
 
     The workers never outlive the run (see the module docstring).
     """
@@ -183,16 +164,16 @@ def _chunk_results(worker, tasks, sizes, workers: int, progress: bool):
     try:
         with Progress(int(sum(sizes)), "Monte Carlo", enabled=progress) as bar:
             if workers == 1:
-                results = map(worker, tasks)
+                results = map(_run_chunk, tasks)
             else:
                 # Workers start with SIGINT/SIGTERM blocked and set up their own handling.
                 with deferred(), signals_blocked():
                     pools.append(
-                        ProcessPoolExecutor(max_workers=workers, initializer=worker_initializer)
+                        ProcessPoolExecutor(max_workers=workers, initializer=_start_worker)
                     )
                     # Not pool.map: its generator cancels the futures when interrupted, and
                     # Python 3.11's pool then fails (a traceback) marking them broken.
-                    futures = [pools[0].submit(worker, task) for task in tasks]
+                    futures = [pools[0].submit(_run_chunk, task) for task in tasks]
                 results = (future.result() for future in futures)
             for result, size in zip(results, sizes, strict=True):
                 yield result
@@ -208,29 +189,39 @@ def _chunk_results(worker, tasks, sizes, workers: int, progress: bool):
         unregister()
 
 
-def run_chunks(worker, tasks, sizes, workers: int, progress: bool):
-    """Run ``worker(task) -> (worst (size, 3), extra)`` on every task, in this process or in at
-    most ``workers`` processes (never more than the CPUs or the tasks; see the module docstring).
+@dataclass(frozen=True)
+class MonteCarloResult:
+    """The outcome of :func:`run_chain_monte_carlo`.
 
-    Returns ``(worst (N, 3) in task order, [extra of each task], workers used, elapsed s)``.
+    Attributes:
+        worst_rad: (N, 3) each table's largest |dpsi|, |dtheta|, |dgamma| over the grid, rad.
+        error_names: the angular errors drawn (the order of the bounds).
+        upper_bounds_rad, lower_bounds_rad: (P,) the box sampled.
+        limits: the orientation limits checked against.  n, seed: sample size and seed.
+        joint_names: the joints of the grid, in chain order.
+        grid_steps_deg: each joint's grid step, degrees.
+        evaluated_deg: each joint's angles evaluated, degrees: its grid, or 0 alone when no drawn
+            table's ``dR`` depends on the joint.
+        max_dependence: each joint's largest harmonic in any table's dpsi, dtheta, dgamma.
+        elapsed_s: wall time.  workers: processes used.
+        urdf, payload_frame: the table, when it was read from a URDF.
     """
-    workers = max(1, min(int(workers), os.cpu_count() or 1, len(tasks)))
-    start = time.perf_counter()
-    worst = np.empty((int(sum(sizes)), 3))
-    extras = []
-    offset = 0
-    for (chunk_worst, extra), size in zip(
-        _chunk_results(worker, tasks, sizes, workers, progress), sizes, strict=True
-    ):
-        worst[offset : offset + size] = chunk_worst
-        extras.append(extra)
-        offset += size
-    return worst, extras, workers, time.perf_counter() - start
 
-
-class MonteCarloSummary:
-    """What every Monte Carlo result (fields ``worst_rad``, ``limits``, ``n``, ``seed``,
-    ``elapsed_s``, ``workers`` and an ``evaluations`` count) says alike."""
+    worst_rad: np.ndarray
+    error_names: tuple[str, ...]
+    upper_bounds_rad: np.ndarray
+    lower_bounds_rad: np.ndarray
+    limits: OrientationLimits
+    n: int
+    seed: int
+    joint_names: tuple[str, ...]
+    grid_steps_deg: tuple[float, ...]
+    evaluated_deg: tuple[tuple[float, ...], ...]
+    max_dependence: tuple[float, ...]
+    elapsed_s: float
+    workers: int
+    urdf: str = ""
+    payload_frame: str = ""
 
     @property
     def max_abs_rad(self) -> np.ndarray:
@@ -242,76 +233,178 @@ class MonteCarloSummary:
         """Whether every table stays within the limits on every angle."""
         return bool(np.all(self.max_abs_rad <= self.limits.as_array()))
 
-    def verdict_dict(self) -> dict:
-        """Largest angles and limits (arcmin), the verdict, tables over each limit, n and seed."""
+    @property
+    def n_grid_points(self) -> int:
+        """Positions of the full grid over every joint."""
+        return int(np.prod([turn_grid_count(step) for step in self.grid_steps_deg]))
+
+    @property
+    def evaluations(self) -> int:
+        """Table x position evaluations done."""
+        return self.n * int(np.prod([len(angles) for angles in self.evaluated_deg]))
+
+    def _parts(self, sampling: str) -> tuple[dict, dict, dict]:
+        """The verdict, the box and the timing, JSON-ready (arcmin, s)."""
         limits = self.limits.as_array()
-        return {
+        exceeding = map(int, np.sum(self.worst_rad > limits, axis=0))
+        verdict = {
             "max_abs_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.max_abs_rad),
             "limits_arcmin": self.limits.to_dict(),
             "all_within": self.all_within,
-            "n_exceeding": dict(
-                zip(
-                    ORIENTATION_ANGLES,
-                    map(int, np.sum(self.worst_rad > limits, axis=0)),
-                    strict=True,
-                )
-            ),
+            "n_exceeding": dict(zip(ORIENTATION_ANGLES, exceeding, strict=True)),
             "n": self.n,
             "seed": self.seed,
         }
-
-    def timing_dict(self) -> dict:
-        """Wall time (s), evaluations per second and workers, JSON-ready."""
-        return {
+        box = {
+            "sampling": f"magnitude uniform in [lower, upper] bound, random sign; {sampling}",
+            "upper_bounds_arcmin": arcmin_by_name(self.error_names, self.upper_bounds_rad),
+            "lower_bounds_arcmin": arcmin_by_name(self.error_names, self.lower_bounds_rad),
+        }
+        timing = {
             "elapsed_s": self.elapsed_s,
             "evaluations_per_s": self.evaluations / max(self.elapsed_s, 1e-12),
             "workers": self.workers,
         }
-
-
-@dataclass(frozen=True)
-class MonteCarloResult(MonteCarloSummary):
-    """The outcome of :func:`run_monte_carlo`.
-
-    Attributes:
-        worst_rad: (N, 3) each turntable's largest |dpsi|, |dtheta|, |dgamma| over the grid, rad.
-        upper_bounds_rad, lower_bounds_rad: (8,) the box sampled.
-        limits: the orientation limits checked against.
-        n, seed: sample size and the seed that reproduces it.
-        phi2_step_deg: grid step of phi2.  phi1_evaluated_deg: the phi1 values evaluated.
-        max_phi1_dependence: largest phi1 harmonic found in any turntable's dR.
-        elapsed_s: wall time.  workers: processes used.
-    """
-
-    worst_rad: np.ndarray
-    upper_bounds_rad: np.ndarray
-    lower_bounds_rad: np.ndarray
-    limits: OrientationLimits
-    n: int
-    seed: int
-    phi2_step_deg: float
-    phi1_evaluated_deg: tuple[float, ...]
-    max_phi1_dependence: float
-    elapsed_s: float
-    workers: int
-
-    @property
-    def evaluations(self) -> int:
-        """Turntable x angle-pair evaluations done."""
-        return self.n * int(round(360.0 / self.phi2_step_deg)) * len(self.phi1_evaluated_deg)
+        return verdict, box, timing
 
     def to_dict(self) -> dict:
         """The outcome as a JSON-ready dict (angles in arcmin, steps in degrees, time in s)."""
+        verdict, box, timing = self._parts("offsets 0")
+        steps = set(self.grid_steps_deg)
         return {
-            **self.verdict_dict(),
-            "sampling": "magnitude uniform in [lower, upper] bound, random sign; deta = 0",
-            "upper_bounds_arcmin": arcmin_by_name(ANGULAR_ERROR_NAMES, self.upper_bounds_rad),
-            "lower_bounds_arcmin": arcmin_by_name(ANGULAR_ERROR_NAMES, self.lower_bounds_rad),
+            "urdf": self.urdf,
+            "payload_frame": self.payload_frame,
+            **verdict,
+            **box,
+            "grid_step_deg": steps.pop() if len(steps) == 1 else list(self.grid_steps_deg),
+            "n_grid_points": self.n_grid_points,
+            **timing,
+        }
+
+
+class PaperMonteCarloResult(MonteCarloResult):
+    """:class:`MonteCarloResult` of the paper's table, said in its terms: a phi2 grid, phi1
+    evaluated at 0 only when it drops out (it does, with the errors of Table 2)."""
+
+    @property
+    def phi2_step_deg(self) -> float:
+        """Grid step of phi2 (the inner axis), degrees."""
+        return self.grid_steps_deg[1]
+
+    @property
+    def phi1_evaluated_deg(self) -> tuple[float, ...]:
+        """The phi1 values evaluated, degrees."""
+        return self.evaluated_deg[0]
+
+    @property
+    def max_phi1_dependence(self) -> float:
+        """Largest phi1 harmonic in any turntable's dpsi, dtheta, dgamma."""
+        return self.max_dependence[0]
+
+    def to_dict(self) -> dict:
+        """The outcome as a JSON-ready dict (angles in arcmin, steps in degrees, time in s)."""
+        verdict, box, timing = self._parts("deta = 0")
+        return {
+            **verdict,
+            **box,
             "phi2_step_deg": self.phi2_step_deg,
             "phi1_evaluated_deg": list(self.phi1_evaluated_deg),
             "max_phi1_dependence": self.max_phi1_dependence,
-            **self.timing_dict(),
+            **timing,
         }
+
+
+def run_chain_monte_carlo(
+    chain,
+    error_names,
+    upper_bounds_rad,
+    limits: OrientationLimits,
+    n: int,
+    seed: int,
+    *,
+    grid_steps_deg,
+    lower_bounds_rad=None,
+    chunk_size: int = CHUNK_SIZE,
+    workers: int = 1,
+    progress: bool = True,
+) -> MonteCarloResult:
+    """Evaluate ``n`` random tables inside the box on the exact chain; compare with ``limits``.
+
+    Args:
+        chain: the table's :class:`~turntable_pin.model.chain.ErrorChain` (1 to 3 joints).
+        error_names: the angular errors drawn, in the order of the bounds (the others stay 0).
+        upper_bounds_rad, lower_bounds_rad: (P,) bounds of their magnitudes (lower default 0).
+        limits: orientation limits.  n: number of tables.  seed: random seed (recorded).
+        grid_steps_deg: each joint's grid step over the whole turn, degrees, in chain order.
+        chunk_size: tables drawn from one spawned seed (the seed's meaning depends on it).
+        workers: processes (the result does not depend on it).  progress: report on stderr.
+
+    Raises:
+        InputError: not one bound per angular error, an upper bound not finite, a lower bound
+            outside ``[0, upper]``, fewer than 1 or too many tables, a bad seed or grid step.
+    """
+    names = tuple(error_names)
+    upper = np.asarray(upper_bounds_rad, dtype=float).reshape(-1)
+    lower = (
+        np.zeros_like(upper) if lower_bounds_rad is None else np.asarray(lower_bounds_rad, float)
+    )
+    if upper.size != len(names) or lower.shape != upper.shape:
+        raise InputError(f"expected {len(names)} upper and lower bounds ({', '.join(names)})")
+    if not np.all(np.isfinite(upper)):
+        raise InputError("every upper bound must be a finite number")
+    if np.any(lower > upper) or np.any(lower < 0.0):
+        raise InputError("every lower bound must be between 0 and its upper bound")
+    if n < 1:
+        raise InputError(f"the number of turntables must be at least 1, got {n}")
+    check_count(n, MAX_MONTE_CARLO_TURNTABLES, "random turntables", TURNTABLE_BYTES)
+    seed = check_seed(seed)
+    steps = tuple(float(step) for step in grid_steps_deg)
+    if len(steps) != len(chain.joint_names) or not all(0.0 < s <= 90.0 for s in steps):
+        raise InputError(
+            f"expected a grid step in (0, 90] degrees for each of {', '.join(chain.joint_names)}"
+            f", got {steps}"
+        )
+    expansion = ChainExpansion(chain)
+    expansion.coefficients(np.zeros((1, expansion.n_errors)))  # prepared before it is sent
+    grids = [np.arange(turn_grid_count(step)) * step / DEG_PER_RAD for step in steps]
+    sizes = [chunk_size] * (n // chunk_size) + ([n % chunk_size] if n % chunk_size else [])
+    chunk_names = (chain.error_names, names)
+    tasks = [
+        (s, size, expansion, chunk_names, upper, lower, grids, DEPENDENCE_TOLERANCE)
+        for s, size in zip(np.random.SeedSequence(seed).spawn(len(sizes)), sizes, strict=True)
+    ]
+    workers = max(1, min(int(workers), os.cpu_count() or 1, len(tasks)))
+    start = time.perf_counter()
+    worst = np.empty((n, 3))
+    dependence = np.zeros(len(steps))
+    offset = 0
+    with one_blas_thread():  # for the chunks run in this process (workers == 1)
+        for (chunk_worst, chunk_dependence), size in zip(
+            _chunk_results(tasks, sizes, workers, progress), sizes, strict=True
+        ):
+            worst[offset : offset + size] = chunk_worst
+            np.maximum(dependence, chunk_dependence, out=dependence)
+            offset += size
+    elapsed = time.perf_counter() - start
+    evaluated = tuple(
+        tuple(float(a) for a in np.arange(g.size) * step) if d > DEPENDENCE_TOLERANCE else (0.0,)
+        for g, step, d in zip(grids, steps, dependence, strict=True)
+    )
+    return MonteCarloResult(
+        worst_rad=worst,
+        error_names=names,
+        upper_bounds_rad=upper,
+        lower_bounds_rad=lower,
+        limits=limits,
+        n=n,
+        seed=seed,
+        joint_names=tuple(chain.joint_names),
+        grid_steps_deg=steps,
+        evaluated_deg=evaluated,
+        max_dependence=tuple(float(d) for d in dependence),
+        elapsed_s=elapsed,
+        workers=workers,
+    )
 
 
 def run_monte_carlo(
@@ -326,44 +419,69 @@ def run_monte_carlo(
     workers: int = 1,
     progress: bool = True,
     urdf_path=None,
-) -> MonteCarloResult:
-    """Evaluate ``n`` random turntables inside the box and compare with ``limits``.
+) -> PaperMonteCarloResult:
+    """:func:`run_chain_monte_carlo` on the paper's table (its eight angular errors, ``deta``
+    0) over a phi2 grid; phi1 on its grid only if some table's ``dR`` depends on it.
 
     Args:
-        upper_bounds_rad, lower_bounds_rad: (8,) bounds of the magnitudes (lower default 0).
-        limits: orientation limits.  n: number of turntables.  seed: random seed (recorded).
-        phi2_step_deg: phi2 grid step over the whole turn.
-        phi1_step_deg: phi1 grid step, used only if dR turns out to depend on phi1.
-        workers: processes (the result does not depend on it).  progress: report on stderr.
+        upper_bounds_rad, lower_bounds_rad: (8,) bounds in ``ANGULAR_ERROR_NAMES`` order.
+        limits, n, seed, workers, progress: as :func:`run_chain_monte_carlo`.
+        phi2_step_deg, phi1_step_deg: the grid steps, degrees.
         urdf_path: nominal URDF (default bundled).
     """
-    count = len(ANGULAR_ERROR_NAMES)
-    message = f"expected {count} upper and lower bounds"
-    upper, lower, seed = check_run(upper_bounds_rad, lower_bounds_rad, n, seed, count, message)
     for name, step in (("phi2", phi2_step_deg), ("phi1", phi1_step_deg)):
         if not 0.0 < step <= 90.0:
             raise InputError(f"{name} grid step must be in (0, 90] degrees, got {step}")
-    phi2_grid = np.arange(0.0, 360.0, phi2_step_deg) / DEG_PER_RAD
-    phi1_grid = np.arange(0.0, 360.0, phi1_step_deg) / DEG_PER_RAD
-    urdf = None if urdf_path is None else str(urdf_path)
-    sizes, seeds = chunk_plan(n, CHUNK_SIZE, seed)
-    tasks = [
-        (s, size, upper, lower, phi2_grid, phi1_grid, urdf)
-        for s, size in zip(seeds, sizes, strict=True)
-    ]
-    worst, dependences, workers, elapsed = run_chunks(_run_chunk, tasks, sizes, workers, progress)
-    dependence = max([0.0, *dependences])
-    phi1_used = (0.0,) if dependence <= PHI1_TOLERANCE else tuple(phi1_grid * DEG_PER_RAD)
-    return MonteCarloResult(
-        worst_rad=worst,
-        upper_bounds_rad=upper,
-        lower_bounds_rad=lower,
-        limits=limits,
-        n=n,
-        seed=seed,
-        phi2_step_deg=phi2_step_deg,
-        phi1_evaluated_deg=phi1_used,
-        max_phi1_dependence=dependence,
-        elapsed_s=elapsed,
+    result = run_chain_monte_carlo(
+        TurntableModel(urdf_path=urdf_path).chain,
+        ANGULAR_ERROR_NAMES,
+        upper_bounds_rad,
+        limits,
+        n,
+        seed,
+        grid_steps_deg=(phi1_step_deg, phi2_step_deg),
+        lower_bounds_rad=lower_bounds_rad,
         workers=workers,
+        progress=progress,
     )
+    return PaperMonteCarloResult(**{f.name: getattr(result, f.name) for f in fields(result)})
+
+
+def run_table_monte_carlo(
+    table,
+    upper_bounds_rad,
+    limits: OrientationLimits,
+    n: int,
+    seed: int,
+    *,
+    lower_bounds_rad=None,
+    grid_step_deg: float | None = None,
+    workers: int = 1,
+    progress: bool = True,
+) -> MonteCarloResult:
+    """:func:`run_chain_monte_carlo` on a
+    :class:`~turntable_pin.model.generic_table.GenericTable` (its angular errors, offsets 0)
+    over the same grid on every joint.
+
+    Args:
+        table: the table.  upper_bounds_rad, lower_bounds_rad: (P,) bounds of its angular errors
+            (:func:`.table_allocation.angular_names` order; lower default 0), radians.
+        grid_step_deg: the grid step (default by joint count).
+        limits, n, seed, workers, progress: as :func:`run_chain_monte_carlo`.
+    """
+    step = default_grid_step_deg(table) if grid_step_deg is None else float(grid_step_deg)
+    grid_angles_rad(table, step)  # checks the step and the grid's size
+    result = run_chain_monte_carlo(
+        table.chain,
+        angular_names(table),
+        upper_bounds_rad,
+        limits,
+        n,
+        seed,
+        grid_steps_deg=(step,) * len(table.joint_names),
+        lower_bounds_rad=lower_bounds_rad,
+        chunk_size=TABLE_CHUNK_SIZE,
+        workers=workers,
+        progress=progress,
+    )
+    return replace(result, urdf=str(table.urdf_path), payload_frame=table.payload_frame)

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..allocation.capability import ManufacturingCapability
-from ..allocation.monte_carlo import run_monte_carlo
+from ..allocation.monte_carlo import run_monte_carlo, run_table_monte_carlo
 from ..allocation.sensitivity import AverageSensitivities, average_sensitivities
 from ..allocation.solver import (
     DEFAULT_ACCURACY_DPH,
@@ -300,81 +300,42 @@ def _scaled_bounds(args: argparse.Namespace, upper, lower):
     return upper, lower
 
 
-def _run_table_montecarlo(args: argparse.Namespace, table) -> int:
-    """``montecarlo`` on a table given by ``--urdf``."""
-    from ..allocation.table_monte_carlo import run_table_monte_carlo
-
-    if args.phi2_step_deg is not None:
-        raise InputError("--phi2-step-deg is the paper table's; for this table: --grid-step-deg")
-    allocation = _table_allocation_from_args(args, table)
-    upper, lower = _scaled_bounds(args, allocation.upper_bounds_rad, allocation.lower_bounds_rad)
-    result = run_table_monte_carlo(
-        table,
-        upper,
-        allocation.limits,
-        args.n,
-        args.seed,
-        lower_bounds_rad=lower,
-        grid_step_deg=allocation.sensitivities.grid_step_deg,
-        workers=args.workers,
-        progress=not (args.quiet or args.json),
-    )
-    report = result.to_dict()
-    report["weights"] = args.weights
-    report["scale_bounds"] = args.scale_bounds
-    if args.json:
-        print_json(report)
-    else:
-        _print_montecarlo(
-            result,
-            allocation.limits,
-            f"Monte Carlo on {table.urdf_path.name}: {result.n} tables (seed {result.seed}), "
-            f"grid {result.grid_step_deg:g} deg over {', '.join(table.joint_names)} "
-            f"({result.n_grid_points} positions), exact chain, {result.elapsed_s:.1f} s",
-        )
-    return 0 if result.all_within else 1
-
-
-def _print_montecarlo(result, limits: OrientationLimits, title: str) -> None:
-    """The text report of a Monte Carlo run: each angle's largest value against its limit."""
-    limits = limits.to_dict()
-    print(title)
-    for k, name in enumerate(ORIENTATION_ANGLES):
-        value = result.max_abs_rad[k] * ARCMIN_PER_RAD
-        flag = "ok" if value <= limits[name] else "EXCEEDED"
-        print(f"  max |d{name}| = {value:.4f}'  limit {limits[name]:.4f}'  {flag}")
-    print("all within the limits" if result.all_within else "a limit is exceeded")
-
-
 def run_montecarlo(args: argparse.Namespace) -> int:
     if args.scale_bounds <= 0.0:
         raise InputError(f"--scale-bounds must be positive, got {args.scale_bounds}")
     table = _table(args)
+    options = {"workers": args.workers, "progress": not (args.quiet or args.json)}
     if table is not None:
-        return _run_table_montecarlo(args, table)
-    if args.phi2_step_deg is None:
-        args.phi2_step_deg = 1.0
-    allocation, _ = _allocation_from_args(args)
-    upper = allocation.upper_bounds_rad * args.scale_bounds
-    if float(upper.max()) > MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD:
-        raise InputError(
-            f"--scale-bounds {args.scale_bounds:g}: the scaled bounds reach "
-            f"{float(upper.max()) * DEG_PER_RAD:g} deg, beyond the {MAX_ANGULAR_ERROR_DEG:g} deg "
-            "of a small error"
+        if args.phi2_step_deg is not None:
+            raise InputError(
+                "--phi2-step-deg is the paper table's; for this table: --grid-step-deg"
+            )
+        allocation = _table_allocation_from_args(args, table)
+        upper, lower = _scaled_bounds(
+            args, allocation.upper_bounds_rad, allocation.lower_bounds_rad
         )
-    lower = allocation.capability.lower_bounds_rad
-    if args.scale_bounds < 1.0:
-        lower = lower * args.scale_bounds
-    result = run_monte_carlo(
-        upper,
-        allocation.limits,
-        args.n,
-        args.seed,
-        lower_bounds_rad=lower,
-        phi2_step_deg=args.phi2_step_deg,
-        workers=args.workers,
-        progress=not (args.quiet or args.json),
-    )
+        result = run_table_monte_carlo(
+            table, upper, allocation.limits, args.n, args.seed, lower_bounds_rad=lower,
+            grid_step_deg=allocation.sensitivities.grid_step_deg, **options,
+        )  # fmt: skip
+        title = (
+            f"Monte Carlo on {table.urdf_path.name}: {result.n} tables (seed {result.seed}), "
+            f"grid {result.grid_steps_deg[0]:g} deg over {', '.join(table.joint_names)} "
+            f"({result.n_grid_points} positions), exact chain, {result.elapsed_s:.1f} s"
+        )
+    else:
+        allocation, _ = _allocation_from_args(args)
+        upper, lower = _scaled_bounds(
+            args, allocation.upper_bounds_rad, allocation.capability.lower_bounds_rad
+        )
+        result = run_monte_carlo(
+            upper, allocation.limits, args.n, args.seed, lower_bounds_rad=lower,
+            phi2_step_deg=args.phi2_step_deg or 1.0, **options,
+        )  # fmt: skip
+        title = (
+            f"Monte Carlo: {result.n} turntables (seed {result.seed}), phi2 step "
+            f"{result.phi2_step_deg:g} deg, exact chain, {result.elapsed_s:.1f} s"
+        )
     report = result.to_dict()
     report["weights"] = args.weights
     report["scale_bounds"] = args.scale_bounds
@@ -386,17 +347,14 @@ def run_montecarlo(args: argparse.Namespace) -> int:
         report["plot"] = str(figure)
     if args.json:
         print_json(report)
-    else:
-        limits = allocation.limits.to_dict()
-        print(
-            f"Monte Carlo: {result.n} turntables (seed {result.seed}), phi2 step "
-            f"{result.phi2_step_deg:g} deg, exact chain, {result.elapsed_s:.1f} s"
-        )
-        for k, name in enumerate(ORIENTATION_ANGLES):
-            value = result.max_abs_rad[k] * ARCMIN_PER_RAD
-            flag = "ok" if value <= limits[name] else "EXCEEDED"
-            print(f"  max |d{name}| = {value:.4f}'  limit {limits[name]:.4f}'  {flag}")
-        print("all within the limits" if result.all_within else "a limit is exceeded")
-        if figure:
-            print(f"wrote {figure}")
+        return 0 if result.all_within else 1
+    limits = allocation.limits.to_dict()
+    print(title)
+    for k, name in enumerate(ORIENTATION_ANGLES):
+        value = result.max_abs_rad[k] * ARCMIN_PER_RAD
+        flag = "ok" if value <= limits[name] else "EXCEEDED"
+        print(f"  max |d{name}| = {value:.4f}'  limit {limits[name]:.4f}'  {flag}")
+    print("all within the limits" if result.all_within else "a limit is exceeded")
+    if figure:
+        print(f"wrote {figure}")
     return 0 if result.all_within else 1
