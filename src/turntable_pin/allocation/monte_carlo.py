@@ -38,9 +38,9 @@ from ..core.sizes import MAX_MONTE_CARLO_TURNTABLES, check_count, turn_grid_coun
 from ..core.units import DEG_PER_RAD, arcmin_by_name
 from ..model.batch_field import ChainExpansion, joint_dependence, max_abs_on_grid
 from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES
-from ..model.turntable import TurntableModel
+from ..model.paper_table import paper_table
 from .solver import ORIENTATION_ANGLES, OrientationLimits
-from .table_allocation import angular_names, default_grid_step_deg, grid_angles_rad
+from .table_allocation import default_grid_step_deg, grid_angles_rad
 
 __all__ = [
     "CHUNK_SIZE",
@@ -103,9 +103,7 @@ def sample_errors(
 
 def sample_table_errors(table, rng: np.random.Generator, n: int, upper_rad, lower_rad):
     """:func:`sample_errors` for a :class:`~turntable_pin.model.generic_table.GenericTable`."""
-    return sample_errors(
-        rng, n, upper_rad, lower_rad, table.chain.error_names, angular_names(table)
-    )
+    return sample_errors(rng, n, upper_rad, lower_rad, table.chain.error_names, table.angular_names)
 
 
 def _run_chunk(task) -> tuple[np.ndarray, np.ndarray]:
@@ -433,7 +431,7 @@ def run_monte_carlo(
         if not 0.0 < step <= 90.0:
             raise InputError(f"{name} grid step must be in (0, 90] degrees, got {step}")
     result = run_chain_monte_carlo(
-        TurntableModel(urdf_path=urdf_path).chain,
+        paper_table(urdf_path).chain,
         ANGULAR_ERROR_NAMES,
         upper_bounds_rad,
         limits,
@@ -465,7 +463,7 @@ def run_table_monte_carlo(
 
     Args:
         table: the table.  upper_bounds_rad, lower_bounds_rad: (P,) bounds of its angular errors
-            (:func:`.table_allocation.angular_names` order; lower default 0), radians.
+            (``table.angular_names`` order; lower default 0), radians.
         grid_step_deg: the grid step (default by joint count).
         limits, n, seed, workers, progress: as :func:`run_chain_monte_carlo`.
     """
@@ -473,7 +471,7 @@ def run_table_monte_carlo(
     grid_angles_rad(table, step)  # checks the step and the grid's size
     result = run_chain_monte_carlo(
         table.chain,
-        angular_names(table),
+        table.angular_names,
         upper_bounds_rad,
         limits,
         n,
