@@ -54,7 +54,6 @@ __all__ = [
     "run_table_monte_carlo",
     "sample_errors",
     "sample_table_errors",
-    "signed_magnitudes",
 ]
 
 CHUNK_SIZE = 2000
@@ -72,18 +71,6 @@ DEPENDENCE_TOLERANCE = 1e-12
 to drop out (rounding of the coefficients is about 1e-16)."""
 
 
-def signed_magnitudes(
-    rng: np.random.Generator, n: int, upper_bounds_rad, lower_bounds_rad
-) -> np.ndarray:
-    """(n, P) errors of magnitude uniform in [LB, UB] and random sign (magnitudes drawn first,
-    then signs)."""
-    upper = np.asarray(upper_bounds_rad, dtype=float)
-    lower = np.asarray(lower_bounds_rad, dtype=float)
-    magnitudes = rng.uniform(lower, upper, size=(n, upper.size))
-    signs = rng.choice(np.array([-1.0, 1.0]), size=(n, upper.size))
-    return magnitudes * signs
-
-
 def sample_errors(
     rng: np.random.Generator,
     n: int,
@@ -93,11 +80,13 @@ def sample_errors(
     drawn_names=ANGULAR_ERROR_NAMES,
 ) -> np.ndarray:
     """(n, E) error vectors in ``error_names`` order: the ``drawn_names`` (the order of the
-    bounds) drawn by :func:`signed_magnitudes`, every other error 0. Default: the paper's nine
-    errors, ``deta = 0``."""
+    bounds) with magnitudes uniform in [LB, UB] and random signs (magnitudes drawn first, then
+    signs), every other error 0. Default: the paper's nine errors, ``deta = 0``."""
+    upper = np.asarray(upper_bounds_rad, dtype=float)
+    magnitudes = rng.uniform(np.asarray(lower_bounds_rad, dtype=float), upper, (n, upper.size))
     values = np.zeros((n, len(error_names)))
     columns = [list(error_names).index(name) for name in drawn_names]
-    values[:, columns] = signed_magnitudes(rng, n, upper_bounds_rad, lower_bounds_rad)
+    values[:, columns] = magnitudes * rng.choice(np.array([-1.0, 1.0]), size=(n, upper.size))
     return values
 
 
@@ -363,7 +352,6 @@ def run_chain_monte_carlo(
             f", got {steps}"
         )
     expansion = ChainExpansion(chain)
-    expansion.coefficients(np.zeros((1, expansion.n_errors)))  # prepared before it is sent
     grids = [np.arange(turn_grid_count(step)) * step / DEG_PER_RAD for step in steps]
     sizes = [chunk_size] * (n // chunk_size) + ([n % chunk_size] if n % chunk_size else [])
     chunk_names = (chain.error_names, names)

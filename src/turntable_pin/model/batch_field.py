@@ -24,8 +24,6 @@ joint at a time (:func:`max_abs_on_grid`), which is what makes the Monte Carlo c
 
 from __future__ import annotations
 
-import weakref
-
 import numpy as np
 
 from .angles import ANGLE_ENTRIES
@@ -114,8 +112,8 @@ class ChainExpansion:
 
     Holds the rotation part of the chain only (translations never change ``dR``): per stretch
     between two joints its constant rotations and its error rotations (error column and
-    Rodrigues terms), the joints' Rodrigues terms, and the nominal coefficients ``D``. Plain
-    arrays: it is cheap to send to worker processes.
+    Rodrigues terms), the joints' Rodrigues terms, and per row of ``dR`` the operator ``L``
+    made from the nominal coefficients ``D``. Plain arrays: cheap to send to worker processes.
 
     Args:
         chain: the error chain (1 to 3 joints).
@@ -135,11 +133,19 @@ class ChainExpansion:
                 joints.append(_rodrigues_terms(link.axis))
                 stretches.append([])
         self.n_joints = len(joints)
-        self._stretches = [_merge_constants(steps) for steps in stretches]
+        self._stretches = stretches
         # (3, 9) per joint: [G0 | G1 | G2], so that X @ it gives the three terms side by side.
         self._joint_terms = [np.concatenate(list(g), axis=1) for g in joints]
-        self._nominal = self._chain_terms(None)[0]  # (3 * 3^J, 3): rows (a, n_1..n_J), cols i
-        self._operators: dict[tuple, list] = {}
+        product = np.ones((1, 1, 1))  # v_n v_m -> u_p over every joint (Kronecker product)
+        for _ in joints:
+            product = np.einsum("nmp,xyz->nxmypz", product, _PRODUCT_TO_SUM)
+            product = product.reshape([3 * product.shape[0], 3 * product.shape[2], -1])
+        nominal = self._chain_terms(None)[0].reshape(3, -1, 3)  # D: (a, n_1..n_J, i)
+        # C_ij = T[:, :, j] @ L_i with L_i[(a, m), p] = sum_n D[a, n, i] W[n, m, p], W = product.
+        self._operators = [
+            np.einsum("an,nmp->amp", nominal[:, :, i], product).reshape(len(product) * 3, -1)
+            for i in range(3)
+        ]
 
     # ---- per error set ---------------------------------------------------------------------
     def _stretch_rotation(self, steps, values: np.ndarray | None) -> np.ndarray:
@@ -168,26 +174,6 @@ class ChainExpansion:
             x = x @ self._stretch_rotation(steps, values)
         return x
 
-    def _operator(self, entries: tuple[tuple[int, int], ...]) -> list[tuple[int, np.ndarray]]:
-        """Per entry ``(i, j)``: ``(j, L)`` with ``C_ij = T[:, :, j] @ L``, ``L`` (3 * 3^J, 5^J)."""
-        if entries not in self._operators:
-            product = np.ones((1, 1, 1))
-            for _ in range(self.n_joints):  # Kronecker product over the joints
-                product = np.einsum("nmp,xyz->nxmypz", product, _PRODUCT_TO_SUM).reshape(
-                    product.shape[0] * 3, product.shape[1] * 3, product.shape[2] * N_BASIS
-                )
-            nominal = self._nominal.reshape(3, -1, 3)  # (a, n, i)
-            self._operators[entries] = [
-                (
-                    j,
-                    np.einsum("an,nmp->amp", nominal[:, :, i], product).reshape(
-                        -1, product.shape[2]
-                    ),
-                )
-                for i, j in entries
-            ]
-        return self._operators[entries]
-
     def coefficients(self, error_values, entries=ANGLE_ENTRIES) -> np.ndarray:
         """Coefficients (K, len(entries), 5^J) of the ``dR`` entries ``entries`` for K error sets.
 
@@ -201,28 +187,7 @@ class ChainExpansion:
         if values.shape[-1] != self.n_errors:
             raise ValueError(f"expected {self.n_errors} error values, got shape {values.shape}")
         terms = self._chain_terms(values)
-        return np.stack([terms[:, :, j] @ op for j, op in self._operator(tuple(entries))], axis=1)
-
-
-def _merge_constants(steps: list) -> list:
-    """``steps`` with each run of constant rotations multiplied into one."""
-    out: list = []
-    for step in steps:
-        if isinstance(step, np.ndarray) and out and isinstance(out[-1], np.ndarray):
-            out[-1] = out[-1] @ step
-        else:
-            out.append(step)
-    return out
-
-
-_EXPANSIONS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
-def _expansion(chain) -> ChainExpansion:
-    """The :class:`ChainExpansion` of ``chain``, made once per chain object."""
-    if chain not in _EXPANSIONS:
-        _EXPANSIONS[chain] = ChainExpansion(chain)
-    return _EXPANSIONS[chain]
+        return np.stack([terms[:, :, j] @ self._operators[i] for i, j in entries], axis=1)
 
 
 def joint_dependence(coefficients: np.ndarray, n_joints: int) -> np.ndarray:
@@ -298,7 +263,7 @@ class OrientationErrorField:
 
         ``error_values`` has shape (K, E) in ``chain.error_names`` order (rad, m).
         """
-        expansion = _expansion(chain)
+        expansion = ChainExpansion(chain)
         c = expansion.coefficients(error_values, _ALL_ENTRIES)
         shape = (c.shape[0], 3, 3) + (N_BASIS,) * expansion.n_joints
         return cls(c.reshape(shape), n_joints=expansion.n_joints)
