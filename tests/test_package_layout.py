@@ -23,9 +23,10 @@ LAYER_RANK = {
     "calibration": 3,
     "measurement": 4,
     "allocation": 4,
-    "report": 5,
+    "design": 5,
+    "report": 6,
     "viewer": 5,
-    "cli": 6,
+    "cli": 7,
 }
 
 

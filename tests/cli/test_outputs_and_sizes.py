@@ -40,6 +40,8 @@ WRITERS = [
     (["allocate", "--lower-bounds", "{in}", "--plots", "{in}"], BOUNDS),
     (["montecarlo", "-n", "10", "--lower-bounds", "{in}", "--plots", "{in}"], BOUNDS),
     (["snapshot", "--errors", "{in}", "-o", "{in}"], ERRORS),
+    (["design", "--urdf", "{in}", "-o", "{in}"], URDF),
+    (["design", "--from", "{in}", "--plots", "{in}"], DATA),
 ]
 
 

@@ -58,6 +58,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "diagnose": ("measurement", "which catalogued physical effect is missing"),
     "report": ("measurement", "one self-contained HTML page with the whole story"),
     "import-tpoint": ("tpoint", "a TPOINT pointing run (telescope mount) as a measurement CSV"),
+    "design": ("design", "which positions to measure next: identify, separate, calibrate"),
     "effects": ("effects", "list the candidate effects of a table, the catalogue and yours"),
     "view": ("viewer", "show the turntable and its (magnified) errors in a meshcat 3-D viewer"),
     "snapshot": ("viewer", "render the 3-D view of the setup to a PNG (headless Chromium)"),

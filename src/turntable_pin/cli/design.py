@@ -1,0 +1,233 @@
+"""``design``: which positions to measure next, to identify, to separate two effects, to calibrate.
+
+The common options say the table (``--urdf``), the joints' limits, the effects, the positions
+already measured (``--from``), how many positions to choose and from how many seeded candidates;
+each mode is one function (``_run_identify``, ``_run_separate``, ``_run_calibrate``) that calls
+the library (:mod:`turntable_pin.design`) and renders its one result as text, JSON, a CSV of the
+positions (``-o``: what ``simulate --positions`` and the test crew read) and figures (``--plots``).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..core.exceptions import InputError
+from .common import (
+    add_table_options,
+    bounded_float,
+    input_path,
+    one_line_errors,
+    positive_int,
+    print_json,
+    seed,
+    table_from_args,
+)
+
+__all__ = ["register"]
+
+DEFAULT_POSITIONS = 24
+"""Positions a design chooses when ``-n`` is not given."""
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``design`` to ``subparsers``."""
+    from ..design.space import DEFAULT_CANDIDATES, GRID_STEP_DEG
+
+    p = subparsers.add_parser(
+        "design",
+        description="Which positions to measure next. Default (identify): the N positions within "
+        "the joints' limits that determine the identifiable combinations of the base errors and "
+        "the chosen effects best (D-optimal: the largest log det of their Fisher information), "
+        "with each combination's expected standard error and the D-efficiency against the "
+        f"{GRID_STEP_DEG:g}-degree grid. --separate A,B: the positions that tell effect A from "
+        "effect B (T-optimal). --calibrate: GyroWheel calibration positions least sensitive to "
+        "the table's orientation errors. Effects that need time_s (thermal drift) make the run "
+        "repeat positions early and late in a seeded random order; backlash makes it approach "
+        "each position from both sides (dirK = +1 and -1).",
+    )
+    one_line_errors(p)
+    add_table_options(p)
+    mode = p.add_mutually_exclusive_group()
+    mode.add_argument(
+        "--separate", metavar="A,B", help="positions that tell effect A from effect B (T-optimal)"
+    )
+    mode.add_argument(
+        "--calibrate",
+        action="store_true",
+        help="GyroWheel calibration positions least sensitive to the table's orientation errors",
+    )
+    p.add_argument(
+        "-n",
+        "--positions-count",
+        type=positive_int,
+        default=DEFAULT_POSITIONS,
+        metavar="N",
+        help=f"positions to choose (default {DEFAULT_POSITIONS})",
+    )
+    p.add_argument(
+        "--effects",
+        action="append",
+        default=[],
+        metavar="A,B",
+        help="effects to identify besides the base errors, as fit --effects takes "
+        "them: catalogue names, effect files (.yaml), inline terms; repeatable",
+    )
+    p.add_argument(
+        "--effects-module",
+        action="append",
+        default=[],
+        type=input_path,
+        metavar="FILE.py",
+        help="a Python file defining Effect subclasses; their names join --effects",
+    )
+    p.add_argument(
+        "--from",
+        "--from-data",
+        dest="from_data",
+        type=input_path,
+        metavar="DATA.csv",
+        help="positions already measured: their information is where the design "
+        "starts, and their fitted noise the design's noise",
+    )
+    p.add_argument(
+        "--limits-deg",
+        metavar="J=LO:HI,...",
+        help="narrow the joints' ranges (J: a joint's name or phiK; default: the "
+        "URDF <limit>s, a full turn for continuous joints)",
+    )
+    p.add_argument(
+        "--candidates",
+        type=positive_int,
+        default=DEFAULT_CANDIDATES,
+        metavar="N",
+        help=f"random candidate positions within the limits (seeded; default "
+        f"{DEFAULT_CANDIDATES}); the {GRID_STEP_DEG:g}-degree grid joins them",
+    )
+    p.add_argument(
+        "--seed",
+        type=seed,
+        default=0,
+        help="seed of the candidates and of the order (recorded in every output)",
+    )
+    p.add_argument(
+        "--noise-arcsec",
+        type=_noise_arcsec,
+        default=None,
+        help="1-sigma noise of a measured angle (default: fitted on --from data, else 1)",
+    )
+    p.add_argument(
+        "--dwell-s",
+        type=_dwell_s,
+        default=60.0,
+        help="time per measurement, for the time_s column (default 60)",
+    )
+    p.add_argument(
+        "-o",
+        "--output",
+        type=Path,
+        metavar="OUT.csv",
+        help="write the positions as a CSV (phiK_deg, with time_s and dirK when "
+        "the design needs them): simulate --positions reads it",
+    )
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--plots", type=Path, metavar="DIR", help="write the design's figures here")
+    p.set_defaults(func=run_design)
+
+
+def _noise_arcsec(text: str) -> float:
+    """argparse type of ``--noise-arcsec``: the noise range of a measurement file."""
+    from ..measurement.data import MAX_SIGMA_ARCSEC, MIN_SIGMA_ARCSEC
+
+    return bounded_float(MIN_SIGMA_ARCSEC, MAX_SIGMA_ARCSEC, "arcsec")(text)
+
+
+def _dwell_s(text: str) -> float:
+    """argparse type of ``--dwell-s``: a time in (0, a year]."""
+    from ..measurement.data import MAX_TIME_S
+
+    return bounded_float(0.0, MAX_TIME_S, "s", low_open=True)(text)
+
+
+def run_design(args: argparse.Namespace) -> int:
+    """Run the mode the options name (identify by default)."""
+    if args.separate is not None:
+        return _run_separate(args)
+    if args.calibrate:
+        return _run_calibrate(args)
+    return _run_identify(args)
+
+
+def _effects(args: argparse.Namespace, table) -> tuple:
+    """The effects of ``--effects`` (and ``--effects-module``) on ``table``."""
+    from ..measurement.user_effects import load_effects_module, resolve_effects
+
+    modules = [e for path in args.effects_module for e in load_effects_module(path)]
+    return resolve_effects(args.effects, table, modules)
+
+
+def _space(args: argparse.Namespace, effects=None):
+    """The :class:`~turntable_pin.design.space.DesignSpace` of the common options (the effects
+    of ``--effects`` unless ``effects`` are given)."""
+    from ..design.space import design_space
+
+    table = table_from_args(args)
+    chosen = _effects(args, table) if effects is None else tuple(effects)
+    return design_space(
+        table, chosen, limits_deg=args.limits_deg, candidates=args.candidates, seed=args.seed
+    )
+
+
+def _from_data(args: argparse.Namespace, table):
+    """The measurements of ``--from`` (None when not given)."""
+    if args.from_data is None:
+        return None
+    from ..measurement.data import read_measurements
+    from ..measurement.table import measured_table
+
+    measured = measured_table(table)
+    return read_measurements(args.from_data, None if measured.paper else measured.joint_names)
+
+
+def _finish(result, args: argparse.Namespace) -> int:
+    """Write the positions (``-o``) and figures (``--plots``) of ``result``, then print it."""
+    out = result.to_dict()
+    if args.output is not None:
+        out["output"] = str(result.plan.write_csv(args.output))
+    if args.plots is not None:
+        out["plots"] = [str(p) for p in result.write_plots(args.plots)]
+    if args.json:
+        print_json(out)
+        return 0
+    print(result.report())
+    for key in ("output",):
+        if key in out:
+            print(f"wrote {out[key]}")
+    for path in out.get("plots", []):
+        print(f"wrote {path}")
+    return 0
+
+
+def _run_identify(args: argparse.Namespace) -> int:
+    """D-optimal positions for the identifiable combinations (the default mode)."""
+    from ..design.identify import design_identify
+
+    space = _space(args)
+    result = design_identify(
+        space,
+        args.positions_count,
+        from_data=_from_data(args, space.table),
+        noise_arcsec=args.noise_arcsec,
+        dwell_s=args.dwell_s,
+    )
+    return _finish(result, args)
+
+
+def _run_separate(args: argparse.Namespace) -> int:
+    """T-optimal positions that tell two effects apart (``--separate A,B``)."""
+    raise InputError("design --separate: not yet available (issue 19, item 2)")
+
+
+def _run_calibrate(args: argparse.Namespace) -> int:
+    """GyroWheel calibration positions least sensitive to the table's errors (``--calibrate``)."""
+    raise InputError("design --calibrate: not yet available (issue 19, item 4)")

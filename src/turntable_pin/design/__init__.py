@@ -1,0 +1,24 @@
+"""What to measure next: test positions that identify, separate and calibrate.
+
+From a table's URDF, the effects to identify and the joints' limits, a design chooses the
+positions of the next measurement run:
+
+- :mod:`.space`: the joints' limits, the candidate positions within them and the 30-degree grid;
+- :mod:`.identify`: D-optimal positions for the identifiable combinations of the base errors and
+  the chosen effects (greedy start and Fedorov exchange, :mod:`turntable_pin.stats.design`);
+- :mod:`.schedule`: the order, times and approach directions of the chosen positions (repeats
+  for time-driven effects, both sides for backlash) and the CSV that ``simulate --positions``
+  and the test crew read.
+"""
+
+from ..core.lazy import lazy_exports
+
+_EXPORTS = {
+    "DesignSpace": "space",
+    "design_identify": "identify",
+    "design_space": "space",
+    "parse_limits_deg": "space",
+}
+
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -1,0 +1,312 @@
+"""The space a design chooses from: the table, the effects, the joints' limits, the candidates.
+
+Every mode of ``turntable-pin design`` starts here. A joint turns within its URDF ``<limit>``
+(a continuous joint, or one whose limits span a full turn, anywhere in [0, 360) deg), narrowed by
+``--limits-deg`` (``J=LO:HI``: ``J`` the joint's name or ``phiK``); the candidate positions are
+drawn uniformly within the limits (seeded) and joined by the 30-degree grid within them, which
+is also the design every result is compared with. The effects decide what the measurements must
+also record: an effect that needs ``time_s`` makes the run repeat its positions early and late,
+one that needs an approach direction ``dirK`` makes it approach each position from both sides
+(:mod:`.schedule`).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.exceptions import InputError, check_seed
+from ..core.sizes import check_count
+from ..core.units import DEG_PER_RAD
+
+__all__ = [
+    "DEFAULT_CANDIDATES",
+    "GRID_STEP_DEG",
+    "MAX_CANDIDATES",
+    "DesignSpace",
+    "JointRange",
+    "design_space",
+    "parse_limits_deg",
+]
+
+GRID_STEP_DEG = 30.0
+"""Step of the grid designs are compared with (and that joins the candidates), degrees."""
+
+DEFAULT_CANDIDATES = 10_000
+"""Random candidate positions a design chooses from by default."""
+
+MAX_CANDIDATES = 200_000
+"""Most random candidates (each costs a few kB of Jacobian rows while the design runs)."""
+
+CANDIDATE_BYTES = 4_000
+"""Memory of one candidate while a design runs (its Jacobian rows and their products), bytes."""
+
+_ROUND_DEG = 6
+"""Candidate angles are rounded to 1e-6 deg (a CSV holds them exactly)."""
+
+
+@dataclass(frozen=True)
+class JointRange:
+    """Where one joint may be commanded, degrees.
+
+    Attributes:
+        joint: the joint's name; index: its place from the base (``phiK``).
+        low_deg, high_deg: the range; a full-turn joint has ``[low_deg, low_deg + 360)``.
+        full_turn: the joint turns all the way round (no limit narrower than a turn).
+        source: ``urdf`` (its ``<limit>``), ``continuous`` (none) or ``--limits-deg``.
+    """
+
+    joint: str
+    index: int
+    low_deg: float
+    high_deg: float
+    full_turn: bool
+    source: str
+
+    def grid_deg(self, step_deg: float = GRID_STEP_DEG) -> np.ndarray:
+        """The multiples of ``step_deg`` within the range (a full turn: [0, 360)); a range that
+        holds none gives its two ends (its one angle when they are equal)."""
+        if self.full_turn:
+            return np.arange(0.0, 360.0 - 1e-9, step_deg)
+        first = math.ceil(self.low_deg / step_deg - 1e-9)
+        last = math.floor(self.high_deg / step_deg + 1e-9)
+        if last >= first:
+            return np.arange(first, last + 1) * step_deg
+        return np.unique([self.low_deg, self.high_deg])
+
+    def draw_deg(self, rng: np.random.Generator, count: int) -> np.ndarray:
+        """``count`` angles uniform in the range, rounded to 1e-6 deg."""
+        high = self.low_deg + 360.0 if self.full_turn else self.high_deg
+        return np.round(rng.uniform(self.low_deg, high, count), _ROUND_DEG)
+
+    def describe(self) -> str:
+        """``outer_axis (phi1): full turn`` or ``elevation (phi2): 0 .. 90 deg (urdf)``."""
+        where = "full turn" if self.full_turn else f"{self.low_deg:g} .. {self.high_deg:g} deg"
+        return f"{self.joint} (phi{self.index}): {where} ({self.source})"
+
+    def to_dict(self) -> dict:
+        """The range as a JSON-ready dict."""
+        return {
+            "joint": self.joint,
+            "angle": f"phi{self.index}",
+            "low_deg": self.low_deg,
+            "high_deg": None if self.full_turn else self.high_deg,
+            "full_turn": self.full_turn,
+            "source": self.source,
+        }
+
+
+_LIMIT = re.compile(r"^\s*([^=\s]+)\s*=\s*([^:]+):(.+)$")
+
+
+def parse_limits_deg(text: str, joint_names: Sequence[str]) -> dict[int, tuple[float, float]]:
+    """``--limits-deg J=LO:HI,...`` as ``{joint index (1 = phi1): (low, high)}``, degrees.
+
+    ``J`` is a joint's name or ``phiK``; each joint at most once; ``LO <= HI``.
+
+    Raises:
+        InputError: a malformed item, an unknown joint, a bound that is not a finite number.
+    """
+    known = {f"phi{k}": k for k in range(1, len(joint_names) + 1)}
+    known.update({name: k for k, name in enumerate(joint_names, start=1)})
+    out: dict[int, tuple[float, float]] = {}
+    for item in filter(None, (x.strip() for x in str(text).split(","))):
+        match = _LIMIT.match(item)
+        if not match:
+            raise InputError(f"--limits-deg '{item}': expected JOINT=LO:HI, e.g. phi2=0:90")
+        name, low_text, high_text = match.groups()
+        if name not in known:
+            raise InputError(
+                f"--limits-deg '{item}': unknown joint '{name}'; the table's joints: "
+                + ", ".join(f"{n} (phi{k})" for k, n in enumerate(joint_names, start=1))
+            )
+        try:
+            low, high = float(low_text), float(high_text)
+        except ValueError:
+            raise InputError(f"--limits-deg '{item}': the bounds must be numbers") from None
+        if not (math.isfinite(low) and math.isfinite(high)):
+            raise InputError(f"--limits-deg '{item}': the bounds must be finite numbers")
+        if low > high:
+            raise InputError(
+                f"--limits-deg '{item}': the lower bound {low:g} is above the upper {high:g}, "
+                "which leaves no position"
+            )
+        if known[name] in out:
+            raise InputError(f"--limits-deg '{item}': joint {name} is limited twice")
+        out[known[name]] = (low, high)
+    return out
+
+
+def joint_ranges(table, limits_deg=None) -> tuple[JointRange, ...]:
+    """Each joint's range: its URDF ``<limit>`` narrowed by ``limits_deg`` (a ``--limits-deg``
+    text or ``{index or name: (low, high)}``); a joint without limits turns a full turn.
+
+    Raises:
+        InputError: limits that leave a joint no position (naming the joint and both ranges).
+    """
+    from ..measurement.table import measured_table
+
+    measured = measured_table(table)
+    names = measured.joint_names
+    if isinstance(limits_deg, str):
+        given = parse_limits_deg(limits_deg, names)
+    else:
+        given = {}
+        for key, bounds in (limits_deg or {}).items():
+            index = key if isinstance(key, int) else (names.index(key) + 1 if key in names else 0)
+            if not 1 <= index <= len(names):
+                raise InputError(f"limits: unknown joint {key!r}; the table's: {', '.join(names)}")
+            given[index] = (float(bounds[0]), float(bounds[1]))
+    out = []
+    for k, (name, urdf) in enumerate(zip(names, measured.joint_limits_rad, strict=True), start=1):
+        if urdf is not None:
+            low, high = (round(v * DEG_PER_RAD, 9) for v in urdf)
+            source = "urdf"
+        else:
+            low, high, source = 0.0, 360.0, "continuous"
+        full = urdf is None
+        if k in given:
+            g_low, g_high = given[k]
+            if full:
+                low, high = g_low, g_high
+                full = g_high - g_low >= 360.0
+            else:
+                if g_low > high or g_high < low:
+                    raise InputError(
+                        f"--limits-deg {name}={g_low:g}:{g_high:g} leaves no position: the URDF "
+                        f"limits {name} to {low:g} .. {high:g} deg"
+                    )
+                low, high = max(low, g_low), min(high, g_high)
+            source = "--limits-deg"
+        out.append(JointRange(name, k, float(low), float(high), bool(full), source))
+    return tuple(out)
+
+
+def _design_columns(effects) -> tuple[bool, bool]:
+    """``(needs time_s, needs dirK)`` of ``effects``.
+
+    Raises:
+        InputError: an effect that needs a column a design cannot set (a temperature log).
+    """
+    needs_time = needs_dirs = False
+    for effect in effects:
+        for column in effect.required_columns:
+            if column == "time_s":
+                needs_time = True
+            elif re.fullmatch(r"dir\d+", column):
+                needs_dirs = True
+            elif not effect.any_column:
+                raise InputError(
+                    f"effect '{effect.name}' needs the column {column}, which a design cannot "
+                    "choose (only positions, their order and time, and approach directions); "
+                    "leave it out of --effects"
+                )
+    return needs_time, needs_dirs
+
+
+@dataclass(frozen=True)
+class DesignSpace:
+    """What a design may choose from and what it must identify.
+
+    Attributes:
+        table: the table (a :class:`~turntable_pin.model.generic_table.GenericTable`).
+        effects: the effects to identify besides the base errors.
+        ranges: each joint's :class:`JointRange`.
+        candidates_deg: the candidate positions (C, J), the random draws then the grid.
+        grid_deg: the 30-degree grid within the limits (G, J).
+        seed: the seed of the random candidates.
+        needs_time: an effect needs ``time_s`` (the run repeats positions early and late).
+        needs_dirs: an effect needs ``dirK`` (each position is approached from both sides).
+    """
+
+    table: object
+    effects: tuple
+    ranges: tuple[JointRange, ...]
+    candidates_deg: np.ndarray = field(repr=False)
+    grid_deg: np.ndarray = field(repr=False)
+    seed: int
+    needs_time: bool
+    needs_dirs: bool
+
+    @property
+    def n_joints(self) -> int:
+        """Number of joints J."""
+        return len(self.ranges)
+
+    @property
+    def measured(self):
+        """The :class:`~turntable_pin.measurement.table.MeasuredTable` of :attr:`table`."""
+        from ..measurement.table import measured_table
+
+        return measured_table(self.table)
+
+    @property
+    def effect_names(self) -> tuple[str, ...]:
+        """The names of :attr:`effects`."""
+        return tuple(e.name for e in self.effects)
+
+    def to_dict(self) -> dict:
+        """The space as a JSON-ready dict (limits, candidate count, grid size, seed)."""
+        return {
+            "table": self.measured.label,
+            "effects": list(self.effect_names),
+            "limits": [r.to_dict() for r in self.ranges],
+            "n_candidates": int(self.candidates_deg.shape[0]),
+            "n_grid": int(self.grid_deg.shape[0]),
+            "grid_step_deg": GRID_STEP_DEG,
+            "seed": self.seed,
+            "needs_time": self.needs_time,
+            "needs_dirs": self.needs_dirs,
+        }
+
+
+def design_space(
+    table=None,
+    effects: Sequence = (),
+    *,
+    limits_deg: str | Mapping | None = None,
+    candidates: int = DEFAULT_CANDIDATES,
+    seed: int = 0,
+) -> DesignSpace:
+    """The :class:`DesignSpace` of a table.
+
+    Args:
+        table: a ``GenericTable`` (default: the paper's table).
+        effects: effects (objects, e.g. from ``resolve_effects``) to identify besides the base.
+        limits_deg: ``--limits-deg`` text or ``{joint name or index: (low, high)}``, degrees.
+        candidates: how many random candidate positions (the grid joins them).
+        seed: seed of the random candidates (0 <= seed < 2**63).
+    """
+    from ..model.paper_table import paper_table
+
+    table = paper_table() if table is None else table
+    seed = check_seed(seed)
+    candidates = int(
+        check_count(candidates, MAX_CANDIDATES, "candidate positions", CANDIDATE_BYTES)
+    )
+    if candidates < 1:
+        raise InputError(f"candidates must be >= 1, got {candidates}")
+    needs_time, needs_dirs = _design_columns(effects)
+    ranges = joint_ranges(table, limits_deg)
+    rng = np.random.default_rng(seed)
+    drawn = np.stack([r.draw_deg(rng, candidates) for r in ranges], axis=1)
+    axes = np.meshgrid(*(r.grid_deg() for r in ranges), indexing="ij")
+    grid = np.stack([a.ravel() for a in axes], axis=1)
+    check_count(grid.shape[0], MAX_CANDIDATES, "grid positions", CANDIDATE_BYTES)
+    all_deg = np.concatenate([drawn, grid])
+    for array in (all_deg, grid):
+        array.setflags(write=False)
+    return DesignSpace(
+        table=table,
+        effects=tuple(effects),
+        ranges=ranges,
+        candidates_deg=all_deg,
+        grid_deg=grid,
+        seed=seed,
+        needs_time=needs_time,
+        needs_dirs=needs_dirs,
+    )
