@@ -40,7 +40,6 @@ from .chain import (
     ErrorChain,
     apply_chain_errors,
     compose_rotation,
-    skew,
 )
 
 __all__ = [
@@ -436,34 +435,35 @@ class GenericTable:
         return write_error_urdf(self.urdf_path, self.chain, np.asarray(error_values, float), path)
 
     # ---- what orientation data determine ---------------------------------------------------
-    def regressor(self, angles_rad: Sequence) -> np.ndarray:
-        """d(dpsi, dtheta, dgamma)/d(errors) at zero errors, (N, 3, P), exact (analytic)."""
+    def regressor(self, angles_rad: Sequence, error_values=None) -> np.ndarray:
+        """d(dpsi, dtheta, dgamma)/d(errors), (N, 3, P), exact (analytic): at zero errors (the
+        first-order model) or, given ``error_values`` (P,), of the exact chain at those errors."""
+        from ..core.rotations import axis_rotation
+
         q = [np.atleast_1d(a) for a in self._angles(angles_rad)]
         n = np.broadcast_shapes(*(a.shape for a in q))[0]
-        rd = compose_rotation(self.chain.placements(), q)  # (N, 3, 3)
+        values = None if error_values is None else np.asarray(error_values, dtype=float)
+        dR = None if values is None else self.rotation_error(values, q)
         out = np.zeros((n, 3, len(self.parameter_names)))
-        prefix = np.broadcast_to(np.eye(3), (n, 3, 3))
-        qi = 0
-        for link in self.chain.links:
-            prefix = prefix @ link.nominal[:3, :3]
-            for factor in link.factors:  # at zero errors the factors are the identity
+        # Rt = P R_u(e) S: d(Rd^T Rt)/de = dR [S^T u]x, S the rotations after the factor (walked
+        # from the payload back, so that a rotation before the factor never enters).
+        suffix = np.broadcast_to(np.eye(3), (n, 3, 3))
+        qi = len(q)
+        for link in reversed(self.chain.links):
+            if link.is_joint:
+                qi -= 1
+                suffix = axis_rotation(link.axis, q[qi]) @ suffix
+            for factor in reversed(link.factors):
                 if factor.kind != ROTATION:
                     continue
-                # Rt = P R_u(e) S with Rd = P S: d(Rd^T Rt)/de = Rd^T P [u]x P^T Rd.
-                d = (
-                    np.swapaxes(rd, -1, -2)
-                    @ prefix
-                    @ skew(factor.unit)
-                    @ np.swapaxes(prefix, -1, -2)
-                    @ rd
-                )
                 col = self.parameter_names.index(factor.error)
+                w = np.swapaxes(suffix, -1, -2) @ factor.unit  # (N, 3)
+                d = np.swapaxes(np.cross(w[:, None, :], np.eye(3)), -1, -2)  # [w]x
+                if dR is not None:
+                    d = dR @ d
+                    suffix = axis_rotation(factor.axis, values[col]) @ suffix
                 out[:, :, col] = np.stack([d[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)
-            if link.is_joint:
-                from ..core.rotations import axis_rotation
-
-                prefix = prefix @ axis_rotation(link.axis, q[qi])
-                qi += 1
+            suffix = link.nominal[:3, :3] @ suffix
         return out
 
     @cached_property
