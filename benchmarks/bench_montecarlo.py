@@ -38,8 +38,12 @@ from turntable_pin.allocation.monte_carlo import (
     run_chain_monte_carlo,
     sample_errors,
 )
-from turntable_pin.allocation.solver import OrientationLimits, allocate_tolerances
-from turntable_pin.allocation.table_allocation import allocate_table_tolerances, angular_names
+from turntable_pin.allocation.solver import (
+    OrientationLimits,
+    allocate_table_tolerances,
+    allocate_tolerances,
+    angular_names,
+)
 from turntable_pin.core.blas_threads import one_blas_thread
 from turntable_pin.core.resources import models_dir
 from turntable_pin.core.units import ARCMIN_PER_RAD

@@ -17,9 +17,10 @@ from turntable_pin.allocation.monte_carlo import (
     sample_errors,
     sample_table_errors,
 )
-from turntable_pin.allocation.solver import OrientationLimits, allocate_tolerances
-from turntable_pin.allocation.table_allocation import (
+from turntable_pin.allocation.solver import (
+    OrientationLimits,
     allocate_table_tolerances,
+    allocate_tolerances,
     angular_names,
     grid_angles_rad,
 )

@@ -1,18 +1,31 @@
-"""Sensitivities (eq. 28): Pinocchio regressor against finite differences, eq. 26, grid averages."""
+"""Sensitivities (eq. 28): the table's regressor against Pinocchio's kinematic regressor and
+finite differences of the exact chain (the paper's table and any other), eq. 26, grid averages."""
 
 import numpy as np
 import pytest
 
-from conftest import random_errors
+from allocation_reference import pinocchio_sensitivity_matrix, sensitivity_matrix_fd
+from conftest import PAPER_TO_GENERIC, REPO_DIR, random_errors
 from turntable_pin import TurntableErrors, TurntableModel, small_angle_matrix
 from turntable_pin.allocation.sensitivity import (
     average_sensitivities,
     paper_style_grid_deg,
+    sensitivities,
     sensitivity_matrix,
-    sensitivity_matrix_fd,
+    table_sensitivities,
     uniform_grid_deg,
 )
+from turntable_pin.allocation.solver import angular_names
+from turntable_pin.model.angles import ANGLE_ENTRIES
+from turntable_pin.model.generic_table import GenericTable
 from turntable_pin.report.allocation_figures import plot_sensitivities
+
+MODELS = REPO_DIR / "models"
+OTHER_TABLES = [
+    "single_axis_rate_table.urdf",
+    "two_axis_vertical_outer.urdf",
+    "three_axis_imu_table.urdf",
+]
 
 
 def test_analytic_matches_central_differences_at_large_errors(rng):
@@ -90,3 +103,87 @@ def test_plot_writes_a_png(tmp_path):
     path = plot_sensitivities(avg, tmp_path / "f8.png")
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert set(avg.to_dict()["sensitivities"]) == {"dpsi", "dtheta", "dgamma"}
+
+
+def test_analytic_equals_pinocchios_kinematic_regressor_at_large_errors(rng):
+    # Pinocchio's computeFrameKinematicRegressor, each error factor moved to its placement's end
+    # by an adjoint: an independent construction of the same derivative.
+    for _ in range(4):
+        model = TurntableModel(random_errors(rng, scale_arcsec=2000.0))
+        phi1, phi2 = rng.uniform(0, 2 * np.pi, 2)
+        np.testing.assert_allclose(
+            sensitivity_matrix(model, phi1, phi2),
+            pinocchio_sensitivity_matrix(model, phi1, phi2),
+            atol=1e-14,
+        )
+
+
+@pytest.mark.parametrize("urdf", OTHER_TABLES)
+def test_sensitivities_equal_central_differences_of_the_exact_chain(urdf, rng):
+    table = GenericTable(MODELS / urdf)
+    sens = table_sensitivities(table, 60.0)
+    names = angular_names(table)
+    assert sens.error_names == names and not any(".offset" in n for n in names)
+    picks = rng.choice(len(sens.grid_rad[0]), size=4, replace=False)
+    step = 1e-6
+    for p in picks:
+        angles = [g[p] for g in sens.grid_rad]
+        for col, name in enumerate(names):
+            sides = []
+            for sign in (1.0, -1.0):
+                values = table.values({name: sign * step})
+                d_r = table.rotation_error(values, angles)
+                sides.append(np.array([d_r[i, j] for i, j in ANGLE_ENTRIES]))
+            fd = (sides[0] - sides[1]) / (2 * step)
+            np.testing.assert_allclose(sens.matrices[p, :, col], fd, atol=1e-9)
+    np.testing.assert_allclose(sens.values, np.abs(sens.matrices).mean(axis=0))
+
+
+def test_the_paper_table_through_the_generic_sensitivities_equals_its_own(rng):
+    from turntable_pin.allocation.sensitivity import sensitivity_matrix
+    from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
+    from turntable_pin.model.turntable import TurntableModel
+
+    mapping = PAPER_TO_GENERIC
+    table = GenericTable(MODELS / "turntable.urdf")
+    names = angular_names(table)
+    model = TurntableModel()
+    for phi1, phi2 in rng.uniform(-np.pi, np.pi, (4, 2)):
+        generic = table.regressor([np.array([phi1]), np.array([phi2])])[0]
+        paper = sensitivity_matrix(model, phi1, phi2)
+        for col, paper_name in enumerate(ANGULAR_ERROR_NAMES):
+            column = table.parameter_names.index(mapping[paper_name])
+            np.testing.assert_allclose(paper[:, col], generic[:, column], atol=1e-12)
+    assert set(mapping.values()) <= set(names)
+
+
+@pytest.mark.parametrize("urdf", OTHER_TABLES)
+def test_sensitivities_at_errors_equal_central_differences_of_the_exact_chain(urdf, rng):
+    table = GenericTable(MODELS / urdf)
+    values = rng.normal(0.0, 0.01, len(table.parameter_names))  # ~0.6 deg, offsets 1 cm
+    axes = [rng.uniform(0, 2 * np.pi, 2) for _ in table.joint_names]
+    sens = sensitivities(table, axes, error_values=values)
+    names = angular_names(table)
+    for p in range(sens.matrices.shape[0]):
+        angles = [g[p] for g in sens.grid_rad]
+        for col, name in enumerate(names):
+            sides = []
+            for sign in (1.0, -1.0):
+                moved = values.copy()
+                moved[table.parameter_names.index(name)] += sign * 1e-6
+                d_r = table.rotation_error(moved, angles)
+                sides.append(np.array([d_r[i, j] for i, j in ANGLE_ENTRIES]))
+            fd = (sides[0] - sides[1]) / 2e-6
+            np.testing.assert_allclose(sens.matrices[p, :, col], fd, atol=1e-9)
+    assert np.abs(sens.matrices - table_sensitivities(table, 90.0).matrices[:1]).max() > 1e-3
+
+
+def test_default_grid_holds_a_joint_the_model_does_not_depend_on():
+    """The paper's phi1 drops out (its errors turn with it): the default grid is 360 phi2 values
+    at phi1 = 0, the averages of Figure 8's first-order values; other tables use every joint."""
+    paper = table_sensitivities(TurntableModel().table)
+    assert paper.grid_step_deg == 1.0 and paper.phi1_grid_deg.tolist() == [0.0]
+    np.testing.assert_allclose(paper.phi2_grid_deg, uniform_grid_deg(360), rtol=1e-15)
+    np.testing.assert_array_equal(paper.values, average_sensitivities(phi1_grid_deg=[0.0]).values)
+    three = table_sensitivities(GenericTable(MODELS / "three_axis_imu_table.urdf"))
+    assert three.grid_step_deg == 15.0 and [a.size for a in three.axes_rad] == [24, 24, 24]

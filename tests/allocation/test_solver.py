@@ -8,6 +8,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from allocation_reference import (
+    _slsqp,
+    lemma1_closed_form,
+    linear_angle_models,
+    solve_subproblem,
+    worst_case_full_circle,
+)
+from conftest import REPO_DIR
 from turntable_pin import ANGULAR_ERROR_NAMES, InfeasibleError, InputError
 from turntable_pin.allocation.capability import ManufacturingCapability
 from turntable_pin.allocation.solver import (
@@ -15,17 +23,15 @@ from turntable_pin.allocation.solver import (
     ORIENTATION_ANGLES,
     PHI2_INTERVALS_RAD,
     OrientationLimits,
-    _slsqp,
     allocate_tolerances,
     allocation_weights,
+    angle_rows,
     default_orientation_limits,
     interval_max,
-    linear_angle_models,
     paper_eq16_limits,
-    solve_subproblem,
-    worst_case_full_circle,
 )
 from turntable_pin.core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, arcmin_to_rad, arcsec_to_rad
+from turntable_pin.model.paper_table import paper_table, table_of
 
 TABLE4_ARCMIN = {
     "dphi_y1": 0.4235, "dphi_z2": 0.7800, "dalpha_x1": 0.4234, "dalpha_z1": 0.7800,
@@ -335,3 +341,94 @@ def test_report_and_dict_name_everything():
     assert d["J"]["total"] == pytest.approx(sum(d["J"][n] for n in ORIENTATION_ANGLES))
     text = allocation.report()
     assert "dalpha_x2" in text and "active" in text and "KKT" in text
+
+
+# ---- one allocation: the paper's problem is the generic one on the paper's table ------------
+def test_the_solvers_rows_on_the_papers_table_are_eq26():
+    """The rows the allocation works on are the table's regressor; on the paper's table they are
+    eq. 26 (independent: small_angle_matrix) for every phi1, with the paper's domains."""
+    rows = angle_rows(paper_table())
+    models = linear_angle_models()
+    rng = np.random.default_rng(3)
+    points = rng.uniform(-np.pi, np.pi, (50, 2))
+    for name in ORIENTATION_ANGLES:
+        idx = models[name].members
+        assert rows[name].error_names == tuple(ANGULAR_ERROR_NAMES[i] for i in idx)
+        eq26 = models[name].basis_values(points[:, 1])[:, idx]
+        np.testing.assert_allclose(rows[name].values(points), eq26, atol=2e-16)
+        assert rows[name].domain_rad == ((0.0, 2 * np.pi), PHI2_INTERVALS_RAD[name])
+        assert rows[name].axes_rad[0].tolist() == [0.0]  # phi1 drops out: never searched
+
+
+def test_table4_from_the_one_allocation_of_the_papers_table_and_its_urdf():
+    paper = allocate_tolerances(PAPER_LIMITS, "paper", table=paper_table())
+    urdf = allocate_tolerances(
+        PAPER_LIMITS, "paper", table=table_of(REPO_DIR / "models/turntable.urdf")
+    )
+    for allocation in (paper, urdf):
+        ours = bounds_arcmin(allocation)
+        for name, value in TABLE4_ARCMIN.items():
+            assert abs(ours[name] - value) <= 1.5e-4, name
+        assert all(s.method == "exact" for s in allocation.subproblems.values())
+    np.testing.assert_array_equal(paper.upper_bounds_rad, urdf.upper_bounds_rad)
+
+
+def test_the_papers_quarter_turns_give_what_the_whole_turns_give(monkeypatch):
+    """|cos| and |sin| are symmetric: the semi-infinite constraint over every phi2 (the generic
+    problem) has the paper's quarter-turn optimum, so Table 4 does not rest on the intervals."""
+    from turntable_pin.allocation import solver
+
+    quarter = allocate_tolerances(PAPER_LIMITS, "paper")
+    whole = dict.fromkeys(ORIENTATION_ANGLES, (0.0, 2 * np.pi))
+    monkeypatch.setattr(solver, "PHI2_INTERVALS_RAD", whole)
+    turn = allocate_tolerances(PAPER_LIMITS, "paper")
+    assert turn.subproblems["psi"].interval_rad == (0.0, 2 * np.pi)
+    np.testing.assert_allclose(turn.upper_bounds_rad, quarter.upper_bounds_rad, rtol=1e-12)
+
+
+@pytest.mark.parametrize("weights", ["model", "paper", "equal"])
+def test_the_worst_case_is_lemma1s_closed_form(weights):
+    allocation = allocate_tolerances(PAPER_LIMITS, weights)
+    models = linear_angle_models()
+    for k, name in enumerate(ORIENTATION_ANGLES):
+        closed = lemma1_closed_form(models[name], allocation.upper_bounds_rad)
+        assert allocation.worst_case_rad[k] == pytest.approx(closed, rel=1e-14)
+
+
+def test_several_active_points_are_solved_by_cutting_planes():
+    """Random rows of degree one on a whole turn: where the optimum needs several points of the
+    constraint the exchange method finds them (KKT over them); SLSQP on a 0.01-degree grid (a
+    relaxation) finds no better point."""
+    from scipy.optimize import minimize
+
+    from turntable_pin.allocation.solver import AngleRows, solve_subproblem
+
+    rng = np.random.default_rng(5)
+    methods = set()
+    dense = np.radians(np.arange(0.0, 360.0, 0.01))[:, None]
+    for _ in range(8):
+        coefficients, w = rng.normal(size=(3, 4)), rng.uniform(0.5, 2.0, 4)
+        axis = np.radians(np.arange(0.0, 360.0, 10.0))
+        rows = AngleRows("psi", ("a", "b", "c", "d"), coefficients, ((0, 2 * np.pi),), (axis,))
+        sub = solve_subproblem(rows, 1.0, w, np.zeros(4))
+        methods.add(sub.method)
+        z = sub.solution_rad
+        g = np.abs(rows.values(dense))
+        assert np.max(g @ z) <= 1.0 + 1e-12
+        g = g[g @ z >= 0.99]
+        res = minimize(
+            lambda v, w=w: float(np.sum(w**2 / v**2)),
+            0.99 * z / np.max(g @ z),
+            jac=lambda v, w=w: -2 * w**2 / v**3,
+            bounds=[(1e-9, None)] * 4,
+            constraints=[
+                {"type": "ineq", "fun": lambda v, g=g: 1 - g @ v, "jac": lambda v, g=g: -g}
+            ],
+            method="SLSQP",
+            options={"ftol": 1e-14, "maxiter": 500},
+        )
+        ours = float(np.sum(w**2 / z**2))
+        theirs = res.x / max(1.0, float(np.max(g @ res.x)))  # SLSQP ends ~1e-7 outside
+        assert ours <= float(np.sum(w**2 / theirs**2)) * (1 + 2e-8)  # its grid spacing
+        assert sub.kkt_residual < (1e-12 if sub.method == "exact" else 1e-4)
+    assert methods == {"exact", "cutting planes"}

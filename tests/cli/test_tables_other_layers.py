@@ -8,8 +8,11 @@ import numpy as np
 import pytest
 
 from conftest import EXAMPLES_DIR, REPO_DIR, cli, needs_chromium, write_file
-from turntable_pin.allocation.solver import OrientationLimits
-from turntable_pin.allocation.table_allocation import allocate_table_tolerances, angular_names
+from turntable_pin.allocation.solver import (
+    OrientationLimits,
+    allocate_table_tolerances,
+    angular_names,
+)
 from turntable_pin.calibration.drift_fit import simulate_run
 from turntable_pin.calibration.gyrowheel import GyroWheelModel
 from turntable_pin.calibration.positions import PositionSet, position_inputs

@@ -9,9 +9,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from allocation_reference import sensitivity_matrix_fd
 from conftest import random_errors
 from turntable_pin import OrientationErrorField, TurntableErrors, TurntableModel
-from turntable_pin.allocation.sensitivity import sensitivity_matrix, sensitivity_matrix_fd
+from turntable_pin.allocation.sensitivity import sensitivity_matrix
 from turntable_pin.core.exceptions import ModelError
 from turntable_pin.measurement.effect_model import OrientationModel
 from turntable_pin.measurement.effects.base import PositionVariables

@@ -6,10 +6,11 @@ check.
 from ..core.lazy import lazy_exports
 
 _EXPORTS = {
-    "TableAllocation": "table_allocation",
-    "allocate_table_tolerances": "table_allocation",
+    "Sensitivities": "sensitivity",
+    "TableAllocation": "solver",
+    "allocate_table_tolerances": "solver",
     "run_table_monte_carlo": "monte_carlo",
-    "table_sensitivities": "table_allocation",
+    "table_sensitivities": "sensitivity",
     "Allocation": "solver",
     "AverageSensitivities": "sensitivity",
     "ManufacturingCapability": "capability",

@@ -1,9 +1,10 @@
-"""Manufacturing capability: the lower bounds ``LB_i`` of the eight angular errors (paper eq. 29).
+"""Manufacturing capability: the lower bounds ``LB_i`` of a table's angular errors (paper eq. 29).
 
 A turntable cannot be made arbitrarily accurate; the allocation must not ask for an error component
-smaller than what manufacturing reaches. The bundled defaults live in
+smaller than what manufacturing reaches. The bundled defaults of the paper's table live in
 ``models/manufacturing_lower_bounds.yaml`` with the reasoning behind each value; users pass their
-own YAML file of the same form.
+own YAML file of the same form, in their table's error names (another table has no bundled
+bounds: 0 unless given).
 """
 
 from __future__ import annotations
@@ -17,8 +18,13 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.files import read_yaml
 from ..core.resources import default_lower_bounds_path
-from ..core.units import ARCSEC_PER_RAD
-from ..model.errors import ANGULAR_ERROR_NAMES, parse_error_value
+from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
+from ..model.errors import (
+    ANGULAR_ERROR_NAMES,
+    ERROR_NAMES,
+    MAX_ANGULAR_ERROR_DEG,
+    parse_error_value,
+)
 
 __all__ = ["ManufacturingCapability", "read_lower_bounds_file"]
 
@@ -45,59 +51,72 @@ def read_lower_bounds_file(path: Path) -> Mapping:
 
 @dataclass(frozen=True)
 class ManufacturingCapability:
-    """Lower bounds of the eight angular errors and why they are what they are.
+    """Lower bounds of a table's angular errors and why they are what they are.
 
     Attributes:
-        lower_bounds_rad: (8,) in :data:`ANGULAR_ERROR_NAMES` order, radians, each >= 0.
+        lower_bounds_rad: (P,) in ``error_names`` order, radians, each in [0, 5 deg].
         reasoning: ``{error name: text}`` saying where each bound comes from.
         source: the file the bounds were read from (or a description).
+        error_names: the table's angular errors (default: the paper's eight).
     """
 
     lower_bounds_rad: np.ndarray
     reasoning: dict[str, str] = field(default_factory=dict)
     source: str = "none"
+    error_names: tuple[str, ...] = ANGULAR_ERROR_NAMES
 
     def __post_init__(self) -> None:
         values = np.array(self.lower_bounds_rad, dtype=float).reshape(-1)
-        if values.size != len(ANGULAR_ERROR_NAMES):
-            raise InputError(f"expected {len(ANGULAR_ERROR_NAMES)} lower bounds, got {values.size}")
+        if values.size != len(self.error_names):
+            raise InputError(
+                f"expected {len(self.error_names)} lower bounds ({', '.join(self.error_names)}), "
+                f"got {values.size}"
+            )
         if not np.all(np.isfinite(values)) or np.any(values < 0.0):
             raise InputError("lower bounds must be finite and not negative")
+        if float(values.max(initial=0.0)) > MAX_ANGULAR_ERROR_DEG / DEG_PER_RAD:
+            raise InputError(f"a lower bound is beyond {MAX_ANGULAR_ERROR_DEG:g} deg")
         values.setflags(write=False)
         object.__setattr__(self, "lower_bounds_rad", values)
+        object.__setattr__(self, "error_names", tuple(self.error_names))
 
     @classmethod
-    def none(cls) -> ManufacturingCapability:
+    def none(cls, error_names=ANGULAR_ERROR_NAMES) -> ManufacturingCapability:
         """No manufacturing limit (every lower bound 0)."""
-        return cls(np.zeros(len(ANGULAR_ERROR_NAMES)), source="none (all lower bounds 0)")
+        return cls(np.zeros(len(error_names)), {}, "none (all lower bounds 0)", error_names)
 
     @classmethod
     def default(cls) -> ManufacturingCapability:
-        """The bundled defaults (:func:`default_lower_bounds_path`)."""
+        """The bundled defaults of the paper's table (:func:`default_lower_bounds_path`)."""
         return cls.from_yaml(default_lower_bounds_path())
 
     @classmethod
-    def from_yaml(cls, path: str | Path) -> ManufacturingCapability:
-        """Read ``lower_bounds: {name[_unit]: value}`` and optional ``reasoning: {name: text}``.
+    def from_yaml(cls, path: str | Path, table=None) -> ManufacturingCapability:
+        """Read ``lower_bounds: {name[_unit]: value}`` and optional ``reasoning: {name: text}``
+        in the names of ``table`` (a :class:`~turntable_pin.model.generic_table.GenericTable`;
+        default the paper's).
 
         Names without a unit suffix are arc seconds; missing names get no lower bound (0). Values
         are at most ``MAX_ANGULAR_ERROR_DEG`` (5 deg), like every angular error.
 
         Raises:
             InputError: unreadable file, not YAML, a key given twice (also as two spellings of one
-                error), an unknown top-level key, an unknown name, a negative or non-numeric
-                value, a value beyond the small-error range, reasoning that is not text.
+                error), an unknown top-level key, an unknown name, a length (offset), a negative or
+                non-numeric value, a value beyond the small-error range, reasoning that is not text.
         """
         path = Path(path)
         data = read_lower_bounds_file(path)
-        values = np.zeros(len(ANGULAR_ERROR_NAMES))
+        names = ERROR_NAMES if table is None else table.parameter_names
+        angular = ANGULAR_ERROR_NAMES if table is None else table.angular_names
+        lengths = [n for n in names if n not in angular]
+        values = np.zeros(len(angular))
         given: dict[str, str] = {}
         for key, raw in data["lower_bounds"].items():
             try:
-                name, value = parse_error_value(str(key), raw)
+                name, value = parse_error_value(str(key), raw, names=names, length_names=lengths)
             except InputError as exc:
                 raise InputError(f"lower_bounds: {exc.detail}", path=path) from None
-            if name not in ANGULAR_ERROR_NAMES:
+            if name not in angular:
                 raise InputError(f"lower_bounds: '{key}' is not an angular error", path=path)
             if name in given:
                 raise InputError(
@@ -106,28 +125,31 @@ class ManufacturingCapability:
             given[name] = str(key)
             if value < 0.0:
                 raise InputError(f"lower_bounds: '{key}' is negative ({raw})", path=path)
-            values[ANGULAR_ERROR_NAMES.index(name)] = value
+            values[angular.index(name)] = value
         reasoning = data.get("reasoning") or {}
         if not isinstance(reasoning, Mapping):
             raise InputError("'reasoning' must map error names to text", path=path)
         for key, text in reasoning.items():
-            if str(key) not in ANGULAR_ERROR_NAMES:
+            if str(key) not in angular:
                 raise InputError(
-                    f"reasoning: '{key}' is not an angular error; known: "
-                    f"{', '.join(ANGULAR_ERROR_NAMES)}",
+                    f"reasoning: '{key}' is not an angular error; known: {', '.join(angular)}",
                     path=path,
                 )
             if isinstance(text, (Mapping, list)):
                 raise InputError(f"reasoning: '{key}' must be text", path=path)
-        return cls(values, {str(k): str(v) for k, v in reasoning.items()}, str(path))
+        return cls(values, {str(k): str(v) for k, v in reasoning.items()}, str(path), angular)
+
+    def arcsec_by_name(self) -> dict[str, float]:
+        """``{error: lower bound in arcsec}``."""
+        return {
+            n: float(v * ARCSEC_PER_RAD)
+            for n, v in zip(self.error_names, self.lower_bounds_rad, strict=True)
+        }
 
     def to_dict(self) -> dict:
         """Source, lower bounds by name (arcsec) and reasoning, as a JSON-ready dict."""
         return {
             "source": self.source,
-            "lower_bounds_arcsec": {
-                n: float(v * ARCSEC_PER_RAD)
-                for n, v in zip(ANGULAR_ERROR_NAMES, self.lower_bounds_rad, strict=True)
-            },
+            "lower_bounds_arcsec": self.arcsec_by_name(),
             "reasoning": dict(self.reasoning),
         }

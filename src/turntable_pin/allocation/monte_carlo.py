@@ -39,8 +39,8 @@ from ..core.units import DEG_PER_RAD, arcmin_by_name
 from ..model.batch_field import ChainExpansion, joint_dependence, max_abs_on_grid
 from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES
 from ..model.paper_table import paper_table
+from .sensitivity import default_grid_step_deg, grid_angles_rad
 from .solver import ORIENTATION_ANGLES, OrientationLimits
-from .table_allocation import default_grid_step_deg, grid_angles_rad
 
 __all__ = [
     "CHUNK_SIZE",

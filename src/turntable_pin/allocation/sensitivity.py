@@ -1,22 +1,16 @@
-"""Sensitivities of the orientation error to the eight angular turntable errors (paper eq. 28).
+"""Sensitivities of the orientation error to a table's angular errors (paper eq. 28, Figure 8).
 
-``C[k, i] = d f_k / d chi_i`` for ``f = (dpsi, dtheta, dgamma)`` of the exact Pinocchio model, at a
-pair of rotation angles. Two independent ways to get it:
+``C[k, i] = d f_k / d chi_i`` for ``f = (dpsi, dtheta, dgamma)``, read off the table's regressor
+(:meth:`GenericTable.regressor <turntable_pin.model.generic_table.GenericTable.regressor>`): the
+first-order model at zero errors, or the exact chain at a given error set. The offsets move the
+payload, never its orientation, so only the angular errors have columns.
 
-* :func:`sensitivity_matrix` (analytic): Pinocchio's kinematic regressor
-  (``computeFrameKinematicRegressor``) gives the payload frame's variation for a variation of each
-  joint placement; an error factor sitting inside a placement (a link of the model's
-  :class:`~turntable_pin.model.chain.ErrorChain`) is moved to the placement's end by the adjoint
-  of the factors after it. A fixed link (the payload mount) is not a Pinocchio joint, so its
-  factors are carried to the payload frame by the placement between the two.
-* :func:`sensitivity_matrix_fd`: central finite differences of
-  :meth:`TurntableModel.orientation_error`.
-
-Because ``C`` depends on the angles, the paper plots averages (Figure 8).
-:func:`average_sensitivities` takes the mean of ``|C|`` over every pair of a grid of (phi1, phi2);
-by default uniform grids over the full turn (with this error model ``dR`` does not depend on phi1
-at all, so the phi1 grid only documents that). For the first-order model the averages are
-``2/pi = 0.6366`` for every sin/cos term and 1 for every constant term. The paper's
+Because ``C`` depends on the angles, the paper plots averages (Figure 8): :func:`sensitivities`
+takes the mean of ``|C|`` over every combination of one grid per joint. By default each joint the
+first-order model depends on runs over a full turn at the table's grid step (1 degree when one
+joint matters, 5 for two, 15 for three) and a joint it does not depend on -- the paper's phi1, whose
+errors turn with it -- is held at 0. On the paper's table that is 360 phi2 values, and the averages
+are ``2/pi = 0.6366`` for every sin/cos term and 1 for every constant term. The paper's
 ``0.6476 / 0.5365`` are the mean of ``|cos|`` and ``|sin|`` over a 45-degree grid that counts both
 0 and 360 degrees (:func:`paper_style_grid_deg`); its ``0.6481 / 0.5372`` and its small non-zero
 off-model values (0.0053, 0.0059, ...) match that grid applied to the exact chain at errors of
@@ -25,103 +19,113 @@ about 0.1-0.2 degrees (see the README).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
-import pinocchio as pin
 
+from ..core.exceptions import InputError
 from ..core.units import DEG_PER_RAD
-from ..model.angles import ANGLE_ENTRIES, ANGLE_NAMES
-from ..model.chain import ROTATION
-from ..model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
-from ..model.turntable import TurntableModel
+from ..model.angles import ANGLE_NAMES
 
 __all__ = [
+    "DEFAULT_GRID_STEPS_DEG",
+    "FULL_TURN_RAD",
+    "MAX_GRID_POINTS",
     "ORIENTATION_ANGLE_NAMES",
     "PAPER_FIGURE8_TRIG",
     "AverageSensitivities",
+    "Sensitivities",
+    "TableSensitivities",
     "average_sensitivities",
+    "default_grid_step_deg",
+    "grid_angles_rad",
+    "grid_axes_rad",
+    "moving_joints",
     "paper_style_grid_deg",
-    "sensitivities_on_grid",
+    "sensitivities",
     "sensitivity_matrix",
-    "sensitivity_matrix_fd",
+    "table_sensitivities",
     "uniform_grid_deg",
 ]
 
 ORIENTATION_ANGLE_NAMES = ANGLE_NAMES
 """Alias of :data:`turntable_pin.model.angles.ANGLE_NAMES` (rows of the sensitivities)."""
+PAPER_FIGURE8_TRIG = 0.6481
+"""The paper's Figure 8 value used for every sin/cos term by ``--weights paper``
+(see docs/model.md)."""
+DEFAULT_GRID_STEPS_DEG: dict[int, float] = {1: 1.0, 2: 5.0, 3: 15.0}
+"""Default grid step by the number of joints the first-order model depends on, degrees."""
+MAX_GRID_POINTS = 200_000
+"""Most positions a grid over every joint may have (memory of the regressor on it)."""
+FULL_TURN_RAD = (0.0, 2.0 * math.pi)
+"""A joint's whole turn, radians."""
 
 
-def _factor_twist(model: TurntableModel, name: str) -> tuple[str, np.ndarray]:
-    """Link holding error ``name`` and the link placement's right-trivialised variation per unit.
-
-    The placement is ``nominal F_1 ... F_k(e) ... F_n``; d/de of it is the placement times
-    ``tail^-1 xi tail`` with ``tail = F_{k+1} ... F_n`` and ``xi`` the factor's unit twist.
-    """
-    chain = model.chain
-    link, index = chain.locate(name)
-    factor = link.factors[index]
-    values = model.errors.as_array().copy()
-    for earlier in link.factors[: index + 1]:
-        values[chain.error_names.index(earlier.error)] = 0.0  # identity factors leave the tail
-    tail = chain.error_transforms(values)[link.name]
-    tail_se3 = pin.SE3(np.array(tail[:3, :3]), np.array(tail[:3, 3]))
-    unit = factor.unit
-    if factor.kind == ROTATION:
-        twist = pin.Motion(np.zeros(3), unit)
-    else:
-        twist = pin.Motion(unit, np.zeros(3))
-    return link.name, tail_se3.actInv(twist).vector
+@lru_cache(maxsize=32)
+def moving_joints(table) -> tuple[bool, ...]:
+    """Whether the table's first-order model depends on each joint (chain order): ``False`` for
+    a joint all of whose error factors before it turn with it (the paper's phi1)."""
+    rng = np.random.default_rng(0)  # generic positions: any random draw is generic
+    angles = [rng.uniform(-math.pi, math.pi, 16) for _ in table.joint_names]
+    base = table.regressor(angles)
+    out = []
+    for j in range(len(angles)):
+        moved = list(angles)
+        moved[j] = angles[j] + 1.0
+        out.append(bool(np.max(np.abs(table.regressor(moved) - base)) > 1e-12))
+    return tuple(out)
 
 
-def sensitivity_matrix(model: TurntableModel, phi1_rad: float, phi2_rad: float) -> np.ndarray:
-    """Analytic ``C`` (3, 8): d(dpsi, dtheta, dgamma)/d chi at (phi1, phi2), from Pinocchio.
+def default_grid_step_deg(table) -> float:
+    """The default grid step of ``table`` (:data:`DEFAULT_GRID_STEPS_DEG` by the number of joints
+    its first-order model depends on), degrees."""
+    return DEFAULT_GRID_STEPS_DEG[max(1, sum(moving_joints(table)))]
 
-    Rows dpsi, dtheta, dgamma; columns :data:`ANGULAR_ERROR_NAMES`. Dimensionless (rad/rad).
-    Exact derivative of the exact chain at the model's error set (not the small-angle model).
-    """
-    pin_model, data = model.pin_model, model.pin_data
-    q = model.joint_vector(phi1_rad, phi2_rad)
-    pin.forwardKinematics(pin_model, data, q)
-    pin.updateFramePlacements(pin_model, data)
-    frame_id = model.payload_frame_id
-    regressor = pin.computeFrameKinematicRegressor(pin_model, data, frame_id, pin.LOCAL)
-    actual = data.oMf[frame_id].rotation
-    ideal = model.ideal_pose(phi1_rad, phi2_rad).rotation
-    dR = ideal.T @ actual
-    payload = pin_model.frames[frame_id].placement
-    out = np.empty((3, len(ANGULAR_ERROR_NAMES)))
-    for col, name in enumerate(ANGULAR_ERROR_NAMES):
-        link, twist = _factor_twist(model, name)
-        if model.chain.link(link).is_joint:
-            block = pin_model.getJointId(link) - 1
-            omega = (regressor[:, 6 * block : 6 * block + 6] @ twist)[3:]
+
+def _step(table, step_deg) -> float:
+    step = default_grid_step_deg(table) if step_deg is None else float(step_deg)
+    if not (math.isfinite(step) and 0.0 < step <= 90.0):
+        raise InputError(f"the grid step must be in (0, 90] degrees, got {step_deg!r}")
+    return step
+
+
+def _check_count(count: int, step: float, joints: int) -> None:
+    if count > MAX_GRID_POINTS:
+        raise InputError(
+            f"a {step:g}-degree grid over {joints} joints has {count} positions, "
+            f"more than {MAX_GRID_POINTS}; choose a coarser --grid-step-deg"
+        )
+
+
+def grid_axes_rad(table, step_deg: float | None = None, domain_rad=None) -> tuple[np.ndarray, ...]:
+    """One grid per joint (chain order), radians: ``0, step, ... < 360`` degrees over a full turn,
+    ``lo .. hi`` with both ends over an interval of ``domain_rad`` (one ``(lo, hi)`` per joint,
+    default full turns); a joint the first-order model does not depend on: ``lo`` only."""
+    step = _step(table, step_deg)
+    domain = domain_rad or (FULL_TURN_RAD,) * len(table.joint_names)
+    axes = []
+    for (lo, hi), moving in zip(domain, moving_joints(table), strict=True):
+        if not moving:
+            axes.append(np.array([lo]))
+        elif hi - lo >= 2.0 * math.pi * (1.0 - 1e-12):
+            axes.append(lo + np.arange(0.0, 360.0 - 1e-9, step) / DEG_PER_RAD)
         else:
-            # Both frames hang on the last joint: the payload relative to the fixed link's frame.
-            relative = pin_model.frames[pin_model.getFrameId(link)].placement.actInv(payload)
-            omega = relative.actInv(pin.Motion(twist)).angular
-        # Rt -> Rt (I + [omega]x de), so d(dR) = dR [omega]x.
-        d_dR = dR @ pin.skew(omega)
-        out[:, col] = [d_dR[i, j] for i, j in ANGLE_ENTRIES]
-    return out
+            count = max(2, math.ceil((hi - lo) * DEG_PER_RAD / step - 1e-9) + 1)
+            axes.append(np.linspace(lo, hi, count))
+    _check_count(math.prod(a.size for a in axes), step, sum(moving_joints(table)))
+    return tuple(axes)
 
 
-def sensitivity_matrix_fd(
-    model: TurntableModel, phi1_rad: float, phi2_rad: float, step_rad: float = 1e-6
-) -> np.ndarray:
-    """``C`` (3, 8) by central finite differences of the exact model (independent check)."""
-    base = model.errors.as_array()
-    out = np.empty((3, len(ANGULAR_ERROR_NAMES)))
-    for col in range(len(ANGULAR_ERROR_NAMES)):
-        sides = []
-        for sign in (1.0, -1.0):
-            values = base.copy()
-            values[col] += sign * step_rad
-            e = model.with_errors(TurntableErrors.from_array(values))
-            r = e.orientation_error(phi1_rad, phi2_rad)
-            sides.append(np.array([r.dpsi_rad, r.dtheta_rad, r.dgamma_rad]))
-        out[:, col] = (sides[0] - sides[1]) / (2.0 * step_rad)
-    return out
+def grid_angles_rad(table, step_deg: float | None = None) -> list[np.ndarray]:
+    """A full grid over every joint, ``0, step, ... < 360`` degrees each: one flat array of
+    radians per joint (chain order), every combination."""
+    step = _step(table, step_deg)
+    axis = np.arange(0.0, 360.0 - 1e-9, step) / DEG_PER_RAD
+    _check_count(axis.size ** len(table.joint_names), step, len(table.joint_names))
+    mesh = np.meshgrid(*([axis] * len(table.joint_names)), indexing="ij")
+    return [m.ravel() for m in mesh]
 
 
 def uniform_grid_deg(n: int) -> np.ndarray:
@@ -135,82 +139,126 @@ def paper_style_grid_deg(step_deg: float = 45.0) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class AverageSensitivities:
-    """Mean of ``|C|`` over a grid of rotation angles (Figure 8).
+class Sensitivities:
+    """``C`` of a table's angular errors on a grid, and its mean magnitude (Figure 8).
 
     Attributes:
-        values: (3, 8) rows dpsi, dtheta, dgamma; columns :data:`ANGULAR_ERROR_NAMES`.
-        phi1_grid_deg, phi2_grid_deg: the grids averaged over (every pair), degrees.
-        errors: the error set at which the exact model was differentiated.
-        max_phi1_variation: largest change of ``C`` along phi1 on the grid (0 up to rounding:
-            with this error model the orientation error does not depend on phi1).
+        error_names: the angular errors (columns).  joint_names: the joints of the grid.
+        axes_rad: one grid per joint (chain order), radians; the positions are every combination.
+        matrices: (N, 3, P) ``d(dpsi, dtheta, dgamma)/d(error)`` at each position (rad/rad).
+        values: (3, P) mean of ``|C|`` over the grid; rows dpsi, dtheta, dgamma.
+        grid_step_deg: the grid step (None: grids given by the caller).
+        error_values: the error set the exact chain was differentiated at (None: zero errors,
+            the first-order model), in the table's parameter order.
     """
 
+    error_names: tuple[str, ...]
+    joint_names: tuple[str, ...]
+    axes_rad: tuple[np.ndarray, ...] = field(repr=False)
+    matrices: np.ndarray = field(repr=False)
     values: np.ndarray
-    phi1_grid_deg: np.ndarray
-    phi2_grid_deg: np.ndarray
-    errors: TurntableErrors = field(default_factory=TurntableErrors)
-    max_phi1_variation: float = 0.0
+    grid_step_deg: float | None = None
+    error_values: np.ndarray | None = None
+
+    @property
+    def grid_rad(self) -> tuple[np.ndarray, ...]:
+        """The positions: one flat array of radians per joint, every combination of the axes."""
+        return tuple(m.ravel() for m in np.meshgrid(*self.axes_rad, indexing="ij"))
+
+    @property
+    def phi1_grid_deg(self) -> np.ndarray:
+        """The first joint's grid, degrees (the paper's phi1)."""
+        return self.axes_rad[0] * DEG_PER_RAD
+
+    @property
+    def phi2_grid_deg(self) -> np.ndarray:
+        """The last joint's grid, degrees (the paper's phi2)."""
+        return self.axes_rad[-1] * DEG_PER_RAD
+
+    @property
+    def max_phi1_variation(self) -> float:
+        """Largest change of ``C`` along the first joint on the grid (the paper's phi1, which
+        drops out: 0 up to rounding)."""
+        shaped = self.matrices.reshape(self.axes_rad[0].size, -1)
+        return float(np.max(np.abs(shaped - shaped[:1])))
 
     def value(self, angle: str, error: str) -> float:
         """Average sensitivity of ``angle`` (dpsi/dtheta/dgamma) to ``error``."""
-        return float(
-            self.values[ORIENTATION_ANGLE_NAMES.index(angle), ANGULAR_ERROR_NAMES.index(error)]
-        )
+        return float(self.values[ANGLE_NAMES.index(angle), self.error_names.index(error)])
+
+    def by_angle(self, angle_keys=ANGLE_NAMES) -> dict:
+        """``{angle: {error: mean |C|}}`` with the rows keyed by ``angle_keys``."""
+        return {
+            key: dict(zip(self.error_names, map(float, self.values[k]), strict=True))
+            for k, key in enumerate(angle_keys)
+        }
 
     def to_dict(self) -> dict:
-        """Grids (degrees), error set, phi1 variation and sensitivities by name, JSON-ready."""
+        """Grids (degrees), error set and sensitivities by angle and error name, JSON-ready."""
         return {
-            "averaging": "mean of |dC/dchi| over every (phi1, phi2) pair of the grids",
-            "phi1_grid_deg": self.phi1_grid_deg.tolist(),
-            "phi2_grid_deg": self.phi2_grid_deg.tolist(),
-            "errors": self.errors.to_user_units(),
-            "max_phi1_variation": self.max_phi1_variation,
-            "sensitivities": {
-                angle: {
-                    name: float(self.values[k, i]) for i, name in enumerate(ANGULAR_ERROR_NAMES)
-                }
-                for k, angle in enumerate(ORIENTATION_ANGLE_NAMES)
+            "averaging": "mean of |d angle / d error| over every combination of the joint grids",
+            "grid_deg": {
+                j: (a * DEG_PER_RAD).tolist()
+                for j, a in zip(self.joint_names, self.axes_rad, strict=True)
             },
+            "grid_step_deg": self.grid_step_deg,
+            "error_values": None if self.error_values is None else self.error_values.tolist(),
+            "max_phi1_variation": self.max_phi1_variation,
+            "sensitivities": self.by_angle(),
         }
 
 
-def sensitivities_on_grid(model: TurntableModel, phi1_grid_rad, phi2_grid_rad) -> np.ndarray:
-    """Analytic ``C`` at every pair of the grids: shape (n1, n2, 3, 8)."""
-    phi1 = np.atleast_1d(np.asarray(phi1_grid_rad, dtype=float))
-    phi2 = np.atleast_1d(np.asarray(phi2_grid_rad, dtype=float))
-    out = np.empty((phi1.size, phi2.size, 3, len(ANGULAR_ERROR_NAMES)))
-    for a, p1 in enumerate(phi1):
-        for b, p2 in enumerate(phi2):
-            out[a, b] = sensitivity_matrix(model, float(p1), float(p2))
-    return out
-
-
-def average_sensitivities(
-    model: TurntableModel | None = None,
-    phi1_grid_deg=None,
-    phi2_grid_deg=None,
-) -> AverageSensitivities:
-    """Mean of ``|C|`` over the grids (default: 4 phi1 values and 360 phi2 values per turn).
-
-    Args:
-        model: the turntable whose exact chain is differentiated (default: no errors).
-        phi1_grid_deg, phi2_grid_deg: grids in degrees (default :func:`uniform_grid_deg`).
-    """
-    model = model or TurntableModel()
-    phi1 = uniform_grid_deg(4) if phi1_grid_deg is None else np.asarray(phi1_grid_deg, float)
-    phi2 = uniform_grid_deg(360) if phi2_grid_deg is None else np.asarray(phi2_grid_deg, float)
-    grid = sensitivities_on_grid(model, phi1 / DEG_PER_RAD, phi2 / DEG_PER_RAD)
-    variation = float(np.max(np.abs(grid - grid[:1]))) if phi1.size > 1 else 0.0
-    return AverageSensitivities(
-        values=np.abs(grid).mean(axis=(0, 1)),
-        phi1_grid_deg=phi1,
-        phi2_grid_deg=phi2,
-        errors=model.errors,
-        max_phi1_variation=variation,
+def sensitivities(
+    table, axes_rad=None, *, grid_step_deg: float | None = None, error_values=None
+) -> Sensitivities:
+    """The mean of ``|C|`` of ``table``'s angular errors over every combination of ``axes_rad``
+    (one grid per joint, radians; default :func:`grid_axes_rad` at ``grid_step_deg``), at zero
+    errors or of the exact chain at ``error_values`` (the table's parameter order)."""
+    step = None
+    if axes_rad is None:
+        step = _step(table, grid_step_deg)
+        axes_rad = grid_axes_rad(table, step)
+    axes = tuple(np.atleast_1d(np.asarray(a, dtype=float)) for a in axes_rad)
+    mesh = [m.ravel() for m in np.meshgrid(*axes, indexing="ij")]
+    columns = [table.parameter_names.index(n) for n in table.angular_names]
+    matrices = table.regressor(mesh, error_values)[:, :, columns]
+    return Sensitivities(
+        error_names=tuple(table.angular_names),
+        joint_names=tuple(table.joint_names),
+        axes_rad=axes,
+        matrices=matrices,
+        values=np.abs(matrices).mean(axis=0),
+        grid_step_deg=step,
+        error_values=None if error_values is None else np.asarray(error_values, dtype=float),
     )
 
 
-PAPER_FIGURE8_TRIG = 0.6481
-"""The paper's Figure 8 value used for every sin/cos term by ``--weights paper``
-(see docs/model.md)."""
+def table_sensitivities(table, grid_step_deg: float | None = None) -> Sensitivities:
+    """:func:`sensitivities` of ``table`` on its default grid at ``grid_step_deg``."""
+    return sensitivities(table, grid_step_deg=grid_step_deg)
+
+
+def average_sensitivities(model=None, phi1_grid_deg=None, phi2_grid_deg=None) -> Sensitivities:
+    """:func:`sensitivities` of the paper's table over every (phi1, phi2) pair of the grids, in
+    degrees (default 4 phi1 and 360 phi2 values per turn), at the errors of ``model`` (a
+    :class:`~turntable_pin.model.turntable.TurntableModel`; default none)."""
+    from ..model.paper_table import paper_table
+
+    phi1 = uniform_grid_deg(4) if phi1_grid_deg is None else np.asarray(phi1_grid_deg, float)
+    phi2 = uniform_grid_deg(360) if phi2_grid_deg is None else np.asarray(phi2_grid_deg, float)
+    table = paper_table() if model is None else model.table
+    errors = None if model is None else model.errors.as_array()
+    return sensitivities(table, (phi1 / DEG_PER_RAD, phi2 / DEG_PER_RAD), error_values=errors)
+
+
+def sensitivity_matrix(model, phi1_rad: float, phi2_rad: float) -> np.ndarray:
+    """``C`` (3, 8) of the paper's table at (phi1, phi2) and the errors of ``model`` (a
+    :class:`~turntable_pin.model.turntable.TurntableModel`), exact (the table's regressor)."""
+    table = model.table
+    columns = [table.parameter_names.index(n) for n in table.angular_names]
+    angles = (np.array([phi1_rad], float), np.array([phi2_rad], float))
+    return table.regressor(angles, model.errors.as_array())[0][:, columns]
+
+
+AverageSensitivities = TableSensitivities = Sensitivities
+"""Earlier names of :class:`Sensitivities` (the paper's and any table's)."""

@@ -1,55 +1,53 @@
-"""Error allocation of the turntable (paper section 4.2, eqs. 29-34) and its worst case (Lemma 1).
+"""Error allocation of a table on its first-order model (paper section 4.2, eqs. 29-34, Lemma 1).
 
-Three problems, one per orientation angle k (psi, theta, gamma), over the magnitudes ``x_i >= 0``
-of the errors that enter the small-angle model of that angle (eq. 26):
+The first-order model is the table's regressor ``C(q) = d(dpsi, dtheta, dgamma)/d(errors)`` at
+zero errors, for its angular errors. Angle k's problem over the magnitudes ``x_i >= LB_i`` of the
+errors that move it (eqs. 29-33) is
 
-    min  J_k = sum_i W_ki^2 / x_i^2
-    s.t. max over phi2 in Omega_k of  f_k(phi2, x) <= I_k,      x_i >= LB_i,
+    min  J_k = sum_i W_ki^2 / x_i^2    s.t.  sum_i |C_ki(q)| x_i <= I_k   for every q in Omega_k,
 
-with ``f_k(phi2, x) = c(x) + a(x) cos(phi2) + b(x) sin(phi2)`` linear in x and the paper's intervals
-``Omega_gamma = [0, pi/2]``, ``Omega_psi = [3pi/2, 2pi]`` (where every term of the model is
-non-negative) and, for theta (no phi2 in its model), the whole turn. The maximum over an interval
-is exact (:func:`interval_max`: the ends and the interior stationary point ``atan2(b, a)``).
+the left side being the largest first-order ``|d angle_k|`` errors of magnitudes x reach at q over
+every sign. ``Omega_k`` is every joint's whole turn, except on the paper's table: there it is the
+paper's (eqs. 31-33, :data:`PHI2_INTERVALS_RAD`), where every term of eq. 26 is non-negative, so
+the left side is the paper's ``f_k(phi2, x)`` and the problem is the paper's.
 
-How it is solved exactly: for one fixed phi2 = t the constraint is linear and the problem has the
-closed-form solution ``x_i = max(LB_i, k_i u)`` with ``k_i = (2 W_i^2 / g_i(t))^(1/3)`` and one
-scalar ``u`` fixed by the constraint (piecewise linear in u, solved through its breakpoints). Its
-optimum ``V(t)`` is a lower bound of the true optimum for every t; maximising ``V`` over t gives a
-candidate that, if it satisfies the constraint for *all* phi2 of the interval, is optimal (lower
-bound reached). That certificate is checked; if it fails (several active angles), SLSQP on the
-exact constraint is used instead, and the result says which method was used.
-
-The upper bounds combine as eq. 34: ``UB_i = min_k x*_ki``. :func:`worst_case_full_circle` gives the
-largest ``|f_k|`` the box ``|chi_i| <= UB_i`` allows over *every* phi2 and every sign (Lemma 1):
-``sum|A_k| UB + hypot(sum|B_k| UB, sum|C_k| UB)`` when no error has both a cos and a sin term.
+The constraint holds on the continuous domain (semi-infinite). ``C_ki`` is a trigonometric
+polynomial of degree one in every joint angle (:class:`AngleRows`), so along one joint the left
+side is ``c + a cos + b sin`` between the zeros of the rows, with an exact maximum; the maximum over
+the domain (:func:`domain_max`) starts from the best points of a grid and maximises exactly along
+one joint at a time until nothing improves. For one point q the problem has a closed form whose
+optimum ``V(q)`` bounds the true one from below. :func:`solve_subproblem` starts at the grid point
+of largest ``V``, moves its points to the local maxima of the constraint at the current solution
+and adds the most violated one (an exchange method; several points: SLSQP) until the constraint
+holds everywhere. One point whose closed form meets it is the optimum (``exact``); otherwise
+(``cutting planes``) the solution is scaled onto the constraint. The bounds combine as eq. 34,
+``UB_i = min_k x*_ki``; the worst case (Lemma 1) is ``max sum_i |C_ki(q)| UB_i`` over whole turns.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
+from pathlib import Path
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from ..calibration.site import DEFAULT_LATITUDE_DEG
-from ..core.exceptions import InputError
+from ..core.exceptions import InfeasibleError, InputError, ModelError
 from ..core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, arcmin_by_name
-from ..model.errors import ANGULAR_ERROR_NAMES, MAX_ANGULAR_ERROR_DEG, TurntableErrors
-from ..model.small_angle import small_angle_matrix
+from ..model.angles import ANGLE_SYMBOLS
+from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors
 from .capability import ManufacturingCapability
-from .common import (
-    ORIENTATION_ANGLES,
-    AllocationSummary,
-    SubproblemOptimum,
-    combine_upper_bounds,
-    fixed_angle_solution,
-    lower_bounds_infeasible,
-    minimize_weighted,
-    render_allocation_report,
+from .sensitivity import (
+    FULL_TURN_RAD,
+    PAPER_FIGURE8_TRIG,
+    Sensitivities,
+    grid_angles_rad,
+    grid_axes_rad,
+    table_sensitivities,
 )
-from .sensitivity import PAPER_FIGURE8_TRIG, AverageSensitivities, average_sensitivities
 
 __all__ = [
     "DEFAULT_ACCURACY_DPH",
@@ -59,36 +57,51 @@ __all__ = [
     "PHI2_INTERVALS_RAD",
     "WEIGHT_SCHEMES",
     "Allocation",
-    "LinearAngleModel",
+    "AngleRows",
     "OrientationLimits",
     "SubproblemResult",
+    "TableAllocation",
+    "allocate_table_tolerances",
     "allocate_tolerances",
     "allocation_weights",
+    "angle_rows",
+    "angular_names",
     "default_orientation_limits",
+    "domain_max",
+    "grid_angles_rad",
     "interval_max",
-    "linear_angle_models",
+    "minimize_weighted",
     "paper_eq16_limits",
     "solve_subproblem",
-    "worst_case_full_circle",
+    "table_lower_bounds",
 ]
 
+ORIENTATION_ANGLES = ANGLE_SYMBOLS  # the limit names: psi_rad, theta_rad, gamma_rad
+"""Names of the three orientation angles dpsi, dtheta, dgamma as used in keys and options."""
 PHI2_INTERVALS_RAD: dict[str, tuple[float, float]] = {
     "gamma": (0.0, 0.5 * math.pi),  # eq. 31
-    "theta": (0.0, 2.0 * math.pi),  # eq. 32 has no phi2; the whole turn is the same constraint
+    "theta": FULL_TURN_RAD,  # eq. 32 has no phi2; the whole turn is the same constraint
     "psi": (1.5 * math.pi, 2.0 * math.pi),  # eq. 33
 }
-"""The phi2 interval ``(lo, hi)`` of each angle's constraint (eqs. 31-33), radians."""
+"""The paper's Omega_k: the phi2 interval ``(lo, hi)`` of each angle's constraint, radians."""
 WEIGHT_SCHEMES: tuple[str, ...] = ("model", "paper", "equal")
-"""The weight schemes :func:`allocation_weights` knows."""
-
-# Eq. 16: 0.027 deg on each angle keeps the GyroWheel calibration error under 0.01 deg/h.
-_EQ16_LIMIT_DEG = 0.027
-
-
+"""The weight schemes :func:`allocation_weights` knows (``paper``: the paper's table only)."""
 MIN_LIMIT_ARCSEC = 1e-6
 """Smallest orientation limit accepted, arcsec (a micro-arcsecond; turntables work in arcsec)."""
+DEFAULT_ACCURACY_DPH = 0.01
+"""Calibration accuracy behind the default limits: the paper's example, 0.01 deg/h."""
+DEFAULT_POSITIONS = "grid:30"
+"""Position scheme behind the default limits (the calibration layer's reference scheme)."""
+
+_EQ16_LIMIT_DEG = 0.027  # eq. 16: 0.027 deg on each angle keeps the calibration under 0.01 deg/h
+_STARTS = 8  # grid points a domain maximum starts from
+_MET = 1e-12  # relative excess of the constraint taken as met
+_FAR = 1e3  # an error no point constrains yet, in units of the limit (surely too large)
+_NODES_RAD = (0.0, 0.5 * math.pi, math.pi)
+_TO_COEFFICIENTS = np.array([[0.5, 0.0, 0.5], [0.5, 0.0, -0.5], [-0.5, 1.0, -0.5]])  # (c, a, b)
 
 
+# ---- limits --------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class OrientationLimits:
     """Required bounds I_psi, I_theta, I_gamma on |dpsi|, |dtheta|, |dgamma|, radians.
@@ -139,12 +152,6 @@ class OrientationLimits:
         return {n: getattr(self, f"{n}_rad") * ARCMIN_PER_RAD for n in ORIENTATION_ANGLES}
 
 
-DEFAULT_ACCURACY_DPH = 0.01
-"""Calibration accuracy behind the default limits: the paper's example, 0.01 deg/h."""
-DEFAULT_POSITIONS = "grid:30"
-"""Position scheme behind the default limits (the calibration layer's reference scheme)."""
-
-
 def paper_eq16_limits() -> OrientationLimits:
     """The paper's eq. 16: 0.027 deg on each angle (for 0.01 deg/h, positions not stated)."""
     return OrientationLimits.from_deg(_EQ16_LIMIT_DEG, _EQ16_LIMIT_DEG, _EQ16_LIMIT_DEG)
@@ -155,63 +162,121 @@ def default_orientation_limits(
     accuracy_dph: float = DEFAULT_ACCURACY_DPH,
     positions: str = DEFAULT_POSITIONS,
     latitude_deg: float = DEFAULT_LATITUDE_DEG,
+    table=None,
 ) -> OrientationLimits:
     """The orientation requirement used when the user gives no limits.
 
     It is the calibration layer's requirement (eqs. 15-16, :func:`orientation_requirement`) for
-    calibration accuracy ``accuracy_dph`` (deg/h) on the position scheme ``positions`` at
-    ``latitude_deg`` (degrees), with the paper's Table 1 GyroWheel. The paper's own numbers are
-    :func:`paper_eq16_limits`.
+    calibration accuracy ``accuracy_dph`` (deg/h) on the position scheme ``positions`` of
+    ``table`` (default the paper's) at ``latitude_deg`` (degrees), with the paper's Table 1
+    GyroWheel. The paper's own numbers are :func:`paper_eq16_limits`.
+
+    Raises:
+        IdentifiabilityError: the positions cannot calibrate the GyroWheel on this table.
     """
     from ..calibration.positions import PositionSet
     from ..calibration.requirement import orientation_requirement
 
     requirement = orientation_requirement(
-        accuracy_dph, PositionSet.parse(positions), math.radians(latitude_deg)
+        accuracy_dph, PositionSet.parse(positions, table), math.radians(latitude_deg)
     )
     return OrientationLimits(*requirement.limits_rad)
 
 
-# ---- the linear model of each angle ----------------------------------------------------------
-@dataclass(frozen=True)
-class LinearAngleModel:
-    """``f(phi2, chi) = const.chi + cos(phi2) cos_coef.chi + sin(phi2) sin_coef.chi`` (eq. 26 row).
+# ---- the rows of one angle and their maximum over a domain ----------------------------------
+# ---- the rows of one angle and their maximum over a domain ----------------------------------
+def _is_paper(table) -> bool:
+    from ..model.paper_table import PAPER_LAYOUT
 
-    Read off :func:`small_angle_matrix` (the foundation's eq. 26), not retyped.
+    return table.layout is PAPER_LAYOUT
+
+
+def _basis(t) -> np.ndarray:
+    """``(1, cos t, sin t)`` along a last axis."""
+    return np.stack([np.ones_like(t), np.cos(t), np.sin(t)], axis=-1)
+
+
+@dataclass(frozen=True, eq=False)
+class AngleRows:
+    """One angle's first-order rows and the domain its constraint holds on.
+
+    Attributes:
+        angle: psi, theta or gamma.  error_names: the errors that move it (the columns).
+        coefficients: ``T`` (3,) * joints + (m,): the signed rows are ``C_k(q) = sum T[i, j, ..]
+            b_i(q_1) b_j(q_2) ..`` with ``b(t) = (1, cos t, sin t)``.
+        domain_rad: Omega_k, one ``(lo, hi)`` per joint.
+        axes_rad: the starting grid, one per joint inside the domain (a single value: a joint the
+            rows do not depend on, never moved).
+        joint_names: the joints.  paper_terms: say it in the paper's terms (over phi2).
     """
 
     angle: str
-    const: np.ndarray
-    cos_coef: np.ndarray
-    sin_coef: np.ndarray
+    error_names: tuple[str, ...]
+    coefficients: np.ndarray = field(repr=False)
+    domain_rad: tuple[tuple[float, float], ...]
+    axes_rad: tuple[np.ndarray, ...] = field(repr=False)
+    joint_names: tuple[str, ...] = ()
+    paper_terms: bool = False
 
-    @property
-    def members(self) -> np.ndarray:
-        """Indices (into :data:`ANGULAR_ERROR_NAMES`) of the errors that enter this angle."""
-        coef = np.abs(self.const) + np.abs(self.cos_coef) + np.abs(self.sin_coef)
-        return np.flatnonzero(coef > 0.0)
+    def values(self, points, keep: int | None = None) -> np.ndarray:
+        """The signed rows (K, m) at points (K, joints), radians; with ``keep``, their ``(c, a,
+        b)`` of ``c + a cos + b sin`` along that joint through each point (K, 3, m)."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        out = np.broadcast_to(self.coefficients, (len(points), *self.coefficients.shape))
+        for j in reversed(range(points.shape[1])):  # the last joint's axis is always at -2
+            if j == keep:
+                out = np.moveaxis(out, -2, 1)
+            else:
+                out = np.einsum("k...im,ki->k...m", out, _basis(points[:, j]))
+        return out
 
-    def basis_values(self, phi2_rad) -> np.ndarray:
-        """``g_i(phi2) = d f / d chi_i``, shape phi2.shape + (8,)."""
-        phi2 = np.asarray(phi2_rad, dtype=float)[..., None]
-        return self.const + self.cos_coef * np.cos(phi2) + self.sin_coef * np.sin(phi2)
-
-    def coefficients(self, chi) -> tuple[float, float, float]:
-        """``(a, b, c)`` of ``c + a cos + b sin`` for the error values ``chi`` (8,)."""
-        chi = np.asarray(chi, dtype=float)
-        return float(self.cos_coef @ chi), float(self.sin_coef @ chi), float(self.const @ chi)
+    @cached_property
+    def grid(self) -> tuple[np.ndarray, np.ndarray]:
+        """The starting grid: positions (N, joints) and ``|C_k|`` there (N, m)."""
+        mesh = np.stack([m.ravel() for m in np.meshgrid(*self.axes_rad, indexing="ij")], axis=1)
+        return mesh, np.abs(self.values(mesh))
 
 
-def linear_angle_models() -> dict[str, LinearAngleModel]:
-    """The eq. 26 model of psi, theta and gamma, each as constant, cos and sin coefficients."""
-    s0, s90, s180 = (small_angle_matrix(a) for a in (0.0, 0.5 * math.pi, math.pi))
-    const = 0.5 * (s0 + s180)
-    cos_coef = 0.5 * (s0 - s180)
-    sin_coef = s90 - const
-    return {
-        name: LinearAngleModel(name, const[k], cos_coef[k], sin_coef[k])
-        for k, name in enumerate(ORIENTATION_ANGLES)
-    }
+def angle_rows(
+    table, grid_step_deg: float | None = None, whole_turns: bool = False
+) -> dict[str, AngleRows]:
+    """The :class:`AngleRows` of psi, theta, gamma on ``table`` over Omega_k (``whole_turns``:
+    every joint's whole turn), starting grid of step ``grid_step_deg`` (default by table). ``T`` is
+    read off the regressor at 0, 90, 180 degrees of every joint and checked on random positions.
+
+    Raises:
+        ModelError: the regressor is not of degree one in every joint angle.
+    """
+    d = len(table.joint_names)
+    columns = [table.parameter_names.index(n) for n in table.angular_names]
+    mesh = np.meshgrid(*([np.array(_NODES_RAD)] * d), indexing="ij")
+    coefficients = table.regressor([m.ravel() for m in mesh])[:, :, columns]
+    coefficients = coefficients.reshape((3,) * d + coefficients.shape[1:])
+    for j in range(d):
+        coefficients = np.moveaxis(np.tensordot(_TO_COEFFICIENTS, coefficients, ([1], [j])), 0, j)
+    full = (FULL_TURN_RAD,) * d
+    probe = np.random.default_rng(0).uniform(-math.pi, math.pi, (16, d))  # generic positions
+    exact = table.regressor(list(probe.T))[:, :, columns]
+    out = {}
+    for k, name in enumerate(ORIENTATION_ANGLES):
+        block = coefficients[..., k, :]
+        peak = np.abs(block).reshape(-1, block.shape[-1]).max(axis=0)
+        members = np.flatnonzero(peak > 1e-12 * max(float(peak.max()), 1e-300))
+        domain = (
+            full if whole_turns or not _is_paper(table) else (full[0], PHI2_INTERVALS_RAD[name])
+        )
+        out[name] = AngleRows(
+            name,
+            tuple(table.angular_names[i] for i in members),
+            block[..., members],
+            domain,
+            grid_axes_rad(table, grid_step_deg, domain),
+            tuple(table.joint_names),
+            _is_paper(table),
+        )
+        if np.max(np.abs(out[name].values(probe) - exact[:, k, members]), initial=0) > 1e-12:
+            raise ModelError(f"{table.urdf_path}: the first-order model is not of degree one")
+    return out
 
 
 def interval_max(a: float, b: float, c: float, lo_rad: float, hi_rad: float) -> tuple[float, float]:
@@ -233,288 +298,542 @@ def interval_max(a: float, b: float, c: float, lo_rad: float, hi_rad: float) -> 
     return values[best], candidates[best]
 
 
-def worst_case_full_circle(model: LinearAngleModel, bounds_rad) -> float:
-    """Largest ``|f|`` over every phi2 and every chi with ``|chi_i| <= bounds_i`` (Lemma 1), rad.
-
-    ``max_{s, phi2} |c(s) + a(s) cos + b(s) sin| = max_s |c(s)| + hypot(a(s), b(s))``; when each
-    error has at most one of a cos and a sin term all three magnitudes peak at the same signs, so
-    it is ``sum |A| x + hypot(sum |B| x, sum |C| x)``. Otherwise every sign corner is tried.
-    """
-    x = np.abs(np.asarray(bounds_rad, dtype=float))
-    if not np.any((model.cos_coef != 0.0) & (model.sin_coef != 0.0)):
-        return float(
-            np.abs(model.const) @ x
-            + math.hypot(np.abs(model.cos_coef) @ x, np.abs(model.sin_coef) @ x)
-        )
-    members = model.members
-    best = 0.0
-    for corner in range(2**members.size):
-        signs = np.ones(x.size)
-        signs[members] = [1.0 if corner >> j & 1 else -1.0 for j in range(members.size)]
-        a, b, c = model.coefficients(signs * x)
-        best = max(best, abs(c) + math.hypot(a, b))
+def _max_along_joint(rows: np.ndarray, z, lo_rad: float, hi_rad: float) -> tuple[float, float]:
+    """Exact maximum of ``h(t) = sum_i z_i |c_i + a_i cos t + b_i sin t|`` over ``[lo, hi]`` (at
+    most a turn), ``rows`` (3, m) holding c, a, b: (value, t). Between the zeros of the rows the
+    signs are fixed and ``h`` is one ``c + a cos + b sin`` (:func:`interval_max` on each piece)."""
+    const, cos, sin = rows
+    r = np.hypot(cos, sin)
+    crossing = (r > 0.0) & (np.abs(const) <= r)
+    phase = np.arctan2(sin[crossing], cos[crossing])
+    half = np.arccos(np.clip(-const[crossing] / r[crossing], -1.0, 1.0))
+    zeros = lo_rad + (np.concatenate([phase + half, phase - half]) - lo_rad) % (2.0 * math.pi)
+    edges = np.unique(np.concatenate([[lo_rad, hi_rad], zeros[zeros < hi_rad]]))
+    best = (-math.inf, lo_rad)
+    for start, end in zip(edges[:-1], edges[1:], strict=True):
+        mid = 0.5 * (start + end)
+        signed = np.sign(const + cos * math.cos(mid) + sin * math.sin(mid)) * z
+        best = max(best, interval_max(signed @ cos, signed @ sin, signed @ const, start, end))
     return best
 
 
-# ---- weights -------------------------------------------------------------------------------
-def allocation_weights(
-    scheme: str, sensitivities: AverageSensitivities | None = None
-) -> np.ndarray:
-    """Weights W (3, 8), rows :data:`ORIENTATION_ANGLES` (only each angle's own errors matter).
+def _ascend(rows: AngleRows, points, z, local: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Each point (K, joints) moved to a local maximum of ``|C_k| @ z`` by exact maximisation
+    along one joint at a time, over the joint's domain or (``local``) within a grid step of the
+    point: (points, values)."""
+    points = np.array(points, dtype=float).reshape(-1, len(rows.domain_rad))
+    values = np.abs(rows.values(points)) @ z
+    moving = [j for j, axis in enumerate(rows.axes_rad) if axis.size > 1]
+    for _ in range(50):
+        improved = False
+        for j in moving:
+            along = rows.values(points, keep=j)
+            lo, hi = rows.domain_rad[j]
+            step = float(rows.axes_rad[j][1] - rows.axes_rad[j][0])
+            for p in range(len(points)):
+                t = points[p, j]
+                full = hi - lo >= 2.0 * math.pi * (1.0 - 1e-12)
+                near = (t - step, t + step) if full else (max(lo, t - step), min(hi, t + step))
+                value, t = _max_along_joint(along[p], z, *(near if local else (lo, hi)))
+                if value > values[p] * (1.0 + 1e-14):
+                    points[p, j], values[p], improved = (
+                        t % (2.0 * math.pi) if full else t,
+                        value,
+                        True,
+                    )
+        if not improved:
+            break
+    return points, values
 
-    ``model``: the inverse of the exact model's average sensitivities (Figure 8, computed);
-    ``paper``: the inverse of the paper's Figure 8 value 0.6481 for every sin/cos term and 1 for
-    every constant term; ``equal``: 1 everywhere (the "traditional" allocation).
+
+def _peaks(rows: AngleRows, z, more=()) -> tuple[np.ndarray, np.ndarray]:
+    """Local maxima of ``|C_k| @ z`` from the best points of the starting grid, after those
+    reached from the points ``more`` within their neighbourhood."""
+    positions, magnitudes = rows.grid
+    values = magnitudes @ z
+    # Ties up to rounding go to the first grid point (a constant row peaks everywhere).
+    ranked = np.round(values / max(float(values.max(initial=0.0)), 1e-300), 12)
+    points, values = _ascend(rows, positions[np.argsort(-ranked, kind="stable")[:_STARTS]], z)
+    if len(more):
+        near, near_values = _ascend(rows, more, z, local=True)
+        points, values = np.vstack([near, points]), np.concatenate([near_values, values])
+    return points, values
+
+
+def domain_max(rows: AngleRows, z) -> tuple[float, np.ndarray]:
+    """``max over q in Omega_k of sum_i |C_ki(q)| z_i`` and where (radians per joint)."""
+    points, values = _peaks(rows, np.asarray(z, dtype=float))
+    best = int(np.argmax(values))
+    return float(values[best]), points[best]
+
+
+# ---- one angle's problem ----------------------------------------------------------------------
+def _fixed_point_optimum(g, weights, lower, limit):
+    """Closed-form optimum of ``min sum W^2/x^2 s.t. g.x <= limit, x >= lower`` for each row of
+    ``g`` (..., m) at once (g may be <= 0). Returns ``(x, V)`` of shapes (..., m) and (...).
+
+    Errors with ``g_i <= 0`` are unconstrained by this relaxation (x_i = inf, no cost). The free
+    optimum is ``x_i = k_i u`` with ``k_i = (2 W_i^2 / g_i)^(1/3)``; with the lower bounds
+    ``x_i = max(lower_i, k_i u)``, and ``sum g_i x_i`` rises piecewise linearly in u: ``u`` is
+    found on the piece where the errors of the j smallest breakpoints ``lower_i / k_i`` are free.
     """
-    models = linear_angle_models()
-    weights = np.ones((3, len(ANGULAR_ERROR_NAMES)))
-    if scheme == "equal":
-        return weights
-    if scheme == "paper":
-        for k, name in enumerate(ORIENTATION_ANGLES):
-            m = models[name]
-            trig = (m.cos_coef != 0.0) | (m.sin_coef != 0.0)
-            weights[k, trig] = 1.0 / PAPER_FIGURE8_TRIG
-        return weights
-    if scheme == "model":
-        sens = sensitivities or average_sensitivities(phi1_grid_deg=[0.0])
-        # Order of sens rows is dpsi, dtheta, dgamma = ORIENTATION_ANGLES.
-        with np.errstate(divide="ignore"):
-            weights = np.where(sens.values > 0.0, 1.0 / sens.values, np.inf)
-        return weights
-    raise InputError(f"unknown weights '{scheme}'; choose one of {', '.join(WEIGHT_SCHEMES)}")
+    g = np.asarray(g, dtype=float)
+    w2, lower = np.asarray(weights, dtype=float) ** 2, np.asarray(lower, dtype=float)
+    positive = g > 0.0
+    safe = np.where(positive, g, 1.0)
+    k = np.where(positive, np.cbrt(2.0 * w2 / safe), 0.0)
+    breaks = np.where(positive, lower / np.where(positive, k, 1.0), np.inf)
+    order = np.argsort(breaks, axis=-1, kind="stable")
+
+    def sort(a):
+        return np.take_along_axis(np.broadcast_to(a, g.shape), order, axis=-1)
+
+    gs, ks, ls, bs = sort(np.where(positive, g, 0.0)), sort(k), sort(lower), sort(breaks)
+    free = np.cumsum(gs * ks, axis=-1)
+    at_lower = np.sum(gs * ls, axis=-1, keepdims=True) - np.cumsum(gs * ls, axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = (limit - at_lower) / free
+    following = np.concatenate([bs[..., 1:], np.full(g.shape[:-1] + (1,), np.inf)], axis=-1)
+    valid = (u <= following) & np.isfinite(bs)
+    j = np.argmax(valid, axis=-1)[..., None]
+    room = np.sum(gs * ls, axis=-1, keepdims=True) < limit
+    u_star = np.where(room & np.any(valid, axis=-1, keepdims=True), np.take_along_axis(u, j, -1), 0)
+    x = np.where(positive, np.maximum(lower, k * u_star), np.inf)
+    value = np.sum(np.where(positive, w2 / np.where(positive, x, 1.0) ** 2, 0.0), axis=-1)
+    return x, value
 
 
-# ---- one sub-problem -----------------------------------------------------------------------
+def minimize_weighted(w, start, lower, fun: Callable, jac: Callable) -> np.ndarray:
+    """SLSQP on ``min sum w^2/z^2`` s.t. ``fun(z) >= 0`` (gradient ``jac``), ``z >= lower``
+    (and ``z >= 1e-12``), in units of the limit."""
+    from scipy.optimize import minimize
+
+    res = minimize(
+        lambda z: float(np.sum(w**2 / z**2)),
+        start,
+        jac=lambda z: -2.0 * w**2 / z**3,
+        bounds=[(max(lb, 1e-12), None) for lb in lower],
+        constraints=[{"type": "ineq", "fun": fun, "jac": jac}],
+        method="SLSQP",
+        options={"ftol": 1e-15, "maxiter": 1000},
+    )
+    return np.asarray(res.x, dtype=float)
+
+
+def lower_bounds_infeasible(
+    angle: str, reached_rad: float, limit_rad: float, names: Sequence[str]
+) -> InfeasibleError:
+    """The error for lower bounds that alone give ``|d angle|`` up to ``reached_rad``, above the
+    limit: no allocation exists."""
+    return InfeasibleError(
+        f"the manufacturing lower bounds alone give d{angle} up to "
+        f"{reached_rad * ARCMIN_PER_RAD:.4f} arcmin, above the limit "
+        f"{limit_rad * ARCMIN_PER_RAD:.4f} arcmin: no allocation exists (lower the bounds of "
+        f"{', '.join(names)} or relax the limit)"
+    )
+
+
+def _distinct(rows: AngleRows, points) -> list[int]:
+    """Indices of the points whose rows ``|C_k|`` differ from every earlier one's (points with
+    the same rows -- a table's symmetric positions -- are one constraint)."""
+    g = np.abs(rows.values(points))
+    scale = max(float(np.abs(g).max(initial=0.0)), 1e-300)
+    return [i for i in range(len(g)) if np.all(np.abs(g[:i] - g[i]).max(axis=1) > 1e-6 * scale)]
+
+
+def _optimum(rows: AngleRows, w, lower_z) -> tuple[np.ndarray, str, np.ndarray]:
+    """``min sum w^2/z^2`` s.t. ``max_q |C_k(q)| @ z <= 1``, ``z >= lower_z`` (see the module):
+    the solution, the method and the points it was solved on."""
+    positions, magnitudes = rows.grid
+    points = positions[[int(np.argmax(_fixed_point_optimum(magnitudes, w, lower_z, 1.0)[1]))]]
+    z = np.full(w.shape, np.inf)
+    for _ in range(100):
+        g = np.abs(rows.values(points))
+        if len(points) == 1:
+            z = _fixed_point_optimum(g[0], w, lower_z, 1.0)[0]
+        else:
+            start = np.where(np.isfinite(z), z, _FAR)
+            start = np.maximum(start / float(np.max(g @ start)), lower_z)
+            z = minimize_weighted(w, start, lower_z, lambda v, g=g: 1.0 - g @ v, lambda v, g=g: -g)
+        finite = np.where(np.isfinite(z), z, _FAR)
+        moved, _ = _ascend(rows, points, finite, local=True)
+        peak, worst = domain_max(rows, finite)
+        new = peak > 1.0 + _MET and len(_distinct(rows, [*moved, worst])) > len(moved)
+        shift = np.abs(np.abs(rows.values(moved)) - g).max() / max(float(g.max()), 1e-300)
+        if not new and shift <= 1e-12:
+            break
+        points = np.array([*moved, worst] if new else moved)
+        points = points[_distinct(rows, points)]
+    exact = len(points) == 1 and peak <= 1.0 + _MET and np.all(np.isfinite(z))
+    z = finite
+    if peak > 1.0 or not exact:  # onto the constraint: admissible, and no cheaper
+        z = np.maximum(lower_z, z / peak)
+    return z, "exact" if exact else "cutting planes", points
+
+
+def _multipliers(rows: AngleRows, w, z, x_arcmin, at_lower, points):
+    """The constraint's maximum at ``z`` (units of the limit) and where, its multiplier (summed
+    over its active points: local maxima from ``points`` and the grid; errors in arc minutes) and
+    the KKT residual (largest relative stationarity error of the free errors)."""
+    from scipy.optimize import nnls
+
+    points, values = _peaks(rows, z, more=points)
+    peak = float(values.max())
+    active = points[values >= peak * (1.0 - 1e-7)]  # (SLSQP meets its points to ~1e-9)
+    g = np.abs(rows.values(active[_distinct(rows, active)]))  # the active gradients (Danskin)
+    grad = -2.0 * w**2 / x_arcmin**3
+    free = ~at_lower
+    scale = max(float(np.abs(grad).max(initial=0.0)), 1e-300)
+    lam = np.zeros(len(g))
+    if peak >= 1.0 - 1e-9 and np.any(free):
+        lam = nnls(g[:, free].T, -grad[free] / scale)[0] * scale
+    closing = np.where(free, grad + lam @ g, 0.0) / np.maximum(np.abs(grad), 1e-300)
+    return peak, points[int(np.argmax(values))], float(lam.sum()), float(np.max(np.abs(closing)))
+
+
 @dataclass(frozen=True)
-class SubproblemResult(SubproblemOptimum):
-    """Optimum of one of eqs. 31-33 (the common fields: :class:`.common.SubproblemOptimum`;
-    ``error_names`` is the vector chi_k of this angle's model, ``method`` "exact" or "slsqp").
+class SubproblemResult:
+    """The optimum of one angle's problem.
 
     Attributes:
-        interval_rad: the phi2 interval of the constraint.
-        constraint_rad: max of f_k over the interval at the optimum;  phi2_at_max_rad: where.
-        multiplier: Lagrange multiplier of the semi-infinite constraint (x in arcmin).
-        bound_multipliers: of the lower bounds (0 for free errors).
-        kkt_residual: largest relative stationarity error over the free errors.
+        angle: psi, theta or gamma.  error_names: the errors that move it.
+        weights, lower_bounds_rad, solution_rad: per error of ``error_names``.
+        limit_rad: I_k.  method: ``exact`` or ``cutting planes``.
+        domain_rad: Omega_k, one ``(lo, hi)`` per joint.  joint_names: the joints.
+        constraint_rad: ``max over Omega_k of sum |C_k| x`` at the solution (<= limit), reached
+            at ``at_angles_rad`` (one angle per joint).
+        multiplier: the constraint's (x in arcmin, summed over its active points).
+        kkt_residual: largest relative stationarity error.
+        paper_terms: say it in the paper's terms (over phi2, the last joint).
     """
 
-    interval_rad: tuple[float, float]
+    angle: str
+    error_names: tuple[str, ...]
+    weights: np.ndarray
+    lower_bounds_rad: np.ndarray
+    solution_rad: np.ndarray
+    limit_rad: float
+    method: str
+    domain_rad: tuple[tuple[float, float], ...]
+    joint_names: tuple[str, ...]
     constraint_rad: float
-    phi2_at_max_rad: float
+    at_angles_rad: tuple[float, ...]
     multiplier: float
-    bound_multipliers: np.ndarray
     kkt_residual: float
+    paper_terms: bool = False
 
-    def details(self) -> dict:
-        """phi2 interval and maximum (degrees), constraint (arcmin), multiplier, KKT residual."""
+    @property
+    def J(self) -> float:
+        """The objective ``sum W^2 / x^2`` at the optimum, errors in arc minutes (1/arcmin^2)."""
+        return float(np.sum(self.weights**2 / (self.solution_rad * ARCMIN_PER_RAD) ** 2))
+
+    @property
+    def worst_rad(self) -> float:
+        """The first-order worst case at the solution (:attr:`constraint_rad`)."""
+        return self.constraint_rad
+
+    @property
+    def interval_rad(self) -> tuple[float, float]:
+        """The last joint's interval (the paper's phi2 interval)."""
+        return self.domain_rad[-1]
+
+    @property
+    def active(self) -> tuple[str, ...]:
+        """The active constraints in words."""
+        deg = [a * DEG_PER_RAD for a in self.at_angles_rad]
+        out = []
+        if self.constraint_rad >= self.limit_rad * (1.0 - 1e-9) and self.paper_terms:
+            lo, hi = (v * DEG_PER_RAD for v in self.interval_rad)
+            out.append(
+                f"max d{self.angle} over phi2 in [{lo:g}, {hi:g}] deg = limit (at phi2 = "
+                f"{deg[-1]:.4f} deg)"
+            )
+        elif self.constraint_rad >= self.limit_rad * (1.0 - 1e-9):
+            where = ", ".join(f"{j} = {a:g}" for j, a in zip(self.joint_names, deg, strict=True))
+            out.append(f"first-order max |d{self.angle}| = limit (at {where} deg)")
+        lower = self.solution_rad <= self.lower_bounds_rad * (1.0 + 1e-9)
+        return (
+            *out,
+            *(f"{n} = lower bound" for n, f in zip(self.error_names, lower, strict=True) if f),
+        )
+
+    def to_dict(self) -> dict:
+        """The optimum, JSON-ready: angle, solution (arcmin), weights, J, limit (arcmin), where
+        the constraint peaks (in the paper's terms also the phi2 interval, the multiplier and the
+        KKT residual), active constraints and method."""
+        if self.paper_terms:
+            details = {
+                "phi2_interval_deg": [v * DEG_PER_RAD for v in self.interval_rad],
+                "constraint_arcmin": self.constraint_rad * ARCMIN_PER_RAD,
+                "phi2_at_max_deg": self.at_angles_rad[-1] * DEG_PER_RAD,
+                "multiplier": self.multiplier,
+                "kkt_residual": self.kkt_residual,
+            }
+        else:
+            details = {
+                "worst_case_arcmin": self.constraint_rad * ARCMIN_PER_RAD,
+                "at_angles_deg": [a * DEG_PER_RAD for a in self.at_angles_rad],
+            }
         return {
-            "phi2_interval_deg": [v * DEG_PER_RAD for v in self.interval_rad],
-            "constraint_arcmin": self.constraint_rad * ARCMIN_PER_RAD,
-            "phi2_at_max_deg": self.phi2_at_max_rad * DEG_PER_RAD,
-            "multiplier": self.multiplier,
-            "kkt_residual": self.kkt_residual,
+            "angle": self.angle,
+            "solution_arcmin": arcmin_by_name(self.error_names, self.solution_rad),
+            "weights": dict(zip(self.error_names, map(float, self.weights), strict=True)),
+            "J": self.J,
+            "limit_arcmin": self.limit_rad * ARCMIN_PER_RAD,
+            **details,
+            "active_constraints": list(self.active),
+            "method": self.method,
         }
 
 
-def solve_subproblem(
-    model: LinearAngleModel,
-    limit_rad: float,
-    weights: np.ndarray,
-    lower_bounds_rad: np.ndarray,
-    interval_rad: tuple[float, float],
-) -> SubproblemResult:
-    """Solve one of eqs. 31-33 exactly (see the module docstring). Radians in and out.
+def solve_subproblem(rows: AngleRows, limit_rad: float, weights, lower_bounds_rad):
+    """:class:`SubproblemResult` of angle ``rows.angle`` (see the module); ``weights`` and
+    ``lower_bounds_rad`` per error of ``rows.error_names``, radians.
 
     Raises:
-        InfeasibleError: the lower bounds alone already exceed the limit somewhere in the interval.
+        InfeasibleError: the lower bounds alone already exceed the limit somewhere in the domain.
     """
-    idx = model.members
-    names = tuple(ANGULAR_ERROR_NAMES[i] for i in idx)
-    w = np.asarray(weights, dtype=float)[idx]
-    lower = np.asarray(lower_bounds_rad, dtype=float)[idx]
-    lo, hi = interval_rad
-    # Work in units of the limit: x = z * limit.
-    lower_z = lower / limit_rad
-
-    def constraint(z):
-        full = np.zeros(len(ANGULAR_ERROR_NAMES))
-        full[idx] = z
-        return interval_max(*model.coefficients(full), lo, hi)
-
-    def basis(t):
-        return model.basis_values(t)[idx]
-
-    at_lower, _ = constraint(lower_z)
-    if at_lower > 1.0 + 1e-12:
-        raise lower_bounds_infeasible(model.angle, at_lower * limit_rad, limit_rad, names)
-
-    def dual(t):
-        return fixed_angle_solution(basis(t), w, lower_z, 1.0)
-
-    grid = np.linspace(lo, hi, 181)
-    values = np.array([dual(t)[1] for t in grid])
-    j = int(np.argmax(values))
-    a, b = grid[max(j - 1, 0)], grid[min(j + 1, grid.size - 1)]
-    res = minimize_scalar(
-        lambda t: -dual(t)[1], bounds=(a, b), method="bounded", options={"xatol": 1e-13}
+    w, lower = np.asarray(weights, dtype=float), np.asarray(lower_bounds_rad, dtype=float)
+    lower_z = lower / limit_rad  # in units of the limit: x = z * limit
+    at_lower, _ = domain_max(rows, lower_z)
+    if at_lower > 1.0 + _MET:
+        raise lower_bounds_infeasible(rows.angle, at_lower * limit_rad, limit_rad, rows.error_names)
+    z, method, points = _optimum(rows, w, lower_z) if w.size else (w, "exact", rows.grid[0][:1])
+    x = z * limit_rad
+    peak, at, multiplier, residual = _multipliers(
+        rows, w, z, x * ARCMIN_PER_RAD, x <= lower * (1.0 + 1e-9), points
     )
-    t_star = float(res.x) if -res.fun >= values[j] else float(grid[j])
-    # Polish: at the optimum t* is where the constraint of x(t*) peaks (a fixed point); the
-    # scalar search leaves t* ~1e-8 off, which this removes.
-    for _ in range(20):
-        t_next = constraint(dual(t_star)[0])[1] if np.all(np.isfinite(dual(t_star)[0])) else t_star
-        t_next = lo + (t_next - lo) % (2.0 * math.pi) if hi - lo < 2.0 * math.pi else t_star
-        if not lo <= t_next <= hi or dual(t_next)[1] < dual(t_star)[1] * (1.0 - 1e-15):
-            break
-        if abs(t_next - t_star) < 1e-15:
-            break
-        t_star = t_next
-    z, _ = dual(t_star)
-    method = "exact"
-    feasible = np.all(np.isfinite(z)) and constraint(z)[0] <= 1.0 + 1e-10
-    if not feasible:
-        z = _slsqp(constraint, basis, w, lower_z)
-        method = "slsqp"
-    # Remove the last rounding-level excess so the bounds are strictly admissible.
-    value, _ = constraint(z)
-    if value > 1.0:
-        z = np.maximum(lower_z, z / value)
-    return _kkt_report(model, names, w, lower, z * limit_rad, limit_rad, interval_rad, method)
-
-
-def _slsqp(constraint, basis, w, lower_z):
-    """Fallback: SLSQP on the exact semi-infinite constraint (Danskin gradient)."""
-    ones_value, _ = constraint(np.ones(lower_z.size))
-    at_lower, _ = constraint(lower_z)
-    start = lower_z + (1.0 - at_lower) / (2.0 * ones_value)
-    return minimize_weighted(
-        w,
-        start,
-        lower_z,
-        lambda z: 1.0 - constraint(z)[0],
-        lambda z: -basis(constraint(z)[1]),
-    )
-
-
-def _kkt_report(model, names, w, lower, x_rad, limit_rad, interval_rad, method):
-    """Multipliers and KKT residual at ``x_rad``, everything in arc minutes."""
-    lo, hi = interval_rad
-    full = np.zeros(len(ANGULAR_ERROR_NAMES))
-    idx = model.members
-    full[idx] = x_rad
-    value, t_max = interval_max(*model.coefficients(full), lo, hi)
-    x = x_rad * ARCMIN_PER_RAD
-    g = model.basis_values(t_max)[idx]  # gradient of the active constraint (Danskin)
-    grad_j = -2.0 * w**2 / x**3
-    at_lb = x_rad <= lower * (1.0 + 1e-9)
-    free = ~at_lb
-    constraint_active = value >= limit_rad * (1.0 - 1e-9)
-    if constraint_active and np.any(free):
-        multiplier = float(np.sum(-grad_j[free] * g[free]) / np.sum(g[free] ** 2))
-    else:
-        multiplier = 0.0
-    bound_multipliers = np.where(at_lb, grad_j + multiplier * g, 0.0)
-    stationarity = grad_j + multiplier * g - bound_multipliers
-    scale = np.maximum(np.abs(grad_j), 1e-300)
-    residual = float(np.max(np.abs(stationarity) / scale))
-    active = []
-    if constraint_active:
-        active.append(
-            f"max d{model.angle} over phi2 in [{lo * DEG_PER_RAD:g}, {hi * DEG_PER_RAD:g}] deg "
-            f"= limit (at phi2 = {t_max * DEG_PER_RAD:.4f} deg)"
-        )
-    active += [f"{n} = lower bound" for n, flag in zip(names, at_lb, strict=True) if flag]
     return SubproblemResult(
-        angle=model.angle,
-        error_names=names,
-        weights=w,
-        lower_bounds_rad=lower,
-        solution_rad=np.asarray(x_rad, dtype=float),
-        limit_rad=limit_rad,
-        interval_rad=(lo, hi),
-        constraint_rad=value,
-        phi2_at_max_rad=t_max,
-        multiplier=multiplier,
-        bound_multipliers=bound_multipliers,
-        kkt_residual=residual,
-        active=tuple(active),
-        method=method,
-    )
+        rows.angle, rows.error_names, w, lower, x, float(limit_rad), method, rows.domain_rad,
+        rows.joint_names, peak * limit_rad, tuple(map(float, at)), multiplier, residual,
+        rows.paper_terms,
+    )  # fmt: skip
 
 
-# ---- the whole allocation ------------------------------------------------------------------
+# ---- weights and the whole allocation ------------------------------------------------------
+def allocation_weights(scheme: str, sensitivities: Sensitivities | None = None, table=None):
+    """Weights W (3, P) of ``table``'s angular errors (default the paper's), rows
+    :data:`ORIENTATION_ANGLES`: ``model``, the inverse of the average sensitivities (Figure 8;
+    default on the table's grid); ``paper`` (its table only), the inverse of the paper's Figure 8
+    value 0.6481 for every term that varies with the angles and 1 for the constant ones;
+    ``equal``, 1 everywhere (the "traditional" allocation).
+    """
+    from ..model.paper_table import paper_table
+
+    table = table or paper_table()
+    if scheme not in WEIGHT_SCHEMES:
+        raise InputError(f"unknown weights '{scheme}'; choose one of {', '.join(WEIGHT_SCHEMES)}")
+    if scheme == "paper" and not _is_paper(table):
+        raise InputError(
+            f"weights '{scheme}' are the paper table's; for this table choose one of model, equal"
+        )
+    if scheme == "equal":
+        return np.ones((3, len(table.angular_names)))
+    sens = sensitivities or table_sensitivities(table)
+    if scheme == "paper":
+        return np.where(np.ptp(sens.matrices, axis=0) > 1e-12, 1.0 / PAPER_FIGURE8_TRIG, 1.0)
+    with np.errstate(divide="ignore"):
+        return np.where(sens.values > 0.0, 1.0 / sens.values, np.inf)
+
+
 @dataclass(frozen=True)
-class Allocation(AllocationSummary):
-    """Upper bounds UB of the eight angular errors (eq. 34) and how they were obtained (the
-    fields of :class:`.common.AllocationSummary`: ``upper_bounds_rad`` (8,) in
-    :data:`ANGULAR_ERROR_NAMES` order; ``weights_scheme`` model, paper or equal; ``subproblems``
-    of :class:`SubproblemResult`; ``worst_case_rad`` over every angle and sign, Lemma 1 closed
-    form).
+class Allocation:
+    """Upper bounds of a table's angular errors (eq. 34) and how they were obtained.
 
     Attributes:
-        capability: the lower bounds used (by keyword).
+        upper_bounds_rad: (P,) radians in the table's angular order (``inf``: moves no angle).
+        limits: the :class:`OrientationLimits`.  weights_scheme: model, paper or equal.
+        weights: (3, P).  subproblems: ``{psi|theta|gamma: SubproblemResult}``.
+        worst_case_rad: (3,) the largest first-order |dpsi|, |dtheta|, |dgamma| the box
+            ``|chi| <= UB`` allows over every sign and every joint angle (Lemma 1).
+        capability: the lower bounds.  table: the table.  sensitivities: behind the weights.
     """
 
+    upper_bounds_rad: np.ndarray
+    limits: OrientationLimits
+    weights_scheme: str
+    weights: np.ndarray
+    subproblems: dict
+    worst_case_rad: np.ndarray
     capability: ManufacturingCapability = field(kw_only=True)
+    table: object = field(kw_only=True, repr=False)
+    sensitivities: Sensitivities = field(kw_only=True, repr=False)
+
+    @property
+    def error_names(self) -> tuple[str, ...]:
+        """The table's angular errors (the order of the bounds)."""
+        return self.capability.error_names
+
+    @property
+    def lower_bounds_rad(self) -> np.ndarray:
+        """The lower bounds used, radians."""
+        return self.capability.lower_bounds_rad
+
+    @property
+    def J(self) -> dict[str, float]:
+        """Objective of each problem at its optimum (1/arcmin^2) and their sum."""
+        out = {name: self.subproblems[name].J for name in ORIENTATION_ANGLES}
+        return {**out, "total": float(sum(out.values()))}
 
     def errors(self) -> TurntableErrors:
-        """The upper bounds as an error set (every error at its bound, positive sign)."""
+        """The upper bounds as an error set of the paper's table (every error at its bound)."""
         return TurntableErrors.from_array(self.upper_bounds_rad)
 
     def to_dict(self) -> dict:
-        """Bounds, objectives, worst case and every sub-problem as a JSON-ready dict (arcmin)."""
+        """Bounds (arcmin), objectives, worst case, sub-problems and sensitivities, JSON-ready;
+        the paper's table also gives its lower bounds' reasoning, any other its URDF, joints and
+        grid step."""
+        summary = {
+            "J": self.J,
+            "J_unit": "1/arcmin^2 (errors in arc minutes)",
+            "worst_case_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.worst_case_rad),
+            "limits_arcmin": self.limits.to_dict(),
+            "weights": self.weights_scheme,
+        }
+        subproblems = {
+            "active_constraints": {n: list(self.subproblems[n].active) for n in ORIENTATION_ANGLES},
+            "subproblems": {n: self.subproblems[n].to_dict() for n in ORIENTATION_ANGLES},
+        }
+        upper = arcmin_by_name(self.error_names, self.upper_bounds_rad)
+        if _is_paper(self.table):
+            return {"upper_bounds_arcmin": upper, **summary,
+                    "lower_bounds": self.capability.to_dict(), **subproblems,
+                    "sensitivities": self.sensitivities.by_angle()}  # fmt: skip
         return {
-            "upper_bounds_arcmin": arcmin_by_name(ANGULAR_ERROR_NAMES, self.upper_bounds_rad),
-            **self.summary_dict(),
-            "lower_bounds": self.capability.to_dict(),
-            **self.subproblems_dict(),
+            "urdf": str(self.table.urdf_path),
+            "payload_frame": self.table.payload_frame,
+            "joints": list(self.table.joint_names),
+            "upper_bounds_arcmin": upper,
+            "lower_bounds_arcsec": self.capability.arcsec_by_name(),
+            **summary,
+            "grid_step_deg": self.sensitivities.grid_step_deg,
+            **subproblems,
+            "sensitivities": self.sensitivities.by_angle(ORIENTATION_ANGLES),
         }
 
     def report(self) -> str:
-        """The table of upper bounds with J, worst case and active constraints, as text."""
-        return render_allocation_report(
-            f"Error allocation (weights: {self.weights_scheme})",
-            ANGULAR_ERROR_NAMES,
-            self.upper_bounds_rad,
-            self.capability.lower_bounds_rad,
-            self.limits,
-            self.worst_case_rad,
-            self.subproblems,
-            lambda sub: f"{sub.method}, KKT residual {sub.kkt_residual:.1e}",
+        """As text: the bounds (upper in arc minutes and seconds, lower in arc seconds), each
+        angle's worst case against its limit, each sub-problem's J, method and active
+        constraints."""
+        name = "the paper's table" if _is_paper(self.table) else Path(self.table.urdf_path).name
+        step = self.sensitivities.grid_step_deg
+        width = max(12, *(len(n) + 2 for n in self.error_names))
+        lines = [
+            f"Error allocation of {name} (joints {', '.join(self.table.joint_names)}; weights: "
+            f"{self.weights_scheme}" + (f"; grid {step:g} deg)" if step else ")"),
+            "",
+            f"{'error':{width}s}{'upper bound':>24s}{'lower bound':>14s}",
+        ]
+        for n, ub, lb in zip(self.error_names, self.upper_bounds_rad * ARCMIN_PER_RAD,
+                             self.lower_bounds_rad * ARCSEC_PER_RAD, strict=True):  # fmt: skip
+            lines.append(f'{n:{width}s}{ub:11.4f}\' = {ub * 60:7.2f}"{lb:12.2f}"')
+        lines += ["", "with every error at its final upper bound (the smallest of the three "
+                  "sub-problems'):"]  # fmt: skip
+        for k, angle in enumerate(ORIENTATION_ANGLES):
+            limit = self.limits.to_dict()[angle]
+            worst = self.worst_case_rad[k] * ARCMIN_PER_RAD
+            state = (
+                "at the limit"
+                if worst >= limit * (1 - 1e-6)
+                else f"{worst / limit:.0%} of the limit"
+            )
+            lines.append(f"d{angle:6s} limit {limit:.4f}'  worst case {worst:.4f}'  ({state})")
+        lines.append(
+            "each angle's own sub-problem (its bounds before the minimum over the angles):"
         )
+        for angle in ORIENTATION_ANGLES:
+            sub = self.subproblems[angle]
+            lines.append(f"d{angle:6s} J = {sub.J:.6g} /arcmin^2  [{sub.method}, KKT residual "
+                         f"{sub.kkt_residual:.1e}]")  # fmt: skip
+            lines += [f"         active in it: {item}" for item in sub.active]
+        return "\n".join(lines)
 
 
 def allocate_tolerances(
     limits: OrientationLimits | None = None,
     weights: str = "model",
     capability: ManufacturingCapability | None = None,
-    sensitivities: AverageSensitivities | None = None,
+    sensitivities: Sensitivities | None = None,
+    *,
+    table=None,
+    grid_step_deg: float | None = None,
 ) -> Allocation:
-    """Allocate the eight angular errors to meet ``limits`` (eqs. 29-34).
+    """Allocate the angular errors of ``table`` (default the paper's) to meet ``limits``
+    (eqs. 29-34; see the module).
 
     Args:
-        limits: orientation limits (default :func:`default_orientation_limits`).
-        weights: ``model`` (default), ``paper`` or ``equal``; see :func:`allocation_weights`.
-        capability: lower bounds (default: the bundled manufacturing capability).
-        sensitivities: averages for ``model`` weights (default: computed from the exact model).
+        limits: orientation limits (default :func:`default_orientation_limits` of the table).
+        weights: ``model`` (default), ``paper`` or ``equal`` (:func:`allocation_weights`).
+        capability: lower bounds (default: the bundled ones on the paper's table, else none).
+        sensitivities: the averages behind ``model`` weights (default on the table's grid).
+        grid_step_deg: the grid of the sensitivities and of the maxima's starting points (default
+            by table: 1, 5, 15 deg when the model depends on 1, 2, 3 joints).
 
     Raises:
         InfeasibleError: the lower bounds alone violate a limit.
     """
-    limits = limits or default_orientation_limits()
-    capability = capability or ManufacturingCapability.default()
-    w = allocation_weights(weights, sensitivities)
-    models = linear_angle_models()
-    subproblems = {}
-    for k, name in enumerate(ORIENTATION_ANGLES):
-        subproblems[name] = solve_subproblem(
-            models[name],
-            limits.as_array()[k],
-            w[k],
-            capability.lower_bounds_rad,
-            PHI2_INTERVALS_RAD[name],
+    from ..model.paper_table import paper_table
+
+    table = table or paper_table()
+    names = tuple(table.angular_names)
+    limits = limits or default_orientation_limits(table=None if _is_paper(table) else table)
+    if capability is None:
+        paper = _is_paper(table)
+        capability = (
+            ManufacturingCapability.default() if paper else ManufacturingCapability.none(names)
         )
-    upper = combine_upper_bounds(subproblems, ANGULAR_ERROR_NAMES)
-    worst = np.array([worst_case_full_circle(models[n], upper) for n in ORIENTATION_ANGLES])
-    return Allocation(upper, limits, weights, w, subproblems, worst, capability=capability)
+    if capability.error_names != names:
+        raise InputError(f"the lower bounds must be of this table's errors: {', '.join(names)}")
+    sensitivities = sensitivities or table_sensitivities(table, grid_step_deg)
+    w = allocation_weights(weights, sensitivities, table)
+    rows = angle_rows(table, grid_step_deg)
+    subproblems = {}
+    for k, angle in enumerate(ORIENTATION_ANGLES):
+        idx = [names.index(n) for n in rows[angle].error_names]
+        subproblems[angle] = solve_subproblem(
+            rows[angle], limits.as_array()[k], w[k, idx], capability.lower_bounds_rad[idx]
+        )
+    upper = np.full(len(names), np.inf)
+    for sub in subproblems.values():  # eq. 34: the smallest of the sub-problems' solutions
+        idx = [names.index(n) for n in sub.error_names]
+        upper[idx] = np.minimum(upper[idx], sub.solution_rad)
+    bounded = np.where(np.isfinite(upper), upper, 0.0)
+    whole = angle_rows(table, grid_step_deg, whole_turns=True)  # Lemma 1: every angle and sign
+    worst = [
+        domain_max(whole[a], bounded[[names.index(n) for n in whole[a].error_names]])[0]
+        for a in ORIENTATION_ANGLES
+    ]
+    return Allocation(
+        upper, limits, weights, w, subproblems, np.array(worst),
+        capability=capability, table=table, sensitivities=sensitivities,
+    )  # fmt: skip
+
+
+# ---- earlier names (a table given by its URDF) ----------------------------------------------
+TableAllocation = Allocation
+"""Earlier name of :class:`Allocation`."""
+
+
+def allocate_table_tolerances(
+    table, limits, weights="model", lower_bounds_rad=None, grid_step_deg=None
+) -> Allocation:
+    """:func:`allocate_tolerances` of ``table`` with lower bounds (P,) in its angular order."""
+    capability = None
+    if lower_bounds_rad is not None:
+        capability = ManufacturingCapability(lower_bounds_rad, {}, "given", table.angular_names)
+    return allocate_tolerances(
+        limits, weights, capability, table=table, grid_step_deg=grid_step_deg
+    )
+
+
+def angular_names(table) -> tuple[str, ...]:
+    """The table's angular errors (every parameter but the offsets), in parameter order."""
+    return tuple(table.angular_names)
+
+
+def table_lower_bounds(table, path: str | Path | None = None) -> np.ndarray:
+    """Lower bounds (P,) of ``table``'s angular errors from a YAML file in its names, radians
+    (default 0; :meth:`ManufacturingCapability.from_yaml`)."""
+    if path is None:
+        return np.zeros(len(table.angular_names))
+    return ManufacturingCapability.from_yaml(path, table).lower_bounds_rad

@@ -7,7 +7,6 @@ from pathlib import Path
 
 from ..allocation.capability import ManufacturingCapability
 from ..allocation.monte_carlo import run_monte_carlo, run_table_monte_carlo
-from ..allocation.sensitivity import AverageSensitivities, average_sensitivities
 from ..allocation.solver import (
     DEFAULT_ACCURACY_DPH,
     DEFAULT_POSITIONS,
@@ -27,15 +26,14 @@ from .common import (
     add_table_options,
     bounded_float,
     finite_float,
-    generic_table_from_args,
     input_path,
     latitude_deg,
     one_line_errors,
-    paper_table_requested,
     positive_float,
     positive_int,
     print_json,
     seed,
+    table_from_args,
 )
 
 __all__ = ["parse_limits", "register"]
@@ -126,9 +124,9 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
         "--grid-step-deg",
         type=bounded_float(0.0, 90.0, "deg", low_open=True),
         default=None,
-        help="a table given by --urdf: step of the grid over every joint on which sensitivities, "
-        "worst cases and the Monte Carlo run are evaluated (default 1, 5, 15 deg for 1, 2, 3 "
-        "joints)",
+        help="a table given by --urdf: step of the grid over every joint on which the "
+        "sensitivities are averaged, the maxima of the constraints start (they hold between the "
+        "grid points too) and the Monte Carlo runs (default 1, 5, 15 deg for 1, 2, 3 joints)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -137,9 +135,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``allocate`` and ``montecarlo`` subcommands to ``subparsers``."""
     a = subparsers.add_parser(
         "allocate",
-        description="Error allocation of paper section 4.2 (eqs. 29-34): three weighted problems "
-        "with their constraints over phi2 solved exactly, combined by eq. 34. Prints the upper "
-        "bounds, J, the active constraints and the worst-case orientation error the bounds allow.",
+        description="Error allocation of paper section 4.2 (eqs. 29-34) on the table's "
+        "first-order model: three weighted problems whose constraints hold over every angle of "
+        "their domain (the paper's phi2 intervals on its table) solved exactly, combined by eq. "
+        "34. Prints the upper bounds, J, the active constraints and the worst-case orientation "
+        "error the bounds allow.",
     )
     _add_allocation_options(a)
     a.add_argument("--plots", type=Path, metavar="DIR", help="write Figure 8 (sensitivities) here")
@@ -182,54 +182,29 @@ def _limits_from_args(args: argparse.Namespace, table=None) -> tuple[Orientation
     if args.limits_deg is not None:
         return parse_limits(args.limits_deg, "deg"), f"--limits-deg {args.limits_deg}"
     given = f"the limits of --accuracy-dph {args.accuracy_dph:g}"
-    if table is None:
-        limits = default_orientation_limits(args.accuracy_dph, args.positions, args.latitude_deg)
-        return limits, given
-    from ..calibration.positions import JointPositions
-    from ..calibration.requirement import orientation_requirement
     from ..core.exceptions import IdentifiabilityError
-    from ..core.units import deg_to_rad
 
     try:
-        requirement = orientation_requirement(
-            args.accuracy_dph,
-            JointPositions.parse(table, args.positions),
-            deg_to_rad(args.latitude_deg),
+        limits = default_orientation_limits(
+            args.accuracy_dph, args.positions, args.latitude_deg, table
         )
     except IdentifiabilityError as exc:
+        if table is None:
+            raise
         raise IdentifiabilityError(
             f"no default limits for this table ({exc}); give --limits-arcmin or --limits-deg"
         ) from None
-    return OrientationLimits(*requirement.limits_rad), given
-
-
-def _table_allocation_from_args(args: argparse.Namespace, table):
-    """The allocation of a table given by ``--urdf`` (:mod:`..allocation.table_allocation`)."""
-    from ..allocation.table_allocation import allocate_table_tolerances, table_lower_bounds
-
-    if args.weights == "paper":
-        raise InputError(
-            "--weights paper: the paper's Figure 8 values belong to its table; for a table given "
-            "by --urdf choose --weights model or --weights equal"
-        )
-    if args.plots:
-        raise InputError("--plots: the figures are drawn for the paper's table only")
-    limits, given = _limits_from_args(args, table)
-    lower = table_lower_bounds(table, args.lower_bounds)
-    try:
-        return allocate_table_tolerances(
-            table, limits, args.weights, lower, grid_step_deg=args.grid_step_deg
-        )
-    except InfeasibleError as exc:
-        source = args.lower_bounds or "no lower bounds"
-        raise InfeasibleError(f"{given} with the lower bounds of {source}: {exc}") from None
+    return limits, given
 
 
 def _table(args: argparse.Namespace):
     """The :class:`GenericTable` of ``--urdf``, or None for the paper's table (whose options
     ``--grid-step-deg`` does not take)."""
-    if not paper_table_requested(args):
-        return generic_table_from_args(args)
+    from ..model.paper_table import PAPER_LAYOUT
+
+    table = table_from_args(args)
+    if table.layout is not PAPER_LAYOUT:
+        return table
     if args.grid_step_deg is not None:
         raise InputError(
             "--grid-step-deg is for a table given by --urdf; the paper's table averages over "
@@ -238,44 +213,42 @@ def _table(args: argparse.Namespace):
     return None
 
 
-def _allocation_from_args(args: argparse.Namespace) -> tuple[Allocation, AverageSensitivities]:
-    """The allocation the options ask for and the sensitivities behind Figure 8."""
-    limits, given = _limits_from_args(args)
-    capability = (
-        ManufacturingCapability.from_yaml(args.lower_bounds)
-        if args.lower_bounds
-        else ManufacturingCapability.default()
-    )
-    # phi1 drops out of dR (tested), so one phi1 value is enough for the averages.
-    sensitivities = average_sensitivities(phi1_grid_deg=[0.0])
+def _allocation_from_args(args: argparse.Namespace, table=None) -> Allocation:
+    """The allocation the options ask for, of ``table`` (None: the paper's, from ``--urdf``)."""
+    if table is not None and args.weights == "paper":
+        raise InputError(
+            "--weights paper: the paper's Figure 8 values belong to its table; for a table given "
+            "by --urdf choose --weights model or --weights equal"
+        )
+    if table is not None and args.plots:
+        raise InputError("--plots: the figures are drawn for the paper's table only")
+    limits, given = _limits_from_args(args, table)
+    capability = None
+    if args.lower_bounds:
+        capability = ManufacturingCapability.from_yaml(args.lower_bounds, table)
+    elif table is None:
+        capability = ManufacturingCapability.default()
+    table = table or table_from_args(args)
     try:
-        allocation = allocate_tolerances(limits, args.weights, capability, sensitivities)
+        return allocate_tolerances(
+            limits, args.weights, capability, table=table, grid_step_deg=args.grid_step_deg
+        )
     except InfeasibleError as exc:  # name the two inputs that conflict
-        source = capability.source
+        source = capability.source if capability else "no lower bounds"
         raise InfeasibleError(f"{given} with the lower bounds of {source}: {exc}") from None
-    return allocation, sensitivities
 
 
 def run_allocate(args: argparse.Namespace) -> int:
-    table = _table(args)
-    if table is not None:
-        allocation = _table_allocation_from_args(args, table)
-        if args.json:
-            report = allocation.to_dict()
-            report["sensitivities"] = allocation.sensitivities.to_dict()["sensitivities"]
-            print_json(report)
-        else:
-            print(allocation.report())
-        return 0
-    allocation, sensitivities = _allocation_from_args(args)
+    allocation = _allocation_from_args(args, _table(args))
     figure = None
     if args.plots:
         from ..report.allocation_figures import plot_sensitivities
 
-        figure = plot_sensitivities(sensitivities, args.plots / "figure8_sensitivities.png")
+        figure = plot_sensitivities(
+            allocation.sensitivities, args.plots / "figure8_sensitivities.png"
+        )
     if args.json:
         report = allocation.to_dict()
-        report["sensitivities"] = sensitivities.to_dict()["sensitivities"]
         if figure:
             report["plot"] = str(figure)
         print_json(report)
@@ -310,7 +283,7 @@ def run_montecarlo(args: argparse.Namespace) -> int:
             raise InputError(
                 "--phi2-step-deg is the paper table's; for this table: --grid-step-deg"
             )
-        allocation = _table_allocation_from_args(args, table)
+        allocation = _allocation_from_args(args, table)
         upper, lower = _scaled_bounds(
             args, allocation.upper_bounds_rad, allocation.lower_bounds_rad
         )
@@ -324,7 +297,7 @@ def run_montecarlo(args: argparse.Namespace) -> int:
             f"({result.n_grid_points} positions), exact chain, {result.elapsed_s:.1f} s"
         )
     else:
-        allocation, _ = _allocation_from_args(args)
+        allocation = _allocation_from_args(args)
         upper, lower = _scaled_bounds(
             args, allocation.upper_bounds_rad, allocation.capability.lower_bounds_rad
         )

@@ -3,24 +3,24 @@
 from __future__ import annotations
 
 from ..allocation.monte_carlo import MonteCarloResult
-from ..allocation.sensitivity import AverageSensitivities
+from ..allocation.sensitivity import Sensitivities
 from ..allocation.solver import ORIENTATION_ANGLES
 from ..core.units import ARCMIN_PER_RAD
-from ..model.angles import ANGLE_NAMES as ORIENTATION_ANGLE_NAMES
-from ..model.errors import ANGULAR_ERROR_NAMES
+from ..model.angles import ANGLE_NAMES
 from .figures import pyplot, save_png
 
 __all__ = ["plot_monte_carlo", "plot_sensitivities"]
 
 
-def plot_sensitivities(average: AverageSensitivities, path, *, title: str | None = None):
+def plot_sensitivities(average: Sensitivities, path, *, title: str | None = None):
     """Figure 8: bar charts of the average sensitivities, one panel per orientation angle (PNG)."""
     plt = pyplot()
-    fig, axes = plt.subplots(1, 3, figsize=(12, 3.8), sharey=True)
-    labels = [f"C{i + 1} {n}" for i, n in enumerate(ANGULAR_ERROR_NAMES)]
-    for k, (ax, angle) in enumerate(zip(axes, ORIENTATION_ANGLE_NAMES, strict=True)):
-        bars = ax.bar(range(8), average.values[k], color="tab:blue")
-        ax.set_xticks(range(8), labels, fontsize=7, rotation=40, ha="right")
+    names = average.error_names
+    fig, axes = plt.subplots(1, 3, figsize=(max(12, 1.1 * len(names) + 3), 3.8), sharey=True)
+    labels = [f"C{i + 1} {n}" for i, n in enumerate(names)]
+    for k, (ax, angle) in enumerate(zip(axes, ANGLE_NAMES, strict=True)):
+        bars = ax.bar(range(len(names)), average.values[k], color="tab:blue")
+        ax.set_xticks(range(len(names)), labels, fontsize=7, rotation=40, ha="right")
         ax.set_title(f"({'abc'[k]}) {angle}")
         for bar, v in zip(bars, average.values[k], strict=True):
             ax.text(
@@ -28,11 +28,8 @@ def plot_sensitivities(average: AverageSensitivities, path, *, title: str | None
             )
         ax.set_ylim(0, 1.15)
     axes[0].set_ylabel("mean |d angle / d error|")
-    fig.suptitle(
-        title
-        or f"Sensitivities of the orientation error (mean over {average.phi1_grid_deg.size} x "
-        f"{average.phi2_grid_deg.size} angle pairs)"
-    )
+    grid = " x ".join(str(a.size) for a in average.axes_rad)
+    fig.suptitle(title or f"Sensitivities of the orientation error (mean over {grid} positions)")
     fig.tight_layout()
     return save_png(fig, path)
 
