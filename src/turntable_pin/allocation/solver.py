@@ -184,11 +184,10 @@ def default_orientation_limits(
 
 
 # ---- the rows of one angle and their maximum over a domain ----------------------------------
-# ---- the rows of one angle and their maximum over a domain ----------------------------------
 def _is_paper(table) -> bool:
-    from ..model.paper_table import PAPER_LAYOUT
+    from ..model.paper_table import is_paper_table
 
-    return table.layout is PAPER_LAYOUT
+    return is_paper_table(table)
 
 
 def _basis(t) -> np.ndarray:

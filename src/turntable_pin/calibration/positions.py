@@ -32,7 +32,7 @@ from ..core.csv_table import CsvTable, closest_column_hint, read_csv_table
 from ..core.exceptions import InputError
 from ..core.sizes import MAX_POSITIONS, check_count, turn_grid_count
 from ..core.units import deg_to_rad, rad_to_deg
-from ..model.paper_table import PAPER_LAYOUT, paper_table
+from ..model.paper_table import is_paper_table, paper_table
 from .site import DEFAULT_LATITUDE_DEG, MAX_LATITUDE_DEG  # noqa: F401  (re-exported)
 
 __all__ = [
@@ -48,7 +48,6 @@ __all__ = [
     "check_commanded_angles",
     "grid_angles_deg",
     "grid_steps",
-    "is_paper_table",
     "position_inputs",
 ]
 
@@ -106,12 +105,6 @@ def grid_angles_deg(steps_deg: Sequence[float]) -> tuple[np.ndarray, str]:
     axes = [np.arange(0.0, 360.0 - 1e-9, s) for s in steps_deg]
     mesh = np.meshgrid(*axes, indexing="ij")
     return np.stack([m.ravel() for m in mesh], axis=1), name
-
-
-def is_paper_table(table) -> bool:
-    """Whether ``table`` is the paper's (under its layout, so its angles go by the paper's names
-    phi1, phi2 in reports and its reports carry no table keys)."""
-    return table.layout is PAPER_LAYOUT
 
 
 @dataclass(frozen=True, init=False)

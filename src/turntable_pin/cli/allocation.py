@@ -200,10 +200,10 @@ def _limits_from_args(args: argparse.Namespace, table=None) -> tuple[Orientation
 def _table(args: argparse.Namespace):
     """The :class:`GenericTable` of ``--urdf``, or None for the paper's table (whose options
     ``--grid-step-deg`` does not take)."""
-    from ..model.paper_table import PAPER_LAYOUT
+    from ..model.paper_table import is_paper_table
 
     table = table_from_args(args)
-    if table.layout is not PAPER_LAYOUT:
+    if not is_paper_table(table):
         return table
     if args.grid_step_deg is not None:
         raise InputError(

@@ -7,13 +7,14 @@ from pathlib import Path
 
 from ..calibration.drift_fit import calibrate_run
 from ..calibration.gyrowheel import GyroWheelModel
-from ..calibration.positions import PositionSet, is_paper_table, position_inputs
+from ..calibration.positions import PositionSet, position_inputs
 from ..calibration.rate_error import DEFINITIONS, rate_error
 from ..calibration.requirement import orientation_requirement
 from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.units import deg_to_rad
 from ..model.angles import ANGLE_NAMES, ANGLE_SYMBOLS
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
+from ..model.paper_table import is_paper_table
 from .common import (
     accuracy_dph,
     add_table_options,

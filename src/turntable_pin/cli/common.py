@@ -23,8 +23,6 @@ __all__ = [
     "bounded_float",
     "error_values_from_args",
     "finite_float",
-    "generic_table_from_args",
-    "paper_table_requested",
     "latitude_deg",
     "one_line_errors",
     "positive_float",
@@ -200,23 +198,6 @@ def table_from_args(args: argparse.Namespace):
     from ..model.paper_table import table_of
 
     return table_of(args.urdf, getattr(args, "payload_frame", None))
-
-
-def paper_table_requested(args: argparse.Namespace) -> bool:
-    """Whether the paper's model (its nine named errors) applies: the bundled table, or a URDF
-    with the paper's joints and payload, and no ``--payload-frame`` naming another frame."""
-    from ..model.paper_table import PAPER_LAYOUT
-
-    return table_from_args(args).layout is PAPER_LAYOUT
-
-
-def generic_table_from_args(args: argparse.Namespace):
-    """The :class:`~turntable_pin.model.generic_table.GenericTable` of ``--urdf`` and
-    ``--payload-frame``."""
-    from ..core.resources import default_urdf_path
-    from ..model.generic_table import GenericTable
-
-    return GenericTable(args.urdf or default_urdf_path(), getattr(args, "payload_frame", None))
 
 
 def error_values_from_args(

@@ -92,20 +92,14 @@ def joint_angles_deg(
     return [d if v is None else v for v, d in zip(given, defaults_deg, strict=False)]
 
 
-def _paper_names(table) -> bool:
-    """Whether reports use the paper's names on ``table`` (its Table 2 errors, angles phi1,
-    phi2 and eq. 26): the paper's table."""
-    from ..model.paper_table import PAPER_LAYOUT
-
-    return table.layout is PAPER_LAYOUT
-
-
 def position_fields(table, angles_deg) -> dict:
     """How a command's JSON names the table and its position: on the paper's table its angles
     ``phi1_deg``, ``phi2_deg`` (the table implied); on any other its URDF, payload frame and
     ``angles_deg``, ``{joint: degrees}``."""
     angles = [float(a) for a in angles_deg]
-    if _paper_names(table):
+    from ..model.paper_table import is_paper_table
+
+    if is_paper_table(table):
         return {f"phi{k}_deg": a for k, a in enumerate(angles, start=1)}
     return {
         "urdf": str(table.urdf_path),
@@ -128,7 +122,9 @@ def _first_order(table, error_values, angles_rad) -> tuple[str, str, np.ndarray]
     """``(key, label, [dpsi, dtheta, dgamma] in rad)`` of the table's first-order model: on the
     paper's table eq. 26 in closed form (exact zeros where its matrix has them), else the exact
     regressor at zero errors times the errors (the same numbers to rounding on the paper's)."""
-    if _paper_names(table):
+    from ..model.paper_table import is_paper_table
+
+    if is_paper_table(table):
         return "small_angle", "eq. 26", small_angle_orientation_error(error_values, angles_rad[1])
     first = table.regressor([np.array([a]) for a in angles_rad])[0] @ error_values
     return "first_order", "first order", first

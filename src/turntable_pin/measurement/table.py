@@ -105,7 +105,7 @@ def measured_table(turntable=None) -> MeasuredTable:
     :class:`~turntable_pin.model.generic_table.GenericTable` (in its layout's names: the paper's
     on the paper's table), a :class:`~turntable_pin.model.turntable.TurntableModel` (its table)
     or a :class:`MeasuredTable` (returned as it is)."""
-    from ..model.paper_table import PAPER_LAYOUT, paper_table
+    from ..model.paper_table import is_paper_table, paper_table
 
     if isinstance(turntable, MeasuredTable):
         return turntable
@@ -118,6 +118,6 @@ def measured_table(turntable=None) -> MeasuredTable:
         ]
         cached = _MEASURED[table] = MeasuredTable(
             table.chain, joints, table.descriptions, label=table.label,
-            paper=table.layout is PAPER_LAYOUT, urdf_path=table.urdf_path,
+            paper=is_paper_table(table), urdf_path=table.urdf_path,
         )  # fmt: skip
     return cached

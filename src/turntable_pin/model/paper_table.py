@@ -28,6 +28,7 @@ __all__ = [
     "PLACEMENT_ERROR_FACTORS",
     "PLACEMENT_ORDER",
     "has_paper_names",
+    "is_paper_table",
     "paper_table",
     "table_of",
 ]
@@ -89,6 +90,12 @@ def paper_table(urdf_path: str | Path | None = None):
     if not path.is_file():
         raise InputError("no such URDF file", path=path)
     return _paper_table(str(path.resolve()))
+
+
+def is_paper_table(table) -> bool:
+    """Whether ``table`` is the paper's: under :data:`PAPER_LAYOUT` (its angles go by the
+    paper's names phi1, phi2 in reports, and its reports carry no table keys)."""
+    return getattr(table, "layout", None) is PAPER_LAYOUT
 
 
 def has_paper_names(table) -> bool:
