@@ -189,21 +189,23 @@ def _from_data(args: argparse.Namespace, table):
     return read_measurements(args.from_data, None if measured.paper else measured.joint_names)
 
 
-def _finish(result, args: argparse.Namespace) -> int:
-    """Write the positions (``-o``) and figures (``--plots``) of ``result``, then print it."""
+def _finish(result, args: argparse.Namespace, write_plots) -> int:
+    """Write the positions (``-o``, with ``result.comment()`` above them) and the figures
+    (``--plots``, by ``write_plots(result, folder)``) of ``result``, then print it (text or
+    JSON)."""
     out = result.to_dict()
+    written = []
     if args.output is not None:
-        out["output"] = str(result.plan.write_csv(args.output))
+        out["output"] = str(result.plan.write_csv(args.output, comment=result.comment()))
+        written.append(out["output"])
     if args.plots is not None:
-        out["plots"] = [str(p) for p in result.write_plots(args.plots)]
+        out["plots"] = [str(p) for p in write_plots(result, args.plots)]
+        written += out["plots"]
     if args.json:
         print_json(out)
         return 0
     print(result.report())
-    for key in ("output",):
-        if key in out:
-            print(f"wrote {out[key]}")
-    for path in out.get("plots", []):
+    for path in written:
         print(f"wrote {path}")
     return 0
 
@@ -220,7 +222,9 @@ def _run_identify(args: argparse.Namespace) -> int:
         noise_arcsec=args.noise_arcsec,
         dwell_s=args.dwell_s,
     )
-    return _finish(result, args)
+    from ..report.design_figures import write_identify_plots
+
+    return _finish(result, args, write_identify_plots)
 
 
 def _run_separate(args: argparse.Namespace) -> int:

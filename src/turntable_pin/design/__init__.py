@@ -15,9 +15,12 @@ from ..core.lazy import lazy_exports
 
 _EXPORTS = {
     "DesignSpace": "space",
+    "IdentifyDesign": "identify",
+    "MeasurementPlan": "schedule",
     "design_identify": "identify",
     "design_space": "space",
     "parse_limits_deg": "space",
+    "plan_measurements": "schedule",
 }
 
 __all__ = sorted(_EXPORTS)

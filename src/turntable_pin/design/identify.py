@@ -1,15 +1,530 @@
 """D-optimal positions that identify the base errors and the chosen effects (issue 19, item 1).
 
-Being written: the skeleton of the ``design`` command runs against this placeholder.
+What orientation data can determine is a set of *combinations* of the parameters (the base
+errors, the effects' parameters): a position measures ``dpsi, dtheta, dgamma``, linear in the
+parameters near zero (the Jacobian of :class:`~turntable_pin.measurement.effect_model.
+OrientationModel`), and some directions (``dphi_y1 - deps_y`` on the paper's table) change no
+orientation anywhere. Those flat directions would make every design singular, so the design
+works on the combinations that *some* position within the limits determines: the row space of
+the Jacobian over all the candidates (:func:`~turntable_pin.stats.least_squares.
+analyse_identifiability`, the same rule as the fit's), in whitened coordinates; the flat
+directions are reported as what no position within the limits can determine.
+
+The positions maximise ``log det`` of the Fisher information of those combinations (D-optimal,
+as FIGAROH chooses robot calibration postures): a greedy start and Fedorov's exchange over the
+candidates (:mod:`turntable_pin.stats.design`), each candidate measured as the run will measure
+it (:mod:`.schedule`: twice, early and late, for a drift; from both sides for a backlash). Each
+combination's expected standard error is then read from the information of the run as it will
+be made (``sqrt(c M^-1 c^T)`` at the noise), the numbers ``fit`` reports on its data; and the
+design is compared with the 30-degree grid within the limits: the D-efficiency
+``(det M_design / det M_grid)^(1/p)`` per position (the grid's information scaled to the
+design's number of positions), above 1 when the design does better.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
+import numpy as np
+
 from ..core.exceptions import InputError
+from ..core.units import ARCSEC_PER_RAD
+from .schedule import MeasurementPlan, Visits, candidate_visits, plan_measurements
+from .space import DesignSpace
 
-__all__ = ["design_identify"]
+__all__ = ["IdentifyDesign", "design_identify", "design_rows"]
+
+DEFAULT_NOISE_ARCSEC = 1.0
+"""Noise of a measured angle when neither ``noise_arcsec`` nor data say it, arc seconds."""
 
 
-def design_identify(space, n_positions: int, **options):
-    """D-optimal positions (being written)."""
-    raise InputError("design: the identify mode is being written (issue 19, item 1)")
+@dataclass(frozen=True)
+class IdentifyDesign:
+    """D-optimal positions and what they will determine.
+
+    Attributes:
+        space: the :class:`~.space.DesignSpace` (table, effects, limits, candidates, seed).
+        positions_deg: the chosen positions (N, J), degrees (in the run's first order).
+        plan: the run that measures them (:class:`~.schedule.MeasurementPlan`).
+        combinations: each determined combination: ``name``, ``unit``, ``coefficients``, the
+            expected standard error of the design (``std``), of the grid as measured (``std_grid``,
+            ``n_grid`` positions) and of the grid scaled to the design's size (``std_grid_same_n``);
+            ``None`` where the grid does not determine it.
+        undetermined: the combinations no position within the limits determines.
+        noise_arcsec, noise_source: the noise of a measured angle and where it comes from.
+        n_from: positions already measured (``--from``), 0 without.
+        log_det, log_det_grid_same_n: ``log det`` of the Fisher information of the determined
+            combinations (in their user units) of the design and of the grid scaled to its size
+            (with the information of the data already measured).
+        d_efficiency: ``exp((log_det - log_det_grid_same_n) / p)``: the design's information per
+            position against the grid's (``None`` when the grid determines not all).
+        n_grid: positions of the grid (those the effects are defined at).
+        greedy_log_det: ``log det`` after the greedy start (same coordinates as ``log_det``).
+        n_exchanges, n_sweeps: of the exchange.
+    """
+
+    space: DesignSpace = field(repr=False)
+    positions_deg: np.ndarray = field(repr=False)
+    plan: MeasurementPlan = field(repr=False)
+    combinations: tuple[dict, ...]
+    undetermined: tuple[str, ...]
+    noise_arcsec: float
+    noise_source: str
+    n_from: int
+    log_det: float
+    log_det_grid_same_n: float | None
+    d_efficiency: float | None
+    n_grid: int
+    greedy_log_det: float
+    n_exchanges: int
+    n_sweeps: int
+
+    @property
+    def n_positions(self) -> int:
+        """Number of positions chosen N."""
+        return int(self.positions_deg.shape[0])
+
+    @property
+    def rank(self) -> int:
+        """Number of determined combinations p."""
+        return len(self.combinations)
+
+    def comment(self) -> str:
+        """The comment lines of the positions' CSV: what made it, with its seed."""
+        effects = ", ".join(self.space.effect_names) or "none"
+        return "\n".join(
+            [
+                "designed by turntable-pin design (identify: D-optimal)",
+                f"table: {self.space.measured.label}; effects: {effects}",
+                f"seed={self.space.seed} candidates={self.space.candidates_deg.shape[0]} "
+                f"n_positions={self.n_positions} n_from={self.n_from}",
+                "limits: " + "; ".join(r.describe() for r in self.space.ranges),
+                f"noise_arcsec={self.noise_arcsec:g} ({self.noise_source})",
+                f"run: {self.plan.rule}",
+            ]
+        )
+
+    def to_dict(self) -> dict:
+        """The design as a JSON-ready dict."""
+        return {
+            "mode": "identify",
+            "space": self.space.to_dict(),
+            "n_positions": self.n_positions,
+            "n_from": self.n_from,
+            "noise_arcsec": self.noise_arcsec,
+            "noise_source": self.noise_source,
+            "rank": self.rank,
+            "log_det": self.log_det,
+            "log_det_grid_same_n": self.log_det_grid_same_n,
+            "d_efficiency": self.d_efficiency,
+            "n_grid": self.n_grid,
+            "greedy_log_det": self.greedy_log_det,
+            "n_exchanges": self.n_exchanges,
+            "n_sweeps": self.n_sweeps,
+            "combinations": [dict(c) for c in self.combinations],
+            "undetermined": list(self.undetermined),
+            "positions_deg": self.positions_deg.tolist(),
+            "plan": self.plan.to_dict(),
+        }
+
+    def report(self) -> str:
+        """The design as text: what it determines, how well, against the grid, the positions."""
+        space = self.space
+        effects = " + ".join(("base", *space.effect_names))
+        lines = [
+            f"design (identify, D-optimal): {self.n_positions} positions of "
+            f"{space.candidates_deg.shape[0]} candidates (seed {space.seed}) on "
+            f"{space.measured.label}, for {effects}"
+            + (f", after the {self.n_from} positions measured" if self.n_from else ""),
+            "limits: " + "; ".join(r.describe() for r in space.ranges),
+            f"run: {self.plan.n_rows} measurements; {self.plan.rule}",
+            f"noise: {self.noise_arcsec:.3g} arcsec per angle ({self.noise_source})",
+        ]
+        if self.d_efficiency is not None:
+            lines.append(
+                f"D-efficiency against the {self.n_grid}-position 30-degree grid: "
+                f"{self.d_efficiency:.3f} per position (log det {self.log_det:.2f} against "
+                f"{self.log_det_grid_same_n:.2f} for the grid's information at "
+                f"{self.n_positions} positions)"
+            )
+        else:
+            lines.append(
+                f"the {self.n_grid}-position 30-degree grid within the limits does not determine "
+                "every combination (no D-efficiency)"
+            )
+        lines.append(
+            f"expected standard error of each of the {self.rank} determined combinations "
+            f"(design; grid of {self.n_grid}; grid scaled to {self.n_positions} positions):"
+        )
+        for c in self.combinations:
+            grid = "  ".join(
+                f"{c[k]:8.3g}" if c[k] is not None else "       -"
+                for k in ("std_grid", "std_grid_same_n")
+            )
+            lines.append(f"  {c['name']:55s} {c['std']:8.3g}  {grid}  {c['unit']}")
+        if self.undetermined:
+            lines.append(
+                "not determined by any position within the limits: " + "; ".join(self.undetermined)
+            )
+        names = ", ".join(f"phi{r.index}" for r in space.ranges)
+        lines.append(f"positions ({names}, deg):")
+        for row in self.positions_deg:
+            lines.append("  " + "  ".join(f"{v:10.4f}" for v in row))
+        return "\n".join(lines)
+
+
+def _evaluate(space: DesignSpace, variables):
+    """The Jacobian (M, 3, n) at zero of the base errors and ``space.effects`` at ``variables``,
+    and the model (its parameter names, units)."""
+    from ..measurement.effect_model import OrientationModel
+
+    model = OrientationModel(variables, space.effects, space.table)
+    return model.jacobian(np.zeros(model.n_params)), model
+
+
+def _variables(joint_deg: np.ndarray, visits: Visits, start_s: float, duration_s: float):
+    """Variables of every position in ``joint_deg`` (C, J) measured as ``visits`` says,
+    position-major (C * visits.count rows)."""
+    from ..core.units import DEG_PER_RAD
+    from ..measurement.effects.base import PositionVariables
+
+    joints = np.repeat(joint_deg / DEG_PER_RAD, visits.count, axis=0)
+    fractions = visits.time_fractions()
+    time_s = None if fractions is None else start_s + fractions.reshape(-1) * duration_s
+    signs = visits.signs()
+    dirs = () if signs is None else tuple(signs.reshape(-1, joint_deg.shape[1]).T)
+    return PositionVariables(joints, time_s, dirs)
+
+
+def design_rows(
+    space: DesignSpace, joint_deg, visits: Visits, start_s: float = 0.0, duration_s: float = 0.0
+):
+    """The Jacobian rows (C, 3 * visits, n) of each position of ``joint_deg`` (C, J) measured as
+    ``visits`` says (internal units: rad per rad; the run lasting ``duration_s`` from
+    ``start_s``), the mask (C,) of the positions every effect is defined at (an effect may
+    refuse some: ``TX`` at the horizon) and the model.
+
+    The rows of positions an effect refuses, or whose derivatives are not finite, are left out
+    (bisection over the positions, so that a few refused ones cost a few evaluations).
+    """
+    joint_deg = np.asarray(joint_deg, dtype=float)
+    keep = np.ones(joint_deg.shape[0], dtype=bool)
+
+    def rows_of(index: np.ndarray):
+        variables = _variables(joint_deg[index], visits.subset(index), start_s, duration_s)
+        jac, model = _evaluate(space, variables)
+        return jac.reshape(index.size, 3 * visits.count, -1), model
+
+    def search(index: np.ndarray) -> None:
+        try:
+            rows_of(index)
+        except InputError:
+            if index.size == 1:
+                keep[index] = False
+                return
+            half = index.size // 2
+            search(index[:half])
+            search(index[half:])
+
+    try:
+        rows, model = rows_of(np.arange(joint_deg.shape[0]))
+    except InputError:
+        search(np.arange(joint_deg.shape[0]))
+        if not keep.any():
+            raise
+        rows, model = rows_of(np.flatnonzero(keep))
+        full = np.full((joint_deg.shape[0], *rows.shape[1:]), np.nan)
+        full[keep] = rows
+        rows = full
+    finite = np.all(np.isfinite(rows), axis=(1, 2))
+    keep &= finite
+    return rows[keep], keep, model
+
+
+def _start_information(space, data, noise_arcsec, dwell_s: float):
+    """What the data already measured bring: ``(information (n, n) or None, noise of the new
+    measurements in arcsec, where it comes from, positions measured, time after them)``."""
+    if data is None:
+        noise = DEFAULT_NOISE_ARCSEC if noise_arcsec is None else float(noise_arcsec)
+        return None, noise, "default" if noise_arcsec is None else "given", 0, 0.0
+    from ..core.exceptions import TurntablePinError
+
+    where = data.source or "the data"
+    try:
+        jac, model = _evaluate(space, data.variables())
+    except InputError as exc:
+        raise InputError(f"--from {where}: {exc.detail}") from None
+    mask = data.measured.reshape(-1)
+    jac = jac.reshape(-1, model.n_params)[mask]
+    known = data.sigma_rad is not None and not data.sigma_relative
+    if known:
+        sigma_rad = np.broadcast_to(
+            np.asarray(data.sigma_rad, dtype=float).reshape(data.n_positions, -1),
+            (data.n_positions, 3),
+        ).reshape(-1)[mask]
+        median = float(np.median(sigma_rad)) * ARCSEC_PER_RAD
+        noise, source = median, "the median sigma of the data measured"
+    elif noise_arcsec is not None:
+        sigma_rad = np.full(jac.shape[0], float(noise_arcsec) / ARCSEC_PER_RAD)
+        noise, source = float(noise_arcsec), "given"
+    else:
+        from ..measurement.fit import fit_orientation
+
+        try:
+            fit = fit_orientation(data, space.effects, turntable=space.table)
+        except TurntablePinError as exc:
+            raise InputError(
+                f"--from {where}: their noise cannot be fitted ({exc}); give --noise-arcsec"
+            ) from None
+        sigma_rad = fit.sigma_angles_rad.reshape(-1)[mask]
+        noise = float(np.median(sigma_rad)) * ARCSEC_PER_RAD
+        source = "fitted on the data measured"
+    if noise_arcsec is not None:
+        noise, source = float(noise_arcsec), "given"
+    weighted = jac / sigma_rad[:, None]
+    start_s = 0.0
+    if data.time_s is not None and space.needs_time:
+        start_s = float(np.max(data.time_s)) + float(dwell_s)
+    return weighted.T @ weighted, noise, source, data.n_positions, start_s
+
+
+def _root(information: np.ndarray) -> np.ndarray:
+    """Rows R (n, n) with ``R^T R = information`` (symmetric, positive semi-definite)."""
+    values, vectors = np.linalg.eigh(information)
+    return np.sqrt(np.clip(values, 0.0, None))[:, None] * vectors.T
+
+
+def _invisible_effects(space, model, stacked: np.ndarray, rank: int) -> list[str]:
+    """The effects whose parameters add no determined combination (on ``stacked`` rows)."""
+    from ..stats.least_squares import analyse_identifiability
+
+    names = model.parameter_names
+    out = []
+    for effect in space.effects:
+        own = np.array([n.startswith(f"{effect.name}.") for n in names])
+        if not own.any():
+            continue
+        rest = analyse_identifiability(stacked[:, ~own], tuple(np.array(names)[~own]))
+        if rest.rank == rank:
+            out.append(effect.name)
+    return out
+
+
+def _fewest_positions(rows, start, rank) -> int | None:
+    """The fewest candidates the greedy design needs to determine ``rank`` combinations (None:
+    not even twice ``rank``)."""
+    from ..stats.design import greedy_design, log_det
+
+    count = min(rows.shape[0], 2 * rank + 2)
+    order = greedy_design(rows, count, start)
+    m = np.zeros((rows.shape[2],) * 2) if start is None else np.array(start)
+    for i, j in enumerate(order, start=1):
+        m = m + rows[j].T @ rows[j]
+        if np.isfinite(log_det(m)):
+            return i
+    return None
+
+
+def _standard_errors(information: np.ndarray, to_user: np.ndarray) -> list[float | None]:
+    """The standard error of each combination ``to_user @ z`` (rows of ``to_user``) under the
+    information (r, r) of ``z``; ``None`` for one the information does not determine."""
+    values, vectors = np.linalg.eigh(0.5 * (information + information.T))
+    top = max(float(values.max(initial=0.0)), 1e-300)
+    live = values > 1e-10 * top
+    projected = to_user @ vectors  # (r, r)
+    out: list[float | None] = []
+    for row in projected:
+        norm = float(np.linalg.norm(row))
+        if np.linalg.norm(row[~live]) > 1e-6 * max(norm, 1e-300):
+            out.append(None)
+            continue
+        out.append(float(np.sqrt(np.sum(row[live] ** 2 / values[live]))))
+    return out
+
+
+def design_identify(
+    space: DesignSpace,
+    n_positions: int,
+    *,
+    from_data=None,
+    noise_arcsec: float | None = None,
+    dwell_s: float = 60.0,
+) -> IdentifyDesign:
+    """The D-optimal ``n_positions`` of ``space`` (module docstring).
+
+    Args:
+        space: the table, effects, limits and candidates (:func:`~.space.design_space`).
+        n_positions: how many positions to choose.
+        from_data: measurements already made (``OrientationMeasurements``): their information
+            is where the design starts; without ``noise_arcsec`` their noise (their sigma
+            column, else fitted) is the new measurements' noise.
+        noise_arcsec: 1-sigma noise of a measured angle (default: from ``from_data``, else 1).
+        dwell_s: time between measurements, seconds (the plan's ``time_s``).
+
+    Raises:
+        InputError: no candidate where the effects are defined; fewer positions than the
+            combinations need; an effect that no position within the limits can see; positions
+            that cannot determine every combination.
+    """
+    from ..core.blas_threads import one_blas_thread
+
+    with one_blas_thread():  # tall-by-small products: many threads on busy cores only wait
+        return _design_identify(space, int(n_positions), from_data, noise_arcsec, dwell_s)
+
+
+def _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s) -> IdentifyDesign:
+    """:func:`design_identify`, on one BLAS thread."""
+    from ..stats.design import d_optimal_design, log_det
+    from ..stats.least_squares import analyse_identifiability, combination_name, tall_r_factor
+
+    start_int, noise, noise_source, n_from, start_s = _start_information(
+        space, from_data, noise_arcsec, dwell_s
+    )
+    noise_rad = noise / ARCSEC_PER_RAD
+    count = space.visits.count
+    duration_s = (n_positions * count - 1) * float(dwell_s)
+    try:
+        rows, keep, model = design_rows(
+            space, space.candidates_deg, space.visits, start_s, duration_s
+        )
+    except InputError as exc:
+        raise InputError(f"no candidate position within the limits can be used: {exc}") from None
+    candidates_deg = space.candidates_deg[keep]
+    if n_positions > candidates_deg.shape[0]:
+        raise InputError(
+            f"{n_positions} positions asked, but only {candidates_deg.shape[0]} candidates: give "
+            "more --candidates"
+        )
+    rows = rows / noise_rad
+    names, n = model.parameter_names, model.n_params
+    candidate_r = tall_r_factor(rows.reshape(-1, n))
+    stacked = candidate_r if start_int is None else np.concatenate([candidate_r, _root(start_int)])
+    ident = analyse_identifiability(stacked, names)
+    rank = ident.rank
+    if rank == 0:
+        raise InputError("no position within the limits determines any error of the table")
+    alone = analyse_identifiability(candidate_r, names).rank
+    invisible = _invisible_effects(space, model, candidate_r, alone)
+    if invisible:
+        others = " and the other effects" if len(space.effects) > 1 else ""
+        raise InputError(
+            f"effect '{invisible[0]}' changes nothing that the base errors{others} do not "
+            "already explain at any position within the limits: no position can see it; leave "
+            "it out of --effects or widen the limits"
+        )
+    angles_per_position = 3 * count
+    from_rows = 0 if from_data is None else int(from_data.measured.sum())
+    if angles_per_position * n_positions + from_rows <= rank:
+        fewest = (rank - from_rows) // angles_per_position + 1
+        raise InputError(
+            f"{n_positions} positions give {angles_per_position * n_positions} measured angles"
+            + (f" (with the {from_rows} measured)" if from_rows else "")
+            + f", not more than the {rank} combinations to identify: choose at least {fewest} "
+            "positions (-n)"
+        )
+    # Whitened coordinates z of the determined combinations: parameters = basis @ z.
+    basis = ident.basis / ident.singular_values[:rank]
+    x = (rows.reshape(-1, n) @ basis).reshape(rows.shape[0], -1, rank)
+    start = None if start_int is None else basis.T @ start_int @ basis
+    found = d_optimal_design(x, n_positions, start)
+    if not np.isfinite(found.log_det):
+        fewest = _fewest_positions(x, start, rank)
+        more = (
+            f"the fewest that do: {fewest} (-n {fewest})"
+            if fewest
+            else "no number of them does: widen the limits or leave effects out"
+        )
+        raise InputError(
+            f"{n_positions} positions within the limits cannot determine all {rank} "
+            f"combinations; {more}"
+        )
+    chosen = np.flatnonzero(keep)[np.sort(found.chosen)]
+    positions = space.candidates_deg[chosen]
+    plan = plan_measurements(
+        positions,
+        needs_time=space.needs_time,
+        needs_dirs=space.needs_dirs,
+        dwell_s=dwell_s,
+        seed=space.seed,
+        start_s=start_s,
+        visits=space.visits.subset(chosen),
+    )
+    first = np.unique(plan.position, return_index=True)[1]
+    positions = positions[plan.position[np.sort(first)]]  # in the order first measured
+
+    def information(plan_: MeasurementPlan) -> np.ndarray:
+        jac = _evaluate(space, plan_.variables())[0].reshape(-1, n) / noise_rad
+        z = jac @ basis
+        return z.T @ z
+
+    m_design = information(plan) + (0.0 if start is None else start)
+    # The grid, measured by the same rules (its positions where the effects are defined).
+    grid_visits = candidate_visits(
+        space.grid_deg.shape[0], space.n_joints, needs_time=space.needs_time,
+        needs_dirs=space.needs_dirs, rng=np.random.default_rng([space.seed, 2]),
+    )  # fmt: skip
+    _, grid_keep, _ = design_rows(space, space.grid_deg, grid_visits, start_s, duration_s)
+    grid = space.grid_deg[grid_keep]
+    n_grid = max(grid.shape[0], 1)
+
+    def grid_information(dwell: float) -> np.ndarray:
+        return information(
+            plan_measurements(
+                grid, needs_time=space.needs_time, needs_dirs=space.needs_dirs, dwell_s=dwell,
+                seed=space.seed, start_s=start_s,
+            )
+        )  # fmt: skip
+
+    zero = 0.0 if start is None else start
+    m_grid = grid_information(dwell_s) + zero
+    # The grid at the design's size: its information per position, in a run as long as the
+    # design's (a drift rate is known better from a longer run, not from better positions).
+    same_duration = dwell_s * (n_positions * count - 1) / max(n_grid * count - 1, 1)
+    m_grid_n = grid_information(same_duration) * (n_positions / n_grid) + zero
+    # Combinations in user units: y = to_user @ z (pivot-scaled rows of the RREF, as fit names).
+    pivots = [int(np.flatnonzero(row)[0]) for row in ident.determined]
+    scale = model.per_user_unit[pivots]
+    to_user = (ident.determined / scale[:, None]) @ basis
+    shift = 2.0 * float(np.linalg.slogdet(to_user)[1])
+    std = _standard_errors(m_design, to_user)
+    std_grid = _standard_errors(m_grid, to_user)
+    std_grid_n = _standard_errors(m_grid_n, to_user)
+    combinations = []
+    for i, row in enumerate(ident.determined):
+        coeffs = row * model.per_user_unit / scale[i]
+        combinations.append(
+            {
+                "name": combination_name(coeffs, names),
+                "unit": model.parameter_units[pivots[i]],
+                "coefficients": {a: float(c) for a, c in zip(names, coeffs, strict=True) if c},
+                "std": std[i],
+                "std_grid": std_grid[i],
+                "std_grid_same_n": std_grid_n[i],
+            }
+        )
+    undetermined = []
+    for row in ident.undetermined:
+        pivot = int(np.flatnonzero(row)[0])
+        undetermined.append(
+            combination_name(row * model.per_user_unit / model.per_user_unit[pivot], names)
+        )
+    ld = log_det(m_design) - shift
+    ld_grid = log_det(m_grid_n) - shift
+    finite_grid = bool(np.isfinite(ld_grid))
+    return IdentifyDesign(
+        space=space,
+        positions_deg=positions,
+        plan=plan,
+        combinations=tuple(combinations),
+        undetermined=tuple(undetermined),
+        noise_arcsec=float(noise),
+        noise_source=noise_source,
+        n_from=n_from,
+        log_det=float(ld),
+        log_det_grid_same_n=float(ld_grid) if finite_grid else None,
+        d_efficiency=float(np.exp((ld - ld_grid) / rank)) if finite_grid else None,
+        n_grid=int(grid.shape[0]),
+        greedy_log_det=float(found.greedy_log_det - shift),
+        n_exchanges=found.n_exchanges,
+        n_sweeps=found.n_sweeps,
+    )

@@ -22,6 +22,7 @@ import numpy as np
 from ..core.exceptions import InputError, check_seed
 from ..core.sizes import check_count
 from ..core.units import DEG_PER_RAD
+from .schedule import Visits, candidate_visits
 
 __all__ = [
     "DEFAULT_CANDIDATES",
@@ -221,6 +222,8 @@ class DesignSpace:
         seed: the seed of the random candidates.
         needs_time: an effect needs ``time_s`` (the run repeats positions early and late).
         needs_dirs: an effect needs ``dirK`` (each position is approached from both sides).
+        visits: how each candidate would be measured (:class:`~.schedule.Visits`: when, from
+            which side; seeded).
     """
 
     table: object
@@ -231,6 +234,7 @@ class DesignSpace:
     seed: int
     needs_time: bool
     needs_dirs: bool
+    visits: Visits = field(repr=False)
 
     @property
     def n_joints(self) -> int:
@@ -298,6 +302,10 @@ def design_space(
     grid = np.stack([a.ravel() for a in axes], axis=1)
     check_count(grid.shape[0], MAX_CANDIDATES, "grid positions", CANDIDATE_BYTES)
     all_deg = np.concatenate([drawn, grid])
+    visits = candidate_visits(
+        all_deg.shape[0], len(ranges), needs_time=needs_time, needs_dirs=needs_dirs,
+        rng=np.random.default_rng([seed, 1]),
+    )  # fmt: skip
     for array in (all_deg, grid):
         array.setflags(write=False)
     return DesignSpace(
@@ -309,4 +317,5 @@ def design_space(
         seed=seed,
         needs_time=needs_time,
         needs_dirs=needs_dirs,
+        visits=visits,
     )

@@ -1,0 +1,146 @@
+"""Figures of a design (``turntable-pin design --plots DIR``): where to measure, and how well.
+
+- ``design_positions.png``: the chosen positions over the joints' ranges (one panel per pair of
+  joints; one joint: its angle against the order of measurement), with the 30-degree grid within
+  the limits behind them;
+- ``design_standard_errors.png``: the expected standard error of each determined combination
+  from the design, against the grid's at the same number of positions.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..design.identify import IdentifyDesign
+from .figures import pyplot, save_png
+
+__all__ = ["plot_design_positions", "plot_design_standard_errors", "write_identify_plots"]
+
+_LABEL_CHARS = 48
+"""Longest combination name shown on an axis (longer ones are cut, with an ellipsis)."""
+
+
+def _axis_label(space, k: int) -> str:
+    r = space.ranges[k]
+    return f"phi{r.index} {r.joint} (deg)"
+
+
+def _range(space, k: int) -> tuple[float, float]:
+    r = space.ranges[k]
+    return (r.low_deg, r.low_deg + 360.0) if r.full_turn else (r.low_deg, r.high_deg)
+
+
+def plot_design_positions(design: IdentifyDesign, path):
+    """The chosen positions over the joints' ranges, the grid behind them (PNG)."""
+    plt = pyplot()
+    space = design.space
+    n_joints = space.n_joints
+    pairs = [(a, b) for a in range(n_joints) for b in range(a + 1, n_joints)]
+    panels = max(len(pairs), 1)
+    fig, axes = plt.subplots(1, panels, figsize=(4.6 * panels + 0.6, 4.4), squeeze=False)
+    chosen, grid = design.positions_deg, space.grid_deg
+    if not pairs:  # one joint: the angle of each measurement in the run's order
+        ax = axes[0, 0]
+        ax.plot(
+            np.arange(1, design.plan.n_rows + 1),
+            design.plan.joint_deg[:, 0],
+            "o",
+            color="tab:blue",
+            label=f"design ({design.n_positions} positions)",
+        )
+        for angle in grid[:, 0]:
+            ax.axhline(angle, color="0.85", linewidth=0.8, zorder=0)
+        ax.set_xlabel("measurement (order of the run)")
+        ax.set_ylabel(_axis_label(space, 0))
+        ax.set_ylim(*_range(space, 0))
+        ax.legend(fontsize=8, loc="upper right")
+    for ax, (a, b) in zip(axes[0], pairs, strict=False):
+        ax.plot(
+            grid[:, a],
+            grid[:, b],
+            "+",
+            color="0.6",
+            markersize=6,
+            label=f"30-degree grid ({design.n_grid})",
+        )
+        ax.plot(
+            chosen[:, a],
+            chosen[:, b],
+            "o",
+            color="tab:blue",
+            markersize=5,
+            label=f"design ({design.n_positions})",
+        )
+        ax.set_xlim(*_range(space, a))
+        ax.set_ylim(*_range(space, b))
+        ax.set_xlabel(_axis_label(space, a))
+        ax.set_ylabel(_axis_label(space, b))
+        ax.legend(fontsize=8, loc="upper right", framealpha=0.9)
+    effects = " + ".join(("base", *space.effect_names))
+    fig.suptitle(
+        f"D-optimal positions on {Path(space.measured.label).name}\nfor {effects}\n"
+        f"(seed {space.seed}, {space.candidates_deg.shape[0]} candidates)",
+        fontsize=9,
+    )
+    fig.tight_layout()
+    return save_png(fig, path)
+
+
+def plot_design_standard_errors(design: IdentifyDesign, path):
+    """Expected standard error of each combination: the design against the grid scaled to its
+    number of positions (PNG, log scale; a combination the grid does not determine has no grid
+    bar)."""
+    plt = pyplot()
+    combinations = design.combinations
+    count = len(combinations)
+    fig, ax = plt.subplots(figsize=(9.0, 1.2 + 0.32 * count))
+    y = np.arange(count)
+    ours = np.array([c["std"] for c in combinations], dtype=float)
+    grid = np.array(
+        [np.nan if c["std_grid_same_n"] is None else c["std_grid_same_n"] for c in combinations]
+    )
+    ax.barh(
+        y - 0.2,
+        ours,
+        height=0.38,
+        color="tab:blue",
+        label=f"design, {design.n_positions} positions",
+    )
+    ax.barh(
+        y + 0.2,
+        np.nan_to_num(grid),
+        height=0.38,
+        color="0.6",
+        label=f"30-degree grid ({design.n_grid}) scaled to {design.n_positions} positions",
+    )
+    for i in np.flatnonzero(np.isnan(grid)):
+        ax.text(ours[i], y[i] + 0.2, "  grid: not determined", va="center", fontsize=7)
+    labels = [
+        (c["name"] if len(c["name"]) <= _LABEL_CHARS else c["name"][: _LABEL_CHARS - 3] + "...")
+        + f" [{c['unit']}]"
+        for c in combinations
+    ]
+    ax.set_yticks(y, labels, fontsize=7)
+    ax.invert_yaxis()
+    ax.set_xscale("log")
+    ax.set_xlabel(f"expected standard error (noise {design.noise_arcsec:.3g} arcsec per angle)")
+    efficiency = (
+        f"D-efficiency {design.d_efficiency:.3f} per position"
+        if design.d_efficiency is not None
+        else "the grid does not determine every combination"
+    )
+    ax.set_title(f"What the design determines, against the grid: {efficiency}", fontsize=10)
+    ax.legend(fontsize=8, loc="lower right")
+    fig.tight_layout()
+    return save_png(fig, path)
+
+
+def write_identify_plots(design: IdentifyDesign, folder) -> list[Path]:
+    """Both figures of an identify design in ``folder`` (created); the paths written."""
+    folder = Path(folder)
+    return [
+        plot_design_positions(design, folder / "design_positions.png"),
+        plot_design_standard_errors(design, folder / "design_standard_errors.png"),
+    ]
