@@ -294,20 +294,44 @@ def _root(information: np.ndarray) -> np.ndarray:
     return np.sqrt(np.clip(values, 0.0, None))[:, None] * vectors.T
 
 
-def _invisible_effects(space, model, stacked: np.ndarray, rank: int) -> list[str]:
-    """The effects whose parameters add no determined combination (on ``stacked`` rows)."""
+def _invisible_effect(space, model, stacked: np.ndarray) -> str | None:
+    """Why one of the effects cannot be identified on the ``stacked`` rows (all the candidates):
+    its parameters add no determined combination to the base errors (no position sees it) or
+    to the other effects (naming those that explain it); ``None`` when every effect adds one."""
     from ..stats.least_squares import analyse_identifiability
 
-    names = model.parameter_names
-    out = []
+    names = np.array(model.parameter_names)
+    owner = {e.name: np.array([n.startswith(f"{e.name}.") for n in names]) for e in space.effects}
+
+    def rank(columns: np.ndarray) -> int:
+        return analyse_identifiability(stacked[:, columns], tuple(names[columns])).rank
+
+    everything = np.ones(names.size, dtype=bool)
+    full = rank(everything)
     for effect in space.effects:
-        own = np.array([n.startswith(f"{effect.name}.") for n in names])
-        if not own.any():
+        own = owner[effect.name]
+        if not own.any() or rank(~own) < full:
             continue
-        rest = analyse_identifiability(stacked[:, ~own], tuple(np.array(names)[~own]))
-        if rest.rank == rank:
-            out.append(effect.name)
-    return out
+        base = ~np.any(list(owner.values()), axis=0)
+        if rank(base | own) == rank(base):
+            return (
+                f"effect '{effect.name}' changes nothing that the base errors do not already "
+                "explain at any position within the limits: no position can see it; leave it out "
+                "of --effects or widen the limits"
+            )
+        culprits = [
+            other.name
+            for other in space.effects
+            if other is not effect and rank(~owner[other.name]) > rank(~owner[other.name] & ~own)
+        ]
+        return (
+            f"effect '{effect.name}' changes nothing that "
+            + " and ".join(f"'{c}'" for c in culprits or ["the other effects"])
+            + f" (with the base errors) {'does' if len(culprits) == 1 else 'do'} not already "
+            "explain at any position within the limits:"
+            " no position tells them apart; fit one of them, or widen the limits"
+        )
+    return None
 
 
 def _fewest_positions(rows, start, rank) -> int | None:
@@ -403,21 +427,16 @@ def _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s) -> Id
     rank = ident.rank
     if rank == 0:
         raise InputError("no position within the limits determines any error of the table")
-    alone = analyse_identifiability(candidate_r, names).rank
-    invisible = _invisible_effects(space, model, candidate_r, alone)
+    invisible = _invisible_effect(space, model, candidate_r)
     if invisible:
-        others = " and the other effects" if len(space.effects) > 1 else ""
-        raise InputError(
-            f"effect '{invisible[0]}' changes nothing that the base errors{others} do not "
-            "already explain at any position within the limits: no position can see it; leave "
-            "it out of --effects or widen the limits"
-        )
+        raise InputError(invisible)
     angles_per_position = 3 * count
     from_rows = 0 if from_data is None else int(from_data.measured.sum())
     if angles_per_position * n_positions + from_rows <= rank:
         fewest = (rank - from_rows) // angles_per_position + 1
         raise InputError(
-            f"{n_positions} positions give {angles_per_position * n_positions} measured angles"
+            f"{n_positions} position{'s give' if n_positions > 1 else ' gives'} "
+            f"{angles_per_position * n_positions} measured angles"
             + (f" (with the {from_rows} measured)" if from_rows else "")
             + f", not more than the {rank} combinations to identify: choose at least {fewest} "
             "positions (-n)"
@@ -426,7 +445,11 @@ def _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s) -> Id
     basis = ident.basis / ident.singular_values[:rank]
     x = (rows.reshape(-1, n) @ basis).reshape(rows.shape[0], -1, rank)
     start = None if start_int is None else basis.T @ start_int @ basis
-    found = d_optimal_design(x, n_positions, start)
+    # The exchange runs from the greedy design and from the grid (its best N, or completed):
+    # never worse than the grid.
+    first_grid = space.candidates_deg.shape[0] - space.grid_deg.shape[0]
+    grid_start = np.flatnonzero(np.flatnonzero(keep) >= first_grid)
+    found = d_optimal_design(x, n_positions, start, also_from=[grid_start])
     if not np.isfinite(found.log_det):
         fewest = _fewest_positions(x, start, rank)
         more = (

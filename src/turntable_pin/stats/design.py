@@ -42,10 +42,21 @@ MAX_SWEEPS = 100
 """Most sweeps of the exchange over the design points."""
 
 
+SINGULAR_RTOL = 1e-12
+"""An information matrix whose smallest eigenvalue is below this fraction of its largest is
+singular (what is left is rounding: a direction no row sees)."""
+
+
 def log_det(information: np.ndarray) -> float:
-    """``log det`` of a symmetric information matrix; ``-inf`` when it is singular."""
-    sign, value = np.linalg.slogdet(np.asarray(information, dtype=float))
-    return float(value) if sign > 0 else float("-inf")
+    """``log det`` of a symmetric information matrix; ``-inf`` when it is singular (its smallest
+    eigenvalue below :data:`SINGULAR_RTOL` of its largest)."""
+    m = np.asarray(information, dtype=float)
+    values = np.linalg.eigvalsh(0.5 * (m + m.T))
+    if values.size == 0:
+        return 0.0
+    if not values[0] > SINGULAR_RTOL * values[-1]:
+        return float("-inf")
+    return float(np.sum(np.log(values)))
 
 
 @dataclass(frozen=True)
@@ -252,27 +263,53 @@ def fedorov_exchange(
     )
 
 
+def _completed(rows, n, start, seed) -> np.ndarray:
+    """The starting design ``seed`` made ``n`` long: its best ``n`` (greedy among them) when
+    longer, completed greedily when shorter."""
+    seed = np.unique(np.asarray(seed, dtype=int))
+    if seed.size >= n:
+        return seed[greedy_design(rows[seed], n, start)]
+    known = _information(rows, seed, start)
+    return np.concatenate([seed, greedy_design(rows, n - seed.size, known, exclude=seed)])
+
+
 def d_optimal_design(
     rows: np.ndarray,
     n: int,
     start: np.ndarray | None = None,
     *,
+    also_from=(),
     tol: float = EXCHANGE_TOL,
     max_sweeps: int = MAX_SWEEPS,
 ) -> ExchangeResult:
     """The D-optimal choice of ``n`` of the candidates: :func:`greedy_design`, then
-    :func:`fedorov_exchange` (when the greedy design's information is nonsingular; else the
-    greedy design, with ``log_det`` ``-inf``: these candidates cannot determine every parameter
-    with ``n`` of them).
+    :func:`fedorov_exchange`; the exchange also runs from each design of ``also_from`` (made
+    ``n`` long: its greedy best ``n``, or completed greedily) and the best result is kept, so
+    that it is never worse than any of them (an exchange can stop in a local optimum).
+
+    When no start's information is nonsingular, the greedy design is returned with ``log_det``
+    ``-inf``: these candidates cannot determine every parameter with ``n`` of them.
 
     Args:
         rows: each candidate's rows (C, k, p) (or (C, p)).
         n: how many candidates to choose.
         start: information already known (p, p), or ``None``.
+        also_from: other designs to start from (index sequences), e.g. a regular grid.
     """
     rows = _as_rows(rows)
-    greedy = greedy_design(rows, n, start)
-    first = log_det(_information(rows, greedy, start))
-    if not np.isfinite(first):
-        return ExchangeResult(greedy, first, first, (first,), 0, 0)
-    return fedorov_exchange(rows, greedy, start, tol=tol, max_sweeps=max_sweeps)
+    best = None
+    for first in (
+        greedy_design(rows, n, start),
+        *(_completed(rows, n, start, s) for s in also_from),
+    ):
+        first_log_det = log_det(_information(rows, first, start))
+        if not np.isfinite(first_log_det):
+            continue
+        found = fedorov_exchange(rows, first, start, tol=tol, max_sweeps=max_sweeps)
+        if best is None or found.log_det > best.log_det:
+            best = found
+    if best is None:
+        first = greedy_design(rows, n, start)
+        value = log_det(_information(rows, first, start))
+        return ExchangeResult(first, value, value, (value,), 0, 0)
+    return best
