@@ -40,6 +40,10 @@ CASES = (
     ("three axes, all wobbles", "three_axis_imu_table.urdf",
      "wobble_harmonics@outer_gimbal,wobble_harmonics@middle_gimbal,"
      "wobble_harmonics@inner_gimbal", None),
+    ("three axes, 11 effects with drift and backlash", "three_axis_imu_table.urdf",
+     ",".join(f"{kind}@{joint}_gimbal" for kind in ("encoder_harmonics", "wobble_harmonics",
+                                                    "backlash")
+              for joint in ("outer", "middle", "inner")) + ",gravity_sag,thermal_drift", None),
 )  # fmt: skip
 
 

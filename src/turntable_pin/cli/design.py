@@ -189,17 +189,19 @@ def _from_data(args: argparse.Namespace, table):
     return read_measurements(args.from_data, None if measured.paper else measured.joint_names)
 
 
-def _finish(result, args: argparse.Namespace, write_plots) -> int:
-    """Write the positions (``-o``, with ``result.comment()`` above them) and the figures
-    (``--plots``, by ``write_plots(result, folder)``) of ``result``, then print it (text or
-    JSON)."""
+def _finish(result, args: argparse.Namespace, write_plots=None) -> int:
+    """Write the positions (``-o``: ``result.plan``'s CSV, with ``result.comment()`` above it when
+    the result has one) and the figures (``--plots``: ``write_plots(result, folder)``, else
+    ``result.write_plots(folder)``) of ``result``, then print it (text or JSON)."""
     out = result.to_dict()
     written = []
     if args.output is not None:
-        out["output"] = str(result.plan.write_csv(args.output, comment=result.comment()))
+        comment = result.comment() if hasattr(result, "comment") else ""
+        out["output"] = str(result.plan.write_csv(args.output, comment=comment))
         written.append(out["output"])
     if args.plots is not None:
-        out["plots"] = [str(p) for p in write_plots(result, args.plots)]
+        plots = write_plots(result, args.plots) if write_plots else result.write_plots(args.plots)
+        out["plots"] = [str(p) for p in plots]
         written += out["plots"]
     if args.json:
         print_json(out)

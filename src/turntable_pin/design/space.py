@@ -31,6 +31,7 @@ __all__ = [
     "DesignSpace",
     "JointRange",
     "design_space",
+    "joint_ranges",
     "parse_limits_deg",
 ]
 

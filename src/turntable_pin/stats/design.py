@@ -100,7 +100,7 @@ def _quadratic(rows: np.ndarray, inverse: np.ndarray) -> np.ndarray:
     """``X_c M^-1 X_c^T`` of every candidate, (C, k, k)."""
     c, k, p = rows.shape
     z = (rows.reshape(-1, p) @ inverse).reshape(c, k, p)
-    return np.einsum("ckp,cmp->ckm", z, rows)
+    return z @ np.swapaxes(rows, 1, 2)
 
 
 def _ridge(rows: np.ndarray, n: int) -> float:
@@ -113,7 +113,7 @@ def _products(left: np.ndarray, middle: np.ndarray, right: np.ndarray) -> np.nda
     """``L_c W R_c^T`` of every candidate (C, a, b) from (C, a, m), (m, m) and (C, b, m)."""
     c, a, m = left.shape
     lw = (left.reshape(-1, m) @ middle).reshape(c, a, m)
-    return np.einsum("cam,cbm->cab", lw, right)
+    return lw @ np.swapaxes(right, 1, 2)
 
 
 def _exchange_ratios(quad: np.ndarray, g: np.ndarray, b: np.ndarray) -> np.ndarray:
