@@ -95,7 +95,7 @@ class IdentifyDesign:
         return "\n".join(
             [
                 "designed by turntable-pin design (identify: D-optimal)",
-                f"table: {self.space.measured.label}; effects: {effects}",
+                f"table: {self.space.table_name}; effects: {effects}",
                 f"seed={self.space.seed} candidates={self.space.candidates_deg.shape[0]} "
                 f"n_positions={self.n_positions} n_from={self.n_from}",
                 "limits: " + "; ".join(r.describe() for r in self.space.ranges),
@@ -134,7 +134,7 @@ class IdentifyDesign:
         lines = [
             f"design (identify, D-optimal): {self.n_positions} positions of "
             f"{space.candidates_deg.shape[0]} candidates (seed {space.seed}) on "
-            f"{space.measured.label}, for {effects}"
+            f"{space.table_name}, for {effects}"
             + (f", after the {self.n_from} positions measured" if self.n_from else ""),
             "limits: " + "; ".join(r.describe() for r in space.ranges),
             f"run: {self.plan.n_rows} measurements; {self.plan.rule}",

@@ -16,6 +16,7 @@ import math
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -250,6 +251,11 @@ class DesignSpace:
         return measured_table(self.table)
 
     @property
+    def table_name(self) -> str:
+        """How the results name the table: ``paper``, or its URDF's file name."""
+        return Path(self.measured.label).name
+
+    @property
     def effect_names(self) -> tuple[str, ...]:
         """The names of :attr:`effects`."""
         return tuple(e.name for e in self.effects)
@@ -257,7 +263,7 @@ class DesignSpace:
     def to_dict(self) -> dict:
         """The space as a JSON-ready dict (limits, candidate count, grid size, seed)."""
         return {
-            "table": self.measured.label,
+            "table": self.table_name,
             "effects": list(self.effect_names),
             "limits": [r.to_dict() for r in self.ranges],
             "n_candidates": int(self.candidates_deg.shape[0]),

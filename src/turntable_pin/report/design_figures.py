@@ -28,8 +28,11 @@ def _axis_label(space, k: int) -> str:
 
 
 def _range(space, k: int) -> tuple[float, float]:
+    """Joint k's range with a margin of 3 % (points at the limits stay whole)."""
     r = space.ranges[k]
-    return (r.low_deg, r.low_deg + 360.0) if r.full_turn else (r.low_deg, r.high_deg)
+    low, high = (r.low_deg, r.low_deg + 360.0) if r.full_turn else (r.low_deg, r.high_deg)
+    pad = 0.03 * max(high - low, 1.0)
+    return low - pad, high + pad
 
 
 def plot_design_positions(design: IdentifyDesign, path):
@@ -77,14 +80,18 @@ def plot_design_positions(design: IdentifyDesign, path):
         ax.set_ylim(*_range(space, b))
         ax.set_xlabel(_axis_label(space, a))
         ax.set_ylabel(_axis_label(space, b))
-        ax.legend(fontsize=8, loc="upper right", framealpha=0.9)
     effects = " + ".join(("base", *space.effect_names))
     fig.suptitle(
-        f"D-optimal positions on {Path(space.measured.label).name}\nfor {effects}\n"
+        f"D-optimal positions on {space.table_name}\nfor {effects}\n"
         f"(seed {space.seed}, {space.candidates_deg.shape[0]} candidates)",
         fontsize=9,
     )
-    fig.tight_layout()
+    if pairs:
+        handles, labels = axes[0, 0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=8, frameon=False)
+        fig.tight_layout(rect=(0, 0.07, 1, 1))
+    else:
+        fig.tight_layout()
     return save_png(fig, path)
 
 
