@@ -60,22 +60,11 @@ def plot_design_positions(design: IdentifyDesign, path):
         ax.set_ylim(*_range(space, 0))
         ax.legend(fontsize=8, loc="upper right")
     for ax, (a, b) in zip(axes[0], pairs, strict=False):
-        ax.plot(
-            grid[:, a],
-            grid[:, b],
-            "+",
-            color="0.6",
-            markersize=6,
-            label=f"30-degree grid ({design.n_grid})",
-        )
-        ax.plot(
-            chosen[:, a],
-            chosen[:, b],
-            "o",
-            color="tab:blue",
-            markersize=5,
-            label=f"design ({design.n_positions})",
-        )
+        for points, marker, colour, label in (
+            (grid, "+", "0.6", f"30-degree grid ({design.n_grid})"),
+            (chosen, "o", "tab:blue", f"design ({design.n_positions})"),
+        ):
+            ax.plot(points[:, a], points[:, b], marker, color=colour, markersize=5, label=label)
         ax.set_xlim(*_range(space, a))
         ax.set_ylim(*_range(space, b))
         ax.set_xlabel(_axis_label(space, a))
