@@ -45,14 +45,14 @@ def _design(key):
     return _DESIGNS[key]
 
 
-def _simulate(design, seed):
+def _simulate(key, seed):
+    design, hidden = _design(key), TABLES[key][2]
     plan = design.plan
     schedule = Schedule(
         positions=tuple(map(tuple, plan.joint_deg)),
         positions_time_s=None if plan.time_s is None else tuple(plan.time_s),
         positions_dirs=() if plan.dirs is None else tuple(tuple(d) for d in plan.dirs.T),
     )
-    hidden = TABLES[next(k for k, d in _DESIGNS.items() if d is design)][2]
     return simulate_measurements(None, hidden, schedule=schedule, noise_arcsec=2.0, seed=seed,
                                  turntable=design.space.table)  # fmt: skip
 
@@ -78,7 +78,7 @@ def test_the_predicted_standard_errors_are_those_fit_reports(key):
     effects = design.space.effects
     estimated = {name: [] for name in predicted}
     for seed in range(5):
-        sim = _simulate(design, seed)
+        sim = _simulate(key, seed)
         # Sigma known (the sigma column): the fit's standard errors are the design's.
         fit = fit_orientation(sim.data, effects, turntable=design.space.table)
         reported = {c["name"]: c["std"] for c in fit.result.combinations()}
