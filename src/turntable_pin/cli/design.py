@@ -52,6 +52,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     mode.add_argument(
         "--separate", metavar="A,B", help="positions that tell effect A from effect B (T-optimal)"
     )
+    p.add_argument(
+        "--amplitude",
+        action="append",
+        default=[],
+        metavar="A:P=V[,P=V...]",
+        help="with --separate: an effect's parameters in its user units (arcsec, arcsec/g), e.g. "
+        "TF:TF=10 (default: fitted with the base errors on --from data); repeatable",
+    )
     mode.add_argument(
         "--calibrate",
         action="store_true",
@@ -230,8 +238,51 @@ def _run_identify(args: argparse.Namespace) -> int:
 
 
 def _run_separate(args: argparse.Namespace) -> int:
-    """T-optimal positions that tell two effects apart (``--separate A,B``)."""
-    raise InputError("design --separate: not yet available (issue 19, item 2)")
+    """T-optimal positions that tell two effects apart (``--separate A,B``): each at its
+    amplitude (``--amplitude``, else fitted on ``--from``), with the chance of the right name;
+    one line (exit 0) when no positions within the limits separate them."""
+    from ..design.separate import design_separate
+    from ..measurement.effects import parse_effect_spec
+    from ..measurement.user_effects import load_effects_module, resolve_effects
+    from ..report.separation_figures import write_separate_plots
+
+    if args.effects:
+        raise InputError(
+            "--separate A,B names the two effects to tell apart; --effects is for the identify mode"
+        )
+    table = table_from_args(args)
+    modules = [e for path in args.effects_module for e in load_effects_module(path)]
+    names = [n.strip() for n in args.separate.split(",") if n.strip()]
+    if len(names) != 2:
+        raise InputError(f"--separate takes two effects, A,B; got '{args.separate}'")
+    pair = resolve_effects(names, table, modules)
+    amplitudes: dict[str, dict[str, float]] = {}
+    for text in args.amplitude:
+        try:
+            name, values = parse_effect_spec(
+                text, lambda n: resolve_effects([n], table, modules)[0]
+            )
+        except InputError as exc:
+            raise InputError(f"--amplitude '{text}': {exc}") from None
+        if name in amplitudes:
+            raise InputError(f"--amplitude '{text}': effect '{name}' is given twice")
+        amplitudes[name] = values
+    space = _space(args, pair)
+    result = design_separate(
+        space,
+        args.positions_count,
+        from_data=_from_data(args, space.table),
+        amplitudes=amplitudes,
+        noise_arcsec=args.noise_arcsec,
+        dwell_s=args.dwell_s,
+    )
+    if result.plan is None:  # no positions separate them: the answer, not an error
+        if args.json:
+            print_json(result.to_dict())
+        else:
+            print(result.report())
+        return 0
+    return _finish(result, args, write_separate_plots)
 
 
 def _run_calibrate(args: argparse.Namespace) -> int:

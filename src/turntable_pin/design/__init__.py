@@ -6,6 +6,8 @@ positions of the next measurement run:
 - :mod:`.space`: the joints' limits, the candidate positions within them and the 30-degree grid;
 - :mod:`.identify`: D-optimal positions for the identifiable combinations of the base errors and
   the chosen effects (greedy start and Fedorov exchange, :mod:`turntable_pin.stats.design`);
+- :mod:`.separate`: T-optimal positions that tell two effects apart, with the chance that the
+  diagnosis names the right one (:mod:`turntable_pin.stats.discrimination`), or why none do;
 - :mod:`.schedule`: the order, times and approach directions of the chosen positions (repeats
   for time-driven effects, both sides for backlash) and the CSV that ``simulate --positions``
   and the test crew read.
@@ -17,7 +19,9 @@ _EXPORTS = {
     "DesignSpace": "space",
     "IdentifyDesign": "identify",
     "MeasurementPlan": "schedule",
+    "SeparationDesign": "separate",
     "design_identify": "identify",
+    "design_separate": "separate",
     "design_space": "space",
     "parse_limits_deg": "space",
     "plan_measurements": "schedule",

@@ -1,0 +1,830 @@
+"""Positions that tell two effects apart (``design --separate A,B``; issue 19, item 2).
+
+When the diagnosis says that effect B reproduces effect A on the positions measured, the
+question is which positions would tell them apart, and how many. Each effect is taken at its
+amplitude (fitted on the data measured with the base errors, or given): if A is true, fitting
+the base errors and B to what A predicts leaves the noise-free misfit
+
+    lambda_AB = || (I - P_B) J_A a ||^2 / sigma^2,   P_B the projector on the base and B's columns
+
+over the measured angles of the design (the Jacobian of
+:class:`~turntable_pin.measurement.effect_model.OrientationModel` at zero: the linearised model),
+and ``lambda_BA`` the other way round. The design maximises the smaller of the two (T-optimal,
+Atkinson and Fedorov 1975): a seeded exchange over the candidate positions within the joints'
+limits (:func:`~turntable_pin.stats.discrimination.t_optimal_exchange`), added to the positions
+already measured when there are some.
+
+The power is the diagnosis' own decision: with sigma known it names the effect with the lower
+``delta_bic = -delta_chi2 + k ln m`` (``k`` the ranks it adds to the base, ``m`` the measured
+angles), once it is accepted (``delta_bic <= -6 - 2 ln K`` for the K catalogued effects,
+:func:`~turntable_pin.stats.model_selection.acceptance_threshold`). So when A is true, A is named
+when it is accepted, ``chi2'(k_A, lambda_A0) > k_A ln m + 6 + 2 ln K`` (a non-central chi-square;
+``lambda_A0`` what the base errors alone leave of A), and preferred to B,
+``rss_B - rss_A > (k_A - k_B) ln m``: a generalised chi-square of the noise in the span of both
+models (:func:`~turntable_pin.stats.discrimination.rss_difference`), the non-central
+``chi2'(k_B - k_A, lambda_BA)`` when one contains the other. The power of a design is the
+smaller of the two chances (A true, B true), each the product of the two; a third catalogued
+effect that might take the name is not counted. The positions needed for the target power are
+found by scaling the design's misfits to other sizes (replicating it is exact) and checked by
+designing that many positions.
+
+When B reproduces A at every candidate position (its misfit is below :data:`SAME_RTOL` of A's
+signal beyond the base errors) and A has no fewer ranks than B, no positions within the limits
+separate them: the result says so, with the independent measurements of the effects' ``confirm``
+texts. When B contains A but has more ranks, a true A is still named by the rule's parsimony
+(B's extra ranks must buy their penalty from the noise alone): that direction is left to it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.units import ARCSEC_PER_RAD
+from .identify import _evaluate, _root, _start_information, design_rows
+from .schedule import MeasurementPlan, candidate_visits, plan_measurements
+from .space import DesignSpace
+
+__all__ = [
+    "POWER_TARGET",
+    "SAME_RTOL",
+    "Hypothesis",
+    "SeparationDesign",
+    "design_command",
+    "design_separate",
+]
+
+POWER_TARGET = 0.9
+"""The chance of the right name the positions count is given for."""
+
+SAME_RTOL = 1e-8
+"""An effect reproduces another's prediction when it leaves less than this fraction of the other's
+signal beyond the base errors (squared), over every candidate position."""
+
+MAX_POWER_POSITIONS = 5000
+"""Most positions the count for the target power is searched up to."""
+
+
+@dataclass(frozen=True)
+class Hypothesis:
+    """One of the two effects taken as the truth, against the other.
+
+    Attributes:
+        effect: its name; rival: the other effect's.
+        amplitude: its parameters in user units (``{name: value}``); unit: their unit(s).
+        signal_chi2: what the base errors alone leave of its prediction on the design (with the
+            positions measured), a noise-free chi2.
+        misfit_chi2: what the base errors and the rival leave of it there (``lambda``).
+        misfit_measured_chi2: the same on the positions measured alone (``None`` without).
+        misfit_grid_chi2: the same on the 30-degree grid within the limits, scaled to the
+            design's number of positions (with the positions measured).
+        added_rank, rival_added_rank: the ranks each adds to the base on the design.
+        determined, rival_determined: whether the design determines each one's parameters by
+            the diagnosis' correlation rule (an undetermined effect is put first only when it
+            explains twice what a determined one does).
+        settled_by: ``misfit`` (the design separates it) or ``parsimony`` (the rival reproduces
+            it everywhere with more ranks: the rule names it for its fewer ranks).
+        power_detect: the chance that it is accepted at all (a non-central chi-square).
+        power_first: the chance that it is put before the rival in the first round.
+        power_on_top: the chance that, the rival first, it is accepted on top of it (a
+            non-central chi-square of ``misfit_chi2``) and the rival then dropped.
+        power_choice: the chance that it ends up named rather than the rival (either way).
+        power: ``power_detect * power_choice``, the chance of its name.
+        power_measured: the same on the positions measured alone (``None`` without).
+        power_new_alone: the same on the new positions alone (``None`` without data measured).
+    """
+
+    effect: str
+    rival: str
+    amplitude: dict[str, float]
+    unit: str
+    signal_chi2: float
+    misfit_chi2: float
+    misfit_measured_chi2: float | None
+    misfit_grid_chi2: float | None
+    added_rank: int
+    rival_added_rank: int
+    determined: bool
+    rival_determined: bool
+    settled_by: str
+    power_detect: float
+    power_first: float
+    power_on_top: float
+    power_choice: float
+    power: float
+    power_measured: float | None
+    power_new_alone: float | None
+
+    def to_dict(self) -> dict:
+        """The hypothesis as a JSON-ready dict."""
+        return dict(vars(self))
+
+
+@dataclass(frozen=True)
+class SeparationDesign:
+    """The positions that tell two effects apart, or why none do.
+
+    Attributes:
+        space: the :class:`~.space.DesignSpace` (table, the two effects, limits, candidates).
+        pair: the two effects' names.
+        positions_deg: the chosen positions (N, J), degrees, in the run's first order (empty
+            when no positions separate them).
+        plan: the run that measures them (``None`` when none do).
+        hypotheses: each effect as the truth (:class:`Hypothesis`), A then B.
+        misfit_by_position: (N, 2) each position's share of the misfit each effect's rival
+            leaves (chi2; zero for a direction left to parsimony), in the order of
+            :attr:`positions_deg`.
+        measured_deg: the positions already measured (M, J), degrees (empty without).
+        noise_arcsec, noise_source: the noise of a measured angle and where it comes from.
+        amplitude_source: where each effect's amplitude comes from (``{effect: text}``).
+        n_from: positions already measured (``--from``), 0 without.
+        power: the smaller chance of the right name at these positions.
+        positions_for_power: the fewest positions with at least :attr:`target` power
+            (``None``: not within :data:`MAX_POWER_POSITIONS`); power_at_positions_for_power:
+            their power; positions_for_power_designed: whether that many were designed to check
+            it (else it is this design's misfits scaled).
+        power_curve: ``(positions, power)`` of this design scaled to other sizes.
+        target: the power asked for.
+        catalogue_size: K of the acceptance threshold ``-6 - 2 ln K``.
+        n_swaps, n_passes: of the exchange.
+        inseparable: why no positions within the limits separate them (one line), or ``None``.
+    """
+
+    space: DesignSpace = field(repr=False)
+    pair: tuple[str, str]
+    positions_deg: np.ndarray = field(repr=False)
+    plan: MeasurementPlan | None = field(repr=False)
+    hypotheses: tuple[Hypothesis, ...]
+    misfit_by_position: np.ndarray = field(repr=False)
+    measured_deg: np.ndarray = field(repr=False)
+    noise_arcsec: float
+    noise_source: str
+    amplitude_source: dict[str, str]
+    n_from: int
+    power: float | None
+    positions_for_power: int | None
+    power_at_positions_for_power: float | None
+    positions_for_power_designed: bool
+    power_curve: tuple[tuple[int, float], ...]
+    target: float
+    catalogue_size: int
+    n_swaps: int
+    n_passes: int
+    inseparable: str | None = None
+
+    @property
+    def n_positions(self) -> int:
+        """Number of positions chosen N."""
+        return int(self.positions_deg.shape[0])
+
+    def comment(self) -> str:
+        """The comment lines of the positions' CSV: what made it, with its seed."""
+        a, b = self.pair
+        return "\n".join(
+            [
+                f"designed by turntable-pin design --separate {a},{b} (T-optimal)",
+                f"table: {self.space.table_name}",
+                f"seed={self.space.seed} candidates={self.space.candidates_deg.shape[0]} "
+                f"n_positions={self.n_positions} n_from={self.n_from}",
+                "limits: " + "; ".join(r.describe() for r in self.space.ranges),
+                f"noise_arcsec={self.noise_arcsec:g} ({self.noise_source})",
+                "amplitudes: "
+                + "; ".join(
+                    f"{h.effect}: {_values(h.amplitude)} {h.unit}" for h in self.hypotheses
+                ),
+                f"power (chance of the right name): {_percent(self.power)}",
+                f"run: {self.plan.rule}" if self.plan is not None else "run: none",
+            ]
+        )
+
+    def to_dict(self) -> dict:
+        """The design as a JSON-ready dict."""
+        return {
+            "mode": "separate",
+            "space": self.space.to_dict(),
+            "effects": list(self.pair),
+            "inseparable": self.inseparable,
+            "n_positions": self.n_positions,
+            "n_from": self.n_from,
+            "noise_arcsec": self.noise_arcsec,
+            "noise_source": self.noise_source,
+            "amplitude_source": dict(self.amplitude_source),
+            "hypotheses": [h.to_dict() for h in self.hypotheses],
+            "power": self.power,
+            "target": self.target,
+            "positions_for_power": self.positions_for_power,
+            "power_at_positions_for_power": self.power_at_positions_for_power,
+            "positions_for_power_designed": self.positions_for_power_designed,
+            "power_curve": [list(p) for p in self.power_curve],
+            "catalogue_size": self.catalogue_size,
+            "n_swaps": self.n_swaps,
+            "n_passes": self.n_passes,
+            "positions_deg": self.positions_deg.tolist(),
+            "misfit_by_position": self.misfit_by_position.tolist(),
+            "plan": self.plan.to_dict() if self.plan is not None else None,
+        }
+
+    def report(self) -> str:
+        """The design as text: the amplitudes, what each effect leaves of the other, the power,
+        how many positions the target needs, and the positions."""
+        if self.inseparable:
+            return self.inseparable
+        space = self.space
+        a, b = self.pair
+        lines = [
+            f"design (separate {a} from {b}, T-optimal): {self.n_positions} positions of "
+            f"{space.candidates_deg.shape[0]} candidates (seed {space.seed}) on "
+            f"{space.table_name}"
+            + (f", after the {self.n_from} positions measured" if self.n_from else ""),
+            "limits: " + "; ".join(r.describe() for r in space.ranges),
+            f"run: {self.plan.n_rows} measurements; {self.plan.rule}",
+            f"noise: {self.noise_arcsec:.3g} arcsec per angle ({self.noise_source})",
+        ]
+        for h in self.hypotheses:
+            lines.append(
+                f"if {h.effect} is true ({_values(h.amplitude)} {h.unit}, "
+                f"{self.amplitude_source[h.effect]}):"
+            )
+            if h.settled_by == "parsimony":
+                lines.append(
+                    f"  {h.rival} reproduces it at every position, with {h.rival_added_rank} "
+                    f"ranks against its {h.added_rank}: the diagnosis names {h.effect} for its "
+                    "fewer parameters unless the noise pays for the others"
+                )
+            else:
+                where = [f"chi2 = {h.misfit_chi2:.3g} here"]
+                if h.misfit_measured_chi2 is not None:
+                    where.append(f"{h.misfit_measured_chi2:.3g} on the positions measured")
+                if h.misfit_grid_chi2 is not None:
+                    where.append(f"{h.misfit_grid_chi2:.3g} on a 30-degree grid of this size")
+                lines.append(f"  fitting {h.rival} instead leaves {'; '.join(where)}")
+            if not h.determined:
+                lines.append(
+                    f"  its parameters are not all determined here (traded off): the diagnosis "
+                    f"puts it first only when it explains twice what {h.rival} does"
+                )
+            also = []
+            if h.power_measured is not None:
+                also.append(f"on the positions measured alone {_percent(h.power_measured)}")
+            if h.power_new_alone is not None:
+                also.append(f"on the new ones alone {_percent(h.power_new_alone)}")
+            lines.append(
+                f"  chance that the diagnosis names {h.effect}: {_percent(h.power)}"
+                + (f" ({'; '.join(also)})" if also else "")
+            )
+        lines.append(f"power (the smaller chance of the right name): {_percent(self.power)}")
+        lines.append(self._count_line())
+        if self.n_from:
+            lines.append(
+                "measure these positions and diagnose them together with the data measured "
+                "(append their rows): the chances above are for both"
+            )
+        names = ", ".join(f"phi{r.index}" for r in space.ranges)
+        lines.append(f"positions ({names}, deg):")
+        for row in self.positions_deg:
+            lines.append("  " + "  ".join(f"{v:10.4f}" for v in row))
+        return "\n".join(lines)
+
+    def _count_line(self) -> str:
+        """How many positions the target needs, in words."""
+        a, b = self.pair
+        if self.positions_for_power is None:
+            return (
+                f"{self.target:.0%} needs more than {MAX_POWER_POSITIONS} positions of this kind: "
+                "no practical set of positions separates them at these amplitudes and noise; "
+                f"an independent measurement does. For {a}: {self.space.effects[0].confirm} "
+                f"For {b}: {self.space.effects[1].confirm}"
+            )
+        count = self.positions_for_power
+        besides = " besides those measured" if self.n_from else ""
+        if self.positions_for_power_designed:
+            return (
+                f"{self.target:.0%} needs {count} positions{besides}: design --separate {a},{b} "
+                f"-n {count} gives {_percent(self.power_at_positions_for_power)}"
+            )
+        return (
+            f"{self.target:.0%} needs about {count} positions{besides} (this design repeated "
+            f"in proportion: {_percent(self.power_at_positions_for_power)})"
+        )
+
+
+def _percent(value: float | None) -> str:
+    return "-" if value is None else f"{100.0 * value:.1f} %"
+
+
+def design_command(data: str, pair: tuple[str, str], urdf: str | None = None,
+                   payload_frame: str | None = None) -> str:  # fmt: skip
+    """The ``turntable-pin design --separate A,B`` command for the data file ``data`` (and the
+    table's ``urdf`` and ``payload_frame`` when not the default ones)."""
+    import shlex
+
+    words = ["turntable-pin", "design", "--separate", ",".join(pair), "--from", data]
+    if urdf:
+        words += ["--urdf", urdf]
+    if payload_frame:
+        words += ["--payload-frame", payload_frame]
+    return " ".join(shlex.quote(w) for w in words)
+
+
+def _columns(model, effect) -> np.ndarray:
+    """The parameter indices of ``effect`` in ``model``."""
+    prefix = f"{effect.name}."
+    return np.array([i for i, n in enumerate(model.parameter_names) if n.startswith(prefix)])
+
+
+def _amplitude_vector(model, effect, values: Mapping[str, float]) -> np.ndarray:
+    """``values`` (user units) of ``effect``'s parameters as a vector in internal units, in the
+    model's order (parameters not given are zero).
+
+    Raises:
+        InputError: a name that is not one of the effect's parameters.
+    """
+    columns = _columns(model, effect)
+    names = [model.parameter_names[i].split(".", 1)[1] for i in columns]
+    unknown = [k for k in values if k not in names]
+    if unknown:
+        raise InputError(
+            f"effect '{effect.name}' has no parameter '{unknown[0]}'; its parameters: "
+            + ", ".join(names)
+        )
+    return np.array(
+        [float(values.get(n, 0.0)) * model.per_user_unit[i] for n, i in zip(names, columns,
+                                                                              strict=True)]
+    )  # fmt: skip
+
+
+def _fitted_amplitude(data, effect, table) -> dict[str, float]:
+    """``effect``'s parameters fitted with the base errors on ``data``, user units."""
+    from ..measurement.fit import fit_orientation
+
+    where = data.source or "the data"
+    try:
+        fit = fit_orientation(data, [effect], turntable=table)
+    except (InputError, IdentifiabilityError) as exc:
+        raise InputError(f"--from {where}: {effect.name} cannot be fitted there ({exc})") from None
+    model, params = fit.model, fit.result.params
+    return {
+        model.parameter_names[i].split(".", 1)[1]: float(params[i] / model.per_user_unit[i])
+        for i in _columns(model, effect)
+    }
+
+
+class _Rows:
+    """Whitened rows of the base errors and the two effects (the measured data as the square
+    root of their information: only the Gram matrix matters), with the amplitudes, and what the
+    diagnosis would make of them (:meth:`numbers`).
+
+    Args:
+        rows: (m', n) the rows; observations: the measured angles m they stand for.
+        base, own: the columns of the base errors and of each effect; amplitude: each effect's
+            parameters (internal units).
+        candidates: K, the catalogued effects the diagnosis tries at once.
+    """
+
+    def __init__(self, rows, observations: int, base, own, amplitude, candidates: int) -> None:
+        self.rows = rows
+        self.observations = int(observations)
+        self.base, self.own, self.amplitude = base, own, amplitude
+        self.candidates = int(candidates)
+
+    def signal(self, x: int) -> np.ndarray:
+        """Effect ``x``'s noise-free prediction (in noise sigmas)."""
+        return self.rows[:, self.own[x]] @ self.amplitude[x]
+
+    def fitted(self, x: int) -> np.ndarray:
+        """The columns fitted when effect ``x`` is the rival: the base and its own."""
+        return self.rows[:, np.concatenate([self.base, self.own[x]])]
+
+    def residual(self, x: int) -> np.ndarray:
+        """What the base errors and the other effect leave of effect ``x``'s prediction, per
+        row (in noise sigmas)."""
+        from ..stats.discrimination import orthonormal_span
+
+        signal = self.signal(x)
+        basis = orthonormal_span(self.fitted(1 - x))
+        return signal - basis @ (basis.T @ signal)
+
+    def numbers(self, x: int) -> dict:
+        """Effect ``x`` as the truth against the other (module docstring): its signal beyond
+        the base and the rival's misfit (chi2), the ranks each adds, whether the data determine
+        each one's parameters, and the chances that the diagnosis accepts it, puts it first,
+        or takes it on top of the rival and drops the rival."""
+        from ..stats.discrimination import (
+            choice_margin,
+            detection_power,
+            generalized_chi2_sf,
+            misfit,
+            orthonormal_span,
+            quadratic_form,
+            rss_difference,
+            traded_off,
+        )
+        from ..stats.model_selection import UNDETERMINED_GAIN_RATIO, acceptance_threshold
+
+        y = 1 - x
+        m = self.observations
+        first_round = acceptance_threshold(self.candidates)
+        second_round = acceptance_threshold(self.candidates - 1)
+        signal = self.signal(x)
+        base = self.rows[:, self.base]
+        own_x, own_y = self.rows[:, self.own[x]], self.rows[:, self.own[y]]
+        weights, nc, k_x, k_y = rss_difference(base, own_x, own_y, signal)
+        alone = misfit(base, signal)
+        left = misfit(self.fitted(y), signal)
+        detect = detection_power(alone, k_x, m, first_round) if k_x else 0.0
+        # First round: the effect put first (determined ones first, then by delta_bic) ...
+        first = generalized_chi2_sf(choice_margin(k_x, k_y, m), weights, nc)
+        determined = (not traded_off(base, own_x), not traded_off(base, own_y))
+        if determined == (False, True):
+            # ... an undetermined one only when it explains more than twice what the rival
+            # does: gain_x - r gain_y = y^T (P_x - P_0 - r (P_y - P_0)) y > 0.
+            ratio = UNDETERMINED_GAIN_RATIO
+            terms = [(self.fitted(x), 1.0), (base, ratio - 1.0), (self.fitted(y), -ratio)]
+            first *= generalized_chi2_sf(0.0, *quadratic_form(terms, signal))
+        # ... or the rival first, this one accepted on top of it (the nested test: a
+        # non-central chi-square of what the rival leaves of it), and the rival then dropped
+        # as not needed beside it (a central one below the first round's threshold).
+        rank_0 = orthonormal_span(base).shape[1]
+        both = orthonormal_span(np.hstack([base, own_x, own_y])).shape[1] - rank_0
+        k_on_top, k_rival = both - k_y, both - k_x
+        on_top = detection_power(left, k_on_top, m, second_round) if k_on_top else 0.0
+        dropped = 1.0 - detection_power(0.0, k_rival, m, first_round) if k_rival else 1.0
+        choice = 1.0 - (1.0 - first) * (1.0 - on_top * dropped)
+        return {
+            "signal_chi2": alone,
+            "misfit_chi2": left,
+            "added_rank": k_x,
+            "rival_added_rank": k_y,
+            "determined": determined[0],
+            "rival_determined": determined[1],
+            "power_detect": detect,
+            "power_first": first,
+            "power_on_top": on_top * dropped,
+            "power_choice": choice,
+            "power": detect * choice,
+        }
+
+    def power(self) -> float:
+        """The smaller chance of the right name (either effect true)."""
+        return min(self.numbers(x)["power"] for x in range(2))
+
+
+def design_separate(
+    space: DesignSpace,
+    n_positions: int,
+    *,
+    from_data=None,
+    amplitudes: Mapping[str, Mapping[str, float]] | None = None,
+    noise_arcsec: float | None = None,
+    dwell_s: float = 60.0,
+    target: float = POWER_TARGET,
+) -> SeparationDesign:
+    """The ``n_positions`` of ``space`` that tell its two effects apart (module docstring).
+
+    Args:
+        space: the table, the two effects (A, B), limits and candidates
+            (:func:`~.space.design_space`).
+        n_positions: how many positions to choose.
+        from_data: measurements already made (``OrientationMeasurements``): the design adds to
+            their positions; each effect not in ``amplitudes`` is fitted on them with the base
+            errors; without ``noise_arcsec`` their noise is the new measurements' noise.
+        amplitudes: ``{effect: {parameter: value in its user units}}`` (parameters not given
+            are zero).
+        noise_arcsec: 1-sigma noise of a measured angle (default: from ``from_data``, else 1).
+        dwell_s: time between measurements, seconds (the plan's ``time_s``).
+        target: the chance of the right name :attr:`SeparationDesign.positions_for_power` is
+            given for.
+
+    Raises:
+        InputError: not two distinct effects; an effect with neither an amplitude nor data to
+            fit it on; an effect whose prediction no position within the limits sees beyond the
+            base errors; more positions than candidates.
+    """
+    from ..core.blas_threads import one_blas_thread
+
+    with one_blas_thread():  # tall-by-small products: many threads on busy cores only wait
+        return _design_separate(
+            space, int(n_positions), from_data, amplitudes, noise_arcsec, dwell_s, target
+        )
+
+
+def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s, target):
+    """:func:`design_separate`, on one BLAS thread."""
+    from ..measurement.catalogue import catalogue
+    from ..stats.discrimination import Direction, misfit, orthonormal_span, t_optimal_exchange
+    from ..stats.least_squares import tall_r_factor
+
+    effects = tuple(space.effects)
+    names = tuple(e.name for e in effects)
+    if len(effects) != 2 or names[0] == names[1]:
+        raise InputError(
+            f"--separate takes two different effects (A,B), got {', '.join(names) or 'none'}"
+        )
+    amplitudes = {k: dict(v) for k, v in (amplitudes or {}).items()}
+    unknown = [k for k in amplitudes if k not in names]
+    if unknown:
+        raise InputError(
+            f"--amplitude names effect '{unknown[0]}', which is not one of {names[0]}, {names[1]}"
+        )
+    start_info, noise, noise_source, n_from, start_s = _start_information(
+        space, from_data, noise_arcsec, dwell_s
+    )
+    noise_rad = noise / ARCSEC_PER_RAD
+    duration_s = (n_positions * space.visits.count - 1) * float(dwell_s)
+    try:
+        rows, keep, model = design_rows(
+            space, space.candidates_deg, space.visits, start_s, duration_s
+        )
+    except InputError as exc:
+        raise InputError(f"no candidate position within the limits can be used: {exc}") from None
+    usable = np.flatnonzero(keep)
+    if n_positions > usable.size:
+        raise InputError(
+            f"{n_positions} positions asked, but only {usable.size} candidates: give more "
+            "--candidates"
+        )
+    rows = rows / noise_rad  # (C, k, n) whitened
+    n = model.n_params
+    base = np.arange(len(model.base_names))
+    own = tuple(_columns(model, e) for e in effects)
+    source, vectors = {}, []
+    for effect in effects:
+        if effect.name in amplitudes:
+            values, source[effect.name] = amplitudes[effect.name], "given"
+        elif from_data is not None:
+            values = _fitted_amplitude(from_data, effect, space.table)
+            source[effect.name] = f"fitted on {from_data.source or 'the data measured'}"
+        else:
+            raise InputError(
+                f"no amplitude for {effect.name}: give it (--amplitude {effect.name}:P=V,...) "
+                "or the data to fit it on (--from DATA.csv)"
+            )
+        vectors.append(_amplitude_vector(model, effect, values))
+    user = [
+        {model.parameter_names[i].split(".", 1)[1]: float(v / model.per_user_unit[i])
+         for i, v in zip(own[x], vectors[x], strict=True)}
+        for x in range(2)
+    ]  # fmt: skip
+    units = [", ".join(dict.fromkeys(model.parameter_units[i] for i in own[x])) for x in range(2)]
+    fixed = None if start_info is None else _rows_of_information(start_info)
+    from_rows = 0 if from_data is None else int(from_data.measured.sum())
+    size = len(catalogue(space.table))
+
+    def rows_of(new: np.ndarray | None, observations: int, factor: float = 1.0) -> _Rows:
+        """The rows of a run (its Gram matrix times ``factor``) and of the data measured."""
+        stacked = [new * math.sqrt(factor)] if new is not None else []
+        stacked += [fixed] if fixed is not None else []
+        return _Rows(np.concatenate(stacked), observations + from_rows, base, own, vectors, size)
+
+    # Which directions positions must separate, judged over every candidate at once.
+    every = _Rows(tall_r_factor(rows.reshape(-1, n)), 1, base, own, vectors, size)
+    settled = []
+    for x in range(2):
+        signal = every.signal(x)
+        alone = misfit(every.rows[:, base], signal)
+        if not alone > SAME_RTOL * max(float(signal @ signal), 1e-300):
+            raise InputError(
+                f"{names[x]} at its amplitude ({_values(user[x])} {units[x]}) changes nothing "
+                "that the base errors do not explain at any position within the limits: there "
+                "is nothing to separate"
+            )
+        if misfit(every.fitted(1 - x), signal) > SAME_RTOL * alone:
+            settled.append("misfit")
+            continue
+        ranks = [
+            orthonormal_span(np.hstack([every.rows[:, base], every.rows[:, own[z]]])).shape[1]
+            for z in (x, 1 - x)
+        ]
+        settled.append("parsimony" if ranks[0] < ranks[1] else "none")
+    if "none" in settled:
+        x = settled.index("none")
+        because = (
+            f"{names[1 - x]} reproduces {names[x]} ({_values(user[x])} {units[x]}) at every "
+            "position, with no fewer parameters"
+        )
+        return _inseparable(space, names, noise, noise_source, source, n_from, target, because)
+
+    directions = []
+    for x in range(2):
+        if settled[x] == "misfit":
+            fitted = np.concatenate([base, own[1 - x]])
+            directions.append(
+                Direction(
+                    rows[:, :, fitted],
+                    rows[:, :, own[x]] @ vectors[x],
+                    None if fixed is None else fixed[:, fitted],
+                    None if fixed is None else fixed[:, own[x]] @ vectors[x],
+                )
+            )
+
+    def run_of(count: int):
+        """The ``count`` designed positions (candidate indices), their run and its rows."""
+        found = t_optimal_exchange(directions, count, seed=space.seed)
+        chosen = usable[np.sort(found.chosen)]
+        plan = plan_measurements(
+            space.candidates_deg[chosen], needs_time=space.needs_time,
+            needs_dirs=space.needs_dirs, dwell_s=dwell_s, seed=space.seed, start_s=start_s,
+            visits=space.visits.subset(chosen),
+        )  # fmt: skip
+        jac = _evaluate(space, plan.variables())[0].reshape(-1, n) / noise_rad
+        return found, chosen, plan, jac
+
+    found, chosen, plan, new = run_of(n_positions)
+    positions = space.candidates_deg[chosen]
+    first = np.unique(plan.position, return_index=True)[1]
+    positions = positions[plan.position[np.sort(first)]]  # in the order first measured
+    measured_deg = np.zeros((0, space.n_joints))
+    if from_data is not None:
+        measured_deg = np.degrees(np.asarray(from_data.joint_rad, dtype=float))
+    design = rows_of(new, 3 * plan.n_rows)
+    numbers = [design.numbers(x) for x in range(2)]
+    # Each position's share of each misfit: where the rival cannot follow.
+    shares = np.zeros((n_positions, 2))
+    order = np.unique(plan.position, return_index=True)[1]
+    for x in range(2):
+        by_row = np.sum(design.residual(x)[: new.shape[0]].reshape(plan.n_rows, 3) ** 2, axis=1)
+        per_position = np.bincount(plan.position, by_row, minlength=n_positions)
+        shares[:, x] = per_position[plan.position[np.sort(order)]]
+    measured = alone = [None, None]
+    if fixed is not None:
+        measured = [rows_of(None, 0).numbers(x) for x in range(2)]
+        alone = [_Rows(new, 3 * plan.n_rows, base, own, vectors, size).numbers(x) for x in range(2)]
+    grid = _grid_misfits(space, rows_of, n_positions, start_s, duration_s, noise_rad)
+    power = min(h["power"] for h in numbers)
+
+    def scaled(count: int) -> float:
+        factor = count / n_positions
+        return rows_of(new, round(3 * plan.n_rows * factor), factor).power()
+
+    def designed(count: int) -> float:
+        run = run_of(count)
+        return rows_of(run[3], 3 * run[2].n_rows).power()
+
+    count, count_power, verified = _positions_for(
+        scaled, designed, target, n_positions, power, usable.size
+    )
+    curve = tuple((c, scaled(c)) for c in _curve_counts(n_positions, count))
+    hypotheses = tuple(
+        Hypothesis(
+            effect=names[x],
+            rival=names[1 - x],
+            amplitude=user[x],
+            unit=units[x],
+            signal_chi2=numbers[x]["signal_chi2"],
+            misfit_chi2=numbers[x]["misfit_chi2"],
+            misfit_measured_chi2=None if measured[x] is None else measured[x]["misfit_chi2"],
+            misfit_grid_chi2=None if grid is None else grid[x],
+            added_rank=numbers[x]["added_rank"],
+            rival_added_rank=numbers[x]["rival_added_rank"],
+            determined=numbers[x]["determined"],
+            rival_determined=numbers[x]["rival_determined"],
+            settled_by=settled[x],
+            power_detect=numbers[x]["power_detect"],
+            power_first=numbers[x]["power_first"],
+            power_on_top=numbers[x]["power_on_top"],
+            power_choice=numbers[x]["power_choice"],
+            power=numbers[x]["power"],
+            power_measured=None if measured[x] is None else measured[x]["power"],
+            power_new_alone=None if alone[x] is None else alone[x]["power"],
+        )
+        for x in range(2)
+    )
+    return SeparationDesign(
+        space=space,
+        pair=names,
+        positions_deg=positions,
+        plan=plan,
+        hypotheses=hypotheses,
+        misfit_by_position=shares,
+        measured_deg=measured_deg,
+        noise_arcsec=float(noise),
+        noise_source=noise_source,
+        amplitude_source=source,
+        n_from=n_from,
+        power=float(power),
+        positions_for_power=count,
+        power_at_positions_for_power=count_power,
+        positions_for_power_designed=verified,
+        power_curve=curve,
+        target=float(target),
+        catalogue_size=size,
+        n_swaps=found.swaps,
+        n_passes=found.passes,
+    )
+
+
+def _values(amplitude: Mapping[str, float]) -> str:
+    return ", ".join(f"{k} = {v:.3g}" for k, v in amplitude.items())
+
+
+def _grid_misfits(space, rows_of, n_positions, start_s, duration_s, noise_rad):
+    """What each effect's rival leaves of it on the 30-degree grid within the limits, scaled to
+    the design's size (with the data measured); ``None`` when no grid position can be used."""
+    from ..stats.discrimination import misfit
+
+    visits = candidate_visits(
+        space.grid_deg.shape[0], space.n_joints, needs_time=space.needs_time,
+        needs_dirs=space.needs_dirs, rng=np.random.default_rng([space.seed, 2]),
+    )  # fmt: skip
+    grid_rows, _, _ = design_rows(space, space.grid_deg, visits, start_s, duration_s)
+    if not grid_rows.shape[0]:
+        return None
+    n = grid_rows.shape[-1]
+    factor = n_positions / grid_rows.shape[0]
+    on_grid = rows_of(grid_rows.reshape(-1, n) / noise_rad, 0, factor)
+    return [misfit(on_grid.fitted(1 - x), on_grid.signal(x)) for x in range(2)]
+
+
+VERIFY_POSITIONS = 96
+"""Counts for the target power up to this many are checked by designing them (larger ones are
+the design's misfits scaled, which replicating it reaches)."""
+
+
+def _positions_for(scaled_power, designed_power, target, n_design, power_design, n_candidates):
+    """The fewest positions with at least ``target`` power, that many positions' power, and
+    whether it was checked by designing them: estimated on the design scaled
+    (``scaled_power(count)``: the design replicated, exact for whole multiples), then, up to
+    :data:`VERIFY_POSITIONS`, checked by designing that many (``designed_power(count)``) and
+    raised by a tenth when short (at most three times); ``(None, None, False)`` when even
+    :data:`MAX_POWER_POSITIONS` (or every candidate) would not do."""
+    top = min(MAX_POWER_POSITIONS, n_candidates)
+    if scaled_power(top) < target:
+        return None, None, False
+    low, high = 0, top  # scaled_power(high) >= target
+    while high - low > 1:
+        middle = (low + high) // 2
+        if scaled_power(middle) >= target:
+            high = middle
+        else:
+            low = middle
+    count = high
+    for _ in range(4):
+        if count == n_design:
+            return count, float(power_design), True
+        if count > VERIFY_POSITIONS:
+            return count, float(scaled_power(count)), False
+        checked = designed_power(count)
+        if checked >= target or count >= top:
+            return count, float(checked), True
+        count = min(top, count + max(1, math.ceil(0.1 * count)))
+    return count, float(designed_power(count)), True
+
+
+def _curve_counts(n_design: int, n_target: int | None) -> list[int]:
+    """The counts the power curve is drawn at: 1 to twice the larger of the design's and the
+    target's (at most 40 points)."""
+    top = 2 * max(n_design, n_target or 0)
+    return sorted({int(round(c)) for c in np.linspace(1, top, min(top, 40))})
+
+
+def _rows_of_information(information: np.ndarray) -> np.ndarray:
+    """Rows R with ``R^T R = information`` (the data measured, whitened), without the directions
+    the data do not see: their eigenvalues are rounding (1e-16 of the largest), and as rows of
+    1e-8 they would count as seen once a column is scaled to unit norm."""
+    rows = _root(information)
+    norms = np.linalg.norm(rows, axis=1)
+    return rows[norms > ROUNDING_ROWS * max(float(norms.max(initial=0.0)), 1e-300)]
+
+
+ROUNDING_ROWS = 1e-7
+"""Rows of the measured data's information root below this fraction of the largest are rounding
+(an eigenvalue of 1e-14 of the largest), not directions the data see."""
+
+
+def _inseparable(space, names, noise, noise_source, source, n_from, target, because):
+    """The result when no positions within the limits separate the two effects: one line saying
+    why, and the independent measurements of their ``confirm`` texts."""
+    a, b = space.effects
+    limits = "; ".join(r.describe() for r in space.ranges)
+    text = (
+        f"no positions within the joints' limits ({limits}) separate {a.name} from {b.name}: "
+        f"{because}; an independent measurement does. For {a.name}: {a.confirm} "
+        f"For {b.name}: {b.confirm}"
+    )
+    return SeparationDesign(
+        space=space,
+        pair=names,
+        positions_deg=np.zeros((0, space.n_joints)),
+        plan=None,
+        hypotheses=(),
+        misfit_by_position=np.zeros((0, 2)),
+        measured_deg=np.zeros((0, space.n_joints)),
+        noise_arcsec=float(noise),
+        noise_source=noise_source,
+        amplitude_source=source,
+        n_from=n_from,
+        power=None,
+        positions_for_power=None,
+        power_at_positions_for_power=None,
+        positions_for_power_designed=False,
+        power_curve=(),
+        target=float(target),
+        catalogue_size=0,
+        n_swaps=0,
+        n_passes=0,
+        inseparable=text,
+    )
