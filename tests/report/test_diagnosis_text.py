@@ -102,3 +102,17 @@ def test_a_real_partial_explanation_is_announced_as_such():
     line = headline(d)
     assert line.startswith("Partial explanation: gravity_sag") and "still unexplained" in line
     assert diagnosis_lines(d)[0] == line
+
+
+def test_a_separation_prints_the_design_command_that_settles_it():
+    d = _dict(steps=["gravity_sag"])
+    verdict = d["verdict"]
+    verdict["alternatives"] = ["outer_encoder_harmonics"]
+    verdict["separations"] = {"outer_encoder_harmonics": "no set of positions separates them"}
+    plain = verdict_lines(d)
+    command = "turntable-pin design --separate gravity_sag,outer_encoder_harmonics --from d.csv"
+    verdict["separation_commands"] = {"outer_encoder_harmonics": command}
+    lines = verdict_lines(d)
+    at = lines.index("  alternative outer_encoder_harmonics: no set of positions separates them")
+    assert lines[at + 1] == f"    to settle it, design the next positions: {command}"
+    assert lines[: at + 1] + lines[at + 2 :] == plain  # nothing else changes

@@ -54,7 +54,6 @@ __all__ = [
     "SAME_RTOL",
     "Hypothesis",
     "SeparationDesign",
-    "design_command",
     "design_separate",
 ]
 
@@ -303,7 +302,8 @@ class SeparationDesign:
         besides = " besides those measured" if self.n_from else ""
         if self.positions_for_power_designed:
             return (
-                f"{self.target:.0%} needs {count} positions{besides}: design --separate {a},{b} "
+                f"{self.target:.0%} needs {count} position{'s' if count > 1 else ''}{besides}: "
+                f"design --separate {a},{b} "
                 f"-n {count} gives {_percent(self.power_at_positions_for_power)}"
             )
         return (
@@ -314,20 +314,6 @@ class SeparationDesign:
 
 def _percent(value: float | None) -> str:
     return "-" if value is None else f"{100.0 * value:.1f} %"
-
-
-def design_command(data: str, pair: tuple[str, str], urdf: str | None = None,
-                   payload_frame: str | None = None) -> str:  # fmt: skip
-    """The ``turntable-pin design --separate A,B`` command for the data file ``data`` (and the
-    table's ``urdf`` and ``payload_frame`` when not the default ones)."""
-    import shlex
-
-    words = ["turntable-pin", "design", "--separate", ",".join(pair), "--from", data]
-    if urdf:
-        words += ["--urdf", urdf]
-    if payload_frame:
-        words += ["--payload-frame", payload_frame]
-    return " ".join(shlex.quote(w) for w in words)
 
 
 def _columns(model, effect) -> np.ndarray:
@@ -383,13 +369,17 @@ class _Rows:
         base, own: the columns of the base errors and of each effect; amplitude: each effect's
             parameters (internal units).
         candidates: K, the catalogued effects the diagnosis tries at once.
+        leader: which effect the diagnosis lists first (catalogue order): it goes first when
+            the two fit exactly alike with the same determination.
     """
 
-    def __init__(self, rows, observations: int, base, own, amplitude, candidates: int) -> None:
+    def __init__(self, rows, observations: int, base, own, amplitude, candidates: int,
+                 leader: int = 0) -> None:  # fmt: skip
         self.rows = rows
         self.observations = int(observations)
         self.base, self.own, self.amplitude = base, own, amplitude
         self.candidates = int(candidates)
+        self.leader = int(leader)
 
     def signal(self, x: int) -> np.ndarray:
         """Effect ``x``'s noise-free prediction (in noise sigmas)."""
@@ -439,7 +429,10 @@ class _Rows:
         # First round: the effect put first (determined ones first, then by delta_bic) ...
         first = generalized_chi2_sf(choice_margin(k_x, k_y, m), weights, nc)
         determined = (not traded_off(base, own_x), not traded_off(base, own_y))
-        if determined == (False, True):
+        if not weights.size:  # the same span: the same fit, whatever the noise
+            first = float(determined[0] > determined[1] or (
+                determined[0] == determined[1] and self.leader == x))  # fmt: skip
+        elif determined == (False, True):
             # ... an undetermined one only when it explains more than twice what the rival
             # does: gain_x - r gain_y = y^T (P_x - P_0 - r (P_y - P_0)) y > 0.
             ratio = UNDETERMINED_GAIN_RATIO
@@ -572,16 +565,20 @@ def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dw
     units = [", ".join(dict.fromkeys(model.parameter_units[i] for i in own[x])) for x in range(2)]
     fixed = None if start_info is None else _rows_of_information(start_info)
     from_rows = 0 if from_data is None else int(from_data.measured.sum())
-    size = len(catalogue(space.table))
+    listed = [e.name for e in catalogue(space.table)]
+    size = len(listed)
+    rank = [listed.index(name) if name in listed else size for name in names]
+    leader = 0 if rank[0] <= rank[1] else 1
 
     def rows_of(new: np.ndarray | None, observations: int, factor: float = 1.0) -> _Rows:
         """The rows of a run (its Gram matrix times ``factor``) and of the data measured."""
         stacked = [new * math.sqrt(factor)] if new is not None else []
         stacked += [fixed] if fixed is not None else []
-        return _Rows(np.concatenate(stacked), observations + from_rows, base, own, vectors, size)
+        rows = np.concatenate(stacked)
+        return _Rows(rows, observations + from_rows, base, own, vectors, size, leader)
 
     # Which directions positions must separate, judged over every candidate at once.
-    every = _Rows(tall_r_factor(rows.reshape(-1, n)), 1, base, own, vectors, size)
+    every = _Rows(tall_r_factor(rows.reshape(-1, n)), 1, base, own, vectors, size, leader)
     settled = []
     for x in range(2):
         signal = every.signal(x)

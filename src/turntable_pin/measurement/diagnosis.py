@@ -41,11 +41,13 @@ from .residuals import ResidualSet, orientation_residuals
 from .table import measured_table
 
 __all__ = [
+    "DATA_PLACEHOLDER",
     "MAX_HARMONIC",
     "NOISE_PER_ANGLE_ALPHA",
     "OUTLIER_RULE",
     "SEPARATION_CHI2",
     "OrientationFamily",
+    "design_command",
     "diagnose_measurements",
     "diagnosis_residuals",
 ]
@@ -776,7 +778,45 @@ def diagnose_measurements(
             )
             diagnosis.warnings.append(_per_angle_note(diagnosis, note))
     diagnosis.doubt = _table_doubt(diagnosis, table)
+    if diagnosis.separations:
+        data_name = data.source if data.source and Path(data.source).is_file() else DATA_PLACEHOLDER
+        urdf = _urdf_option(turntable)
+        diagnosis.separation_commands = {
+            name: design_command(data_name, (diagnosis.missing_effect, name), urdf)
+            for name in diagnosis.separations
+        }
     return diagnosis
+
+
+DATA_PLACEHOLDER = "DATA.csv"
+"""The data file a command names when the data were not read from one (simulated in memory)."""
+
+
+def design_command(data: str, pair: tuple[str, str], urdf: str | None = None) -> str:
+    """The ``turntable-pin design --separate A,B --from DATA`` command (with ``--urdf`` when the
+    table is not the paper's) that chooses the positions telling the two effects apart, or
+    says that none do (``turntable_pin.design.separate``)."""
+    import shlex
+
+    words = ["turntable-pin", "design", "--separate", ",".join(pair), "--from", data]
+    if urdf:
+        words += ["--urdf", urdf]
+    return " ".join(shlex.quote(w) for w in words)
+
+
+def _urdf_option(turntable) -> str | None:
+    """What ``--urdf`` names the table by: nothing for the paper's bundled table, the name of a
+    bundled table, else its URDF's path."""
+    from ..core.resources import default_urdf_path, models_dir
+
+    table = getattr(turntable, "table", turntable)
+    path = getattr(table, "urdf_path", None)
+    if path is None:
+        return None
+    path = Path(path).resolve()
+    if path == default_urdf_path().resolve():
+        return None
+    return path.stem if path.parent == models_dir().resolve() else str(path)
 
 
 WRONG_TABLE_CHI2_REDUCED = 9.0

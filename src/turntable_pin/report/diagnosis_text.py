@@ -196,9 +196,11 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
             + ", ".join(verdict["also_significant"])
             + " (--until-explained names every step)"
         )
+    commands = verdict.get("separation_commands", {})
     for name in verdict.get("alternatives", []):
         if name in verdict["separations"]:
             lines.append(f"  alternative {name}: {verdict['separations'][name]}")
+            lines += _settle(commands, name)
     kept = (
         "the effect named, whose parameters are determined, is kept"
         if d["steps"] and not verdict.get("named_undetermined")
@@ -213,6 +215,7 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
         )
         if entry["effect"] in verdict["separations"]:
             lines.append(f"  {entry['effect']}: {verdict['separations'][entry['effect']]}")
+            lines += _settle(commands, entry["effect"])
     for entry in verdict.get("unneeded_given_structure", []):
         lines.append(
             f"not named: {entry['effect']} was significant on its own, but the best description "
@@ -261,6 +264,14 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
             f"{d.get('outlier_rule')}; --keep-outliers keeps them"
         )
     return lines
+
+
+def _settle(commands: dict, name: str) -> list[str]:
+    """The line with the ``design`` command that settles the separation of ``name`` (none when
+    the JSON has no command for it)."""
+    if name not in commands:
+        return []
+    return [f"    to settle it, design the next positions: {commands[name]}"]
 
 
 def fit_command(data: str, specs: list[str]) -> str:

@@ -419,6 +419,9 @@ class Diagnosis:
         structure: terms the structure search finds in the best model's residuals.
         fails_fit_test: the best model's chi2 p-value is below ``FIT_TEST_ALPHA``.
         separations: advice per alternative of the accepted first effect.
+        separation_commands: for entries of ``separations``, the command that would settle
+            each (the caller's: e.g. a design of the next measurements); in the JSON only when
+            there are some.
         until_explained: whether the verdict names every accepted effect (``missing_effects``)
             or the first one, with the others as ``also_significant``.
         after_first: delta_bic of each other effect on top of the first accepted one: an effect
@@ -454,6 +457,7 @@ class Diagnosis:
     unneeded_given_structure: dict[str, float] = field(default_factory=dict)
     doubt: str | None = None
     group_variance: np.ndarray | None = field(default=None, repr=False)
+    separation_commands: dict[str, str] = field(default_factory=dict)
 
     @property
     def missing_effect(self) -> str | None:
@@ -576,6 +580,8 @@ class Diagnosis:
                 for name, value in self.unneeded_given_structure.items()
             ],
         }
+        if self.separation_commands:
+            verdict["separation_commands"] = dict(self.separation_commands)
         named_parameters = self.named_parameters()
         verdict["named_parameters"] = named_parameters
         loose = {name: undetermined_parameters(e) for name, e in named_parameters.items() if e}
