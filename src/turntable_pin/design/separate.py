@@ -601,7 +601,7 @@ def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dw
         x = settled.index("none")
         because = (
             f"{names[1 - x]} reproduces {names[x]} ({_values(user[x])} {units[x]}) at every "
-            "position, with no fewer parameters"
+            "position, with no more parameters"
         )
         return _inseparable(space, names, noise, noise_source, source, n_from, target, because)
 
