@@ -14,19 +14,19 @@ Atkinson and Fedorov 1975): a seeded exchange over the candidate positions withi
 limits (:func:`~turntable_pin.stats.discrimination.t_optimal_exchange`), added to the positions
 already measured when there are some.
 
-The power is the diagnosis' own decision: with sigma known it names the effect with the lower
-``delta_bic = -delta_chi2 + k ln m`` (``k`` the ranks it adds to the base, ``m`` the measured
-angles), once it is accepted (``delta_bic <= -6 - 2 ln K`` for the K catalogued effects,
-:func:`~turntable_pin.stats.model_selection.acceptance_threshold`). So when A is true, A is named
-when it is accepted, ``chi2'(k_A, lambda_A0) > k_A ln m + 6 + 2 ln K`` (a non-central chi-square;
-``lambda_A0`` what the base errors alone leave of A), and preferred to B,
-``rss_B - rss_A > (k_A - k_B) ln m``: a generalised chi-square of the noise in the span of both
-models (:func:`~turntable_pin.stats.discrimination.rss_difference`), the non-central
-``chi2'(k_B - k_A, lambda_BA)`` when one contains the other. The power of a design is the
-smaller of the two chances (A true, B true), each the product of the two; a third catalogued
-effect that might take the name is not counted. The positions needed for the target power are
-found by scaling the design's misfits to other sizes (replicating it is exact) and checked by
-designing that many positions.
+The power is the diagnosis' own decision (sigma known): when A is true, A is named when it is
+accepted, ``chi2'(k_A, lambda_A0) > k_A ln m + 6 + 2 ln K`` (a non-central chi-square:
+``lambda_A0`` what the base errors alone leave of A, ``k_A`` the ranks A adds to the base, ``m``
+the measured angles, ``K`` the catalogue's size:
+:func:`~turntable_pin.stats.model_selection.acceptance_threshold`), and then either put before
+B in the first round, ``rss_B - rss_A > (k_A - k_B) ln m`` (a generalised chi-square of the
+noise in the span of both models, :func:`~turntable_pin.stats.discrimination.rss_difference`;
+with A's parameters traded off and B's not, also ``gain_A > 2 gain_B``), or, B first, accepted
+on top of B (the nested test: ``chi2'(k_A|B, lambda_AB)`` above the second round's threshold)
+with B then dropped as not needed beside it. The power of a design is the smaller of the two
+chances (A true, B true); a third catalogued effect that might take the name is not counted.
+The positions needed for the target power are found by scaling the design's misfits to other
+sizes (replicating it is exact) and checked by designing that many positions.
 
 When B reproduces A at every candidate position (its misfit is below :data:`SAME_RTOL` of A's
 signal beyond the base errors) and A has no fewer ranks than B, no positions within the limits
