@@ -303,10 +303,11 @@ def test_view_interrupted_stops_its_server(signum, moment, tmp_path):
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="montecarlo uses one worker per core")
 @pytest.mark.parametrize("signum", SIGNALS, ids=ids)
 def test_montecarlo_interrupted_stops_its_workers(signum, tmp_path):
-    command = Command(["montecarlo", "--workers", "2", "-n", "2000000"], tmp_path)
+    command = Command(["montecarlo", "--workers", "2", "-n", "10000000"], tmp_path)
     watch = command.watch
     try:
-        # Two workers exist and the first chunks came back: the workers are computing.
+        # Two workers exist and the first chunks came back: the workers are computing. (10^7
+        # tables, about 25 s on two workers: the signal lands inside the run, not at its end.)
         command.wait_until(
             lambda: (
                 len(watch.descendant_pids) >= 2
