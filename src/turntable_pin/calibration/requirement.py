@@ -62,6 +62,8 @@ __all__ = [
     "PlaneRectangle",
     "RequirementBox",
     "box_corners",
+    "check_accuracy_dph",
+    "holding_scale",
     "largest_box",
     "largest_rectangle",
     "orientation_requirement",
@@ -323,21 +325,18 @@ def rate_error_jacobian(
 
 
 def _undominated(rows: np.ndarray) -> np.ndarray:
-    """The rows no other row bounds componentwise (only they can bind a box)."""
-    rows = np.unique(rows, axis=0)
-    rows = rows[np.argsort(-rows.sum(axis=1), kind="stable")]
-    keep: list[np.ndarray] = []
-    for start in range(0, rows.shape[0], 512):
-        chunk = rows[start : start + 512]
-        pool = np.concatenate([np.array(keep).reshape(-1, 3), chunk])
-        dominated = np.all(pool[None, :, :] >= chunk[:, None, :], axis=-1)
-        dominated &= np.any(pool[None, :, :] > chunk[:, None, :], axis=-1)
-        keep.extend(chunk[~dominated.any(axis=1)])
-    return np.array(keep).reshape(-1, 3)
+    """The rows no other row bounds componentwise (only they can bind a box; of equal rows
+    all are kept)."""
+    keep = np.ones(rows.shape[0], dtype=bool)
+    for start in range(0, rows.shape[0], 256):
+        chunk = rows[start : start + 256, None, :]
+        above = np.all(rows[None] >= chunk, axis=-1) & np.any(rows[None] > chunk, axis=-1)
+        keep[start : start + 256] = ~above.any(axis=1)
+    return rows[keep]
 
 
 def largest_box(
-    jacobian, accuracy_dph: float, *, cap_rad: float = MAX_ANGLE_RAD
+    jacobian, accuracy_dph: float, *, cap_rad: float = MAX_ANGLE_RAD, start_rad=None
 ) -> tuple[np.ndarray, np.ndarray]:
     """The box of largest volume whose first-order worst case meets ``w_m`` (see module).
 
@@ -346,6 +345,8 @@ def largest_box(
             dtheta, dgamma), e.g. :func:`rate_error_jacobian`'s (N, 2, 3).
         accuracy_dph: ``w_m``, deg/h.
         cap_rad: largest limit of any angle (an angle no row depends on stops there).
+        start_rad: a box near the answer to start the search from (e.g. that of similar
+            rows), radians; default the largest cube.
 
     Returns:
         ``(limits_rad, capped)``: the (3,) half-widths, radians, and which of them the cap set.
@@ -355,10 +356,14 @@ def largest_box(
     rows = _undominated(np.abs(np.asarray(jacobian, dtype=float)).reshape(-1, 3)) / accuracy_dph
     rows = np.vstack([rows, np.eye(3) / cap_rad])  # the cap, as one more row per angle
     cube = 1.0 / float(np.max(rows.sum(axis=1)))
+    first = np.full(3, cube)
+    if start_rad is not None:
+        first = np.minimum(np.maximum(np.asarray(start_rad, dtype=float), cube), cap_rad)
+        first /= max(1.0, float(np.max(rows @ first)))
     # max sum log I subject to rows @ I <= 1: concave in x = log(I / cube), started inside.
     result = minimize(
         lambda x: -np.sum(x),
-        np.full(3, np.log1p(-1e-6)),
+        np.log(first / cube) + np.log1p(-1e-6),
         jac=lambda x: -np.ones(3),
         method="SLSQP",
         constraints=[
@@ -428,27 +433,30 @@ class RequirementBox:
         }
 
 
-def requirement_box(
+def holding_scale(
     accuracy_dph: float,
     gyrowheel: GyroWheelModel,
     inputs: PositionInputs,
+    limits_rad,
     *,
     exact: bool = False,
     definition: str = "true_coefficients",
-) -> RequirementBox:
-    """The largest box that holds (:class:`RequirementBox`) for accuracy ``w_m`` (deg/h) at the
-    positions of ``inputs``, with the rate-error model of ``exact`` and ``definition``."""
-    jacobian = rate_error_jacobian(gyrowheel, inputs, exact=exact, definition=definition)
-    first_order, capped = largest_box(jacobian, accuracy_dph)
+) -> tuple[float, np.ndarray]:
+    """The largest ``s`` such that the box ``s * limits_rad`` holds: its worst corner meets
+    ``w_m`` (deg/h) exactly, by the full model (eqs. 7-14) at the positions of ``inputs``.
+
+    Returns ``(s, worst)`` with ``worst`` (N, 2) each position's largest ``|dw|`` (x, y) over
+    the corners of ``s * limits_rad``, deg/h.
+    """
+    limits = np.asarray(limits_rad, dtype=float)
 
     def worst(scale: float) -> np.ndarray:
-        corners = box_corners(scale * first_order)
-        rotations = orientation_error_rotation(*corners.T, exact=exact)
+        rotations = orientation_error_rotation(*box_corners(scale * limits).T, exact=exact)
         dw = np.abs(rate_error_vectors_dph(gyrowheel, inputs, rotations, definition=definition))
-        return dw.max(axis=0)  # (N, 2): each position's worst corner
+        return dw.max(axis=0)
 
-    # The full model differs from the first-order one by terms of relative size ~I: a few
-    # fixed-point steps s <- s w_m / worst(s) meet the contour, then the last rounding is shed.
+    # dw is first order in the angles up to terms of relative size ~I: a few fixed-point steps
+    # s <- s w_m / worst(s) meet the contour, then the last rounding is shed.
     scale = 1.0
     for _ in range(20):
         ratio = float(worst(scale).max()) / accuracy_dph
@@ -461,6 +469,24 @@ def requirement_box(
             break
         scale *= 1.0 - 2.0 ** (attempt - 52)
         per_position = worst(scale)
+    return float(scale), per_position
+
+
+def requirement_box(
+    accuracy_dph: float,
+    gyrowheel: GyroWheelModel,
+    inputs: PositionInputs,
+    *,
+    exact: bool = False,
+    definition: str = "true_coefficients",
+) -> RequirementBox:
+    """The largest box that holds (:class:`RequirementBox`) for accuracy ``w_m`` (deg/h) at the
+    positions of ``inputs``, with the rate-error model of ``exact`` and ``definition``."""
+    jacobian = rate_error_jacobian(gyrowheel, inputs, exact=exact, definition=definition)
+    first_order, capped = largest_box(jacobian, accuracy_dph)
+    scale, per_position = holding_scale(
+        accuracy_dph, gyrowheel, inputs, first_order, exact=exact, definition=definition
+    )
     corner = per_position.max(axis=0)
     first_order_worst = np.abs(jacobian) @ first_order  # (N, 2)
     binding = tuple(
@@ -578,6 +604,20 @@ class OrientationRequirement:
         return out
 
 
+def check_accuracy_dph(accuracy_dph: float) -> float:
+    """``accuracy_dph`` (the required accuracy ``w_m``, deg/h) as a float, or
+    :class:`InputError` unless it is a number in :data:`ACCURACY_RANGE_DPH`."""
+    if not (np.isfinite(accuracy_dph) and accuracy_dph > 0):
+        raise InputError(f"the required accuracy must be a positive number, got {accuracy_dph!r}")
+    low, high = ACCURACY_RANGE_DPH
+    if not low <= accuracy_dph <= high:
+        raise InputError(
+            f"the required accuracy must be between {low:g} and {high:g} deg/h, "
+            f"got {accuracy_dph!r}"
+        )
+    return float(accuracy_dph)
+
+
 def orientation_requirement(
     accuracy_dph: float,
     positions: PositionSet,
@@ -600,14 +640,7 @@ def orientation_requirement(
         exact: exact rotation for ``dR`` instead of eq. 7.
         definition: the rate-error definition (see :mod:`turntable_pin.calibration.rate_error`).
     """
-    if not (np.isfinite(accuracy_dph) and accuracy_dph > 0):
-        raise InputError(f"the required accuracy must be a positive number, got {accuracy_dph!r}")
-    low, high = ACCURACY_RANGE_DPH
-    if not low <= accuracy_dph <= high:
-        raise InputError(
-            f"the required accuracy must be between {low:g} and {high:g} deg/h, "
-            f"got {accuracy_dph!r}"
-        )
+    check_accuracy_dph(accuracy_dph)
     if definition not in DEFINITIONS:
         raise InputError(f"unknown rate-error definition '{definition}'; expected {DEFINITIONS}")
     gyrowheel = gyrowheel if gyrowheel is not None else GyroWheelModel.nominal()
