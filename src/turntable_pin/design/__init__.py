@@ -6,6 +6,8 @@ positions of the next measurement run:
 - :mod:`.space`: the joints' limits, the candidate positions within them and the 30-degree grid;
 - :mod:`.identify`: D-optimal positions for the identifiable combinations of the base errors and
   the chosen effects (greedy start and Fedorov exchange, :mod:`turntable_pin.stats.design`);
+- :mod:`.calibrate`: GyroWheel calibration positions with the loosest orientation requirement
+  (the largest box that holds) at the precision of the grid of the same number of positions;
 - :mod:`.schedule`: the order, times and approach directions of the chosen positions (repeats
   for time-driven effects, both sides for backlash) and the CSV that ``simulate --positions``
   and the test crew read.
@@ -14,9 +16,11 @@ positions of the next measurement run:
 from ..core.lazy import lazy_exports
 
 _EXPORTS = {
+    "CalibrationDesign": "calibrate",
     "DesignSpace": "space",
     "IdentifyDesign": "identify",
     "MeasurementPlan": "schedule",
+    "design_calibration": "calibrate",
     "design_identify": "identify",
     "design_space": "space",
     "parse_limits_deg": "space",

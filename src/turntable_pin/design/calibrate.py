@@ -406,13 +406,13 @@ class CalibrationDesign:
             f"against it {self.d_efficiency:.3f} (floor {self.min_efficiency:g}: the 14 drift "
             "coefficients at least as precisely)",
             "the largest box that holds (every orientation error in it meets the accuracy), deg:",
-            f"  {'':10s}{'I_psi':>10s}{'I_theta':>10s}{'I_gamma':>10s}",
+            f"  {'':16s}{'I_psi':>10s}{'I_theta':>10s}{'I_gamma':>10s}",
         ]
         for name, box in (("design", self.box), (ref, self.reference_box)):
             values = "".join(f"{v * DEG_PER_RAD:10.5f}" for v in box.limits_rad)
-            lines.append(f"  {name[:10]:10s}{values}")
+            lines.append(f"  {name[:16]:16s}{values}")
         ratios = "".join(f"{v:10.3f}" for v in self.looser_by_angle.values())
-        lines.append(f"  {'ratio':10s}{ratios}")
+        lines.append(f"  {'ratio':16s}{ratios}")
         lines.append(
             f"the same calibration accuracy with a table {self.looser_by:.2f} times less accurate "
             f"(ratio of the boxes' geometric means; {self.uniform_factor:.2f} times on every "
@@ -422,7 +422,7 @@ class CalibrationDesign:
         for name, result in (("design", self.planes), (ref, self.reference_planes)):
             values = "".join(f"{v * DEG_PER_RAD:10.5f}" for v in result.limits_rad)
             lines.append(
-                f"  {name[:10]:10s}{values}   (corners: dwx {result.box_dwx_dph:.4g}, "
+                f"  {name[:16]:16s}{values}   (corners: dwx {result.box_dwx_dph:.4g}, "
                 f"dwy {result.box_dwy_dph:.4g} deg/h)"
             )
         names = ", ".join(f"phi{r.index}" for r in space.ranges)
@@ -472,19 +472,17 @@ def design_calibration(
         )
     gyrowheel = gyrowheel if gyrowheel is not None else GyroWheelModel.nominal()
     table = space.table
-    drawn = PositionSet(space.candidates_deg / DEG_PER_RAD, table=table, name="candidates")
-    try:
-        require_identifiable(position_inputs(drawn, latitude_rad))
-    except IdentifiabilityError as exc:
-        raise IdentifiabilityError(f"no positions within the limits calibrate: {exc}") from None
+    drawn = PositionSet(space.candidates_deg / DEG_PER_RAD, table=table, name="within the limits")
+    require_identifiable(position_inputs(drawn, latitude_rad))
     reference = comparison_grid(space, n_positions, latitude_rad)
+    others = _without(drawn.angles_rad, reference.angles_rad)
     candidates = PositionSet(
-        np.concatenate([drawn.angles_rad, reference.angles_rad]), table=table, name="candidates"
+        np.concatenate([others, reference.angles_rad]), table=table, name="candidates"
     )
     inputs = position_inputs(candidates, latitude_rad)
     features = np.stack([regressor_matrix(a, inputs.specific_force_g) for a in AXES], axis=1)
     sensitivity = np.abs(rate_error_jacobian(gyrowheel, inputs))
-    reference_index = np.arange(len(drawn), len(candidates))
+    reference_index = np.arange(len(others), len(candidates))
     reference_log_det = _log_det(features, reference_index)
     floor = reference_log_det + _N_PARAMETERS * np.log(min_efficiency)
     start = reference_index
@@ -531,6 +529,18 @@ def design_calibration(
         steps=steps,
         latitude_rad=float(latitude_rad),
     )
+
+
+def _without(angles_rad: np.ndarray, known_rad: np.ndarray) -> np.ndarray:
+    """The rows of ``angles_rad`` that command no position of ``known_rad`` (to 1e-9 deg,
+    modulo a turn): a candidate the reference grid already holds is not drawn twice."""
+
+    def key(angles):
+        return np.round(np.mod(angles * DEG_PER_RAD, 360.0), 9) % 360.0
+
+    known = {tuple(row) for row in key(known_rad)}
+    keep = [tuple(row) not in known for row in key(angles_rad)]
+    return angles_rad[np.array(keep, dtype=bool)]
 
 
 def _most_precise(features, n_positions, reference_index, floor, min_efficiency) -> np.ndarray:
