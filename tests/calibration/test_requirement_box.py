@@ -95,7 +95,8 @@ def test_the_box_has_the_largest_volume_of_the_boxes_that_hold_to_first_order(re
     assert np.prod(limits) >= np.prod(best) * (1 - 1e-9)
     # and the full model's box is the first-order one scaled (by 1 - O(I))
     assert requirement.box.scale == pytest.approx(1.0, abs=1e-3)
-    np.testing.assert_allclose(requirement.box.limits_rad, requirement.box.scale * limits, rtol=1e-9)
+    box = requirement.box
+    np.testing.assert_allclose(box.limits_rad, box.scale * limits, rtol=1e-9)
 
 
 def test_jacobian_is_the_rate_error_of_small_single_angles():

@@ -37,7 +37,8 @@ def _design(n, seed=3, **kwargs):
 
 def _log_det(positions: PositionSet) -> float:
     a = position_inputs(positions, LAT_RAD).specific_force_g
-    return sum(np.linalg.slogdet(regressor_matrix(x, a).T @ regressor_matrix(x, a))[1] for x in AXES)
+    matrices = [regressor_matrix(axis, a) for axis in AXES]
+    return sum(np.linalg.slogdet(m.T @ m)[1] for m in matrices)
 
 
 @pytest.mark.parametrize(("n", "grid"), [(24, "grid:90x60"), (36, "grid:60"), (64, "grid:45")])

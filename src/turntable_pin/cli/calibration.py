@@ -194,9 +194,7 @@ def run_requirement(args: argparse.Namespace) -> int:
         "w_m; allocate's default limits):"
     )
     for name in ANGLE_SYMBOLS:
-        print(
-            f"|d{name}| <= {box[f'I_{name}_deg']:.5f} deg ({box[f'I_{name}_arcsec']:.2f} arcsec)"
-        )
+        print(f"|d{name}| <= {box[f'I_{name}_deg']:.5f} deg ({box[f'I_{name}_arcsec']:.2f} arcsec)")
     print(
         f"its corners: dwx <= {box['dwx_dph']:.4g}, dwy <= {box['dwy_dph']:.4g} deg/h"
         + ("; a limit stopped at the 10-degree search cap" if any(box["capped"]) else "")
