@@ -356,7 +356,7 @@ class CalibrationDesign:
         return "\n".join(
             [
                 "designed by turntable-pin design --calibrate (loosest orientation requirement)",
-                f"table: {self.space.measured.label}; accuracy_dph={self.accuracy_dph:g}",
+                f"table: {self.space.table_name}; accuracy_dph={self.accuracy_dph:g}",
                 f"seed={self.space.seed} candidates={self.space.candidates_deg.shape[0]} "
                 f"n_positions={self.n_positions} min_efficiency={self.min_efficiency:g}",
                 "limits: " + "; ".join(r.describe() for r in self.space.ranges),
@@ -400,7 +400,7 @@ class CalibrationDesign:
         lines = [
             f"design (calibrate, loosest orientation requirement): {self.n_positions} positions "
             f"of {space.candidates_deg.shape[0]} candidates (seed {space.seed}) on "
-            f"{space.measured.label}, for a rate accuracy of {self.accuracy_dph:g} deg/h",
+            f"{space.table_name}, for a rate accuracy of {self.accuracy_dph:g} deg/h",
             "limits: " + "; ".join(r.describe() for r in space.ranges),
             f"reference: {ref} ({len(self.reference)} positions); D-efficiency of the design "
             f"against it {self.d_efficiency:.3f} (floor {self.min_efficiency:g}: the 14 drift "

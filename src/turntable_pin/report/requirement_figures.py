@@ -250,7 +250,7 @@ def plot_calibration_design(design: CalibrationDesign, path: str | Path) -> Path
     ax.grid(alpha=0.3)
     fig.suptitle(
         f"GyroWheel calibration positions least sensitive to the table's orientation errors: "
-        f"{design.n_positions} positions, {design.space.measured.label}, seed {design.space.seed}",
+        f"{design.n_positions} positions, {design.space.table_name}, seed {design.space.seed}",
         fontsize=10,
     )
     fig.tight_layout()
