@@ -311,10 +311,16 @@ def test_default_limits_are_the_calibration_layers_requirement():
     from turntable_pin import PositionSet, orientation_requirement
 
     requirement = orientation_requirement(0.01, PositionSet.parse("grid:30"), np.radians(45.75))
+    # the box that holds: every orientation error within the limits meets the accuracy
     limits = default_orientation_limits()
-    assert limits.psi_rad == requirement.I_psi_rad
-    assert limits.theta_rad == requirement.I_theta_rad
-    assert limits.gamma_rad == requirement.I_gamma_rad
+    assert limits.psi_rad == requirement.box.psi_rad
+    assert limits.theta_rad == requirement.box.theta_rad
+    assert limits.gamma_rad == requirement.box.gamma_rad
+    # the paper's planes on request
+    planes = default_orientation_limits(requirement="planes")
+    assert planes.psi_rad == requirement.I_psi_rad
+    assert planes.theta_rad == requirement.I_theta_rad
+    assert planes.gamma_rad == requirement.I_gamma_rad
     # a looser calibration accuracy allows a larger orientation error
     assert np.all(default_orientation_limits(0.02).as_array() > limits.as_array())
 

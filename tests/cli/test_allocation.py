@@ -49,10 +49,15 @@ def test_default_limits_are_the_orientation_requirement(capsys):
 
     _, out = json_of(capsys, ["allocate", "--json"])
     req = orientation_requirement(0.01, PositionSet.parse("grid:30"), np.radians(45.75))
-    expected = {"psi": req.I_psi_rad, "theta": req.I_theta_rad, "gamma": req.I_gamma_rad}
+    expected = {"psi": req.box.psi_rad, "theta": req.box.theta_rad, "gamma": req.box.gamma_rad}
     assert out["limits_arcmin"] == pytest.approx(
         {k: v * ARCMIN_PER_RAD for k, v in expected.items()}
     )
+    _, planes = json_of(capsys, ["allocate", "--json", "--requirement", "planes"])
+    assert planes["limits_arcmin"] == pytest.approx(
+        {"psi": req.I_psi_rad * ARCMIN_PER_RAD, "theta": req.I_theta_rad * ARCMIN_PER_RAD,
+         "gamma": req.I_gamma_rad * ARCMIN_PER_RAD}
+    )  # fmt: skip
     assert out["weights"] == "model"
     _, looser = json_of(capsys, ["allocate", "--json", "--accuracy-dph", "0.02"])
     assert all(looser["limits_arcmin"][k] > out["limits_arcmin"][k] for k in expected)

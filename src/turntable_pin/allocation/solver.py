@@ -55,6 +55,7 @@ __all__ = [
     "MIN_LIMIT_ARCSEC",
     "ORIENTATION_ANGLES",
     "PHI2_INTERVALS_RAD",
+    "REQUIREMENT_KINDS",
     "WEIGHT_SCHEMES",
     "Allocation",
     "AngleRows",
@@ -157,19 +158,29 @@ def paper_eq16_limits() -> OrientationLimits:
     return OrientationLimits.from_deg(_EQ16_LIMIT_DEG, _EQ16_LIMIT_DEG, _EQ16_LIMIT_DEG)
 
 
+REQUIREMENT_KINDS: tuple[str, ...] = ("box", "planes")
+"""Which requirement the default limits are: ``box``, the largest box whose every point meets
+the accuracy (the limits hold together: a table within the allocated bounds calibrates to the
+accuracy, by Lemma 1); ``planes``, the paper's method (eqs. 15-16: each plane's rectangle,
+dtheta shared; with all three angles at their limits at once the rate error exceeds the
+accuracy, by 5 and 14 % on grid:30)."""
+
+
 @lru_cache(maxsize=16)
 def default_orientation_limits(
     accuracy_dph: float = DEFAULT_ACCURACY_DPH,
     positions: str = DEFAULT_POSITIONS,
     latitude_deg: float = DEFAULT_LATITUDE_DEG,
     table=None,
+    requirement: str = "box",
 ) -> OrientationLimits:
     """The orientation requirement used when the user gives no limits.
 
     It is the calibration layer's requirement (eqs. 15-16, :func:`orientation_requirement`) for
     calibration accuracy ``accuracy_dph`` (deg/h) on the position scheme ``positions`` of
     ``table`` (default the paper's) at ``latitude_deg`` (degrees), with the paper's Table 1
-    GyroWheel. The paper's own numbers are :func:`paper_eq16_limits`.
+    GyroWheel: its box that holds (``requirement="box"``) or the paper's planes (``"planes"``,
+    :data:`REQUIREMENT_KINDS`). The paper's own numbers are :func:`paper_eq16_limits`.
 
     Raises:
         IdentifiabilityError: the positions cannot calibrate the GyroWheel on this table.
@@ -177,10 +188,14 @@ def default_orientation_limits(
     from ..calibration.positions import PositionSet
     from ..calibration.requirement import orientation_requirement
 
-    requirement = orientation_requirement(
+    if requirement not in REQUIREMENT_KINDS:
+        raise InputError(
+            f"unknown requirement '{requirement}'; expected one of {REQUIREMENT_KINDS}"
+        )
+    result = orientation_requirement(
         accuracy_dph, PositionSet.parse(positions, table), math.radians(latitude_deg)
     )
-    return OrientationLimits(*requirement.limits_rad)
+    return OrientationLimits(*(result.box if requirement == "box" else result).limits_rad)
 
 
 # ---- the rows of one angle and their maximum over a domain ----------------------------------

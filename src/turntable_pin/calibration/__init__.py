@@ -1,6 +1,6 @@
 """The GyroWheel calibration layer (paper section 2): drift model (eq. 1), test positions,
 multi-position least-squares calibration, rate error from an orientation error (eqs. 8-13), and
-the orientation requirement (eq. 16).
+the orientation requirement (eq. 16: the paper's planes, and the largest box that holds).
 """
 
 from ..core.lazy import lazy_exports
@@ -12,11 +12,13 @@ _EXPORTS = {
     "OrientationRequirement": "requirement",
     "PositionSet": "positions",
     "RateErrorResult": "rate_error",
+    "RequirementBox": "requirement",
     "calibrate": "drift_fit",
     "calibrate_run": "drift_fit",
     "orientation_requirement": "requirement",
     "position_inputs": "positions",
     "rate_error": "rate_error",
+    "requirement_box": "requirement",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -17,7 +17,18 @@ contour at that ``I_theta`` (it can only grow). The result is therefore maximal:
 of ``I_psi, I_theta, I_gamma`` makes ``dwx`` or ``dwy`` exceed ``w_m``.
 
 The result also reports ``dwx`` and ``dwy`` at the corners of the three-dimensional box (all three
-angles at their limits), which the paper's planar analysis does not look at.
+angles at their limits), which the paper's planar analysis does not look at: with the planes'
+limits they exceed ``w_m`` (by 5 and 14 % on ``grid:30``).
+
+The box that holds (:class:`RequirementBox`): the rate errors are linear in the orientation
+error to first order (:func:`rate_error_jacobian`, ``J`` of shape (N, 2, 3) per position), so
+over the box ``|dpsi| <= I_psi, ...`` the largest ``|dw_j|`` at a position is
+``sum_k |J_jk| I_k``, reached at a corner. Of all the boxes with ``sum_k |J_jk(p)| I_k <= w_m``
+for both axes j and every position p (a polytope), :func:`largest_box` takes the one of largest
+volume ``I_psi I_theta I_gamma`` (the largest geometric mean of the three limits: no angle is
+preferred, and any box not inside it can be shrunk into it). The full model (eq. 7's second-order
+terms, or the exact rotation) then sets the scale: the box is scaled so that its worst corner
+meets ``w_m`` exactly. Every point of it meets the accuracy; scaled up by any factor it does not.
 """
 
 from __future__ import annotations
@@ -30,20 +41,34 @@ from ..core.exceptions import InputError
 from ..core.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
 from ..model.angles import ANGLE_SYMBOLS
 from .drift_fit import require_identifiable
-from .gyrowheel import GyroWheelModel
+from .gyrowheel import AXES, GyroWheelModel
 from .positions import PositionInputs, PositionSet, position_inputs
-from .rate_error import DEFINITIONS, rate_errors_at_angles_dph
+from .rate_error import (
+    DEFINITIONS,
+    orientation_error_rotation,
+    rate_error_vectors_dph,
+    rate_errors_at_angles_dph,
+)
 
 __all__ = [
     "ACCURACY_RANGE_DPH",
     "ANGLE_NAMES",
+    "BOX_CRITERION",
+    "JACOBIAN_STEP_RAD",
     "MAX_ANGLE_RAD",
     "PLANES",
     "OrientationRequirement",
     "PlaneRateError",
     "PlaneRectangle",
+    "RequirementBox",
+    "box_corners",
+    "check_accuracy_dph",
+    "holding_scale",
+    "largest_box",
     "largest_rectangle",
     "orientation_requirement",
+    "rate_error_jacobian",
+    "requirement_box",
 ]
 
 MAX_ANGLE_RAD = np.radians(10.0)
@@ -260,6 +285,229 @@ def _settle(function: PlaneRateError, a: float, b: float, accuracy_dph: float):
     return a, b
 
 
+# ---- the box that holds ---------------------------------------------------------------------
+BOX_CRITERION = "largest volume"
+"""How :func:`largest_box` chooses among the boxes that hold: the largest product
+``I_psi I_theta I_gamma``."""
+
+JACOBIAN_STEP_RAD = 1e-4
+"""Step of the central differences of :func:`rate_error_jacobian`, radians (about 20 arcsec, the
+size of the requirement itself): under eq. 7 ``dw`` is a quadratic of the angles, whose central
+difference is its exact linear part for any step; a step this large keeps rounding far below the
+result (the 90-degree grid's nearly singular ``A'`` solves to about 1e-10)."""
+
+_CORNER_SIGNS = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
+
+
+def box_corners(limits_rad) -> np.ndarray:
+    """The eight corners ``(+-I_psi, +-I_theta, +-I_gamma)`` of a box, (8, 3) radians."""
+    return _CORNER_SIGNS * np.asarray(limits_rad, dtype=float)
+
+
+def rate_error_jacobian(
+    gyrowheel: GyroWheelModel,
+    inputs: PositionInputs,
+    *,
+    exact: bool = False,
+    definition: str = "true_coefficients",
+) -> np.ndarray:
+    """``d dw / d(dpsi, dtheta, dgamma)`` at zero orientation error, per position.
+
+    Returns the (N, 2, 3) array ``J[p, j, k]``: the rate error of axis j (x, y) at position p per
+    radian of angle k (psi, theta, gamma), deg/h/rad, by central differences of eqs. 7-14
+    (:func:`~turntable_pin.calibration.rate_error.rate_error_vectors_dph`, step
+    :data:`JACOBIAN_STEP_RAD`). Under the printed eq. 13 row p depends on position p alone.
+    """
+    angles = np.concatenate([np.eye(3), -np.eye(3)]) * JACOBIAN_STEP_RAD
+    rotations = orientation_error_rotation(*angles.T, exact=exact)
+    dw = rate_error_vectors_dph(gyrowheel, inputs, rotations, definition=definition)
+    return ((dw[:3] - dw[3:]) / (2 * JACOBIAN_STEP_RAD)).transpose(1, 2, 0)
+
+
+def _undominated(rows: np.ndarray) -> np.ndarray:
+    """The rows no other row bounds componentwise (only they can bind a box; of equal rows
+    all are kept)."""
+    keep = np.ones(rows.shape[0], dtype=bool)
+    for start in range(0, rows.shape[0], 256):
+        chunk = rows[start : start + 256, None, :]
+        above = np.all(rows[None] >= chunk, axis=-1) & np.any(rows[None] > chunk, axis=-1)
+        keep[start : start + 256] = ~above.any(axis=1)
+    return rows[keep]
+
+
+def largest_box(
+    jacobian, accuracy_dph: float, *, cap_rad: float = MAX_ANGLE_RAD, start_rad=None
+) -> tuple[np.ndarray, np.ndarray]:
+    """The box of largest volume whose first-order worst case meets ``w_m`` (see module).
+
+    Args:
+        jacobian: rate-error Jacobian rows, any shape ending in 3 (deg/h per rad of dpsi,
+            dtheta, dgamma), e.g. :func:`rate_error_jacobian`'s (N, 2, 3).
+        accuracy_dph: ``w_m``, deg/h.
+        cap_rad: largest limit of any angle (an angle no row depends on stops there).
+        start_rad: a box near the answer to start the search from (e.g. that of similar
+            rows), radians; default the largest cube.
+
+    Returns:
+        ``(limits_rad, capped)``: the (3,) half-widths, radians, and which of them the cap set.
+    """
+    from scipy.optimize import minimize
+
+    rows = _undominated(np.abs(np.asarray(jacobian, dtype=float)).reshape(-1, 3)) / accuracy_dph
+    rows = np.vstack([rows, np.eye(3) / cap_rad])  # the cap, as one more row per angle
+    cube = 1.0 / float(np.max(rows.sum(axis=1)))
+    first = np.full(3, cube)
+    if start_rad is not None:
+        first = np.minimum(np.maximum(np.asarray(start_rad, dtype=float), cube), cap_rad)
+        first /= max(1.0, float(np.max(rows @ first)))
+    # max sum log I subject to rows @ I <= 1: concave in x = log(I / cube), started inside.
+    result = minimize(
+        lambda x: -np.sum(x),
+        np.log(first / cube) + np.log1p(-1e-6),
+        jac=lambda x: -np.ones(3),
+        method="SLSQP",
+        constraints=[
+            {
+                "type": "ineq",
+                "fun": lambda x: 1.0 - rows @ (cube * np.exp(x)),
+                "jac": lambda x: -rows * (cube * np.exp(x)),
+            }
+        ],
+        options={"ftol": 1e-15, "maxiter": 500},
+    )
+    limits = cube * np.exp(result.x if np.all(np.isfinite(result.x)) else np.zeros(3))
+    limits /= max(1.0, float(np.max(rows @ limits)))
+    return limits, limits >= cap_rad * (1 - 1e-9)
+
+
+@dataclass(frozen=True)
+class RequirementBox:
+    """The largest box ``|dpsi| <= I_psi, |dtheta| <= I_theta, |dgamma| <= I_gamma`` whose every
+    point meets the required accuracy (see the module docstring).
+
+    Attributes:
+        psi_rad, theta_rad, gamma_rad: the half-widths, radians.
+        criterion: :data:`BOX_CRITERION`.
+        dwx_dph, dwy_dph: the largest ``dwx``, ``dwy`` over the box's corners (the full model);
+            the larger one is ``w_m``.
+        binding: for each axis (x, y) whose first-order worst case meets ``w_m`` (to 1e-7),
+            the index of the position where it does.
+        capped: which limits stopped at :data:`MAX_ANGLE_RAD` (no position limits them).
+        scale: the full model's correction of the first-order box (1 to about 1e-4).
+    """
+
+    psi_rad: float
+    theta_rad: float
+    gamma_rad: float
+    criterion: str
+    dwx_dph: float
+    dwy_dph: float
+    binding: tuple[tuple[str, int], ...]
+    capped: tuple[bool, bool, bool]
+    scale: float
+
+    @property
+    def limits_rad(self) -> np.ndarray:
+        """``[I_psi, I_theta, I_gamma]``, radians."""
+        return np.array([self.psi_rad, self.theta_rad, self.gamma_rad])
+
+    @property
+    def volume_rad3(self) -> float:
+        """``I_psi I_theta I_gamma``, rad^3 (the criterion)."""
+        return float(np.prod(self.limits_rad))
+
+    def to_dict(self) -> dict:
+        """The limits (degrees, arc seconds), the criterion and the worst corner, JSON-ready."""
+        limits = zip(ANGLE_NAMES, self.limits_rad, strict=True)
+        out: dict = {}
+        for name, value in limits:
+            out[f"I_{name}_deg"] = rad_to_deg(value)
+            out[f"I_{name}_arcsec"] = rad_to_arcsec(value)
+        return {
+            **out,
+            "criterion": self.criterion,
+            "dwx_dph": self.dwx_dph,
+            "dwy_dph": self.dwy_dph,
+            "binding": [{"axis": a, "position_index": i} for a, i in self.binding],
+            "capped": list(self.capped),
+        }
+
+
+def holding_scale(
+    accuracy_dph: float,
+    gyrowheel: GyroWheelModel,
+    inputs: PositionInputs,
+    limits_rad,
+    *,
+    exact: bool = False,
+    definition: str = "true_coefficients",
+) -> tuple[float, np.ndarray]:
+    """The largest ``s`` such that the box ``s * limits_rad`` holds: its worst corner meets
+    ``w_m`` (deg/h) exactly, by the full model (eqs. 7-14) at the positions of ``inputs``.
+
+    Returns ``(s, worst)`` with ``worst`` (N, 2) each position's largest ``|dw|`` (x, y) over
+    the corners of ``s * limits_rad``, deg/h.
+    """
+    limits = np.asarray(limits_rad, dtype=float)
+
+    def worst(scale: float) -> np.ndarray:
+        rotations = orientation_error_rotation(*box_corners(scale * limits).T, exact=exact)
+        dw = np.abs(rate_error_vectors_dph(gyrowheel, inputs, rotations, definition=definition))
+        return dw.max(axis=0)
+
+    # dw is first order in the angles up to terms of relative size ~I: a few fixed-point steps
+    # s <- s w_m / worst(s) meet the contour, then the last rounding is shed.
+    scale = 1.0
+    for _ in range(20):
+        ratio = float(worst(scale).max()) / accuracy_dph
+        if abs(ratio - 1.0) <= 1e-13:
+            break
+        scale /= ratio
+    per_position = worst(scale)
+    for attempt in range(50):
+        if float(per_position.max()) <= accuracy_dph:
+            break
+        scale *= 1.0 - 2.0 ** (attempt - 52)
+        per_position = worst(scale)
+    return float(scale), per_position
+
+
+def requirement_box(
+    accuracy_dph: float,
+    gyrowheel: GyroWheelModel,
+    inputs: PositionInputs,
+    *,
+    exact: bool = False,
+    definition: str = "true_coefficients",
+) -> RequirementBox:
+    """The largest box that holds (:class:`RequirementBox`) for accuracy ``w_m`` (deg/h) at the
+    positions of ``inputs``, with the rate-error model of ``exact`` and ``definition``."""
+    jacobian = rate_error_jacobian(gyrowheel, inputs, exact=exact, definition=definition)
+    first_order, capped = largest_box(jacobian, accuracy_dph)
+    scale, per_position = holding_scale(
+        accuracy_dph, gyrowheel, inputs, first_order, exact=exact, definition=definition
+    )
+    corner = per_position.max(axis=0)
+    first_order_worst = np.abs(jacobian) @ first_order  # (N, 2)
+    binding = tuple(
+        (axis, int(np.argmax(first_order_worst[:, j])))
+        for j, axis in enumerate(AXES)
+        if first_order_worst[:, j].max() >= accuracy_dph * (1 - 1e-7)
+    )
+    limits = scale * first_order
+    return RequirementBox(
+        psi_rad=float(limits[0]),
+        theta_rad=float(limits[1]),
+        gamma_rad=float(limits[2]),
+        criterion=BOX_CRITERION,
+        dwx_dph=float(corner[0]),
+        dwy_dph=float(corner[1]),
+        binding=binding,
+        capped=tuple(bool(c) for c in capped),
+        scale=float(scale),
+    )
+
+
 @dataclass(frozen=True)
 class OrientationRequirement:
     """The requirement ``|dpsi| <= I_psi, |dtheta| <= I_theta, |dgamma| <= I_gamma`` (eq. 15).
@@ -272,6 +520,8 @@ class OrientationRequirement:
         rectangles: the largest-area rectangle of each plane before ``I_theta`` was shared.
         box_dwx_dph, box_dwy_dph: largest ``dwx``, ``dwy`` over the eight corners of the box
             with all three angles at their limits (the paper's planes leave the third angle out).
+        box: the largest box whose every point meets ``w_m`` (:class:`RequirementBox`), beside
+            the planes' limits above.
         latitude_rad, positions_name, n_positions, definition, exact: the set-up.
     """
 
@@ -283,6 +533,7 @@ class OrientationRequirement:
     rectangles: tuple[PlaneRectangle, PlaneRectangle]
     box_dwx_dph: float
     box_dwy_dph: float
+    box: RequirementBox
     latitude_rad: float
     positions_name: str
     n_positions: int
@@ -347,9 +598,24 @@ class OrientationRequirement:
                 "rectangles": [r.to_dict() for r in self.rectangles],
                 "box_dwx_dph": self.box_dwx_dph,
                 "box_dwy_dph": self.box_dwy_dph,
+                "box": self.box.to_dict(),
             }
         )
         return out
+
+
+def check_accuracy_dph(accuracy_dph: float) -> float:
+    """``accuracy_dph`` (the required accuracy ``w_m``, deg/h) as a float, or
+    :class:`InputError` unless it is a number in :data:`ACCURACY_RANGE_DPH`."""
+    if not (np.isfinite(accuracy_dph) and accuracy_dph > 0):
+        raise InputError(f"the required accuracy must be a positive number, got {accuracy_dph!r}")
+    low, high = ACCURACY_RANGE_DPH
+    if not low <= accuracy_dph <= high:
+        raise InputError(
+            f"the required accuracy must be between {low:g} and {high:g} deg/h, "
+            f"got {accuracy_dph!r}"
+        )
+    return float(accuracy_dph)
 
 
 def orientation_requirement(
@@ -374,14 +640,7 @@ def orientation_requirement(
         exact: exact rotation for ``dR`` instead of eq. 7.
         definition: the rate-error definition (see :mod:`turntable_pin.calibration.rate_error`).
     """
-    if not (np.isfinite(accuracy_dph) and accuracy_dph > 0):
-        raise InputError(f"the required accuracy must be a positive number, got {accuracy_dph!r}")
-    low, high = ACCURACY_RANGE_DPH
-    if not low <= accuracy_dph <= high:
-        raise InputError(
-            f"the required accuracy must be between {low:g} and {high:g} deg/h, "
-            f"got {accuracy_dph!r}"
-        )
+    check_accuracy_dph(accuracy_dph)
     if definition not in DEFINITIONS:
         raise InputError(f"unknown rate-error definition '{definition}'; expected {DEFINITIONS}")
     gyrowheel = gyrowheel if gyrowheel is not None else GyroWheelModel.nominal()
@@ -409,8 +668,7 @@ def orientation_requirement(
             )[0]
         )
         psi, theta = _settle(fx, psi, theta, accuracy_dph)
-    signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
-    corners = signs * np.array([psi, theta, gamma])
+    corners = box_corners([psi, theta, gamma])
     box = rate_errors_at_angles_dph(
         gyrowheel, inputs, corners, exact=exact, definition=definition
     ).max(axis=0)
@@ -423,6 +681,7 @@ def orientation_requirement(
         rectangles=(rect_x, rect_y),
         box_dwx_dph=float(box[0]),
         box_dwy_dph=float(box[1]),
+        box=requirement_box(accuracy_dph, gyrowheel, inputs, exact=exact, definition=definition),
         latitude_rad=float(latitude_rad),
         positions_name=positions.name,
         n_positions=len(positions),

@@ -11,6 +11,7 @@ from ..allocation.solver import (
     DEFAULT_ACCURACY_DPH,
     DEFAULT_POSITIONS,
     ORIENTATION_ANGLES,
+    REQUIREMENT_KINDS,
     WEIGHT_SCHEMES,
     Allocation,
     OrientationLimits,
@@ -104,6 +105,14 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
         help=f"latitude behind the default limits, degrees ({DEFAULT_LATITUDE_DEG})",
     )
     p.add_argument(
+        "--requirement",
+        choices=REQUIREMENT_KINDS,
+        default=REQUIREMENT_KINDS[0],
+        help="which requirement the default limits are: the largest box whose every point "
+        "meets the accuracy (default) or the paper's planes (eqs. 15-16; all three at their "
+        "limits at once exceed it)",
+    )
+    p.add_argument(
         "--weights",
         choices=WEIGHT_SCHEMES,
         default="model",
@@ -181,12 +190,12 @@ def _limits_from_args(args: argparse.Namespace, table=None) -> tuple[Orientation
         return parse_limits(args.limits_arcmin, "arcmin"), f"--limits-arcmin {args.limits_arcmin}"
     if args.limits_deg is not None:
         return parse_limits(args.limits_deg, "deg"), f"--limits-deg {args.limits_deg}"
-    given = f"the limits of --accuracy-dph {args.accuracy_dph:g}"
+    given = f"the limits ({args.requirement}) of --accuracy-dph {args.accuracy_dph:g}"
     from ..core.exceptions import IdentifiabilityError
 
     try:
         limits = default_orientation_limits(
-            args.accuracy_dph, args.positions, args.latitude_deg, table
+            args.accuracy_dph, args.positions, args.latitude_deg, table, args.requirement
         )
     except IdentifiabilityError as exc:
         if table is None:

@@ -80,7 +80,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     q = subparsers.add_parser(
         "requirement",
         description="Largest centred rectangles inside dwx <= w_m over (dpsi, dtheta) and "
-        "dwy <= w_m over (dtheta, dgamma), sharing dtheta; Figures 4 and 5 with --plots.",
+        "dwy <= w_m over (dtheta, dgamma), sharing dtheta (the paper's planes, eqs. 15-16), and "
+        "beside them the largest box whose every point meets w_m (all three angles at once: "
+        "allocate's default limits); Figures 4 and 5 with --plots.",
     )
     one_line_errors(q)
     q.add_argument(
@@ -185,6 +187,17 @@ def run_requirement(args: argparse.Namespace) -> int:
     print(
         f"all three angles at their limits at once: dwx <= {report['box_dwx_dph']:.4g}, "
         f"dwy <= {report['box_dwy_dph']:.4g} deg/h"
+    )
+    box = report["box"]
+    print(
+        "the largest box that holds (largest volume; every orientation error in it meets "
+        "w_m; allocate's default limits):"
+    )
+    for name in ANGLE_SYMBOLS:
+        print(f"|d{name}| <= {box[f'I_{name}_deg']:.5f} deg ({box[f'I_{name}_arcsec']:.2f} arcsec)")
+    print(
+        f"its corners: dwx <= {box['dwx_dph']:.4g}, dwy <= {box['dwy_dph']:.4g} deg/h"
+        + ("; a limit stopped at the 10-degree search cap" if any(box["capped"]) else "")
     )
     for path in report.get("plots", []):
         print(f"wrote {path}")

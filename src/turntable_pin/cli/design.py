@@ -14,6 +14,7 @@ from pathlib import Path
 
 from ..core.exceptions import InputError
 from .common import (
+    accuracy_dph,
     add_table_options,
     bounded_float,
     input_path,
@@ -32,6 +33,7 @@ DEFAULT_POSITIONS = 24
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``design`` to ``subparsers``."""
+    from ..design.calibrate import DEFAULT_MIN_EFFICIENCY, MAX_MIN_EFFICIENCY
     from ..design.space import DEFAULT_CANDIDATES, GRID_STEP_DEG
 
     p = subparsers.add_parser(
@@ -65,6 +67,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         action="store_true",
         help="GyroWheel calibration positions least sensitive to the table's orientation errors",
     )
+    p.add_argument(
+        "--accuracy-dph", type=accuracy_dph, default=0.01,
+        help="--calibrate: the required calibration accuracy w_m, deg/h (default 0.01)",
+    )  # fmt: skip
+    p.add_argument(
+        "--min-efficiency", type=bounded_float(0.0, MAX_MIN_EFFICIENCY, low_open=True),
+        default=DEFAULT_MIN_EFFICIENCY, metavar="E",
+        help="--calibrate: the precision floor, D-efficiency of the 14 drift coefficients "
+        f"against the grid of the same N (default {DEFAULT_MIN_EFFICIENCY:g}: at least as "
+        "precise as the grid)",
+    )  # fmt: skip
     p.add_argument(
         "-n",
         "--positions-count",
@@ -286,5 +299,26 @@ def _run_separate(args: argparse.Namespace) -> int:
 
 
 def _run_calibrate(args: argparse.Namespace) -> int:
-    """GyroWheel calibration positions least sensitive to the table's errors (``--calibrate``)."""
-    raise InputError("design --calibrate: not yet available (issue 19, item 4)")
+    """GyroWheel calibration positions least sensitive to the table's errors (``--calibrate``):
+    the loosest orientation requirement (the largest box that holds) at the reference grid's
+    precision (:func:`~turntable_pin.design.calibrate.design_calibration`)."""
+    from ..design.calibrate import design_calibration
+    from ..report.requirement_figures import write_calibration_design_figures
+
+    for option, given in (
+        ("--effects", args.effects or args.effects_module),
+        ("--from", args.from_data),
+        ("--noise-arcsec", args.noise_arcsec is not None),
+    ):
+        if given:
+            raise InputError(
+                f"design --calibrate: {option} is for identify and --separate; a GyroWheel "
+                "calibration design needs the table, its limits and -n only"
+            )
+    result = design_calibration(
+        _space(args, effects=()),
+        args.positions_count,
+        accuracy_dph=args.accuracy_dph,
+        min_efficiency=args.min_efficiency,
+    )
+    return _finish(result, args, write_calibration_design_figures)

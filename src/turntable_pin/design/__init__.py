@@ -8,6 +8,8 @@ positions of the next measurement run:
   the chosen effects (greedy start and Fedorov exchange, :mod:`turntable_pin.stats.design`);
 - :mod:`.separate`: T-optimal positions that tell two effects apart, with the chance that the
   diagnosis names the right one (:mod:`turntable_pin.stats.discrimination`), or why none do;
+- :mod:`.calibrate`: GyroWheel calibration positions with the loosest orientation requirement
+  (the largest box that holds) at the precision of the grid of the same number of positions;
 - :mod:`.schedule`: the order, times and approach directions of the chosen positions (repeats
   for time-driven effects, both sides for backlash) and the CSV that ``simulate --positions``
   and the test crew read.
@@ -16,10 +18,12 @@ positions of the next measurement run:
 from ..core.lazy import lazy_exports
 
 _EXPORTS = {
+    "CalibrationDesign": "calibrate",
     "DesignSpace": "space",
     "IdentifyDesign": "identify",
     "MeasurementPlan": "schedule",
     "SeparationDesign": "separate",
+    "design_calibration": "calibrate",
     "design_identify": "identify",
     "design_separate": "separate",
     "design_space": "space",

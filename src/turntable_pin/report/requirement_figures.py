@@ -1,9 +1,13 @@
-"""Figures 4 and 5 of the paper for an :class:`OrientationRequirement`, as PNG files.
+"""Figures of the orientation requirement, as PNG files: Figures 4 and 5 of the paper for an
+:class:`OrientationRequirement`, and the calibration design (``design --calibrate``).
 
 Figure 4: the rate-sensing errors over the orientation-error angles: the surfaces Gamma1
 (``dwx`` over dpsi, dtheta) and Gamma2 (``dwy`` over dtheta, dgamma) with the plane ``w_m``, and
 slices showing that ``dwx`` hardly depends on dgamma and ``dwy`` hardly on dpsi.
-Figure 5: the contour lines ``dwx = w_m`` and ``dwy = w_m`` with the requirement rectangles.
+Figure 5: the contour lines ``dwx = w_m`` and ``dwy = w_m`` with the requirement rectangles and
+the box that holds (every angle at its limit at once).
+``design_calibrate.png``: the designed positions against the reference grid, the boxes and
+planes of both, and the search.
 """
 
 from __future__ import annotations
@@ -12,12 +16,21 @@ from pathlib import Path
 
 import numpy as np
 
+from ..calibration.positions import PositionSet
 from ..calibration.rate_error import rate_errors_at_angles_dph
 from ..calibration.requirement import MAX_ANGLE_RAD, OrientationRequirement
 from ..core.units import deg_to_rad, rad_to_deg
+from ..design.calibrate import CalibrationDesign
 from .figures import pyplot, save_png
 
-__all__ = ["plot_figure4", "plot_figure5", "plot_span_deg", "write_requirement_figures"]
+__all__ = [
+    "plot_calibration_design",
+    "plot_figure4",
+    "plot_figure5",
+    "plot_span_deg",
+    "write_calibration_design_figures",
+    "write_requirement_figures",
+]
 
 _LABELS = {"psi": r"$\Delta\psi$ (deg)", "theta": r"$\Delta\theta$ (deg)",
            "gamma": r"$\Delta\gamma$ (deg)"}  # fmt: skip
@@ -135,6 +148,11 @@ def plot_figure5(result: OrientationRequirement, path: str | Path, *, points: in
             [-ra, ra, ra, -ra, -ra], [-rb, -rb, rb, rb, -rb], color="C1", ls="--",
             label="largest rectangle of this plane alone",
         )  # fmt: skip
+        bu, bv = rad_to_deg(result.box.limits_rad[[index, index + 1]])
+        ax.plot(
+            [-bu, bu, bu, -bu, -bu], [-bv, -bv, bv, bv, -bv], color="C2", lw=1.8,
+            label="largest box that holds (all three angles at once)",
+        )  # fmt: skip
         ax.plot([], [], color="C0", label=f"$\\Delta\\omega_{axis} = \\omega_m$")
         ax.set_xlabel(_LABELS[names[0]])
         ax.set_ylabel(_LABELS[names[1]])
@@ -152,3 +170,95 @@ def write_requirement_figures(result: OrientationRequirement, directory: str | P
         plot_figure4(result, directory / "figure4_rate_errors.png"),
         plot_figure5(result, directory / "figure5_requirement.png"),
     ]
+
+
+# ---- the calibration design (design --calibrate) ----------------------------------------------
+def _gravity_map(positions: PositionSet) -> tuple[np.ndarray, np.ndarray]:
+    """Where gravity points in the payload frame at each position: its azimuth
+    ``atan2(a_y, a_x)`` (deg) and ``a_z`` (g): an equal-area map of the sphere."""
+    from ..calibration.positions import position_inputs
+
+    a = position_inputs(positions, 0.0).specific_force_g
+    return np.degrees(np.arctan2(a[:, 1], a[:, 0])), a[:, 2]
+
+
+def plot_calibration_design(design: CalibrationDesign, path: str | Path) -> Path:
+    """The calibration design against its reference grid (PNG): (a) the positions over the first
+    two joints, (b) where gravity points in the payload frame, (c) the limits of the boxes and of
+    the paper's planes, (d) the search: each step's box against its D-efficiency."""
+    plt = pyplot()
+    fig, axes = plt.subplots(2, 2, figsize=(12, 9.5))
+    ref_name, ref = design.reference.name, design.reference
+    chosen = design.positions()
+    ax = axes[0, 0]
+    ref_deg, chosen_deg = np.degrees(ref.angles_rad), design.positions_deg
+    ax.plot(ref_deg[:, 0], ref_deg[:, 1], "s", mfc="none", color="0.45", ms=8, label=ref_name)
+    ax.plot(chosen_deg[:, 0], chosen_deg[:, 1], "o", color="C0", ms=5, label="design")
+    names = [f"phi{r.index} {r.joint}" for r in design.space.ranges]
+    ax.set_xlabel(f"{names[0]} (deg)")
+    ax.set_ylabel(f"{names[1]} (deg)")
+    ax.set_title("(a) positions")
+    ax.legend(fontsize=8, loc="upper right")
+    ax.grid(alpha=0.3)
+    ax = axes[0, 1]
+    for positions, style, label in (
+        (ref, dict(marker="s", mfc="none", color="0.45", ms=8), ref_name),
+        (chosen, dict(marker="o", color="C0", ms=5), "design"),
+    ):
+        azimuth, up = _gravity_map(positions)
+        ax.plot(azimuth, up, ls="none", label=label, **style)
+    ax.set_xlim(-180, 180)
+    ax.set_ylim(-1.05, 1.05)
+    ax.set_xlabel(r"azimuth of gravity in the payload frame, atan2($a_y$, $a_x$) (deg)")
+    ax.set_ylabel(r"$a_z$ (g)")
+    ax.set_title("(b) gravity directions (equal-area map)")
+    ax.legend(fontsize=8, loc="upper right")
+    ax.grid(alpha=0.3)
+    ax = axes[1, 0]
+    bars = (
+        ("design: box that holds", design.box.limits_rad, "C0"),
+        (f"{ref_name}: box that holds", design.reference_box.limits_rad, "0.45"),
+        ("design: paper's planes", design.planes.limits_rad, "C1"),
+        (f"{ref_name}: paper's planes", design.reference_planes.limits_rad, "C3"),
+    )
+    x = np.arange(3)
+    for k, (label, limits, color) in enumerate(bars):
+        ax.bar(x + (k - 1.5) * 0.2, np.degrees(limits), 0.2, color=color, label=label,
+               hatch="//" if "planes" in label else None, alpha=0.9)  # fmt: skip
+    ax.set_xticks(x, [r"$I_\psi$", r"$I_\theta$", r"$I_\gamma$"])
+    ax.set_ylabel("limit (deg)")
+    ax.set_title(
+        f"(c) orientation requirement for {design.accuracy_dph:g} deg/h: "
+        f"{design.looser_by:.2f} x looser (geometric mean)"
+    )
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, axis="y")
+    ax = axes[1, 1]
+    volume = np.array([s.volume_rad3 for s in design.steps])
+    log_det = np.array([s.log_det for s in design.steps])
+    reference_log_det = log_det[-1] - 14 * np.log(design.d_efficiency)
+    ratio = (volume / design.steps[0].volume_rad3) ** (1 / 3)
+    ax.plot(np.exp((log_det - reference_log_det) / 14), ratio, ".-", color="C0", lw=0.8)
+    ax.plot([1.0], [1.0], "s", mfc="none", color="0.45", ms=9, label=ref_name)
+    ax.plot(np.exp((log_det[-1] - reference_log_det) / 14), ratio[-1], "o", color="C0", ms=8,
+            label="design")  # fmt: skip
+    ax.axvline(design.min_efficiency, color="red", ls="--", lw=0.8, label="precision floor")
+    ax.set_xlabel("D-efficiency against the reference (14 drift coefficients)")
+    ax.set_ylabel("box (geometric mean) / start's")
+    ax.set_title(f"(d) the search ({len(design.steps) - 1} steps)")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.suptitle(
+        f"GyroWheel calibration positions least sensitive to the table's orientation errors: "
+        f"{design.n_positions} positions, {design.space.table_name}, seed {design.space.seed}",
+        fontsize=10,
+    )
+    fig.tight_layout()
+    return save_png(fig, path)
+
+
+def write_calibration_design_figures(
+    design: CalibrationDesign, directory: str | Path
+) -> list[Path]:
+    """Write ``design_calibrate.png`` into ``directory``."""
+    return [plot_calibration_design(design, Path(directory) / "design_calibrate.png")]
