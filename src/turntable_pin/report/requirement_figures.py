@@ -198,7 +198,7 @@ def plot_calibration_design(design: CalibrationDesign, path: str | Path) -> Path
     ax.set_xlabel(f"{names[0]} (deg)")
     ax.set_ylabel(f"{names[1]} (deg)")
     ax.set_title("(a) positions")
-    ax.legend(fontsize=8, loc="upper right")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
     ax.grid(alpha=0.3)
     ax = axes[0, 1]
     for positions, style, label in (
@@ -212,7 +212,7 @@ def plot_calibration_design(design: CalibrationDesign, path: str | Path) -> Path
     ax.set_xlabel(r"azimuth of gravity in the payload frame, atan2($a_y$, $a_x$) (deg)")
     ax.set_ylabel(r"$a_z$ (g)")
     ax.set_title("(b) gravity directions (equal-area map)")
-    ax.legend(fontsize=8, loc="upper right")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
     ax.grid(alpha=0.3)
     ax = axes[1, 0]
     bars = (
