@@ -7,8 +7,10 @@ the largest box ``|dpsi| <= I_psi, |dtheta| <= I_theta, |dgamma| <= I_gamma`` (l
 whose every orientation error keeps the rate errors of eqs. 7-14 within ``w_m``. To first order
 the rate error at a position is ``J(p) (dpsi, dtheta, dgamma)`` (the printed eq. 13: the drift at
 the actual gravity direction minus the drift at the ideal one), so the box is set by the most
-sensitive positions: those where tilting gravity changes the drift most (gravity along the
-payload's z axis, across both sensing axes, is the worst on the paper's Table 1 GyroWheel).
+sensitive positions: those where tilting gravity changes the drift most. On the paper's Table 1
+GyroWheel gravity along the payload's z axis bounds dpsi and dgamma (through the 43.2 and 33.2
+deg/h/g terms), and gravity in or near the payload's x-y plane bounds dtheta, by how much
+depending on its azimuth there (15 to 82 deg/h per rad).
 
 The design chooses ``N`` positions within the joints' limits that make the box as large as
 possible, i.e. the loosest orientation requirement for the same ``w_m``, while still calibrating
@@ -53,7 +55,7 @@ from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError, InputError
 from ..core.units import DEG_PER_RAD
 from ..model.angles import ANGLE_SYMBOLS
-from ..stats.design import fedorov_exchange, log_det
+from ..stats.design import d_optimal_design, fedorov_exchange, log_det
 from .schedule import MeasurementPlan, plan_measurements
 from .space import DesignSpace
 
@@ -550,8 +552,6 @@ def _most_precise(features, n_positions, reference_index, floor, min_efficiency)
     Raises:
         InputError: they do not reach the floor either.
     """
-    from ..stats.design import d_optimal_design
-
     found = d_optimal_design(_stacked_rows(features), n_positions, also_from=[reference_index])
     if not found.log_det >= floor:
         best = np.exp((found.log_det - floor) / _N_PARAMETERS) * min_efficiency
