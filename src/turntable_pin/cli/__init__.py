@@ -183,6 +183,11 @@ def _interrupted(exc: BaseException, command: str | None, console: bool) -> int:
         # The atexit functions (say, a coverage tool's) still run.
         import atexit
 
+        # multiprocessing's exit function joins the pool's queue feeder threads; the workers
+        # are killed, so a feeder blocked writing to them would wait for ever (seen 3 in 40).
+        util = sys.modules.get("multiprocessing.util")
+        if util is not None:
+            atexit.unregister(util._exit_function)
         atexit._run_exitfuncs()
         for stream in (sys.stdout, sys.stderr):
             try:
