@@ -435,6 +435,8 @@ def test_several_active_points_are_solved_by_cutting_planes():
         )
         ours = float(np.sum(w**2 / z**2))
         theirs = res.x / max(1.0, float(np.max(g @ res.x)))  # SLSQP ends ~1e-7 outside
-        assert ours <= float(np.sum(w**2 / theirs**2)) * (1 + 2e-8)  # its grid spacing
+        # SLSQP on the denser grid may sit below the continuous optimum by its grid spacing (and
+        # its versions land differently: scipy 1.13, the floor, ends 9e-8 below)
+        assert ours <= float(np.sum(w**2 / theirs**2)) * (1 + 2e-7)
         assert sub.kkt_residual < (1e-12 if sub.method == "exact" else 1e-4)
     assert methods == {"exact", "cutting planes"}
