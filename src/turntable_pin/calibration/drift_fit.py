@@ -25,10 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.csv_table import read_csv_table, refuse_repeated_rows, write_csv_table
+from ..core.csv_table import write_csv_table
 from ..core.exceptions import IdentifiabilityError, InputError, check_seed
 from ..core.units import rad_to_deg
-from ..model.paper_table import paper_table
 from .gyrowheel import (
     AXES,
     N_COEFFICIENTS,
@@ -37,7 +36,15 @@ from .gyrowheel import (
     GyroWheelModel,
     regressor_matrix,
 )
-from .positions import PositionInputs, PositionSet, position_inputs
+from .positions import PositionInputs, PositionSet
+from .run import (
+    MAX_RUN_OUTPUT_DPH,
+    MIN_RUN_SIGMA_DPH,
+    RUN_OPTIONAL_COLUMNS,
+    RUN_REQUIRED_COLUMNS,
+    read_run,
+    refuse_copied_rows,
+)
 
 __all__ = [
     "MAX_RUN_OUTPUT_DPH",
@@ -54,18 +61,6 @@ __all__ = [
     "simulate_run",
     "write_simulated_run",
 ]
-
-RUN_REQUIRED_COLUMNS: tuple[str, ...] = ("out_x_dph", "out_y_dph")
-"""Columns every calibration run CSV must have besides the angle of each joint (deg/h)."""
-RUN_OPTIONAL_COLUMNS: tuple[str, ...] = ("sigma_dph", "time_s")
-"""Columns read when present: 1-sigma output noise (deg/h) and time (s)."""
-MAX_RUN_OUTPUT_DPH = 1e6
-"""Largest ``|out_x_dph|``, ``|out_y_dph|`` and ``sigma_dph`` of a run, deg/h: the earth rate
-(15 deg/h) plus seven drift terms each within ``MAX_COEFFICIENT_DPH`` at 1 g stay below it; more
-is a unit mix-up (deg/s or rad/s written as deg/h), and the fit's squares would overflow."""
-MIN_RUN_SIGMA_DPH = 1e-9
-"""Smallest ``sigma_dph``, deg/h: far below any rate sensor's noise; a smaller sigma is a typo,
-and its weight 1/sigma would overflow the fit."""
 
 
 @dataclass(frozen=True)
@@ -316,64 +311,19 @@ def require_identifiable(inputs: PositionInputs, *, every_coefficient: bool = Tr
 
 
 def calibrate_run(path: str | Path, latitude_rad: float, table=None) -> CalibrationResult:
-    """Read a calibration run CSV and fit it (see the module docstring for the format).
+    """Read a calibration run CSV (:func:`~.run.read_run`) and fit it.
 
     ``table``: the :class:`~turntable_pin.model.generic_table.GenericTable` whose run this is
     (default the paper's table).
     """
-    table = paper_table() if table is None else table
-    optional = PositionSet.candidate_columns(table) + RUN_OPTIONAL_COLUMNS
-    csv = read_csv_table(path, RUN_REQUIRED_COLUMNS, optional)
-    columns = PositionSet.columns_of(csv, table)
-    positions = PositionSet.from_csv_table(csv, columns, table, str(path))
-    _check_run_values(path, csv)
-    inputs = position_inputs(positions, latitude_rad)
+    run = read_run(path, latitude_rad, table)
     try:
-        result = calibrate(
-            inputs,
-            csv["out_x_dph"],
-            csv["out_y_dph"],
-            csv["sigma_dph"] if csv.has("sigma_dph") else None,
-        )
+        result = calibrate(run.inputs, run.outputs_dph[:, 0], run.outputs_dph[:, 1], run.sigma_dph)
     except IdentifiabilityError as exc:
         raise IdentifiabilityError(f"{path}: {exc}") from None
     # After the fit: positions that cannot determine the coefficients are the first problem.
-    refuse_repeated_rows(
-        csv,
-        (*columns, "time_s"),
-        "a copied row counts one measurement twice (repeats must differ in time_s)",
-    )
+    refuse_copied_rows(run)
     return result
-
-
-def _check_run_values(path, table) -> None:
-    """Refuse outputs, sigmas or times out of range (naming file, row and column)."""
-    for column in ("out_x_dph", "out_y_dph", "sigma_dph"):
-        if not table.has(column):
-            continue
-        values = table[column]
-        bad = np.flatnonzero(np.abs(values) > MAX_RUN_OUTPUT_DPH)
-        if bad.size:
-            raise InputError(
-                f"must be within +-{MAX_RUN_OUTPUT_DPH:g} deg/h, found {values[bad[0]]:g}",
-                path=table.path, row=int(table.rows[bad[0]]), column=column,
-            )  # fmt: skip
-    if table.has("sigma_dph"):
-        bad = np.flatnonzero(table["sigma_dph"] <= 0)
-        if bad.size:
-            raise InputError(
-                "sigma_dph must be positive", path=path, row=int(table.rows[bad[0]]),
-                column="sigma_dph",
-            )  # fmt: skip
-        bad = np.flatnonzero(table["sigma_dph"] < MIN_RUN_SIGMA_DPH)
-        if bad.size:
-            raise InputError(
-                f"sigma_dph must be at least {MIN_RUN_SIGMA_DPH:g} deg/h, found "
-                f"{table['sigma_dph'][bad[0]]:g}",
-                path=table.path, row=int(table.rows[bad[0]]), column="sigma_dph",
-            )  # fmt: skip
-    if table.has("time_s"):
-        table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
 
 
 def simulate_run(
