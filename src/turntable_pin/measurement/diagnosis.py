@@ -50,6 +50,9 @@ __all__ = [
     "design_command",
     "diagnose_measurements",
     "diagnosis_residuals",
+    "harmonic_basis",
+    "max_harmonic_order",
+    "polynomial_basis",
 ]
 
 MAX_HARMONIC = 5
@@ -57,12 +60,12 @@ SEPARATION_CHI2 = 25.0
 """Noise-free misfit chi2 above which a denser design is said to separate two effects."""
 
 
-def _harmonic(k: int):
+def harmonic_basis(k: int):
     """The basis functions ``cos(k x), sin(k x)`` of a k/rev probe, (p,) -> (p, 2)."""
     return lambda x: np.stack([np.cos(k * x), np.sin(k * x)], axis=-1)
 
 
-def _polynomial(values: np.ndarray):
+def polynomial_basis(values: np.ndarray):
     """The basis ``u, u^2`` with ``u`` the column scaled to [0, 1] over the data, (p,) -> (p, 2)."""
     low, span = float(np.min(values)), float(np.ptp(values))
 
@@ -98,7 +101,7 @@ def _along_error(jac: np.ndarray, w: np.ndarray, e: int):
     return direction
 
 
-def _max_order(angle_rad: np.ndarray) -> int:
+def max_harmonic_order(angle_rad: np.ndarray) -> int:
     distinct = np.unique(np.round(np.mod(angle_rad, 2 * np.pi), 9)).size
     return int(min(MAX_HARMONIC, max(0, (distinct - 1) // 2)))
 
@@ -450,8 +453,8 @@ class OrientationFamily:
         probes = []
         labels = [self.table.angle_label(k) for k in range(1, data.n_joints + 1)]
         for var, phi in zip(labels, data.joint_rad.T, strict=True):
-            for k in range(1, _max_order(phi) + 1):
-                plot = (var, phi, _harmonic(k), DEG_PER_RAD, "deg")
+            for k in range(1, max_harmonic_order(phi) + 1):
+                plot = (var, phi, harmonic_basis(k), DEG_PER_RAD, "deg")
                 shape = f"{k}/rev in {var}"
                 spec = f"h{k}({var})"
                 probes += self._error_probes(
@@ -467,8 +470,8 @@ class OrientationFamily:
                 a, b = data.joint_rad[:, i], data.joint_rad[:, j]
                 for sign, combined in (("+", a + b), ("-", a - b)):
                     label = f"{labels[i]}{sign}{labels[j]}"
-                    for k in range(1, min(2, _max_order(combined)) + 1):
-                        plot = (label, combined, _harmonic(k), DEG_PER_RAD, "deg")
+                    for k in range(1, min(2, max_harmonic_order(combined)) + 1):
+                        plot = (label, combined, harmonic_basis(k), DEG_PER_RAD, "deg")
                         probes += self._measured_angle_probes(
                             f"{k}/rev in {label}",
                             f"a {k}/rev term in {label} of {{angle}} itself",
@@ -477,7 +480,7 @@ class OrientationFamily:
                             f"h{k}({label})",
                         )
         if data.time_s is not None and np.ptp(data.time_s) > 0:
-            plot = ("time_s", data.time_s, _polynomial(data.time_s), 1.0, "s")
+            plot = ("time_s", data.time_s, polynomial_basis(data.time_s), 1.0, "s")
             probes += self._measured_angle_probes(
                 "drift in time",
                 "a drift with time (quadratic over the run) in {angle}",
@@ -500,7 +503,7 @@ class OrientationFamily:
         for column, values in data.extra.items():
             if not np.ptp(values) > 0:
                 continue
-            plot = (column, values, _polynomial(values), 1.0, "")
+            plot = (column, values, polynomial_basis(values), 1.0, "")
             text = f"term linear and quadratic in {column}"
             spec = f"poly2({column})"
             probes += self._error_probes(along, f"in {column}", text, plot, spec, unseen, alike)

@@ -23,6 +23,15 @@ def _rms_key(summary: dict) -> str:
     return next(k for k in summary if k.startswith("rms_"))
 
 
+_FORMAT = {"arcsec": ".3f", "dph": ".3g"}
+"""How an rms is printed in each observation unit (arc seconds to 0.001; deg/h to 3 digits)."""
+
+
+def _unit(d: dict) -> str:
+    """The observations' unit of a diagnosis dict (``arcsec``, ``dph``)."""
+    return _rms_key(d["base"])[len("rms_") :]
+
+
 def _term_words(term: dict) -> str:
     return f"{term['term']} ({term['amplitude']:.3g} {term['unit']})"
 
@@ -114,15 +123,17 @@ def _verdict_headline(d: dict) -> str:
 def header_lines(d: dict) -> list[str]:
     """The data, the base fit and the table of candidates."""
     lines = []
+    unit = _unit(d)
     sig = (
-        "from the sigma_arcsec column"
+        f"from the sigma_{unit} column"
         if d["sigma_source"] == "column"
-        else f"estimated from the best fit: {d['sigma_arcsec']:.3g} arcsec"
+        else f"estimated from the best fit: {d[f'sigma_{unit}']:.3g} {unit}"
     )
-    lines.append(f"{d['n_positions']} positions, {d['n_observations']} angles; noise {sig}")
+    what = "outputs" if unit == "dph" else "angles"
+    lines.append(f"{d['n_positions']} positions, {d['n_observations']} {what}; noise {sig}")
     b = d["base"]
     lines.append(
-        f"base model: rms {b['rms_arcsec']:.3f} arcsec, chi2_reduced "
+        f"base model: rms {b[f'rms_{unit}']:{_FORMAT[unit]}} {unit}, chi2_reduced "
         f"{b['chi2_reduced']:.3f}, {b['n_params']} parameters of rank {b['rank']}"
         + (f", p-value {b['p_value']:.3g}" if b["p_value"] is not None else "")
     )
@@ -148,7 +159,7 @@ def header_lines(d: dict) -> list[str]:
             alt += "  parameters not determined"
         lines.append(
             f"  {c['effect']:26s} delta_bic {c['delta_bic']:10.1f}  rms "
-            f"{c['rms_arcsec']:.3f}  chi2_red {c['chi2_reduced']:.3f}"
+            f"{c[f'rms_{unit}']:{_FORMAT[unit]}}  chi2_red {c['chi2_reduced']:.3f}"
             f"{'  *' if accepted else ''}{alt}"
         )
     lines.append("  (* in the final model)")
@@ -162,9 +173,11 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
     lines = []
     if d["steps"]:
         for i, s in enumerate(d["steps"], 1):
+            unit = _unit(d)
             lines.append(
                 f"step {i}: add {s['added']} (delta_bic {s['delta_bic']:.1f}) -> rms "
-                f"{s['rms_arcsec']:.3f} arcsec, chi2_reduced {s['chi2_reduced']:.3f}"
+                f"{s[f'rms_{unit}']:{_FORMAT[unit]}} {unit}, chi2_reduced "
+                f"{s['chi2_reduced']:.3f}"
             )
         story = verdict["effect_story"]
         if verdict["unexplained"]:
@@ -256,7 +269,8 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
     outliers = d.get("outliers", [])
     if outliers:
         shown = ", ".join(
-            f"row {o['row']} {o['angle']} ({o['residual_sigma']:+.1f} sigma)" for o in outliers[:10]
+            f"row {o['row']} {o.get('angle', o.get('output'))} ({o['residual_sigma']:+.1f} sigma)"
+            for o in outliers[:10]
         )
         more = f" and {len(outliers) - 10} more" if len(outliers) > 10 else ""
         lines.append(

@@ -1,0 +1,494 @@
+"""Diagnose a calibration run: is the missing effect the table's or the instrument's?
+
+:class:`RunFamily` is the run's model family for the generic diagnosis
+(:func:`turntable_pin.stats.model_selection.diagnose`): the base is the 2 x 7 drift
+coefficients (eq. 1), the candidates are the run catalogue (:mod:`.effects`: the table's errors
+and effects through eqs. 8-13, and the instrument's own), with the same rules as the orientation
+diagnosis: BIC with the look-elsewhere penalty, determined parameters, alternatives, gross
+outliers left out (per output, groups ``out_x``/``out_y``), a noise level per output channel
+when sigma is not given and the two channels' noise differ, and the structure search.
+
+Probes of the structure search (the shape of what is missing):
+
+- ``out_x k/rev in phiK`` / ``out_y ...``: a harmonic of order k of a joint angle on one output
+  (k = 1 .. 5, fewer with fewer distinct angles), and ``k/rev in phiA+phiB``, ``phiA-phiB``
+  (k = 1, 2);
+- ``dpsi k/rev in phiK`` (and ``dtheta``, ``dgamma``): a harmonic orientation error of the table,
+  through the rate sensitivity;
+- ``out_x drift in time``, ``out_x in <column>``: a quadratic in ``time_s`` or in another numeric
+  column (``temperature_c``...).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
+from ..core.units import DEG_PER_RAD
+from ..measurement.diagnosis import harmonic_basis, max_harmonic_order, polynomial_basis
+from ..measurement.table import measured_table
+from ..model.angles import ANGLE_NAMES
+from ..stats.least_squares import zero_point
+from ..stats.model_selection import Diagnosis, diagnose
+from ..stats.structure_search import Probe, ProbeFactors
+from .effects import run_catalogue
+from .effects.base import RunEffect
+from .model import CHANNELS, RunFit, RunModel, fit_run, reference_coefficients, run_context
+
+__all__ = [
+    "NOISE_PER_CHANNEL_ALPHA",
+    "OUTLIER_RULE",
+    "SEPARATION_CHI2",
+    "RunFamily",
+    "channel_variances",
+    "diagnose_run",
+    "gravity_words",
+]
+
+SEPARATION_CHI2 = 25.0
+"""Noise-free misfit chi2 above which a denser set of positions is said to separate two effects."""
+
+NOISE_PER_CHANNEL_ALPHA = 0.01
+"""Without sigmas, out_x and out_y get their own noise level when an F test of their residual
+variances rejects equal noise at this level."""
+
+NOISE_ITERATIONS = 20
+NOISE_RTOL = 1e-2
+
+OUTLIER_RULE = (
+    "studentized residual |t| = |r| / (s sqrt(1 - h)) above the two-sided normal quantile at "
+    "0.01 / m (m outputs; h the leverage; s the robust scale 1.4826 median |r| / sqrt(1 - h), "
+    "the larger of that of the same output channel and that of both), iterated: the worst "
+    "(|t| at least half the largest) left out, refitted, tested again; first on the base "
+    "model, then on the model with the accepted effects; at most 5 % of the outputs"
+)
+"""The outlier rule of :func:`diagnose_run` in words (``turntable_pin.stats.outliers``)."""
+
+_MAX_SCREEN_ROUNDS = 20
+
+
+def gravity_words(specific_force_g: np.ndarray) -> list[str]:
+    """What the positions never do with gravity, in plain words: a component along the
+    GyroWheel that stays the same at every position, a product that is zero everywhere."""
+    a = np.asarray(specific_force_g, dtype=float)
+    out = []
+    for i, name in enumerate("xyz"):
+        values = a[:, i]
+        if np.ptp(values) < 1e-9:
+            out.append(
+                f"gravity's {name} component along the GyroWheel stays {values[0]:.3g} g at "
+                "every position"
+            )
+    if not out:
+        for (i, j), name in (((0, 1), "ax*ay"), ((0, 2), "ax*az"), ((1, 2), "ay*az")):
+            if np.max(np.abs(a[:, i] * a[:, j])) < 1e-9:
+                out.append(f"the product {name} is zero at every position (gravity never lies "
+                           f"between those two axes: a 90-degree grid)")  # fmt: skip
+    return out
+
+
+class RunFamily:
+    """A calibration run, its 14 coefficients and the run catalogue (a ``ModelFamily``).
+
+    Args:
+        run: the :class:`~turntable_pin.calibration.run.CalibrationRun`.
+        catalogue: the candidate effects (default :func:`~.effects.run_catalogue` of the run's
+            table).
+        mask: (N, 2) the outputs fitted (False: left out as outliers).
+        noise_per_channel: sigma unknown and the channels' noise differ: every model is fitted
+            with a noise level per output estimated with that model, and scored with each level
+            profiled.
+    """
+
+    record_label = "positions"
+    observation_unit = "dph"
+
+    def __init__(
+        self,
+        run,
+        catalogue: Sequence[RunEffect] | None = None,
+        mask: np.ndarray | None = None,
+        noise_per_channel: bool = False,
+    ) -> None:
+        self.run = self.data = run
+        self.table = measured_table(run.table)
+        self.catalogue = tuple(catalogue if catalogue is not None else run_catalogue(self.table))
+        self.n_records = run.n_positions
+        self.mask = np.ones((run.n_positions, 2), bool) if mask is None else mask
+        self.noise_per_channel = noise_per_channel
+        self.sigma_scale = float(np.median(run.sigma_dph)) if run.sigma_dph is not None else 1.0
+        self.context = run_context(run, reference_coefficients(run, self.mask))
+        self._cache: dict[tuple[str, ...], RunFit] = {}
+        self._zero = None
+
+    # ---- fits -------------------------------------------------------------------------------
+    def fit(self, effects: Sequence[RunEffect], noise_variance: float | None = None) -> RunFit:
+        """The fit of the 14 coefficients plus ``effects`` (cached per effect list)."""
+        key = tuple(e.name for e in effects)
+        if key not in self._cache:
+            fit = fit_run(self.run, effects, context=self.context, mask=self.mask,
+                          zero_point=self._zero_point())  # fmt: skip
+            self._cache[key] = self._own_noise(fit) if self.noise_per_channel else fit
+        return self._cache[key]
+
+    def _zero_point(self):
+        """The reduced Jacobian of the base and every testable effect, shared by the fits."""
+        if self._zero is None:
+            testable = [e for e in self.catalogue if not self.untestable_reason(e)]
+            try:
+                model = RunModel(self.context, testable, self.mask)
+            except InputError:
+                return None
+            w = 1.0 / model.sigma if model.sigma is not None else np.ones(model.observed.size)
+            jac = model.jacobian(None) * w[:, None]
+            res = (model.observed - model.predict(np.zeros(model.n_params))) * w
+            self._zero = zero_point(model.parameter_names, [(jac, res, w)])
+        return self._zero
+
+    def _own_noise(self, fit: RunFit) -> RunFit:
+        """``fit`` refitted with the per-channel noise levels it estimates itself."""
+        sigma = None
+        for _ in range(NOISE_ITERATIONS):
+            variance, _, _ = channel_variances(fit)
+            new = np.sqrt(variance)
+            if sigma is not None and np.all(np.abs(new - sigma) <= NOISE_RTOL * sigma):
+                break
+            sigma = new
+            fit = fit_run(self.run, fit.model.effects, context=self.context, mask=self.mask,
+                          channel_sigma=sigma)  # fmt: skip
+        groups = np.broadcast_to(np.arange(2), self.mask.shape)[self.mask]
+        return dataclasses.replace(fit, result=dataclasses.replace(fit.result, noise_groups=groups))
+
+    # ---- what the diagnosis asks ------------------------------------------------------------
+    def untestable_reason(self, effect: RunEffect) -> str | None:
+        """Why ``effect`` cannot be tested here (its columns are missing), or None."""
+        missing = effect.missing_columns(self.run)
+        if missing:
+            return f"needs the column(s) {', '.join(missing)}, absent from the run"
+        return None
+
+    def effect(self, name: str) -> RunEffect:
+        return next(e for e in self.catalogue if e.name == name)
+
+    def describe(self, effect: RunEffect | str) -> dict:
+        """The effect's story, with the side it lives on."""
+        return (self.effect(effect) if isinstance(effect, str) else effect).describe()
+
+    def inputs(self, effect: RunEffect) -> set[str]:
+        """The run columns ``effect`` depends on beyond the joint angles."""
+        return set(effect.required_columns)
+
+    def design_warnings(self, base_fit: RunFit) -> list[str]:
+        """What the positions cannot tell, in plain words: the coefficients they leave
+        undetermined (and the physical reason), too few angles for the harmonic shapes."""
+        out = []
+        undetermined = base_fit.result.undetermined_combinations()
+        if undetermined:
+            why = gravity_words(self.run.inputs.specific_force_g)
+            reason = (
+                f"on these positions {'; '.join(why)}, so "
+                if why
+                else "these positions turn gravity through too few directions, so "
+            )
+            out.append(
+                f"{reason}these coefficients cannot be told apart: "
+                + "; ".join(undetermined[:6])
+                + " (each is fitted as the combination the positions see; an effect that moves "
+                "the outputs the same way is indistinguishable from them)"
+            )
+        wrapped = np.round(np.mod(np.degrees(self.run.joint_rad), 360.0), 6) % 360.0
+        for k in range(wrapped.shape[1]):
+            count = np.unique(wrapped[:, k]).size
+            if 1 < count < 5:
+                out.append(
+                    f"phi{k + 1} takes only {count} distinct angles: k/rev shapes in phi{k + 1} "
+                    "of order (count - 1) / 2 and above cannot be tested"
+                )
+        return out
+
+    # ---- the structure search ---------------------------------------------------------------
+    def _weights(self, fit: RunFit) -> np.ndarray:
+        """(N, 2) the weights of ``fit``'s residuals, 0 where an output was left out."""
+        w = np.zeros(self.mask.shape)
+        w[self.mask] = fit.result.weights
+        return w
+
+    def _probe(self, name, description, factors: ProbeFactors, spec, basis) -> Probe:
+        mask = self.mask.reshape(-1)
+        factors = dataclasses.replace(factors, basis=basis)
+
+        def columns():
+            cols = factors.direction_matrix()[:, :, None] * basis[:, None, :]
+            cols = cols.reshape(-1, cols.shape[-1])
+            return cols if mask.all() else cols[mask]
+
+        return Probe(name, description, columns, 1.0, "deg/h", factors, effect_spec=spec)
+
+    def _shape_probes(self, directions, plot, shape, text, spec) -> list[Probe]:
+        """One probe per direction ``(site, description, (N, 2) direction)`` for one shape."""
+        var, values, functions, scale, unit = plot
+        basis = functions(values)
+        out = []
+        for site, what, direction in directions:
+            factors = ProbeFactors(var, values, functions, direction, scale, unit, self.mask)
+            out.append(self._probe(f"{site} {shape}", f"{text} {what}", factors,
+                                   f"{site}~{spec}", basis))  # fmt: skip
+        return out
+
+    def probes(self, fit: RunFit) -> list[Probe]:
+        """The structure-search probes, weighted like the residuals of ``fit`` (module)."""
+        run = self.run
+        w = self._weights(fit)
+        channels = []
+        for c, name in enumerate(CHANNELS):
+            d = np.zeros_like(w)
+            d[:, c] = w[:, c]
+            channels.append((name, f"on {name} itself", d))
+        sensitivity = fit.model.context.sensitivity
+        angles = [
+            (name, f"of the table's {name}, through the outputs", sensitivity[:, :, a] * w)
+            for a, name in enumerate(ANGLE_NAMES)
+        ]
+        probes = []
+        labels = [f"phi{k}" for k in range(1, run.joint_rad.shape[1] + 1)]
+        for var, phi in zip(labels, run.joint_rad.T, strict=True):
+            for k in range(1, max_harmonic_order(phi) + 1):
+                plot = (var, phi, harmonic_basis(k), DEG_PER_RAD, "deg")
+                probes += self._shape_probes(
+                    channels + angles, plot, f"{k}/rev in {var}", f"a {k}/rev term in {var}",
+                    f"h{k}({var})",
+                )  # fmt: skip
+        for i in range(len(labels)):
+            for j in range(i + 1, len(labels)):
+                a, b = run.joint_rad[:, i], run.joint_rad[:, j]
+                for sign, combined in (("+", a + b), ("-", a - b)):
+                    label = f"{labels[i]}{sign}{labels[j]}"
+                    for k in range(1, min(2, max_harmonic_order(combined)) + 1):
+                        plot = (label, combined, harmonic_basis(k), DEG_PER_RAD, "deg")
+                        probes += self._shape_probes(
+                            channels, plot, f"{k}/rev in {label}", f"a {k}/rev term in {label}",
+                            f"h{k}({label})",
+                        )  # fmt: skip
+        columns = {"time_s": run.time_s, **run.extra}
+        for column, values in columns.items():
+            if values is None or not np.ptp(values) > 0:
+                continue
+            unit = "s" if column == "time_s" else ""
+            plot = (column, values, polynomial_basis(values), 1.0, unit)
+            shape = "drift in time" if column == "time_s" else f"in {column}"
+            probes += self._shape_probes(
+                channels, plot, shape, f"a term linear and quadratic in {column}", "poly2("
+                f"{column})",
+            )  # fmt: skip
+        return probes
+
+    def suspect_probes(self, fit: RunFit) -> list[Probe]:
+        """The probes in inputs other than the joint angles (time, other columns)."""
+        return [
+            p for p in self.probes(fit)
+            if p.factors is not None and not p.factors.variable.startswith("phi")
+        ]  # fmt: skip
+
+    # ---- separation ---------------------------------------------------------------------------
+    def _dense_run(self):
+        """The run's positions replaced by a dense grid over every joint (15 degrees; 30 for
+        three joints), time and extra columns spread over their ranges in random order."""
+        from ..calibration.positions import PositionSet, position_inputs
+        from ..calibration.run import CalibrationRun
+
+        run = self.run
+        n_joints = run.joint_rad.shape[1]
+        positions = PositionSet.grid(30.0 if n_joints > 2 else 15.0, table=run.table)
+        inputs = position_inputs(positions, run.inputs.latitude_rad)
+        n = len(positions)
+        rng = np.random.default_rng(0)
+
+        def spread(v):
+            return None if v is None else rng.permutation(np.linspace(v.min(), v.max(), n))
+
+        extra = {k: spread(v) for k, v in run.extra.items()}
+        dense = CalibrationRun(inputs, np.zeros((n, 2)), None, spread(run.time_s), extra)
+        return dense, positions.name
+
+    def separation(self, fit_a: RunFit, effect_b: RunEffect) -> str:
+        """Whether more positions would separate effect A (fitted) from B, or only another test."""
+        a = fit_a.model.effects[-1]
+        dense, grid = self._dense_run()
+        context = run_context(dense, fit_a.model.context.coefficients)
+        truth = RunModel(context, fit_a.model.effects).full_prediction(fit_a.result.params)
+        sigma = np.sqrt(fit_a.result.noise_variance) * (
+            self.sigma_scale if self.run.sigma_dph is not None else 1.0
+        )
+        try:
+            model = RunModel(context, [*fit_a.model.effects[:-1], effect_b])
+        except InputError as exc:
+            return (
+                f"{effect_b.name} cannot be compared with {a.name} on a dense {grid} "
+                f"({exc.detail}); an independent test tells them apart. For {a.name}: "
+                f"{a.confirm} For {effect_b.name}: {effect_b.confirm}"
+            )
+        jac = model.jacobian(None)
+        target = truth.reshape(-1) - model.predict(np.zeros(model.n_params))
+        coef = np.linalg.lstsq(jac, target, rcond=None)[0]
+        chi2 = float(np.sum((target - jac @ coef) ** 2)) / sigma**2
+        if chi2 > SEPARATION_CHI2:
+            return (
+                f"{effect_b.name} mimics {a.name} on these positions only: on a {grid} "
+                f"({len(truth)} positions) it would leave chi2 = {chi2:.0f} of misfit at the "
+                "same noise, so calibrating at more varied positions separates them"
+            )
+        return (
+            f"{effect_b.name} reproduces the fitted {a.name} at every position of the table "
+            f"(noise-free misfit chi2 = {chi2:.2g} on a {grid}), so no set of positions "
+            f"separates them; an independent test does. For {a.name}: {a.confirm} "
+            f"For {effect_b.name}: {effect_b.confirm}"
+        )
+
+
+def channel_variances(fit: RunFit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(variance deg^2/h^2, counts, degrees of freedom)`` of each output's residuals."""
+    residuals = fit.residuals_dph
+    counts = np.sum(np.isfinite(residuals), axis=0)
+    dof = counts * fit.result.dof / max(fit.result.n_obs, 1)
+    return np.nansum(residuals**2, axis=0) / np.maximum(dof, 1.0), counts, dof
+
+
+def _noise_per_channel(diagnosis: Diagnosis) -> tuple[np.ndarray, str] | None:
+    """Without sigmas: the residual rms of each output under the best model and a sentence,
+    when the two channels' noise differ (F test), else None."""
+    from scipy import special
+
+    variance, counts, dof = channel_variances(diagnosis.best_fit)
+    if min(counts) < 10:
+        return None
+    hi, lo = (0, 1) if variance[0] >= variance[1] else (1, 0)
+    p = 2.0 * float(special.fdtrc(dof[hi], dof[lo], variance[hi] / max(variance[lo], 1e-300)))
+    if p >= NOISE_PER_CHANNEL_ALPHA:
+        return None
+    sigma = np.sqrt(variance)
+    return sigma, (
+        f"sigma not given, and the two outputs' noise differ (estimated out_x {sigma[0]:.3g}, "
+        f"out_y {sigma[1]:.3g} deg/h; F test p < {NOISE_PER_CHANNEL_ALPHA:g}): each output was "
+        "weighted by its own noise, estimated with each model"
+    )
+
+
+def _screen(run, effects, catalogue, first=None) -> tuple[np.ndarray, str | None]:
+    """The outlier cells (N, 2) of ``run`` under base + ``effects`` by the iterated rule."""
+    from ..stats.outliers import MAX_OUTLIER_FRACTION, screen_outliers
+
+    flagged = np.zeros((run.n_positions, 2), bool)
+    total = flagged.size
+    for _ in range(_MAX_SCREEN_ROUNDS):
+        try:
+            fit = first if first is not None and not flagged.any() else None
+            if fit is None:
+                family = RunFamily(run, catalogue, ~flagged)
+                fit = family.fit(effects)
+        except IdentifiabilityError:
+            return np.zeros_like(flagged), None
+        result = fit.result
+        groups = np.broadcast_to(np.arange(2), flagged.shape)[~flagged]
+        span = result.jacobian_weighted @ result.identifiability.basis
+        test = screen_outliers(result.residuals * result.weights, span, groups=groups)
+        if not test.flagged.size:
+            break
+        worst = test.flagged[test.studentized[test.flagged] >= 0.5 * test.studentized.max()]
+        cells = np.flatnonzero(~flagged.reshape(-1))[worst]
+        flagged.reshape(-1)[cells] = True
+        if flagged.sum() > MAX_OUTLIER_FRACTION * total:
+            return np.zeros_like(flagged), (
+                f"the outlier rule would leave out more than {MAX_OUTLIER_FRACTION:.0%} of the "
+                "outputs: these are not a handful of bad points but a model or a noise level "
+                "that does not fit, so none is left out"
+            )
+    return flagged, None
+
+
+def _outlier_records(diagnosis: Diagnosis, run, cells: np.ndarray) -> list[dict]:
+    """``{"row", "output", "residual_sigma"}`` of each outlier cell under the final model."""
+    fit = diagnosis.best_fit
+    residual = run.outputs_dph - fit.fitted_dph
+    if run.sigma_dph is not None:
+        sigma = run.sigma_dph[:, None] * np.sqrt(diagnosis.noise_variance) * np.ones((1, 2))
+    else:
+        sigma = np.full(cells.shape, np.sqrt(diagnosis.noise_variance))
+        if diagnosis.group_variance is not None:
+            sigma = np.broadcast_to(np.sqrt(diagnosis.group_variance), cells.shape)
+    out = [
+        {"row": int(run.rows[i]), "output": CHANNELS[c],
+         "residual_sigma": float(residual[i, c] / sigma[i, c])}
+        for i, c in zip(*np.nonzero(cells), strict=True)
+    ]  # fmt: skip
+    return sorted(out, key=lambda o: -abs(o["residual_sigma"]))
+
+
+def diagnose_run(
+    run,
+    *,
+    until_explained: bool = False,
+    catalogue: Sequence[RunEffect] | None = None,
+    outliers: bool = True,
+) -> Diagnosis:
+    """Diagnose a calibration run against the run catalogue (module docstring).
+
+    Raises:
+        InputError: more rows than ``MAX_DIAGNOSED_ROWS``.
+    """
+    check_count(run.n_positions, MAX_DIAGNOSED_ROWS, "run rows", DIAGNOSIS_ROW_BYTES)
+    catalogue = tuple(catalogue if catalogue is not None else run_catalogue(run.table))
+    diagnosis = _diagnose(run, until_explained, catalogue, outliers)
+    if run.sigma_dph is None:
+        per_channel = _noise_per_channel(diagnosis)
+        if per_channel is not None:
+            _, note = per_channel
+            diagnosis = None
+            diagnosis = _diagnose(run, until_explained, catalogue, outliers, True)
+            diagnosis.warnings.append(note)
+    diagnosis.doubt = _instrument_doubt(diagnosis)
+    return diagnosis
+
+
+def _instrument_doubt(diagnosis: Diagnosis) -> str | None:
+    """With sigma given, a best model still far from the noise: the stated sigma or the run."""
+    best = diagnosis.best_fit.result
+    if not best.sigma_known or best.dof <= 0:
+        return None
+    chi2_reduced = best.rss / best.dof
+    if chi2_reduced <= 9.0:
+        return None
+    return (
+        f"with every accepted effect the residuals are still {chi2_reduced**0.5:.1f} times the "
+        f"stated noise (chi2_reduced {chi2_reduced:.3g}): no catalogued effect of the table or "
+        "the instrument makes this run; is the stated sigma_dph too small, the latitude or the "
+        "table (--urdf) wrong?"
+    )
+
+
+def _diagnose(run, until_explained, catalogue, outliers, per_channel=False) -> Diagnosis:
+    def go(cells):
+        family = RunFamily(run, catalogue, ~cells, per_channel)
+        return diagnose(family, until_explained=until_explained)
+
+    empty = np.zeros((run.n_positions, 2), bool)
+    if not outliers:
+        return go(empty)
+    cells, note = _screen(run, (), catalogue)
+    diagnosis = go(cells)
+    effects = list(diagnosis.best_fit.model.effects)
+    if effects:
+        again, note_again = _screen(run, effects, catalogue)
+        note = note_again or note
+        if not np.array_equal(again, cells):
+            cells = again
+            diagnosis = None
+            diagnosis = go(cells)
+    diagnosis.outliers = _outlier_records(diagnosis, run, cells)
+    diagnosis.outlier_rule = OUTLIER_RULE
+    if note:
+        diagnosis.warnings.append(note)
+    return diagnosis

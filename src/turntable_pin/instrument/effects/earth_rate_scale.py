@@ -1,0 +1,44 @@
+"""A scale factor on the earth-rate term: the GyroWheel's rate gain is not exactly one."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect
+
+__all__ = ["EarthRateScale"]
+
+PPM = 1e-6
+
+
+class EarthRateScale(RunEffect):
+    """``out_c -> out_c + s_c w_c`` (``s_c`` in ppm, ``w_c`` the earth rate along axis c)."""
+
+    name = "earth_rate_scale"
+    side = INSTRUMENT
+    title = "a scale-factor error of the GyroWheel's rate outputs"
+    definition = "out_x += sx wx, out_y += sy wy (ppm of the earth rate along each axis)"
+    explanation = (
+        "Eq. 1 takes the outputs' rate gain as exactly one (ky*iy and kx*ix scaled to deg/h). "
+        "A gain error -- a rotor speed or a pick-off gain off its nominal value -- scales the "
+        "earth rate each axis sees, about 10 deg/h here, by the same fraction at every "
+        "position."
+    )
+    confirm = (
+        "Calibrate the scale factor on a rate table (several rates, both directions): the "
+        "slope of output against rate is the gain. At the earth rate alone, a gain error shows "
+        "as residuals following the earth rate's component along the axis."
+    )
+
+    def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        return tuple(
+            ParameterSpec(axis, "ppm", PPM, f"earth-rate scale error of axis {axis}")
+            for axis in "xy"
+        )
+
+    def columns(self, context: RunContext) -> np.ndarray:
+        w = context.run.inputs.earth_rate_dph
+        out = np.zeros((w.shape[0], 2, 2))
+        out[:, 0, 0] = w[:, 0]
+        out[:, 1, 1] = w[:, 1]
+        return out

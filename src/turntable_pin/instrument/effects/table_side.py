@@ -1,0 +1,118 @@
+"""The table's errors and effects, as a calibration run sees them (eqs. 7-14).
+
+Any orientation error the table's URDF can carry (a base error of
+:class:`~turntable_pin.measurement.table.MeasuredTable`: an orthogonality, a wobble, a
+position error) and any effect of the table's orientation catalogue (encoder and wobble
+harmonics, gravity sag, base tilt...) moves the payload by ``(dpsi, dtheta, dgamma)`` at each
+position; the outputs change by the rate sensitivity times that (:mod:`..sensitivity`). The
+orientation derivatives come from the measurement layer's exact chain
+(:class:`~turntable_pin.measurement.effect_model.OrientationModel`), so every table the
+orientation diagnosis knows is known here, under the same names, prefixed ``table:``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...measurement.effect_model import OrientationModel
+from ...measurement.effects.base import ARCSEC, Effect
+from .base import TABLE, ParameterSpec, RunContext, RunEffect
+
+__all__ = ["PREFIX", "TableEffect", "TableError"]
+
+PREFIX = "table:"
+"""The prefix of the name of a table-side candidate."""
+
+
+def _orientation_jacobian(context: RunContext, table, effects=()) -> np.ndarray:
+    """``d(dpsi, dtheta, dgamma)/d(parameters)`` of the table's base errors and ``effects`` at
+    zero, (N, 3, n) (the base errors' part computed once per run)."""
+    model = OrientationModel(context.variables, tuple(effects), table)
+    return model.jacobian(np.zeros(model.n_params))
+
+
+class TableError(RunEffect):
+    """One of the table's base errors (a constant orientation error of a joint placement).
+
+    Args:
+        table: the :class:`~turntable_pin.measurement.table.MeasuredTable`.
+        error: the base error's name (``deps_x``).
+    """
+
+    side = TABLE
+
+    def __init__(self, table, error: str) -> None:
+        self.table = table
+        self.error = error
+        self.name = f"{PREFIX}{error}"
+        what = table.descriptions.get(error, error)
+        self.title = f"the table's {what}"
+        self.definition = (
+            f"{error} (arcsec) in the table's joint placements: the payload turns by "
+            f"d(dpsi, dtheta, dgamma)/d{error} x {error} at each position; the outputs by the "
+            "rate sensitivity times that (eqs. 8-13)"
+        )
+        self.explanation = (
+            f"The turntable's {what} turns the payload away from the attitude the calibration "
+            "assumes, so the GyroWheel sees gravity and the earth rate along slightly other "
+            "directions than eq. 3 says. The drift coefficients absorb what moves the outputs "
+            "like a change of the coefficients; the rest is left in the residuals with the "
+            "pattern of this error over the positions."
+        )
+        self.confirm = (
+            "Measure the table's orientation errors directly (autocollimator and polygon, or "
+            f"an inclinometer on the payload) and fit them: `turntable-pin diagnose` of those "
+            f"measurements names {error} when it is there; or calibrate again with the table's "
+            "error compensated in the positions (eq. 3 computed from the measured attitude)."
+        )
+
+    def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        return (ParameterSpec("value", "arcsec", ARCSEC, f"{self.error}: the table error"),)
+
+    def columns(self, context: RunContext) -> np.ndarray:
+        key = ("table_base", id(self.table))
+        if key not in context.memo:
+            context.memo[key] = _orientation_jacobian(context, self.table)
+        jac = context.memo[key]
+        k = self.table.base_names.index(self.error)
+        return np.einsum("nca,na->nc", context.sensitivity, jac[:, :, k])[:, :, None]
+
+
+class TableEffect(RunEffect):
+    """An effect of the table's orientation catalogue (wobble or encoder harmonics, gravity
+    sag...), seen through the outputs.
+
+    Args:
+        table: the :class:`~turntable_pin.measurement.table.MeasuredTable`.
+        effect: the orientation :class:`~turntable_pin.measurement.effects.base.Effect`.
+    """
+
+    side = TABLE
+
+    def __init__(self, table, effect: Effect) -> None:
+        self.table = table
+        self.effect = effect
+        self.name = f"{PREFIX}{effect.name}"
+        self.title = f"the table's {effect.title}"
+        self.definition = (
+            f"{effect.definition}; the outputs change by the rate sensitivity times the "
+            "orientation it adds (eqs. 8-13)"
+        )
+        self.explanation = effect.explanation
+        self.confirm = effect.confirm
+        self.required_columns = tuple(effect.required_columns)
+
+    def missing_columns(self, run) -> tuple[str, ...]:
+        from ..model import run_variables
+
+        return self.effect.missing_columns(run_variables(run))
+
+    def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        from ..model import run_variables
+
+        return tuple(self.effect.parameters(run_variables(run)))
+
+    def columns(self, context: RunContext) -> np.ndarray:
+        jac = _orientation_jacobian(context, self.table, (self.effect,))
+        own = jac[:, :, len(self.table.base_names) :]
+        return np.einsum("nca,nap->ncp", context.sensitivity, own)
