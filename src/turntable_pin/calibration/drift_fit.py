@@ -57,6 +57,7 @@ __all__ = [
     "calibrate_run",
     "check_identifiable",
     "fit_axis",
+    "gravity_words",
     "require_identifiable",
     "simulate_run",
     "write_simulated_run",
@@ -216,11 +217,39 @@ def check_identifiable(design: np.ndarray, axis: str, positions: PositionSet) ->
                     f"{v:.3g}*D{axis}{n}" for v, n in zip(null, names, strict=True) if abs(v) > 1e-6
                 )
             )
+        why = gravity_words(design[:, 1:4])
+        physics = (
+            f"on these positions {' and '.join(why)}, so some coefficients cannot be told apart"
+            if why
+            else "these positions turn gravity through too few directions, so some coefficients "
+            "cannot be told apart"
+        )
         raise IdentifiabilityError(
-            f"axis {axis}: the positions give A of rank {rank} < 7; they cannot determine "
-            f"{'; '.join(combos)} (choose positions where those regressors vary independently)"
+            f"axis {axis}: {physics} (the positions give A of rank {rank} < 7; they cannot "
+            f"determine {'; '.join(combos)}); choose positions where those regressors vary "
+            "independently"
         )
     return rank
+
+
+def gravity_words(specific_force_g: np.ndarray) -> list[str]:
+    """What a set of positions never does with gravity, in plain words: a component along the
+    GyroWheel that stays the same at every position, or a product of two that is zero at every
+    position (gravity never between those axes)."""
+    a = np.asarray(specific_force_g, dtype=float)
+    out = [
+        f"gravity's {name} component along the GyroWheel stays {a[0, i]:.3g} g at every position"
+        for i, name in enumerate("xyz")
+        if np.ptp(a[:, i]) < 1e-9
+    ]
+    if not out:
+        for (i, j), name in (((0, 1), "ax*ay"), ((0, 2), "ax*az"), ((1, 2), "ay*az")):
+            if np.max(np.abs(a[:, i] * a[:, j])) < 1e-9:
+                out.append(
+                    f"the product {name} is zero at every position (gravity never lies between "
+                    "those two axes, as on a 90-degree grid)"
+                )
+    return [w.replace("stays -0 g", "stays 0 g") for w in out]
 
 
 def fit_axis(

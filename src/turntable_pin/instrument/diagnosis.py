@@ -26,6 +26,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..calibration.drift_fit import gravity_words
 from ..core.exceptions import IdentifiabilityError, InputError
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from ..core.units import DEG_PER_RAD
@@ -46,7 +47,6 @@ __all__ = [
     "RunFamily",
     "channel_variances",
     "diagnose_run",
-    "gravity_words",
 ]
 
 SEPARATION_CHI2 = 25.0
@@ -69,26 +69,6 @@ OUTLIER_RULE = (
 """The outlier rule of :func:`diagnose_run` in words (``turntable_pin.stats.outliers``)."""
 
 _MAX_SCREEN_ROUNDS = 20
-
-
-def gravity_words(specific_force_g: np.ndarray) -> list[str]:
-    """What the positions never do with gravity, in plain words: a component along the
-    GyroWheel that stays the same at every position, a product that is zero everywhere."""
-    a = np.asarray(specific_force_g, dtype=float)
-    out = []
-    for i, name in enumerate("xyz"):
-        values = a[:, i]
-        if np.ptp(values) < 1e-9:
-            out.append(
-                f"gravity's {name} component along the GyroWheel stays {values[0]:.3g} g at "
-                "every position"
-            )
-    if not out:
-        for (i, j), name in (((0, 1), "ax*ay"), ((0, 2), "ax*az"), ((1, 2), "ay*az")):
-            if np.max(np.abs(a[:, i] * a[:, j])) < 1e-9:
-                out.append(f"the product {name} is zero at every position (gravity never lies "
-                           f"between those two axes: a 90-degree grid)")  # fmt: skip
-    return out
 
 
 class RunFamily:
