@@ -11,6 +11,7 @@ from ..calibration.positions import PositionSet, position_inputs
 from ..calibration.rate_error import DEFINITIONS, rate_error
 from ..calibration.requirement import orientation_requirement
 from ..calibration.site import DEFAULT_LATITUDE_DEG
+from ..core.exceptions import InputError
 from ..core.units import deg_to_rad
 from ..model.angles import ANGLE_NAMES, ANGLE_SYMBOLS
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
@@ -105,6 +106,42 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     c.add_argument("run", type=input_path, metavar="RUN.csv")
     _add_setup_options(c, positions=False)
     c.add_argument("--json", action="store_true", help="print one JSON object")
+    c.add_argument(
+        "--diagnose", action="store_true",
+        help="is it the table or the instrument? test every candidate effect of the run (the "
+        "table's errors and effects through eqs. 8-13; the instrument's tilt, heading, bias "
+        "drift, temperature coefficient, earth-rate scale, g-squared terms) and name what is "
+        "missing, verdict first",
+    )  # fmt: skip
+    c.add_argument(
+        "--effects", action="append", default=[], metavar="A,B",
+        help="fit the coefficients with these effects added and show the residuals before and "
+        "after: run catalogue names (instrument_tilt, bias_drift, table:deps_x, ...) and inline "
+        "terms (out_x~h2(phi1), out_y~poly2(time_s), dpsi~h1(phi2)); comma-separated, "
+        "repeatable",
+    )  # fmt: skip
+    c.add_argument(
+        "--until-explained",
+        action="store_true",
+        help="with --diagnose: name every effect the stepwise search accepts",
+    )
+    c.add_argument(
+        "--keep-outliers",
+        action="store_true",
+        help="with --diagnose: keep every output (no outlier rule)",
+    )
+    c.add_argument(
+        "--plots",
+        type=Path,
+        metavar="DIR",
+        help="with --diagnose or --effects: residual plots (PNG) before and after",
+    )
+    c.add_argument(
+        "--report",
+        type=Path,
+        metavar="OUT.html",
+        help="with --diagnose: one self-contained HTML page with the whole story",
+    )
     c.set_defaults(func=run_calibrate)
 
 
@@ -206,9 +243,115 @@ def run_requirement(args: argparse.Namespace) -> int:
 
 def run_calibrate(args: argparse.Namespace) -> int:
     table = table_from_args(args)
+    only = [(f"--{k.replace('_', '-')}", getattr(args, k)) for k in
+            ("until_explained", "keep_outliers", "report")]  # fmt: skip
+    if not args.diagnose:
+        for option, value in only:
+            if value:
+                raise InputError(f"{option} goes with --diagnose")
+        if args.plots and not args.effects:
+            raise InputError("--plots goes with --diagnose or --effects")
+    elif args.effects:
+        raise InputError(
+            "--diagnose names what is missing from the base model; --effects fits a model you "
+            "choose: give one of them"
+        )
+    if args.diagnose:
+        return _diagnose_run(args, table)
+    if args.effects:
+        return _fit_run_effects(args, table)
     result = calibrate_run(args.run, deg_to_rad(args.latitude_deg), table)
     if args.json:
         print_json({**result.to_dict(), **_table_keys(table)})
     else:
         print(result.report())
+    return 0
+
+
+def _read_run(args: argparse.Namespace, table):
+    from ..calibration.run import read_run, refuse_copied_rows
+
+    run = read_run(args.run, deg_to_rad(args.latitude_deg), table)
+    refuse_copied_rows(run)
+    return run
+
+
+def _diagnose_run(args: argparse.Namespace, table) -> int:
+    from ..instrument.diagnosis import diagnose_run, run_diagnosis_dict
+    from ..report.run_report import run_report_lines, write_run_plots, write_run_report
+
+    run = _read_run(args, table)
+    diagnosis = diagnose_run(
+        run, until_explained=args.until_explained, outliers=not args.keep_outliers
+    )
+    out = {**run_diagnosis_dict(diagnosis), **_table_keys(table)}
+    if args.plots:
+        out["plots"] = [str(p) for p in write_run_plots(diagnosis, args.plots)]
+    if args.report:
+        title = f"Calibration run {Path(args.run).name}: the table or the GyroWheel?"
+        out["report"] = str(write_run_report(diagnosis, out, args.report, title=title))
+    if args.json:
+        print_json(out)
+        return 0
+    _print_table(table)
+    print("\n".join(run_report_lines(out)))
+    for path in [*out.get("plots", []), *([out["report"]] if "report" in out else [])]:
+        print(f"wrote {path}")
+    return 0
+
+
+def _fit_run_effects(args: argparse.Namespace, table) -> int:
+    from ..instrument.effects import resolve_run_effects
+    from ..instrument.model import fit_run
+    from ..instrument.residuals import run_residuals
+    from ..measurement.residuals import analyse_residuals
+    from ..report.measurement_figures import write_residual_plots
+
+    run = _read_run(args, table)
+    names = [n for group in args.effects for n in group.split(",") if n.strip()]
+    effects = resolve_run_effects(names, table)
+    for effect in effects:
+        missing = effect.missing_columns(run)
+        if missing:
+            raise InputError(
+                f"effect '{effect.name}' needs the column(s) {', '.join(missing)}, absent "
+                "from the run", path=args.run,
+            )  # fmt: skip
+    after = fit_run(run, effects)
+    before = fit_run(run, (), context=after.model.context)
+    before = before.with_noise_variance(after.result.noise_variance)
+    out = {"run": str(args.run), **after.to_dict(), **_table_keys(table)}
+    out["before"] = {k: before.result.to_dict()[k] for k in
+                     ("rms_dph", "chi2_reduced", "p_value", "rank", "n_params")}  # fmt: skip
+    analysis = analyse_residuals(run_residuals(after))
+    out["where_it_fails"] = analysis.to_dict()
+    if args.plots:
+        sets = [run_residuals(before), run_residuals(after)]
+        out["plots"] = [str(p) for p in write_residual_plots(sets, args.plots)]
+    if args.json:
+        print_json(out)
+        return 0
+    _print_table(table)
+    sigma = "from the sigma_dph column" if out["sigma_source"] == "column" else "estimated"
+    print(f"{args.run}: {run.n_positions} positions, noise {sigma}")
+    for label, summary in (("before: base", out["before"]),
+                           ("after: base + " + " + ".join(after.effect_names), out)):  # fmt: skip
+        p = summary["p_value"]
+        print(f"  {label:44s} rms {summary['rms_dph']:.4g} deg/h   chi2_reduced "
+              f"{summary['chi2_reduced']:.3f}   rank {summary['rank']}/{summary['n_params']}"
+              + (f"   p {p:.3g}" if p is not None else ""))  # fmt: skip
+    print("effect parameters (value +- std):")
+    for name, entry in out["params"].items():
+        if "." in name:
+            std = "not determined alone" if entry["std"] is None else f"+- {entry['std']:.3g}"
+            print(f"  {name:40s} {entry['value']:12.5g} {std} {entry['unit']}")
+    for axis, terms in out["coefficients_dph"].items():
+        print(f"axis {axis}: " + ", ".join(f"D{axis}{k} = {v['value']:.6g}"
+                                           for k, v in terms.items()))  # fmt: skip
+    undetermined = after.result.undetermined_combinations()
+    if undetermined:
+        print("not determined by this run: " + "; ".join(undetermined[:6]))
+    print(f"outputs beyond 3 sigma after: {len(analysis.failing)}")
+    for path in out.get("plots", []):
+        print(f"wrote {path}")
     return 0

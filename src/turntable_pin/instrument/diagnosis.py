@@ -47,6 +47,8 @@ __all__ = [
     "RunFamily",
     "channel_variances",
     "diagnose_run",
+    "run_diagnosis_dict",
+    "run_diagnosis_residuals",
 ]
 
 SEPARATION_CHI2 = 25.0
@@ -472,3 +474,41 @@ def _diagnose(run, until_explained, catalogue, outliers, per_channel=False) -> D
     if note:
         diagnosis.warnings.append(note)
     return diagnosis
+
+
+def run_diagnosis_residuals(diagnosis: Diagnosis):
+    """The residual sets of a run diagnosis' base and best fits, judged with its noise."""
+    from .residuals import run_residuals
+
+    return tuple(
+        run_residuals(fit.with_noise_variance(diagnosis.noise_variance))
+        for fit in (diagnosis.base_fit, diagnosis.best_fit)
+    )
+
+
+def run_diagnosis_dict(diagnosis: Diagnosis) -> dict:
+    """The structured result of a run diagnosis that the text, JSON and HTML views render:
+    the diagnosis dict, the side of every candidate and of the verdict (``table`` or
+    ``instrument``), the calibrated coefficients of the best model and what the run tells
+    about the table (:mod:`.table_errors`)."""
+    from .table_errors import table_from_run
+
+    family = diagnosis.family
+    run = family.run
+    out = diagnosis.to_dict()
+    verdict = out["verdict"]
+    sides = {e.name: e.side for e in family.catalogue}
+    verdict["sides"] = sides
+    named = verdict["missing_effects"]
+    verdict["side"] = (
+        None if not named else sides[named[0]] if len({sides[n] for n in named}) == 1 else "both"
+    )
+    best = diagnosis.best_fit.with_noise_variance(diagnosis.noise_variance)
+    out["coefficients_dph"] = best.to_dict()["coefficients_dph"]
+    out["refit_command"] = "calibrate"
+    out["source"] = run.source
+    out["latitude_deg"] = float(np.degrees(run.inputs.latitude_rad))
+    out["table_from_run"] = table_from_run(
+        run, family.table, mask=family.mask, context=family.context
+    ).to_dict()
+    return out

@@ -52,6 +52,16 @@ class TableFromRun:
     per_error: dict[str, dict]
     sigma_dph: float
 
+    @property
+    def absorbed(self) -> list[dict]:
+        """``{error, correlation}`` of the errors the calibration mostly absorbs (multiple
+        correlation with the coefficients above :data:`ABSORBED_CORRELATION`)."""
+        return [
+            {"error": name, "correlation": entry["correlation"]}
+            for name, entry in self.per_error.items()
+            if entry["correlation"] > ABSORBED_CORRELATION
+        ]
+
     def to_dict(self) -> dict:
         """The findings as a JSON-ready dict."""
         return {
@@ -61,37 +71,10 @@ class TableFromRun:
             "with_coefficients": [dict(c) for c in self.with_coefficients],
             "undetermined": list(self.undetermined),
             "per_error": {k: dict(v) for k, v in self.per_error.items()},
+            "absorbed": self.absorbed,
+            "absorbed_above": ABSORBED_CORRELATION,
             "sigma_dph": self.sigma_dph,
         }
-
-    def lines(self) -> list[str]:
-        """The findings in words."""
-        out = [
-            f"the table from the run: its {len(self.errors)} errors add {self.rank_added} "
-            f"combination(s) the outputs determine (noise {self.sigma_dph:.3g} deg/h)"
-        ]
-        for c in self.determined:
-            out.append(f"  {c['name']} = {c['value']:.3g} +- {c['std']:.2g} {c['unit']}")
-        if self.with_coefficients:
-            out.append(
-                "  not told apart from the instrument's coefficients (determined only together "
-                "with them): " + "; ".join(c["name"] for c in self.with_coefficients[:6])
-            )
-        absorbed = [
-            f"{name} ({entry['correlation']:.2f})"
-            for name, entry in self.per_error.items()
-            if entry["correlation"] > ABSORBED_CORRELATION
-        ]
-        if absorbed:
-            out.append(
-                "  mostly absorbed by the coefficients (correlation with them above "
-                f"{ABSORBED_CORRELATION:g}; the calibration takes them for instrument terms): "
-                + ", ".join(absorbed)
-            )
-        if self.undetermined:
-            out.append("  not seen at all (only their sums above are): "
-                       + "; ".join(self.undetermined[:6]))  # fmt: skip
-        return out
 
 
 def table_from_run(run, table=None, *, mask=None, context=None) -> TableFromRun:

@@ -27,6 +27,14 @@ _FORMAT = {"arcsec": ".3f", "dph": ".3g"}
 """How an rms is printed in each observation unit (arc seconds to 0.001; deg/h to 3 digits)."""
 
 
+_SIDE_WORDS = {
+    "table": "the table (its error reaches the outputs through the payload's attitude, eqs. 8-13)",
+    "instrument": "the instrument (the GyroWheel itself, not the table)",
+    "both": "the table and the instrument (the effects named are on both sides)",
+}
+"""The verdict's side in words (calibration runs: ``verdict.side``)."""
+
+
 def _unit(d: dict) -> str:
     """The observations' unit of a diagnosis dict (``arcsec``, ``dph``)."""
     return _rms_key(d["base"])[len("rms_") :]
@@ -94,8 +102,11 @@ def _verdict_headline(d: dict) -> str:
             f"{_number(base['chi2_reduced'])} -> {_number(best['chi2_reduced'])}"
         )
         loose = verdict.get("named_undetermined", {})
+        sides = verdict.get("sides", {})
         named = " + ".join(
-            e + (f" (parameters not determined: {_short(loose[e])})" if e in loose else "")
+            e
+            + (f" [{sides[e]}]" if e in sides else "")
+            + (f" (parameters not determined: {_short(loose[e])})" if e in loose else "")
             for e in effects
         ) + (f" (also significant: {', '.join(also)})" if also else "")
         if verdict["unexplained"]:
@@ -187,6 +198,9 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
             )
         else:
             lines.append(f"missing effect: {verdict['missing_effect']} ({story['title']})")
+        side = verdict.get("side")
+        if side:
+            lines.append(f"  side: {_SIDE_WORDS.get(side, side)}")
         lines.append(f"  why: {story['explanation']}")
         lines.append(f"  confirm on the machine: {story['confirm']}")
         for name, entries in verdict.get("named_parameters", {}).items():
@@ -263,7 +277,10 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
         specs = [t["effect_spec"] for t in structure if t.get("effect_spec")]
         if specs:
             effects = [*d.get("best", {}).get("effects", []), *specs]
-            lines.append("  fit with what remains: " + fit_command(data, effects))
+            lines.append(
+                "  fit with what remains: "
+                + fit_command(data, effects, d.get("refit_command", "fit"))
+            )
     else:
         lines.append("unexplained: no (the residuals are consistent with the noise)")
     outliers = d.get("outliers", [])
@@ -288,11 +305,12 @@ def _settle(commands: dict, name: str) -> list[str]:
     return [f"    to settle it, design the next positions: {commands[name]}"]
 
 
-def fit_command(data: str, specs: list[str]) -> str:
-    """The ``turntable-pin fit`` command that adds the inline terms ``specs`` to the model."""
+def fit_command(data: str, specs: list[str], command: str = "fit") -> str:
+    """The ``turntable-pin fit`` command (``calibrate`` for a run) that adds the inline terms
+    ``specs`` to the model."""
     import shlex
 
-    return f"turntable-pin fit {shlex.quote(data)} --effects {shlex.quote(','.join(specs))}"
+    return f"turntable-pin {command} {shlex.quote(data)} --effects {shlex.quote(','.join(specs))}"
 
 
 def diagnosis_lines(d: dict, data: str = "DATA.csv") -> list[str]:

@@ -1,0 +1,182 @@
+"""The diagnosis of a calibration run in words, figures and one HTML page.
+
+Three views of one structured result
+(:func:`~turntable_pin.instrument.diagnosis.run_diagnosis_dict`): the text opens with the
+verdict (which effect is missing, on the table's side or the instrument's); the HTML page tells
+the same story with the residuals against each joint angle, time and temperature before and
+after; the figures are written once by :func:`write_run_plots`.
+"""
+
+from __future__ import annotations
+
+import html
+from pathlib import Path
+
+from ..core.files import write_text_atomic
+from .diagnosis_text import diagnosis_lines, headline, verdict_lines
+from .html_report import _STYLE, _img, _table
+from .measurement_figures import (
+    harmonics_figure,
+    residual_figure,
+    structure_term_figure,
+    write_residual_plots,
+    write_structure_plots,
+)
+
+__all__ = ["coefficient_lines", "run_diagnosis_html", "run_report_lines", "write_run_plots",
+           "write_run_report"]  # fmt: skip
+
+
+def coefficient_lines(d: dict) -> list[str]:
+    """The calibrated coefficients of the best model, both axes (deg/h-based units)."""
+    lines = ["coefficients of the final model (value +- std):"]
+    for axis, terms in d["coefficients_dph"].items():
+        for name, entry in terms.items():
+            std = "-" if entry["std"] is None else f"{entry['std']:.3g}"
+            lines.append(f"  D{axis}{name:3s} = {entry['value']:12.6f} +- {std} {entry['unit']}")
+    return lines
+
+
+def _table_lines(d: dict) -> list[str]:
+    t = d["table_from_run"]
+    lines = [
+        f"the table from the run: its {len(t['errors'])} errors add {t['rank_added']} "
+        f"combination(s) the outputs determine (noise {t['sigma_dph']:.3g} deg/h):"
+    ]
+    lines += [f"  {c['name']} = {c['value']:.3g} +- {c['std']:.2g} {c['unit']}"
+              for c in t["determined"]]  # fmt: skip
+    absorbed = [f"{a['error']} ({a['correlation']:.2f})" for a in t["absorbed"]]
+    if t["with_coefficients"]:
+        lines.append("  determined only together with the instrument's coefficients: "
+                     + "; ".join(c["name"] for c in t["with_coefficients"][:6]))  # fmt: skip
+    if absorbed:
+        lines.append(f"  mostly absorbed by the coefficients (correlation > "
+                     f"{t['absorbed_above']:g}: the calibration takes them for instrument terms): "
+                     + ", ".join(absorbed))  # fmt: skip
+    if t["undetermined"]:
+        lines.append("  not seen at all (only the sums above are): "
+                     + "; ".join(t["undetermined"][:6]))  # fmt: skip
+    return lines
+
+
+def run_report_lines(d: dict) -> list[str]:
+    """The whole run diagnosis in words: verdict first, then the candidates, the verdict's
+    reasons, the coefficients and what the run tells about the table."""
+    data = d.get("source") or "RUN.csv"
+    return [*diagnosis_lines(d, data=data), *coefficient_lines(d), *_table_lines(d)]
+
+
+def write_run_plots(diagnosis, directory: str | Path) -> list[Path]:
+    """Residuals against each joint angle, time and extra columns (before and after), their
+    harmonics, the residual maps, and each structure term, as PNGs into ``directory``."""
+    from ..instrument.diagnosis import run_diagnosis_residuals
+
+    base, best = run_diagnosis_residuals(diagnosis)
+    sets = [base, best] if diagnosis.steps else [base]
+    return [*write_residual_plots(sets, directory), *write_structure_plots(diagnosis.structure,
+                                                                           directory)]  # fmt: skip
+
+
+def run_diagnosis_html(diagnosis, d: dict, *, title: str = "") -> str:
+    """The self-contained HTML page of a run diagnosis (``d``: its structured result)."""
+    from ..instrument.diagnosis import run_diagnosis_residuals
+    from ..measurement.residuals import analyse_residuals
+
+    verdict = d["verdict"]
+    base_rs, best_rs = run_diagnosis_residuals(diagnosis)
+    explained = not verdict["unexplained"]
+    parts = [f"<h1>{html.escape(title or 'GyroWheel calibration run diagnosis')}</h1>"]
+    parts.append(
+        f'<p class="verdict headline{"" if explained else " warn"}">{html.escape(headline(d))}</p>'
+    )
+    sigma = (
+        "from the file's <code>sigma_dph</code> column"
+        if d["sigma_source"] == "column"
+        else f"not given: estimated, {d['sigma_dph']:.3g} deg/h"
+    )
+    parts.append(
+        f"<p>Run <code>{html.escape(str(d.get('source') or ''))}</code>: {d['n_positions']} "
+        f"positions, {d['n_observations']} outputs, latitude {d['latitude_deg']:g} deg; noise "
+        f"{sigma}.</p>"
+    )
+    parts += [f'<p class="verdict warn">warning: {html.escape(w)}</p>' for w in d["warnings"]]
+    parts.append(
+        "<h2>1. The base model: eq. 1's 2 x 7 coefficients</h2>"
+        + _table(
+            ["model", "rms (deg/h)", "chi2_reduced", "rank", "params"],
+            [
+                [
+                    "base",
+                    d["base"]["rms_dph"],
+                    d["base"]["chi2_reduced"],
+                    d["base"]["rank"],
+                    d["base"]["n_params"],
+                ]
+            ],
+        )  # fmt: skip
+    )
+    if not verdict["missing_effect"]:
+        parts.append(_img(residual_figure([base_rs]), "base residuals"))
+    parts.append("<h2>2. Which effect is missing: the table or the instrument?</h2>")
+    parts.append(
+        _table(
+            ["effect", "side", "delta BIC", "rms (deg/h)", "chi2_reduced", "new rank", "same as"],
+            [
+                [
+                    c["effect"],
+                    verdict["sides"].get(c["effect"], ""),
+                    "-" if c["delta_bic"] is None else f"{c['delta_bic']:.1f}",
+                    "-" if c["rms_dph"] is None else c["rms_dph"],
+                    "-" if c["chi2_reduced"] is None else c["chi2_reduced"],
+                    c["added_rank"] if c["testable"] else "-",
+                    ", ".join(c["alternatives"]),
+                ]
+                for c in d["candidates"]
+            ],
+        )  # fmt: skip
+    )
+    words = "<br>".join(html.escape(line) for line in verdict_lines(d, d.get("source") or ""))
+    parts.append(f'<div class="verdict{"" if explained else " warn"}">{words}</div>')
+    for term in diagnosis.structure:
+        parts.append(f"<p><b>{html.escape(term.name)}</b>: {html.escape(term.description)}</p>")
+        if term.factors is not None and term.residual_weighted is not None:
+            parts.append(_img(structure_term_figure(term), f"structure: {term.name}"))
+    if verdict["missing_effect"]:
+        parts.append(
+            "<h2>3. Add it and watch the error fall</h2>"
+            + _table(
+                ["model", "rms (deg/h)", "chi2_reduced", "rank", "params"],
+                [
+                    [
+                        "base",
+                        d["base"]["rms_dph"],
+                        d["base"]["chi2_reduced"],
+                        d["base"]["rank"],
+                        d["base"]["n_params"],
+                    ]
+                ]
+                + [
+                    [f"+ {s['added']}", s["rms_dph"], s["chi2_reduced"], s["rank"], s["n_params"]]
+                    for s in d["steps"]
+                ],
+            )  # fmt: skip
+            + _img(residual_figure([base_rs, best_rs]), "residuals before and after")
+            + _img(
+                harmonics_figure([analyse_residuals(base_rs), analyse_residuals(best_rs)]),
+                "harmonics before and after",
+            )
+        )
+    parts.append("<h2>4. Coefficients and the table</h2><p>"
+                 + "<br>".join(html.escape(x) for x in coefficient_lines(d)) + "</p><p>"
+                 + "<br>".join(html.escape(x) for x in _table_lines(d)) + "</p>")  # fmt: skip
+    body = "\n".join(parts)
+    return (
+        "<!DOCTYPE html><html><head><meta charset='utf-8'>"
+        f"<title>{html.escape(title or 'turntable-pin run report')}</title><style>{_STYLE}"
+        f"</style></head><body>{body}</body></html>\n"
+    )
+
+
+def write_run_report(diagnosis, d: dict, path: str | Path, *, title: str = "") -> Path:
+    """Write :func:`run_diagnosis_html` to ``path`` atomically."""
+    return write_text_atomic(path, run_diagnosis_html(diagnosis, d, title=title))
