@@ -296,32 +296,45 @@ class RunFamily:
         dense = CalibrationRun(inputs, np.zeros((n, 2)), None, spread(run.time_s), extra)
         return dense, positions.name
 
+    def misfit(self, fit_a: RunFit, effect_b: RunEffect, dense: bool) -> float:
+        """The noise-free chi2 left when the model with ``effect_b`` instead of ``fit_a``'s last
+        effect is fitted to ``fit_a``'s prediction: on the run's positions, or (``dense``) on a
+        dense grid over every joint (:meth:`_dense_run`). Raises :class:`InputError` when
+        ``effect_b`` cannot be evaluated there (a column the grid has not)."""
+        if dense:
+            run, _ = self._dense_run()
+            context = run_context(run, fit_a.model.context.coefficients)
+            mask = None
+        else:
+            context, mask = fit_a.model.context, self.mask
+        truth = RunModel(context, fit_a.model.effects, mask).predict(fit_a.result.params)
+        model = RunModel(context, [*fit_a.model.effects[:-1], effect_b], mask)
+        jac = model.jacobian(None)
+        target = truth - model.predict(np.zeros(model.n_params))
+        w = 1.0 / model.sigma if model.sigma is not None and not dense else 1.0
+        coef = np.linalg.lstsq(jac * np.reshape(w, (-1, 1)), target * w, rcond=None)[0]
+        sigma = np.sqrt(fit_a.result.noise_variance)
+        if dense:
+            sigma *= self.sigma_scale
+        return float(np.sum(((target - jac @ coef) * w) ** 2)) / sigma**2
+
     def separation(self, fit_a: RunFit, effect_b: RunEffect) -> str:
         """Whether more positions would separate effect A (fitted) from B, or only another test."""
         a = fit_a.model.effects[-1]
-        dense, grid = self._dense_run()
-        context = run_context(dense, fit_a.model.context.coefficients)
-        truth = RunModel(context, fit_a.model.effects).full_prediction(fit_a.result.params)
-        sigma = np.sqrt(fit_a.result.noise_variance) * (
-            self.sigma_scale if self.run.sigma_dph is not None else 1.0
-        )
+        _, grid = self._dense_run()
         try:
-            model = RunModel(context, [*fit_a.model.effects[:-1], effect_b])
+            chi2 = self.misfit(fit_a, effect_b, dense=True)
         except InputError as exc:
             return (
                 f"{effect_b.name} cannot be compared with {a.name} on a dense {grid} "
                 f"({exc.detail}); an independent test tells them apart. For {a.name}: "
                 f"{a.confirm} For {effect_b.name}: {effect_b.confirm}"
             )
-        jac = model.jacobian(None)
-        target = truth.reshape(-1) - model.predict(np.zeros(model.n_params))
-        coef = np.linalg.lstsq(jac, target, rcond=None)[0]
-        chi2 = float(np.sum((target - jac @ coef) ** 2)) / sigma**2
         if chi2 > SEPARATION_CHI2:
             return (
-                f"{effect_b.name} mimics {a.name} on these positions only: on a {grid} "
-                f"({len(truth)} positions) it would leave chi2 = {chi2:.0f} of misfit at the "
-                "same noise, so calibrating at more varied positions separates them"
+                f"{effect_b.name} mimics {a.name} on these positions only: on a {grid} it would "
+                f"leave chi2 = {chi2:.0f} of misfit at the same noise, so calibrating at more "
+                "varied positions separates them"
             )
         return (
             f"{effect_b.name} reproduces the fitted {a.name} at every position of the table "
@@ -329,6 +342,39 @@ class RunFamily:
             f"separates them; an independent test does. For {a.name}: {a.confirm} "
             f"For {effect_b.name}: {effect_b.confirm}"
         )
+
+    def other_side(self, fit_a: RunFit) -> list[dict]:
+        """The effects of the other side that move the outputs like ``fit_a``'s last effect on
+        this run's positions (noise-free misfit chi2 below :data:`SEPARATION_CHI2`): for an
+        instrument effect, the table's errors together (``table:errors``) and each table
+        effect; for a table effect, each instrument effect. Each entry: ``effect``,
+        ``chi2_run``, ``chi2_dense`` (None when it cannot be evaluated on the grid) and the
+        ``words`` of :meth:`separation`."""
+        from .effects import TABLE
+        from .effects.table_side import TableErrors
+
+        a = fit_a.model.effects[-1]
+        if a.side == TABLE:
+            rivals = [e for e in self.catalogue if e.side != TABLE]
+        else:
+            rivals = [TableErrors(self.table), *(e for e in self.catalogue if e.side == TABLE)]
+        out = []
+        for b in rivals:
+            if self.untestable_reason(b):
+                continue
+            try:
+                chi2_run = self.misfit(fit_a, b, dense=False)
+            except InputError:
+                continue
+            if chi2_run > SEPARATION_CHI2:
+                continue
+            try:
+                chi2_dense = self.misfit(fit_a, b, dense=True)
+            except InputError:
+                chi2_dense = None
+            out.append({"effect": b.name, "side": b.side, "chi2_run": chi2_run,
+                        "chi2_dense": chi2_dense, "words": self.separation(fit_a, b)})  # fmt: skip
+        return sorted(out, key=lambda e: e["chi2_run"])
 
 
 def channel_variances(fit: RunFit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -506,8 +552,14 @@ def run_diagnosis_dict(diagnosis: Diagnosis) -> dict:
     best = diagnosis.best_fit.with_noise_variance(diagnosis.noise_variance)
     out["coefficients_dph"] = best.to_dict()["coefficients_dph"]
     out["refit_command"] = "calibrate"
+    out["base_label"] = "the coefficients"
     out["source"] = run.source
     out["latitude_deg"] = float(np.degrees(run.inputs.latitude_rad))
+    if diagnosis.steps:
+        first = family.fit(diagnosis.best_fit.model.effects[:1])
+        verdict["other_side"] = family.other_side(first)
+    else:
+        verdict["other_side"] = []
     out["table_from_run"] = table_from_run(
         run, family.table, mask=family.mask, context=family.context
     ).to_dict()

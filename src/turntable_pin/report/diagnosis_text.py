@@ -64,7 +64,7 @@ def _short(names: list[str]) -> str:
     return ", ".join(n.rsplit(".", 1)[-1] for n in names)
 
 
-def _parameter_words(entry: dict) -> str:
+def _parameter_words(entry: dict, base: str = "the base errors") -> str:
     """``c1 = -57.3 +- 37.4 arcsec (correlation with the base errors 0.91)``."""
     name = entry["name"].rsplit(".", 1)[-1]
     if entry["std"] is None:
@@ -72,7 +72,7 @@ def _parameter_words(entry: dict) -> str:
     mark = "" if entry["determined"] else ", not determined"
     return (
         f"{name} = {entry['value']:.3g} +- {entry['std']:.2g} {entry['unit']} (correlation "
-        f"with the base errors {entry['correlation']:.2f}{mark})"
+        f"with {base} {entry['correlation']:.2f}{mark})"
     )
 
 
@@ -206,7 +206,10 @@ def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
         for name, entries in verdict.get("named_parameters", {}).items():
             if entries:
                 lines.append(
-                    f"  {name} parameters: " + "; ".join(_parameter_words(e) for e in entries)
+                    f"  {name} parameters: "
+                    + "; ".join(
+                        _parameter_words(e, d.get("base_label", "the base errors")) for e in entries
+                    )  # fmt: skip
                 )
         for name, loose in verdict.get("named_undetermined", {}).items():
             lines.append(

@@ -23,8 +23,14 @@ from .measurement_figures import (
     write_structure_plots,
 )
 
-__all__ = ["coefficient_lines", "run_diagnosis_html", "run_report_lines", "write_run_plots",
-           "write_run_report"]  # fmt: skip
+__all__ = [
+    "coefficient_lines",
+    "other_side_lines",
+    "run_diagnosis_html",
+    "run_report_lines",
+    "write_run_plots",
+    "write_run_report",
+]
 
 
 def coefficient_lines(d: dict) -> list[str]:
@@ -59,11 +65,36 @@ def _table_lines(d: dict) -> list[str]:
     return lines
 
 
+def other_side_lines(d: dict) -> list[str]:
+    """The effects of the other side (table vs instrument) that move the outputs like the one
+    named, on the run's positions: the confounded explanations, and what would separate them."""
+    verdict = d["verdict"]
+    rivals = verdict.get("other_side", [])
+    if not verdict["missing_effect"]:
+        return []
+    other = "instrument" if verdict["side"] == "table" else "table"
+    if not rivals:
+        return [
+            f"the other side: no effect of the {other} moves the outputs like "
+            f"{verdict['missing_effect']} on these positions"
+        ]
+    lines = [
+        f"the other side: on these positions, {len(rivals)} effect(s) of the "
+        f"{other} move the outputs like "
+        f"{verdict['missing_effect']} (confounded: the run alone cannot say which side it is):"
+    ]
+    lines += [f"  {r['effect']} (noise-free misfit chi2 {r['chi2_run']:.2g} here): {r['words']}"
+              for r in rivals]  # fmt: skip
+    return lines
+
+
 def run_report_lines(d: dict) -> list[str]:
     """The whole run diagnosis in words: verdict first, then the candidates, the verdict's
-    reasons, the coefficients and what the run tells about the table."""
+    reasons, the confounded explanations of the other side, the coefficients and what the run
+    tells about the table."""
     data = d.get("source") or "RUN.csv"
-    return [*diagnosis_lines(d, data=data), *coefficient_lines(d), *_table_lines(d)]
+    return [*diagnosis_lines(d, data=data), *other_side_lines(d), *coefficient_lines(d),
+            *_table_lines(d)]  # fmt: skip
 
 
 def write_run_plots(diagnosis, directory: str | Path) -> list[Path]:
@@ -135,7 +166,8 @@ def run_diagnosis_html(diagnosis, d: dict, *, title: str = "") -> str:
             ],
         )  # fmt: skip
     )
-    words = "<br>".join(html.escape(line) for line in verdict_lines(d, d.get("source") or ""))
+    lines = [*verdict_lines(d, d.get("source") or ""), *other_side_lines(d)]
+    words = "<br>".join(html.escape(line) for line in lines)
     parts.append(f'<div class="verdict{"" if explained else " warn"}">{words}</div>')
     for term in diagnosis.structure:
         parts.append(f"<p><b>{html.escape(term.name)}</b>: {html.escape(term.description)}</p>")

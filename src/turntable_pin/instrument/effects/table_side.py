@@ -18,7 +18,7 @@ from ...measurement.effect_model import OrientationModel
 from ...measurement.effects.base import ARCSEC, Effect
 from .base import TABLE, ParameterSpec, RunContext, RunEffect
 
-__all__ = ["PREFIX", "TableEffect", "TableError"]
+__all__ = ["PREFIX", "TableEffect", "TableError", "TableErrors"]
 
 PREFIX = "table:"
 """The prefix of the name of a table-side candidate."""
@@ -29,6 +29,14 @@ def _orientation_jacobian(context: RunContext, table, effects=()) -> np.ndarray:
     zero, (N, 3, n) (the base errors' part computed once per run)."""
     model = OrientationModel(context.variables, tuple(effects), table)
     return model.jacobian(np.zeros(model.n_params))
+
+
+def _base_jacobian(context: RunContext, table) -> np.ndarray:
+    """The orientation Jacobian (N, 3, n_base) of the table's base errors, once per run."""
+    key = ("table_base", id(table))
+    if key not in context.memo:
+        context.memo[key] = _orientation_jacobian(context, table)
+    return context.memo[key]
 
 
 class TableError(RunEffect):
@@ -70,10 +78,7 @@ class TableError(RunEffect):
         return (ParameterSpec("value", "arcsec", ARCSEC, f"{self.error}: the table error"),)
 
     def columns(self, context: RunContext) -> np.ndarray:
-        key = ("table_base", id(self.table))
-        if key not in context.memo:
-            context.memo[key] = _orientation_jacobian(context, self.table)
-        jac = context.memo[key]
+        jac = _base_jacobian(context, self.table)
         k = self.table.base_names.index(self.error)
         return np.einsum("nca,na->nc", context.sensitivity, jac[:, :, k])[:, :, None]
 
@@ -116,3 +121,34 @@ class TableEffect(RunEffect):
         jac = _orientation_jacobian(context, self.table, (self.effect,))
         own = jac[:, :, len(self.table.base_names) :]
         return np.einsum("nca,nap->ncp", context.sensitivity, own)
+
+
+class TableErrors(RunEffect):
+    """All of the table's base errors at once (``table:errors``): what any rigid error set of
+    the URDF does to the outputs. Not a catalogue candidate (it would pay for every error);
+    the diagnosis asks it whether an instrument effect is one the table's errors make too."""
+
+    side = TABLE
+    name = f"{PREFIX}errors"
+    title = "the table's errors (any rigid error set of its URDF)"
+    definition = "every base error of the table at once, through eqs. 8-13"
+    explanation = (
+        "Any set of the table's constant errors (orthogonality, wobble constants, position "
+        "offsets) turns the payload by a pattern over the positions fixed by the URDF."
+    )
+    confirm = (
+        "Measure the table's orientation errors directly (autocollimator and polygon, or an "
+        "inclinometer on the payload) and diagnose them with `turntable-pin diagnose`."
+    )
+
+    def __init__(self, table) -> None:
+        self.table = table
+
+    def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        return tuple(
+            ParameterSpec(name, "arcsec", ARCSEC, self.table.descriptions.get(name, name))
+            for name in self.table.base_names
+        )
+
+    def columns(self, context: RunContext) -> np.ndarray:
+        return np.einsum("nca,nap->ncp", context.sensitivity, _base_jacobian(context, self.table))
