@@ -57,9 +57,14 @@ def test_a_masked_output_is_left_out_of_the_fit():
     assert np.max(np.abs(fit.coefficients_dph - BETA)) < 0.01
 
 
-@pytest.mark.parametrize("effect, values", [("bias_drift", (0.004, -0.003)),
-                                            ("instrument_tilt", (60.0, -40.0)),
-                                            ("g_squared_terms", (0.03, 0.0, 0.0, -0.02))])  # fmt: skip
+@pytest.mark.parametrize(
+    "effect, values",
+    [
+        ("bias_drift", (0.004, -0.003)),
+        ("instrument_tilt", (60.0, -40.0)),
+        ("g_squared_terms", (0.03, 0.0, 0.0, -0.02)),
+    ],
+)
 def test_an_effect_in_the_data_comes_back_with_its_values(effect, values):
     run = _clean_run()
     n = run.n_positions
