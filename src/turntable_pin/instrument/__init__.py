@@ -27,12 +27,16 @@ _EXPORTS = {
     "RunFamily": "diagnosis",
     "RunFit": "model",
     "RunModel": "model",
+    "SimulatedRun": "simulate",
+    "TemperatureProfile": "simulate",
     "TableFromRun": "table_errors",
     "diagnose_run": "diagnosis",
     "fit_run": "model",
     "rate_sensitivity_dph": "sensitivity",
     "run_catalogue": "effects",
+    "simulate_calibration_run": "simulate",
     "table_from_run": "table_errors",
+    "temperature_profile": "simulate",
 }
 
 __all__ = sorted(_EXPORTS)
