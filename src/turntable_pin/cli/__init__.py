@@ -139,6 +139,7 @@ def main(argv: list[str] | None = None) -> int:
         # --help lists every command from the table alone; an unknown command: argparse's message.
         parser = _parser(set()) if command is None else build_parser(command)
         args = parser.parse_args(argv)
+        args.argv = tuple(argv)  # the command line as given (a simulation records it)
         command = args.command
         from .common import refuse_inputs_as_outputs  # no output may be one of the inputs
 

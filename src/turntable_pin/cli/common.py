@@ -257,7 +257,7 @@ def print_json(payload: dict) -> None:
     sys.stdout.write("\n")
 
 
-OUTPUT_OPTIONS: tuple[str, ...] = ("output", "plots", "write_urdf")
+OUTPUT_OPTIONS: tuple[str, ...] = ("output", "plots", "write_urdf", "truth")
 """Destinations of the options through which a command writes (a file, or a folder of files)."""
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import shlex
 from pathlib import Path
 
 from ..core.exceptions import InputError
@@ -102,7 +103,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="record only seed, noise and schedule, not the errors and effects (blind rehearsal)",
     )
     s.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.csv")
-    s.set_defaults(func=run_simulate)
+    _add_run_options(s)
+    s.set_defaults(
+        func=run_simulate,
+        orientation_defaults={d: s.get_default(d) for d in ORIENTATION_ONLY_OPTIONS},
+    )
 
     f = subparsers.add_parser(
         "fit",
@@ -163,6 +168,94 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     r.add_argument("-o", "--output", type=Path, required=True, metavar="report.html")
     _add_catalogue_option(r)
     r.set_defaults(func=run_report)
+
+
+RUN_ONLY_OPTIONS: tuple[str, ...] = (
+    "noise_dph", "latitude_deg", "gyrowheel", "temperature", "outliers", "outlier_dph", "truth",
+)  # fmt: skip
+"""The ``simulate`` options of a calibration run (``--run``) alone."""
+ORIENTATION_ONLY_OPTIONS: tuple[str, ...] = (
+    "noise_arcsec", "noise_spread", "phi1_step_deg", "phi2_step_deg", "phi3_step_deg",
+    "phi1_start_deg", "phi2_start_deg", "phi3_start_deg", "sweep", "order", "repeats", "passes",
+    "approach",
+)  # fmt: skip
+"""The ``simulate`` options of orientation measurements alone (refused with ``--run``)."""
+
+
+def _add_run_options(s: argparse.ArgumentParser) -> None:
+    """The options of ``simulate --run``: a GyroWheel calibration run (``docs/measurements.md``,
+    "GyroWheel calibration runs") instead of orientation measurements."""
+    from ..calibration.site import DEFAULT_LATITUDE_DEG
+    from .common import latitude_deg
+
+    g = s.add_argument_group(
+        "calibration run (--run)",
+        "with --run, simulate a GyroWheel calibration run: the outputs out_x_dph, out_y_dph at "
+        "each position through the exact chain of the table's errors and effects, with the "
+        "instrument effects of --effect (instrument_mount:mx,my,mz arcsec; bias_drift:x,y "
+        "deg/h per h; temperature_coefficient:x,y deg/h/degC; earth_rate_scale:x,y ppm; "
+        "g_squared_terms:x_xz,x_yz,y_xz,y_yz deg/h/g^2); --positions takes a scheme "
+        "(grid:STEP, grid:S1xS2; default grid:30) or a CSV of angles",
+    )
+    g.add_argument("--run", action="store_true",
+                   help="simulate a GyroWheel calibration run (what calibrate reads)")  # fmt: skip
+    g.add_argument("--truth", type=Path, metavar="OUT.yaml",
+                   help="also write the truth (and this command) as YAML: the key to a blind run "
+                   "made with --hide-truth")  # fmt: skip
+    g.add_argument("--noise-dph", type=_noise_dph, metavar="S|SX,SY",
+                   help="1-sigma output noise, deg/h: one value for both channels or x,y "
+                   "(default 0.002)")  # fmt: skip
+    g.add_argument("--latitude-deg", type=latitude_deg,
+                   help=f"site latitude, degrees (default {DEFAULT_LATITUDE_DEG})")  # fmt: skip
+    g.add_argument("--gyrowheel", type=input_path, metavar="FILE.yaml",
+                   help="the true drift coefficients (default: paper Table 1)")  # fmt: skip
+    g.add_argument("--temperature", type=_temperature, metavar="START,RAMP_PER_H,SWING,PERIOD_H",
+                   help="a temperature_c column: START degC + RAMP_PER_H degC/h * t + SWING degC "
+                   "* sin(2 pi t / PERIOD_H h)")  # fmt: skip
+    g.add_argument("--outliers", type=_non_negative_int, metavar="N",
+                   help="N rows (seeded) get a gross error on one channel")  # fmt: skip
+    g.add_argument("--outlier-dph", type=positive_float, metavar="D",
+                   help="size of an outlier, deg/h (default 30 sigma of its channel)")  # fmt: skip
+
+
+def _noise_dph(text: str) -> float | tuple[float, float]:
+    """argparse type of ``--noise-dph``: one number >= 0 or two (x, y), deg/h."""
+    from ..calibration.run import MAX_RUN_OUTPUT_DPH
+
+    parse = bounded_float(0.0, MAX_RUN_OUTPUT_DPH / 100.0, "deg/h")
+    parts = text.split(",")
+    if len(parts) == 1:
+        return parse(text)
+    if len(parts) != 2:
+        raise argparse.ArgumentTypeError(
+            f"expected one value or two (x,y), got {len(parts)}: '{text}'"
+        )
+    return tuple(parse(p.strip()) for p in parts)
+
+
+def _temperature(text: str) -> tuple[float, float, float, float]:
+    """argparse type of ``--temperature``: four numbers START,RAMP_PER_H,SWING,PERIOD_H."""
+    parts = text.split(",")
+    if len(parts) != 4:
+        raise argparse.ArgumentTypeError(
+            f"expected START,RAMP_PER_H,SWING,PERIOD_H (degC, degC/h, degC, h), got '{text}'"
+        )
+    start = bounded_float(-100.0, 200.0, "degC")(parts[0].strip())
+    ramp = bounded_float(-100.0, 100.0, "degC/h")(parts[1].strip())
+    swing = bounded_float(-100.0, 100.0, "degC")(parts[2].strip())
+    period = bounded_float(0.0, 1e4, "h", low_open=True)(parts[3].strip())
+    return start, ramp, swing, period
+
+
+def _non_negative_int(text: str) -> int:
+    """argparse type: a whole number >= 0."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got '{text}'")
+    return value
 
 
 def _noise_arcsec(text: str) -> float | tuple[float, float, float]:
@@ -269,7 +362,108 @@ def _parse_effect_options(texts: list[str], table=None, user=()) -> dict[str, di
     return effects
 
 
+def _option(dest: str) -> str:
+    return "--" + dest.replace("_", "-")
+
+
 def run_simulate(args: argparse.Namespace) -> int:
+    if args.run:
+        return run_simulate_run(args)
+    given = [d for d in RUN_ONLY_OPTIONS if getattr(args, d) is not None]
+    if given:
+        raise InputError(
+            f"{_option(given[0])} is an option of a calibration run; add --run, or leave it out"
+        )
+    return _run_simulate_orientation(args)
+
+
+def run_simulate_run(args: argparse.Namespace) -> int:
+    """``simulate --run``: a GyroWheel calibration run CSV (``calibrate`` reads it)."""
+    from ..calibration.gyrowheel import GyroWheelModel
+    from ..calibration.positions import PositionSet
+    from ..calibration.site import DEFAULT_LATITUDE_DEG
+    from ..core.units import deg_to_rad
+    from ..instrument.simulate import (
+        INSTRUMENT_EFFECTS,
+        TemperatureProfile,
+        random_positions,
+        simulate_calibration_run,
+    )
+    from ..measurement.user_effects import inline_effect, load_catalogue, resolve_effects
+
+    # A default given explicitly changes nothing and passes.
+    defaults = args.orientation_defaults
+    refused = [d for d in ORIENTATION_ONLY_OPTIONS if getattr(args, d) != defaults[d]]
+    if refused:
+        raise InputError(
+            f"{_option(refused[0])} is an option of orientation measurements, not of a "
+            "calibration run (--run); leave it out"
+        )
+    table = table_from_args(args)
+    user = load_catalogue(args.catalogue, table)
+    table_effects: dict[str, dict[str, float]] = {}
+    instrument: dict[str, dict[str, float]] = {}
+
+    def resolve(name: str):
+        if name.strip() in INSTRUMENT_EFFECTS:
+            return INSTRUMENT_EFFECTS[name.strip()]
+        try:
+            return resolve_effects([name], table, user)[0]
+        except InputError as exc:
+            raise InputError(
+                f"{exc.detail}; instrument effects: {', '.join(INSTRUMENT_EFFECTS)}"
+            ) from None
+
+    for text in args.effect:
+        try:
+            name, params = parse_effect_spec(text, resolve)
+        except InputError as exc:
+            raise InputError(f"--effect '{text}': {exc.detail}") from None
+        into = instrument if name in INSTRUMENT_EFFECTS else table_effects
+        if name in into:
+            raise InputError(f"--effect '{text}': effect '{name}' is given twice")
+        into[name] = params
+    user = (*user, *(inline_effect(name, table) for name in table_effects if "~" in name))
+    if args.random_positions:
+        positions = random_positions(args.random_positions, table, args.seed)
+    else:
+        positions = PositionSet.parse(
+            "grid:30" if args.positions is None else str(args.positions), table
+        )
+    noise = 0.002 if args.noise_dph is None else args.noise_dph
+    latitude = DEFAULT_LATITUDE_DEG if args.latitude_deg is None else args.latitude_deg
+    gyrowheel = GyroWheelModel.from_yaml(args.gyrowheel) if args.gyrowheel else None
+    temperature = TemperatureProfile(*args.temperature) if args.temperature else None
+    errors = error_values_from_args(table, args)
+    sim = simulate_calibration_run(
+        positions,
+        deg_to_rad(latitude),
+        gyrowheel=gyrowheel,
+        table_errors_rad=dict(zip(table.parameter_names, errors, strict=True)),
+        table_effects=table_effects,
+        instrument=instrument,
+        noise_dph=noise,
+        dwell_s=args.dwell_s,
+        temperature_c=temperature,
+        outliers=args.outliers or 0,
+        outlier_dph=args.outlier_dph,
+        seed=args.seed,
+        catalogue=user,
+    )
+    path = sim.write_csv(args.output, hide_truth=args.hide_truth, with_sigma=not args.no_sigma)
+    print(f"wrote {path}: {sim.n_positions} positions, seed {sim.seed}")
+    if args.truth is not None:
+        argv = list(getattr(args, "argv", ()))
+        if "--truth" in argv:  # the truth file is no part of what made the data
+            del argv[argv.index("--truth") : argv.index("--truth") + 2]
+        argv = [a for a in argv if not a.startswith("--truth=")]
+        command = "turntable-pin " + shlex.join(argv) if argv else ""
+        truth = sim.write_truth(args.truth, data=Path(path).name, command=command)
+        print(f"wrote {truth}")
+    return 0
+
+
+def _run_simulate_orientation(args: argparse.Namespace) -> int:
     from ..measurement.simulation import (
         MAX_NOISE_ARCSEC,
         Schedule,

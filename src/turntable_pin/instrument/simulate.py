@@ -225,7 +225,7 @@ def random_positions(n: int, table, seed: int) -> PositionSet:
         raise InputError(f"random positions: expected N >= 1, got {n}")
     rng = np.random.default_rng([seed, 1])
     angles = np.round(rng.uniform(0.0, 360.0, (int(n), len(table.joint_names))), 6)
-    return PositionSet(deg_to_rad(angles), table=table, name=f"random:{n} (seed {seed})")
+    return PositionSet(deg_to_rad(angles), table=table, name=f"random:{n}")
 
 
 @dataclass(frozen=True)
@@ -556,7 +556,7 @@ def simulate_calibration_run(
         "table_effects": effects,
         "instrument_effects": {
             k: {p: v for p, v in ps.items() if v} for k, ps in instrument.items()
-        },  # fmt: skip
+        },
         "instrument_units": {k: INSTRUMENT_EFFECTS[k].unit for k in instrument},
         "temperature_profile": None if profile is None else profile.to_dict(),
         "outliers": outlier_rows,
