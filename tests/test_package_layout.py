@@ -24,6 +24,7 @@ LAYER_RANK = {
     "measurement": 4,
     "allocation": 4,
     "design": 5,
+    "instrument": 5,
     "report": 6,
     "viewer": 5,
     "cli": 7,
