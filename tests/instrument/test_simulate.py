@@ -265,3 +265,12 @@ def test_make_runs_script_lists_every_run():
     script = (REPO_DIR / "models" / "examples" / "runs" / "make_runs.sh").read_text()
     for path in RUNS:
         assert f"make {path.stem} " in script
+
+
+def test_cli_run_on_a_three_axis_table_with_a_table_effect(tmp_path):
+    out = tmp_path / "three.csv"
+    result = cli("simulate", "--run", "--urdf", "three_axis_imu_table", "--positions", "grid:45",
+                 "--error", "middle_gimbal.tilt_a=10", "--effect", "instrument_mount:mz=30",
+                 "--effect", "wobble_harmonics@inner_gimbal:a_c1=5", "-o", str(out))  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert cli("calibrate", str(out), "--urdf", "three_axis_imu_table").returncode == 0

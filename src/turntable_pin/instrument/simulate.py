@@ -385,6 +385,12 @@ def _table_rotation_errors(
                 f"table effect '{effect.name}' is given without parameters, so it would "
                 "simulate nothing; give at least one"
             )
+        missing = effect.missing_columns(variables)
+        if missing:
+            raise InputError(
+                f"table effect '{effect.name}' needs {', '.join(missing)}, which a simulated "
+                "calibration run does not have (it has time_s only)"
+            )
         objects.append(effect)
         effects[effect.name] = {str(k): float(v) for k, v in params.items()}
     model = OrientationModel(variables, objects, measured)
