@@ -384,7 +384,7 @@ def run_simulate_run(args: argparse.Namespace) -> int:
     from ..calibration.site import DEFAULT_LATITUDE_DEG
     from ..core.units import deg_to_rad
     from ..instrument.simulate import (
-        INSTRUMENT_EFFECTS,
+        SIMULATED_INSTRUMENT_EFFECTS,
         TemperatureProfile,
         random_positions,
         simulate_calibration_run,
@@ -405,13 +405,13 @@ def run_simulate_run(args: argparse.Namespace) -> int:
     instrument: dict[str, dict[str, float]] = {}
 
     def resolve(name: str):
-        if name.strip() in INSTRUMENT_EFFECTS:
-            return INSTRUMENT_EFFECTS[name.strip()]
+        if name.strip() in SIMULATED_INSTRUMENT_EFFECTS:
+            return SIMULATED_INSTRUMENT_EFFECTS[name.strip()]
         try:
             return resolve_effects([name], table, user)[0]
         except InputError as exc:
             raise InputError(
-                f"{exc.detail}; instrument effects: {', '.join(INSTRUMENT_EFFECTS)}"
+                f"{exc.detail}; instrument effects: {', '.join(SIMULATED_INSTRUMENT_EFFECTS)}"
             ) from None
 
     for text in args.effect:
@@ -419,7 +419,7 @@ def run_simulate_run(args: argparse.Namespace) -> int:
             name, params = parse_effect_spec(text, resolve)
         except InputError as exc:
             raise InputError(f"--effect '{text}': {exc.detail}") from None
-        into = instrument if name in INSTRUMENT_EFFECTS else table_effects
+        into = instrument if name in SIMULATED_INSTRUMENT_EFFECTS else table_effects
         if name in into:
             raise InputError(f"--effect '{text}': effect '{name}' is given twice")
         into[name] = params

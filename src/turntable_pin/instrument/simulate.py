@@ -11,8 +11,14 @@ check the run diagnosis' first-order columns:
   about payload x, y, z; as row vectors it senses ``a = a0 Rd dR M`` and ``w = w0 Rd dR M``
   (``a0 = (0, 0, 1) g`` and ``w0`` the earth rate in the base frame F0, x north, y west, z up);
 - each channel c (x, y) reads ``(1 + s_c 1e-6) w_c + A_c(a) beta_c`` (eq. 1, Table 1 by
-  default) plus the instrument effects of :data:`INSTRUMENT_EFFECTS` and Gaussian noise; a few
-  seeded rows get a gross outlier on one channel.
+  default) plus the instrument effects of :data:`SIMULATED_INSTRUMENT_EFFECTS` and Gaussian
+  noise; a few seeded rows get a gross outlier on one channel.
+
+The instrument effects carry the names and units of the run diagnosis' catalogue
+(:mod:`turntable_pin.instrument.effects`: ``bias_drift``, ``temperature_coefficient``,
+``earth_rate_scale``, ``g_squared_terms``), except the mount: ``instrument_mount`` is one exact
+rotation ``exp([m]x)``, whose ``mx, my`` the diagnosis names ``instrument_tilt`` and whose ``mz``
+it names ``instrument_heading`` (equal to first order).
 
 The run CSV is the one :func:`~turntable_pin.calibration.run.read_run` reads, with the seed,
 the noise and the positions in ``#`` comment lines and, unless hidden, the truth.
@@ -43,7 +49,7 @@ from ..model.paper_table import is_paper_table
 __all__ = [
     "DEFAULT_DWELL_S",
     "DEFAULT_OUTLIER_SIGMAS",
-    "INSTRUMENT_EFFECTS",
+    "SIMULATED_INSTRUMENT_EFFECTS",
     "MAX_RUN_TIME_S",
     "InstrumentEffect",
     "SimulatedRun",
@@ -93,7 +99,7 @@ class _Parameter:
     unit: str
 
 
-INSTRUMENT_EFFECTS: dict[str, InstrumentEffect] = {
+SIMULATED_INSTRUMENT_EFFECTS: dict[str, InstrumentEffect] = {
     e.name: e
     for e in (
         InstrumentEffect(
@@ -128,20 +134,20 @@ INSTRUMENT_EFFECTS: dict[str, InstrumentEffect] = {
 def check_instrument_effects(
     instrument: Mapping[str, Mapping[str, float]],
 ) -> dict[str, dict[str, float]]:
-    """``{effect: {parameter: value}}`` checked against :data:`INSTRUMENT_EFFECTS` (names known,
-    at least one parameter, finite values within the effect's limit), every parameter filled
-    (zero when not given).
+    """``{effect: {parameter: value}}`` checked against :data:`SIMULATED_INSTRUMENT_EFFECTS`
+    (names known, at least one parameter, finite values within the effect's limit), every
+    parameter filled (zero when not given).
 
     Raises:
         InputError: an unknown effect or parameter (listing the known ones), or a bad value.
     """
     out: dict[str, dict[str, float]] = {}
     for name, params in dict(instrument or {}).items():
-        effect = INSTRUMENT_EFFECTS.get(str(name))
+        effect = SIMULATED_INSTRUMENT_EFFECTS.get(str(name))
         if effect is None:
             raise InputError(
                 f"unknown instrument effect '{name}'; instrument effects: "
-                f"{', '.join(INSTRUMENT_EFFECTS)}"
+                f"{', '.join(SIMULATED_INSTRUMENT_EFFECTS)}"
             )
         if not isinstance(params, Mapping) or not params:
             raise InputError(
@@ -451,8 +457,9 @@ def simulate_calibration_run(
         table_effects: catalogued table effects ``{effect: {parameter: value in its user unit}}``
             (arcsec, arcsec/g, arcsec/h), e.g. ``{"inner_wobble_harmonics": {"x_c1": 15}}``.
         instrument: instrument effects ``{effect: {parameter: value}}`` of
-            :data:`INSTRUMENT_EFFECTS` (mount in arcsec, bias drift in deg/h per h, temperature
-            coefficient in deg/h/degC, earth-rate scale in ppm, g^2 terms in deg/h/g^2).
+            :data:`SIMULATED_INSTRUMENT_EFFECTS` (mount in arcsec, bias drift in deg/h per h,
+            temperature coefficient in deg/h/degC, earth-rate scale in ppm, g^2 terms in
+            deg/h/g^2).
         noise_dph: 1-sigma Gaussian noise of ``out_x, out_y`` (one number for both), deg/h.
         time_s: (N,) time of each row, s; default ``index * dwell_s`` in measurement order.
         dwell_s: time per position when ``time_s`` is not given, s.
@@ -563,7 +570,7 @@ def simulate_calibration_run(
         "instrument_effects": {
             k: {p: v for p, v in ps.items() if v} for k, ps in instrument.items()
         },
-        "instrument_units": {k: INSTRUMENT_EFFECTS[k].unit for k in instrument},
+        "instrument_units": {k: SIMULATED_INSTRUMENT_EFFECTS[k].unit for k in instrument},
         "temperature_profile": None if profile is None else profile.to_dict(),
         "outliers": outlier_rows,
     }
