@@ -110,7 +110,7 @@ def test_a_table_effect_goes_through_the_exact_chain(grid30, clean):
 def test_a_mount_rotation_about_z_changes_out_x_by_the_closed_form(grid30):
     m = arcsec_to_rad(100.0)
     run = simulate_calibration_run(
-        grid30, LATITUDE_RAD, instrument={"instrument_mount": {"mz": 100.0}}
+        grid30, LATITUDE_RAD, instrument={"instrument_heading": {"mz": 100.0}}
     )
     inputs = position_inputs(grid30, LATITUDE_RAD)
     (ax, ay, az), (wx, _, _) = inputs.specific_force_g.T, inputs.earth_rate_dph.T
@@ -176,7 +176,7 @@ def test_seeds_reproduce_and_outliers_are_where_the_truth_says(grid30):
         (dict(table_errors_rad={"deps_z": 1e-5}), "its errors: dphi_y1"),
         (dict(table_effects={"inner_wiggle": {"c1": 1}}), "inner_wiggle"),
         (dict(table_effects={"inner_wobble_harmonics": {"c1": 1}}), "x_c1"),
-        (dict(instrument={"mount": {"mx": 1}}), "instrument effects: instrument_mount"),
+        (dict(instrument={"mount": {"mx": 1}}), "instrument effects: instrument_tilt"),
         (dict(instrument={"bias_drift": {"z": 1}}), "its parameters: x, y"),
         (dict(instrument={"temperature_coefficient": {"x": 1}}), "needs a temperature"),
         (dict(noise_dph=(0.1, 0.2, 0.3)), "one number or two"),
@@ -214,7 +214,7 @@ def test_cli_run_writes_a_file_calibrate_reads(tmp_path):
         (["--run", "--noise-arcsec", "2"], "--noise-arcsec is an option of orientation"),
         (["--noise-dph", "0.01"], "--noise-dph is an option of a calibration run"),
         (["--outliers", "2"], "--outliers is an option of a calibration run"),
-        (["--run", "--effect", "nothing:x=1"], "instrument effects: instrument_mount"),
+        (["--run", "--effect", "nothing:x=1"], "instrument effects: instrument_tilt"),
         (["--run", "--effect", "bias_drift:x=1", "--effect", "bias_drift:y=1"], "twice"),
         (["--run", "--noise-dph", "1,2,3"], "one value or two"),
         (["--run", "--temperature", "20,1"], "START,RAMP_PER_H,SWING,PERIOD_H"),
@@ -270,7 +270,7 @@ def test_make_runs_script_lists_every_run():
 def test_cli_run_on_a_three_axis_table_with_a_table_effect(tmp_path):
     out = tmp_path / "three.csv"
     result = cli("simulate", "--run", "--urdf", "three_axis_imu_table", "--positions", "grid:45",
-                 "--error", "middle_gimbal.tilt_a=10", "--effect", "instrument_mount:mz=30",
+                 "--error", "middle_gimbal.tilt_a=10", "--effect", "instrument_heading:mz=30",
                  "--effect", "wobble_harmonics@inner_gimbal:a_c1=5", "-o", str(out))  # fmt: skip
     assert result.returncode == 0, result.stderr
     assert cli("calibrate", str(out), "--urdf", "three_axis_imu_table").returncode == 0

@@ -16,7 +16,7 @@ make() {
 make run_clean --seed 101
 make run_orthogonality --error deps_x=60 --seed 102
 make run_inner_wobble --effect inner_wobble_harmonics:x_c1=60 --seed 103
-make run_mount --effect instrument_mount:mx=60,my=-40 --seed 104
+make run_mount --effect instrument_tilt:mx=60,my=-40 --seed 104
 make run_bias_drift --effect bias_drift:x=0.004,y=-0.003 --seed 105
 make run_temperature --effect temperature_coefficient:x=0.003 --temperature 20,1,2.5,3 --seed 106
 make run_g_squared --effect g_squared_terms:x_xz=0.03 --seed 107

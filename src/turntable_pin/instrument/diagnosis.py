@@ -154,6 +154,7 @@ class RunFamily:
         return None
 
     def effect(self, name: str) -> RunEffect:
+        """The catalogued effect called ``name``."""
         return next(e for e in self.catalogue if e.name == name)
 
     def describe(self, effect: RunEffect | str) -> dict:

@@ -145,6 +145,7 @@ class RunModel:
 
     @property
     def n_params(self) -> int:
+        """Number of parameters: the 14 coefficients plus the effects'."""
         return len(self.parameter_names)
 
     def predict(self, params) -> np.ndarray:
@@ -176,10 +177,12 @@ class RunFit:
 
     @property
     def run(self):
+        """The fitted run."""
         return self.model.run
 
     @property
     def effect_names(self) -> tuple[str, ...]:
+        """The names of the effects in the model."""
         return self.model.effect_names
 
     @property

@@ -15,10 +15,10 @@ check the run diagnosis' first-order columns:
   noise; a few seeded rows get a gross outlier on one channel.
 
 The instrument effects carry the names and units of the run diagnosis' catalogue
-(:mod:`turntable_pin.instrument.effects`: ``bias_drift``, ``temperature_coefficient``,
-``earth_rate_scale``, ``g_squared_terms``), except the mount: ``instrument_mount`` is one exact
-rotation ``exp([m]x)``, whose ``mx, my`` the diagnosis names ``instrument_tilt`` and whose ``mz``
-it names ``instrument_heading`` (equal to first order).
+(:mod:`turntable_pin.instrument.effects`: ``instrument_tilt`` (``mx, my``),
+``instrument_heading`` (``mz``), ``bias_drift``, ``temperature_coefficient``,
+``earth_rate_scale``, ``g_squared_terms``); the tilt and the heading make one exact rotation
+``exp([m]x)`` here, whose first order is the diagnosis' linear columns.
 
 The run CSV is the one :func:`~turntable_pin.calibration.run.read_run` reads, with the seed,
 the noise and the positions in ``#`` comment lines and, unless hidden, the truth.
@@ -103,9 +103,13 @@ SIMULATED_INSTRUMENT_EFFECTS: dict[str, InstrumentEffect] = {
     e.name: e
     for e in (
         InstrumentEffect(
-            "instrument_mount", ("mx", "my", "mz"), "arcsec", _MOUNT_LIMIT_ARCSEC,
-            "the GyroWheel turned on the payload by exp([m]x), m = (mx, my, mz) about payload "
-            "x, y, z: it senses a M and w M",
+            "instrument_tilt", ("mx", "my"), "arcsec", _MOUNT_LIMIT_ARCSEC,
+            "the GyroWheel tilted on the payload about payload x and y: with the heading, it "
+            "senses a M and w M, M = exp([m]x), m = (mx, my, mz)",
+        ),
+        InstrumentEffect(
+            "instrument_heading", ("mz",), "arcsec", _MOUNT_LIMIT_ARCSEC,
+            "the GyroWheel turned on the payload about payload z (mz of the same M)",
         ),
         InstrumentEffect(
             "bias_drift", ("x", "y"), "deg/h per h", 1e3,
@@ -507,7 +511,9 @@ def simulate_calibration_run(
     table_dR, errors, effects = _table_rotation_errors(
         positions, table_errors_rad or {}, table_effects or {}, time_s, catalogue
     )
-    mount = instrument.get("instrument_mount", {"mx": 0.0, "my": 0.0, "mz": 0.0})
+    mount = {"mx": 0.0, "my": 0.0, "mz": 0.0}
+    for name in ("instrument_tilt", "instrument_heading"):
+        mount.update(instrument.get(name, {}))
     m_rad = {k: v / ARCSEC_PER_RAD for k, v in mount.items()}
     mount_rotation = orientation_error_rotation(m_rad["my"], m_rad["mz"], m_rad["mx"], exact=True)
     chain = inputs.payload_rotation @ table_dR @ mount_rotation

@@ -102,6 +102,8 @@ def _along_error(jac: np.ndarray, w: np.ndarray, e: int):
 
 
 def max_harmonic_order(angle_rad: np.ndarray) -> int:
+    """The highest harmonic order a structure search tries in an angle: at most
+    :data:`MAX_HARMONIC`, and (distinct angles - 1) // 2 (a k/rev term needs 2k + 1 angles)."""
     distinct = np.unique(np.round(np.mod(angle_rad, 2 * np.pi), 9)).size
     return int(min(MAX_HARMONIC, max(0, (distinct - 1) // 2)))
 

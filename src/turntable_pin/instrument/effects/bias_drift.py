@@ -32,12 +32,14 @@ class BiasDrift(RunEffect):
     required_columns = ("time_s",)
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        """This effect's parameters on ``run`` (their user units and scales)."""
         return tuple(
             ParameterSpec(axis, "deg/h/h", 1.0 / SECONDS_PER_HOUR, f"bias drift of axis {axis}")
             for axis in "xy"
         )
 
     def columns(self, context: RunContext) -> np.ndarray:
+        """``d(out_x, out_y)/d(parameter)`` at each position, (N, 2, p), deg/h per internal unit."""
         t = np.asarray(context.run.time_s, dtype=float)
         out = np.zeros((t.size, 2, 2))
         out[:, 0, 0] = t

@@ -31,12 +31,14 @@ class EarthRateScale(RunEffect):
     )
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        """This effect's parameters on ``run`` (their user units and scales)."""
         return tuple(
             ParameterSpec(axis, "ppm", PPM, f"earth-rate scale error of axis {axis}")
             for axis in "xy"
         )
 
     def columns(self, context: RunContext) -> np.ndarray:
+        """``d(out_x, out_y)/d(parameter)`` at each position, (N, 2, p), deg/h per internal unit."""
         w = context.run.inputs.earth_rate_dph
         out = np.zeros((w.shape[0], 2, 2))
         out[:, 0, 0] = w[:, 0]

@@ -35,6 +35,7 @@ class GSquaredTerms(RunEffect):
     )
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        """This effect's parameters on ``run`` (their user units and scales)."""
         return tuple(
             ParameterSpec(f"{axis}_{term}", "deg/h/g^2", 1.0, f"{term} term on axis {axis}")
             for axis in "xy"
@@ -42,6 +43,7 @@ class GSquaredTerms(RunEffect):
         )
 
     def columns(self, context: RunContext) -> np.ndarray:
+        """``d(out_x, out_y)/d(parameter)`` at each position, (N, 2, p), deg/h per internal unit."""
         a = context.run.inputs.specific_force_g
         xz, yz = a[:, 0] * a[:, 2], a[:, 1] * a[:, 2]
         out = np.zeros((a.shape[0], 2, 4))

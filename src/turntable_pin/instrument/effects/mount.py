@@ -24,12 +24,14 @@ class _Mount(RunEffect):
     side = INSTRUMENT
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        """This effect's parameters on ``run`` (their user units and scales)."""
         return tuple(
             ParameterSpec(f"m{axis}", "arcsec", ARCSEC, f"mounting rotation about payload {axis}")
             for axis in self.axes
         )
 
     def columns(self, context: RunContext) -> np.ndarray:
+        """``d(out_x, out_y)/d(parameter)`` at each position, (N, 2, p), deg/h per internal unit."""
         # The sensitivity's columns are (dpsi, dtheta, dgamma) = rotations about (y, z, x).
         order = {"x": 2, "y": 0, "z": 1}
         return np.ascontiguousarray(context.sensitivity[:, :, [order[a] for a in self.axes]])

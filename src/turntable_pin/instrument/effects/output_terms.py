@@ -45,6 +45,7 @@ class OutputTerm(RunEffect):
         self.required_columns = self.term.required_columns()
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        """This effect's parameters on ``run`` (their user units and scales)."""
         out = []
         for spec in self.term.parameters():
             unit = spec.unit.replace("arcsec", "deg/h")
@@ -53,6 +54,7 @@ class OutputTerm(RunEffect):
         return tuple(out)
 
     def columns(self, context: RunContext) -> np.ndarray:
+        """``d(out_x, out_y)/d(parameter)`` at each position, (N, 2, p), deg/h per internal unit."""
         weights = self.term.chain_term(context.variables).weights
         names = [s.name for s in self.term.parameters()]
         out = np.zeros((context.run.n_positions, 2, len(names)))

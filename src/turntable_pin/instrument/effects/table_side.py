@@ -75,9 +75,11 @@ class TableError(RunEffect):
         )
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        """This effect's parameters on ``run`` (their user units and scales)."""
         return (ParameterSpec("value", "arcsec", ARCSEC, f"{self.error}: the table error"),)
 
     def columns(self, context: RunContext) -> np.ndarray:
+        """``d(out_x, out_y)/d(parameter)`` at each position, (N, 2, p), deg/h per internal unit."""
         jac = _base_jacobian(context, self.table)
         k = self.table.base_names.index(self.error)
         return np.einsum("nca,na->nc", context.sensitivity, jac[:, :, k])[:, :, None]
@@ -108,16 +110,19 @@ class TableEffect(RunEffect):
         self.required_columns = tuple(effect.required_columns)
 
     def missing_columns(self, run) -> tuple[str, ...]:
+        """The run columns the orientation effect needs and ``run`` lacks."""
         from ..model import run_variables
 
         return self.effect.missing_columns(run_variables(run))
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        """This effect's parameters on ``run`` (their user units and scales)."""
         from ..model import run_variables
 
         return tuple(self.effect.parameters(run_variables(run)))
 
     def columns(self, context: RunContext) -> np.ndarray:
+        """``d(out_x, out_y)/d(parameter)`` at each position, (N, 2, p), deg/h per internal unit."""
         jac = _orientation_jacobian(context, self.table, (self.effect,))
         own = jac[:, :, len(self.table.base_names) :]
         return np.einsum("nca,nap->ncp", context.sensitivity, own)
@@ -145,10 +150,12 @@ class TableErrors(RunEffect):
         self.table = table
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        """This effect's parameters on ``run`` (their user units and scales)."""
         return tuple(
             ParameterSpec(name, "arcsec", ARCSEC, self.table.descriptions.get(name, name))
             for name in self.table.base_names
         )
 
     def columns(self, context: RunContext) -> np.ndarray:
+        """``d(out_x, out_y)/d(parameter)`` at each position, (N, 2, p), deg/h per internal unit."""
         return np.einsum("nca,nap->ncp", context.sensitivity, _base_jacobian(context, self.table))

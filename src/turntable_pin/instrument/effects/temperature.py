@@ -35,12 +35,14 @@ class TemperatureCoefficient(RunEffect):
     required_columns = (TEMPERATURE_COLUMN,)
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
+        """This effect's parameters on ``run`` (their user units and scales)."""
         return tuple(
             ParameterSpec(axis, "deg/h/degC", 1.0, f"temperature coefficient of axis {axis}")
             for axis in "xy"
         )
 
     def columns(self, context: RunContext) -> np.ndarray:
+        """``d(out_x, out_y)/d(parameter)`` at each position, (N, 2, p), deg/h per internal unit."""
         t = np.asarray(context.run.column(TEMPERATURE_COLUMN), dtype=float)
         t = t - float(np.mean(t))
         out = np.zeros((t.size, 2, 2))
