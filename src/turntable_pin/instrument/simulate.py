@@ -548,7 +548,9 @@ def simulate_calibration_run(
             measured[row, channel] += sign * size
             outlier_rows.append(
                 {
-                    "row": int(row) + 2,  # the file row (header = row 1)
+                    # the position (0 = the first data row): the file row depends on how many
+                    # comment lines the CSV is written with
+                    "index": int(row),
                     "column": f"out_{AXES[channel]}_dph",
                     "offset_dph": float(sign * size),
                 }
