@@ -30,7 +30,12 @@ from ..calibration.drift_fit import gravity_words
 from ..core.exceptions import IdentifiabilityError, InputError
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from ..core.units import DEG_PER_RAD
-from ..measurement.diagnosis import harmonic_basis, max_harmonic_order, polynomial_basis
+from ..measurement.diagnosis import (
+    dense_joint_grid,
+    harmonic_basis,
+    max_harmonic_order,
+    polynomial_basis,
+)
 from ..measurement.table import measured_table
 from ..model.angles import ANGLE_NAMES
 from ..stats.least_squares import zero_point
@@ -278,14 +283,15 @@ class RunFamily:
 
     # ---- separation ---------------------------------------------------------------------------
     def _dense_run(self):
-        """The run's positions replaced by a dense grid over every joint (15 degrees; 30 for
-        three joints), time and extra columns spread over their ranges in random order."""
+        """The run's positions replaced by a dense grid over every joint within its limits
+        (:func:`~turntable_pin.measurement.diagnosis.dense_joint_grid`), time and extra columns
+        spread over their ranges in random order; and the grid's name."""
         from ..calibration.positions import PositionSet, position_inputs
         from ..calibration.run import CalibrationRun
 
         run = self.run
-        n_joints = run.joint_rad.shape[1]
-        positions = PositionSet.grid(30.0 if n_joints > 2 else 15.0, table=run.table)
+        joints = dense_joint_grid(self.table)
+        positions = PositionSet(joints, table=run.table, name="dense grid")
         inputs = position_inputs(positions, run.inputs.latitude_rad)
         n = len(positions)
         rng = np.random.default_rng(0)
@@ -295,7 +301,8 @@ class RunFamily:
 
         extra = {k: spread(v) for k, v in run.extra.items()}
         dense = CalibrationRun(inputs, np.zeros((n, 2)), None, spread(run.time_s), extra)
-        return dense, positions.name
+        step = "30" if joints.shape[1] > 2 else "15"
+        return dense, f"{step}-degree grid within the joints' limits ({n} positions)"
 
     def misfit(self, fit_a: RunFit, effect_b: RunEffect, dense: bool) -> float:
         """The noise-free chi2 left when the model with ``effect_b`` instead of ``fit_a``'s last
@@ -327,7 +334,7 @@ class RunFamily:
             chi2 = self.misfit(fit_a, effect_b, dense=True)
         except InputError as exc:
             return (
-                f"{effect_b.name} cannot be compared with {a.name} on a dense {grid} "
+                f"{effect_b.name} cannot be compared with {a.name} on a {grid} "
                 f"({exc.detail}); an independent test tells them apart. For {a.name}: "
                 f"{a.confirm} For {effect_b.name}: {effect_b.confirm}"
             )

@@ -50,6 +50,7 @@ __all__ = [
     "design_command",
     "diagnose_measurements",
     "diagnosis_residuals",
+    "dense_joint_grid",
     "harmonic_basis",
     "max_harmonic_order",
     "polynomial_basis",
@@ -99,6 +100,22 @@ def _along_error(jac: np.ndarray, w: np.ndarray, e: int):
         return jac[:, :, e] * w
 
     return direction
+
+
+def dense_joint_grid(table) -> np.ndarray:
+    """A dense grid over every joint of ``table`` (a ``MeasuredTable``), (N, J) rad: every 15
+    degrees (30 for three joints) over a joint that turns all the way round; within a joint's
+    limits, the same number of angles at the centres of equal cells (the ends, where a term such
+    as cot(elevation) may be infinite, are not positions)."""
+    step = 30.0 if table.n_joints > 2 else 15.0
+    count = int(round(360.0 / step))
+    g = np.radians(np.arange(0.0, 360.0, step))
+    axes = [
+        g if limits is None else limits[0] + (np.arange(count) + 0.5) * np.ptp(limits) / count
+        for limits in table.joint_limits_rad
+    ]
+    grids = np.meshgrid(*axes, indexing="ij")
+    return np.stack([x.ravel() for x in grids], axis=1)
 
 
 def max_harmonic_order(angle_rad: np.ndarray) -> int:
@@ -535,17 +552,7 @@ class OrientationFamily:
         """A dense design over every axis (15-degree grid; 30 degrees for three axes; as many
         angles within the limits of a joint that does not turn all the way round), with a
         random time order and random approach directions where the data have them."""
-        step = 30.0 if self.data.n_joints > 2 else 15.0
-        count = int(round(360.0 / step))
-        g = np.radians(np.arange(0.0, 360.0, step))
-        # Within a joint's limits, the same number of angles at the centres of equal cells
-        # (the ends, where a term such as cot(elevation) may be infinite, are not positions).
-        axes = [
-            g if limits is None else limits[0] + (np.arange(count) + 0.5) * np.ptp(limits) / count
-            for limits in self.table.joint_limits_rad
-        ]
-        grids = np.meshgrid(*axes, indexing="ij")
-        joints = np.stack([x.ravel() for x in grids], axis=1)
+        joints = dense_joint_grid(self.table)
         n = joints.shape[0]
         rng = np.random.default_rng(0)
         data = self.data
