@@ -18,6 +18,7 @@ from .common import (
     add_table_options,
     bounded_float,
     input_path,
+    latitude_deg,
     one_line_errors,
     positive_int,
     print_json,
@@ -33,6 +34,7 @@ DEFAULT_POSITIONS = 24
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``design`` to ``subparsers``."""
+    from ..calibration.site import DEFAULT_LATITUDE_DEG
     from ..design.calibrate import DEFAULT_MIN_EFFICIENCY, MAX_MIN_EFFICIENCY
     from ..design.space import DEFAULT_CANDIDATES, GRID_STEP_DEG
 
@@ -151,6 +153,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="write the positions as a CSV (phiK_deg, with time_s and dirK when "
         "the design needs them): simulate --positions reads it",
     )
+    p.add_argument(
+        "--run", type=input_path, metavar="RUN.csv",
+        help="with --separate: A and B are effects of this GyroWheel calibration run (its "
+        "catalogue: table:<error>, instrument_tilt, g_squared_terms, ...; as calibrate "
+        "--diagnose names them), each at the amplitude the run fits; the design adds "
+        "calibration positions to the run",
+    )  # fmt: skip
+    p.add_argument(
+        "--latitude-deg", type=latitude_deg, default=DEFAULT_LATITUDE_DEG,
+        help=f"with --run: the latitude of the run's site, degrees (default "
+        f"{DEFAULT_LATITUDE_DEG})",
+    )  # fmt: skip
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plots", type=Path, metavar="DIR", help="write the design's figures here")
     p.set_defaults(func=run_design)
@@ -172,6 +186,10 @@ def _dwell_s(text: str) -> float:
 
 def run_design(args: argparse.Namespace) -> int:
     """Run the mode the options name (identify by default)."""
+    if args.run is not None:
+        if args.separate is None:
+            raise InputError("--run goes with --separate A,B (the run's two explanations)")
+        return _run_separate_run(args)
     if args.separate is not None:
         return _run_separate(args)
     if args.calibrate:
@@ -322,3 +340,47 @@ def _run_calibrate(args: argparse.Namespace) -> int:
         min_efficiency=args.min_efficiency,
     )
     return _finish(result, args, write_calibration_design_figures)
+
+
+def _run_separate_run(args: argparse.Namespace) -> int:
+    """Calibration positions that tell two explanations of a run apart (``--separate A,B
+    --run RUN.csv``: :func:`~turntable_pin.instrument.separate.design_run_separation`)."""
+    from ..calibration.run import read_run
+    from ..core.csv_table import write_csv_table
+    from ..core.units import deg_to_rad
+    from ..instrument.separate import design_run_separation
+
+    for option, given in (
+        ("--effects", args.effects or args.effects_module),
+        ("--from", args.from_data),
+        ("--amplitude", args.amplitude),
+        ("--noise-arcsec", args.noise_arcsec is not None),
+        ("--plots", args.plots),
+    ):
+        if given:
+            raise InputError(
+                f"design --separate --run: {option} is for orientation measurements; the run "
+                "gives the amplitudes and the noise"
+            )
+    names = [n.strip() for n in args.separate.split(",") if n.strip()]
+    if len(names) != 2:
+        raise InputError(f"--separate takes two effects, A,B; got '{args.separate}'")
+    space = _space(args, effects=())
+    run = read_run(args.run, deg_to_rad(args.latitude_deg), space.table)
+    result = design_run_separation(
+        run, tuple(names), deg_to_rad(space.candidates_deg), args.positions_count, seed=args.seed
+    )
+    out = {**result.to_dict(), "run": str(args.run)}
+    if args.output is not None and result.separable:
+        comment = (
+            f"calibration positions separating {result.effects[0]} from {result.effects[1]} "
+            f"(turntable-pin design --separate --run {args.run}; seed {result.seed})"
+        )
+        out["output"] = str(write_csv_table(args.output, result.columns(), comment=comment))
+    if args.json:
+        print_json(out)
+        return 0
+    print(result.report())
+    if "output" in out:
+        print(f"wrote {out['output']}")
+    return 0

@@ -52,6 +52,7 @@ __all__ = [
     "RunFamily",
     "channel_variances",
     "diagnose_run",
+    "run_design_command",
     "run_diagnosis_dict",
     "run_diagnosis_residuals",
 ]
@@ -540,6 +541,25 @@ def run_diagnosis_residuals(diagnosis: Diagnosis):
     )
 
 
+def run_design_command(run, pair: tuple[str, str]) -> str:
+    """The ``turntable-pin design --separate A,B --run RUN`` command (with ``--urdf`` and
+    ``--latitude-deg`` when they are not the defaults) that chooses the calibration positions
+    telling the two effects apart, or says that none do (:mod:`.separate`)."""
+    import shlex
+
+    from ..calibration.site import DEFAULT_LATITUDE_DEG
+    from ..measurement.diagnosis import urdf_option
+
+    words = ["turntable-pin", "design", "--separate", ",".join(pair), "--run", run.source]
+    urdf = urdf_option(run.table)
+    if urdf:
+        words += ["--urdf", urdf]
+    latitude = float(np.degrees(run.inputs.latitude_rad))
+    if abs(latitude - DEFAULT_LATITUDE_DEG) > 1e-9:
+        words += ["--latitude-deg", f"{latitude:g}"]
+    return " ".join(shlex.quote(w) for w in words)
+
+
 def run_diagnosis_dict(diagnosis: Diagnosis) -> dict:
     """The structured result of a run diagnosis that the text, JSON and HTML views render:
     the diagnosis dict, the side of every candidate and of the verdict (``table`` or
@@ -568,6 +588,16 @@ def run_diagnosis_dict(diagnosis: Diagnosis) -> dict:
         verdict["other_side"] = family.other_side(first)
     else:
         verdict["other_side"] = []
+    commands = {}
+    if diagnosis.steps and run.source:
+        first = verdict["missing_effect"]
+        rivals = [*verdict["separations"], *(r["effect"] for r in verdict["other_side"])]
+        known = {e.name for e in family.catalogue}
+        for name in dict.fromkeys(rivals):
+            if name in known:
+                commands[name] = run_design_command(run, (first, name))
+    if commands:
+        verdict["separation_commands"] = commands
     out["table_from_run"] = table_from_run(
         run, family.table, mask=family.mask, context=family.context
     ).to_dict()

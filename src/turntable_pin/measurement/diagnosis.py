@@ -54,6 +54,7 @@ __all__ = [
     "harmonic_basis",
     "max_harmonic_order",
     "polynomial_basis",
+    "urdf_option",
 ]
 
 MAX_HARMONIC = 5
@@ -792,7 +793,7 @@ def diagnose_measurements(
     diagnosis.doubt = _table_doubt(diagnosis, table)
     if diagnosis.separations:
         data_name = data.source if data.source and Path(data.source).is_file() else DATA_PLACEHOLDER
-        urdf = _urdf_option(turntable)
+        urdf = urdf_option(turntable)
         diagnosis.separation_commands = {
             name: design_command(data_name, (diagnosis.missing_effect, name), urdf)
             for name in diagnosis.separations
@@ -816,7 +817,7 @@ def design_command(data: str, pair: tuple[str, str], urdf: str | None = None) ->
     return " ".join(shlex.quote(w) for w in words)
 
 
-def _urdf_option(turntable) -> str | None:
+def urdf_option(turntable) -> str | None:
     """What ``--urdf`` names the table by: nothing for the paper's bundled table, the name of a
     bundled table, else its URDF's path."""
     from ..core.resources import default_urdf_path, models_dir

@@ -83,8 +83,12 @@ def other_side_lines(d: dict) -> list[str]:
         f"{other} move the outputs like "
         f"{verdict['missing_effect']} (confounded: the run alone cannot say which side it is):"
     ]
-    lines += [f"  {r['effect']} (noise-free misfit chi2 {r['chi2_run']:.2g} here): {r['words']}"
-              for r in rivals]  # fmt: skip
+    commands = verdict.get("separation_commands", {})
+    for r in rivals:
+        lines.append(f"  {r['effect']} (noise-free misfit chi2 {r['chi2_run']:.2g} here): "
+                     f"{r['words']}")  # fmt: skip
+        if r["effect"] in commands:
+            lines.append(f"    to settle it, design the next positions: {commands[r['effect']]}")
     return lines
 
 

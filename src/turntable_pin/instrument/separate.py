@@ -1,0 +1,228 @@
+"""Positions that tell two explanations of a calibration run apart (``design --separate A,B
+--run RUN.csv``).
+
+When the run diagnosis says that effect B moves the outputs like effect A on the run's
+positions (a table error and the instrument's tilt, a g-squared term and a wobble), the question
+is at which positions to calibrate next. Each effect is taken at the amplitude the run fits it
+with (with the 14 coefficients); if A is true, fitting the coefficients and B to what A predicts
+leaves the noise-free misfit
+
+    lambda_AB = || (I - P_B) J_A a ||^2 / sigma^2   (P_B: the projector on the coefficients and B)
+
+over the outputs of the run and the new positions, and ``lambda_BA`` the other way round. The
+design maximises the smaller of the two (T-optimal, :func:`~turntable_pin.stats.discrimination.
+t_optimal_exchange`) over seeded candidate positions within the joints' limits, added to the run.
+A misfit of :data:`~.diagnosis.SEPARATION_CHI2` (25: five sigma) tells them apart clearly.
+When B reproduces A at every candidate, no position separates them, and the result says so with
+the independent tests of the two effects' stories. Effects that need ``time_s`` or another
+column are refused: positions alone do not decide them (repeat positions late, or change the
+temperature).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.exceptions import InputError
+from ..stats.discrimination import Direction, t_optimal_exchange
+from .diagnosis import SEPARATION_CHI2, RunFamily
+from .model import RunModel, run_context
+
+__all__ = ["SAME_RTOL", "RunSeparation", "design_run_separation"]
+
+SAME_RTOL = 1e-8
+"""B reproduces A at every candidate when the best design's misfit is below this fraction of
+A's signal beyond the coefficients."""
+
+
+@dataclass(frozen=True)
+class RunSeparation:
+    """The positions that tell two run effects apart, or why none do.
+
+    Attributes:
+        effects: the two effects ``(A, B)``.
+        joint_names: the table's joints.
+        positions_deg: (n, J) the chosen positions, degrees (empty when none separate them).
+        misfit_run: ``(lambda_AB, lambda_BA)`` on the run's positions alone (chi2 units).
+        misfit_design: the same with the chosen positions added.
+        separable: whether some positions within the limits tell them apart.
+        words: the conclusion in a sentence.
+        n_candidates, seed: the candidates chosen from and their seed.
+        noise_dph: the output noise the misfits are in units of.
+    """
+
+    effects: tuple[str, str]
+    joint_names: tuple[str, ...]
+    positions_deg: np.ndarray
+    misfit_run: tuple[float, float]
+    misfit_design: tuple[float, float]
+    separable: bool
+    words: str
+    n_candidates: int
+    seed: int
+    noise_dph: float
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The positions as run columns ``phiK_deg`` (what ``simulate --run --positions``
+        reads)."""
+        return {f"phi{k + 1}_deg": self.positions_deg[:, k] for k in range(len(self.joint_names))}
+
+    def to_dict(self) -> dict:
+        """The result as a JSON-ready dict."""
+        return {
+            "effects": list(self.effects),
+            "separable": self.separable,
+            "words": self.words,
+            "misfit_run": list(self.misfit_run),
+            "misfit_design": list(self.misfit_design),
+            "separation_chi2": SEPARATION_CHI2,
+            "noise_dph": self.noise_dph,
+            "n_candidates": self.n_candidates,
+            "seed": self.seed,
+            "positions": [dict(zip(self.columns(), map(float, row), strict=True))
+                          for row in self.positions_deg],
+        }  # fmt: skip
+
+    def report(self) -> str:
+        """The result in words, with the positions."""
+        a, b = self.effects
+        lines = [
+            f"separate {a} from {b} (calibration run; noise {self.noise_dph:.3g} deg/h, "
+            f"{self.n_candidates} candidates, seed {self.seed})",
+            f"on the run alone: misfit {self.misfit_run[0]:.3g} ({a} true, {b} fitted), "
+            f"{self.misfit_run[1]:.3g} ({b} true, {a} fitted); {SEPARATION_CHI2:g} separates "
+            "clearly",
+            self.words,
+        ]
+        if self.separable:
+            lines.append(" ".join(f"{k:>10s}" for k in self.columns()))
+            lines += [" ".join(f"{v:10.3f}" for v in row) for row in self.positions_deg]
+        return "\n".join(lines)
+
+
+def _refuse_columns(effect) -> None:
+    if effect.required_columns:
+        raise InputError(
+            f"effect '{effect.name}' depends on {', '.join(effect.required_columns)}, which a "
+            "choice of positions cannot set: repeat positions late in the run (a drift), or "
+            "calibrate at another temperature (a temperature coefficient), to tell it apart"
+        )
+
+
+def _whitened(context, effects, params_of, sigma):
+    """The model's columns (N, 2, q) at ``context`` over ``sigma``, and the predicted signal of
+    the effects' parameters ``params_of`` (N, 2) over ``sigma``."""
+    model = RunModel(context, effects)
+    columns = model.columns / sigma
+    signal = None
+    if params_of is not None:
+        n_base = model.n_params - len(params_of)
+        signal = np.einsum("ncp,p->nc", model.columns[:, :, n_base:], params_of) / sigma
+    return columns, signal
+
+
+def design_run_separation(
+    run, names: tuple[str, str], candidates_rad: np.ndarray, n: int, *, seed: int = 0,
+    catalogue=None,
+) -> RunSeparation:  # fmt: skip
+    """The ``n`` positions among ``candidates_rad`` (C, J) that best tell the run effects
+    ``names`` apart (module docstring), each at the amplitude ``run`` fits it with."""
+    from ..calibration.positions import PositionSet, position_inputs
+    from ..calibration.run import CalibrationRun
+
+    family = RunFamily(run, catalogue)
+    known = {e.name: e for e in family.catalogue}
+    for name in names:
+        if name not in known and f"table:{name}" not in known:
+            raise InputError(f"unknown run effect '{name}'; known: {', '.join(known)}")
+    a, b = (known.get(name) or known[f"table:{name}"] for name in names)
+    if a is b:
+        raise InputError(f"--separate needs two different effects, got '{a.name}' twice")
+    for effect in (a, b):
+        _refuse_columns(effect)
+    base_rank = family.fit([]).result.rank
+    fit_a, fit_b = family.fit([a]), family.fit([b])
+    for effect, fit in ((a, fit_a), (b, fit_b)):
+        if fit.result.rank <= base_rank:
+            raise InputError(
+                f"the run does not see {effect.name}: on its positions it moves the outputs only "
+                "like the 14 coefficients, so its amplitude cannot be fitted there; calibrate at "
+                "more varied positions first (a grid), or design with the orientation effects"
+            )
+    # the noise of one output: the stated one, else the run's estimate under the base model
+    if run.sigma_dph is not None:
+        sigma = float(np.median(run.sigma_dph))
+    else:
+        sigma = float(np.sqrt(family.fit([]).result.noise_variance))
+    positions = PositionSet(candidates_rad, table=run.table, name="candidates")
+    candidates = CalibrationRun(position_inputs(positions, run.inputs.latitude_rad),
+                                np.zeros((len(positions), 2)))  # fmt: skip
+    context = run_context(candidates, family.context.coefficients)
+
+    def direction(true_fit, true_effect, rival):
+        p = true_fit.result.params[-len(true_effect.parameters(run)) :]
+        _, signal = _whitened(context, [true_effect], p, sigma)
+        fitted, _ = _whitened(context, [rival], None, sigma)
+        fixed_fitted, fixed_signal = _whitened(family.context, [rival], None, sigma)
+        _, run_signal = _whitened(family.context, [true_effect], p, sigma)
+        return Direction(fitted, signal, fixed_fitted.reshape(-1, fitted.shape[-1]),
+                         run_signal.reshape(-1))  # fmt: skip
+
+    directions = [direction(fit_a, a, b), direction(fit_b, b, a)]
+    before = tuple(float(d.misfit(np.zeros(0, int))) for d in directions)
+    n = min(int(n), len(positions))
+    exchange = t_optimal_exchange(directions, n, seed=seed)
+    after = tuple(float(v) for v in exchange.noncentralities)
+    scales = [float(np.sum(d.signal[exchange.chosen] ** 2)) for d in directions]
+    same = [v <= SAME_RTOL * max(w, 1e-300) for v, w in zip(after, scales, strict=True)]
+    separable = not any(same)
+    chosen = np.degrees(candidates_rad[exchange.chosen])
+    if all(same):
+        words = (
+            f"no positions within the limits separate them: {b.name} reproduces {a.name} at "
+            "every candidate position (and the other way round); an independent test does. "
+            f"For {a.name}: {a.confirm} For {b.name}: {b.confirm}"
+        )
+        chosen = np.zeros((0, candidates_rad.shape[1]))
+    elif any(same):
+        small, large = (b, a) if same[1] else (a, b)
+        words = (
+            f"{small.name} is a special case of {large.name} at every position: when "
+            f"{small.name} is true, {large.name} reproduces it and the diagnosis keeps the "
+            f"simpler {small.name} (its rule makes the extra parameters pay); when {large.name} "
+            f"is true, {small.name} leaves a misfit of {max(after):.3g} with these positions "
+            f"({max(before):.3g} on the run alone). No positions make them more different; an "
+            f"independent test does. For {a.name}: {a.confirm} For {b.name}: {b.confirm}"
+        )
+        chosen = np.zeros((0, candidates_rad.shape[1]))
+    elif min(after) >= SEPARATION_CHI2:
+        already = (
+            "the run alone already tells them apart (misfit at least "
+            f"{min(before):.3g} both ways); "
+            if min(before) >= SEPARATION_CHI2
+            else ""
+        )
+        words = (
+            f"{already}these {n} positions, calibrated besides the run, leave a misfit of at "
+            f"least {min(after):.3g} whichever is true: the diagnosis of the two runs together "
+            "tells them apart"
+        )
+    else:
+        words = (
+            f"these {n} positions raise the smaller misfit to {min(after):.3g}, still below "
+            f"{SEPARATION_CHI2:g}: choose more positions (-n) or repeat them"
+        )
+    return RunSeparation(
+        effects=(a.name, b.name),
+        joint_names=tuple(run.table.joint_names),
+        positions_deg=np.round(chosen, 6),
+        misfit_run=before,
+        misfit_design=after,
+        separable=bool(separable),
+        words=words,
+        n_candidates=len(positions),
+        seed=int(seed),
+        noise_dph=sigma,
+    )
