@@ -29,7 +29,7 @@ from .measurement_figures import (
     structure_term_figure,
 )
 
-_STYLE = """
+PAGE_STYLE = """
 body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
 h1{font-size:1.5em}h2{font-size:1.2em;border-bottom:1px solid #ccc;margin-top:2em}
 table{border-collapse:collapse;font-size:.9em;margin:.5em 0}
@@ -40,12 +40,15 @@ td.l,th.l{text-align:left}.verdict{background:#eef6ee;padding:.8em;border-left:4
 """
 
 
-def _img(png: bytes, alt: str) -> str:
+def img_tag(png: bytes, alt: str) -> str:
+    """An ``<img>`` with the PNG embedded as base64 (the page needs no other file)."""
     data = base64.b64encode(png).decode("ascii")
     return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{data}">'
 
 
-def _table(header: list[str], rows: list[list], left: int = 1) -> str:
+def html_table(header: list[str], rows: list[list], left: int = 1) -> str:
+    """An HTML table (floats to 4 digits; the first ``left`` columns aligned left)."""
+
     def cell(v, i, tag):
         cls = ' class="l"' if i < left else ""
         if isinstance(v, float):
@@ -108,7 +111,7 @@ def _structure_section(diagnosis: Diagnosis, best_fit) -> list[str]:
             f"{term.amplitude:.3g} {html.escape(term.unit)}, delta BIC {term.delta_bic:.0f}.</p>"
         )
         if term.factors is not None and term.residual_weighted is not None:
-            words += _img(structure_term_figure(term), f"structure: {term.name}")
+            words += img_tag(structure_term_figure(term), f"structure: {term.name}")
         parts.append(words)
     return parts
 
@@ -144,12 +147,12 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
         parts.append(
             f"<p>{len(d['outliers'])} gross outlier(s) were left out of every fit (shown here, "
             f"not silently dropped; rule: {html.escape(d['outlier_rule'])}):</p>"
-            + _table(
+            + html_table(
                 ["row", "angle", "residual (sigma, final model)"],
                 [[o["row"], o["angle"], o["residual_sigma"]] for o in d["outliers"][:50]],
             )
         )
-    parts.append("<h2>1. The data</h2>" + _img(data_figure(data), "measured angles"))
+    parts.append("<h2>1. The data</h2>" + img_tag(data_figure(data), "measured angles"))
     b = d["base"]
     parts.append(
         "<h2>2. The base model</h2><p>"
@@ -165,7 +168,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
     )
     combos = base_fit.result.combinations()
     parts.append(
-        _table(
+        html_table(
             ["combination", "value", "std", "unit"],
             [[c["name"], c["value"], c["std"], c["unit"]] for c in combos],
         )
@@ -178,7 +181,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
             + ".</p>"
         )
     parts.append(
-        _table(
+        html_table(
             ["model", "rms (arcsec)", "chi2_reduced", "rank", "params", "p-value"],
             _fit_rows(diagnosis, [("base", base_fit)]),
         )
@@ -191,7 +194,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
     if failing:
         joints = range(1, data.n_joints + 1)
         parts.append(
-            _table(
+            html_table(
                 ["row", *(f"phi{k} (deg)" for k in joints), "angle", "residual (arcsec)", "sigmas"],
                 [
                     [
@@ -211,16 +214,16 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
         parts.append(
             "<p>The residuals over both angles (one square per position, repeats averaged): "
             "structure in phi1 and phi2 at once shows here, while the plots against one angle "
-            "average over the other.</p>" + _img(base_map, "base residual map")
+            "average over the other.</p>" + img_tag(base_map, "base residual map")
         )
     if not verdict["missing_effect"]:  # else shown before/after in section 5
-        parts.append(_img(residual_figure([base_rs]), "base residuals"))
-        parts.append(_img(harmonics_figure([base_an]), "base harmonics"))
+        parts.append(img_tag(residual_figure([base_rs]), "base residuals"))
+        parts.append(img_tag(harmonics_figure([base_an]), "base harmonics"))
     cls = "verdict" if not verdict["unexplained"] else "verdict warn"
     parts.append("<h2>4. Diagnosis: which physical effect is missing?</h2>")
     first = verdict["missing_effect"]
     parts.append(
-        _table(
+        html_table(
             [
                 "effect",
                 "delta BIC",
@@ -265,7 +268,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
         best_an = analyse_residuals(best_rs)
         parts.append(
             "<h2>5. Add it and watch the error fall</h2>"
-            + _table(
+            + html_table(
                 ["model", "rms (arcsec)", "chi2_reduced", "rank", "params", "p-value"],
                 _fit_rows(diagnosis, [("base", base_fit)])
                 + [
@@ -280,14 +283,14 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
                     for s in d["steps"]
                 ],
             )  # fmt: skip
-            + _img(residual_figure([base_rs, best_rs]), "residuals before and after")
-            + _img(harmonics_figure([base_an, best_an]), "harmonics before and after")
+            + img_tag(residual_figure([base_rs, best_rs]), "residuals before and after")
+            + img_tag(harmonics_figure([base_an, best_an]), "harmonics before and after")
         )
         best_map = residual_map_figure([best_rs], limit)
         if best_map is not None:
             parts.append(
                 "<p>The residual map after, on the colour scale of the map in section 3:</p>"
-                + _img(best_map, "residual map after")
+                + img_tag(best_map, "residual map after")
             )
     res = best_fit.result
     parts.append(
@@ -295,7 +298,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
         f"standard error; rank {res.rank} of {res.n_params} parameters):</p>"
     )
     parts.append(
-        _table(
+        html_table(
             ["combination", "value", "std", "unit"],
             [[c["name"], c["value"], c["std"], c["unit"]] for c in res.combinations()],
         )
@@ -316,7 +319,7 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
     body = "\n".join(parts)
     return (
         "<!DOCTYPE html><html><head><meta charset='utf-8'>"
-        f"<title>{html.escape(title or 'turntable-pin report')}</title><style>{_STYLE}</style>"
+        f"<title>{html.escape(title or 'turntable-pin report')}</title><style>{PAGE_STYLE}</style>"
         f"</head><body>{body}</body></html>\n"
     )
 
@@ -326,4 +329,4 @@ def write_report(diagnosis: Diagnosis, path: str | Path, *, title: str = "") -> 
     return write_text_atomic(path, diagnosis_html(diagnosis, title=title))
 
 
-__all__ = ["data_figure", "diagnosis_html", "write_report"]
+__all__ = ["PAGE_STYLE", "data_figure", "diagnosis_html", "html_table", "img_tag", "write_report"]

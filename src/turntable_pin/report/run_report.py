@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ..core.files import write_text_atomic
 from .diagnosis_text import diagnosis_lines, headline, verdict_lines
-from .html_report import _STYLE, _img, _table
+from .html_report import PAGE_STYLE, html_table, img_tag
 from .measurement_figures import (
     harmonics_figure,
     residual_figure,
@@ -137,7 +137,7 @@ def run_diagnosis_html(diagnosis, d: dict, *, title: str = "") -> str:
     parts += [f'<p class="verdict warn">warning: {html.escape(w)}</p>' for w in d["warnings"]]
     parts.append(
         "<h2>1. The base model: eq. 1's 2 x 7 coefficients</h2>"
-        + _table(
+        + html_table(
             ["model", "rms (deg/h)", "chi2_reduced", "rank", "params"],
             [
                 [
@@ -151,10 +151,10 @@ def run_diagnosis_html(diagnosis, d: dict, *, title: str = "") -> str:
         )  # fmt: skip
     )
     if not verdict["missing_effect"]:
-        parts.append(_img(residual_figure([base_rs]), "base residuals"))
+        parts.append(img_tag(residual_figure([base_rs]), "base residuals"))
     parts.append("<h2>2. Which effect is missing: the table or the instrument?</h2>")
     parts.append(
-        _table(
+        html_table(
             ["effect", "side", "delta BIC", "rms (deg/h)", "chi2_reduced", "new rank", "same as"],
             [
                 [
@@ -176,11 +176,11 @@ def run_diagnosis_html(diagnosis, d: dict, *, title: str = "") -> str:
     for term in diagnosis.structure:
         parts.append(f"<p><b>{html.escape(term.name)}</b>: {html.escape(term.description)}</p>")
         if term.factors is not None and term.residual_weighted is not None:
-            parts.append(_img(structure_term_figure(term), f"structure: {term.name}"))
+            parts.append(img_tag(structure_term_figure(term), f"structure: {term.name}"))
     if verdict["missing_effect"]:
         parts.append(
             "<h2>3. Add it and watch the error fall</h2>"
-            + _table(
+            + html_table(
                 ["model", "rms (deg/h)", "chi2_reduced", "rank", "params"],
                 [
                     [
@@ -196,8 +196,8 @@ def run_diagnosis_html(diagnosis, d: dict, *, title: str = "") -> str:
                     for s in d["steps"]
                 ],
             )  # fmt: skip
-            + _img(residual_figure([base_rs, best_rs]), "residuals before and after")
-            + _img(
+            + img_tag(residual_figure([base_rs, best_rs]), "residuals before and after")
+            + img_tag(
                 harmonics_figure([analyse_residuals(base_rs), analyse_residuals(best_rs)]),
                 "harmonics before and after",
             )
@@ -208,7 +208,7 @@ def run_diagnosis_html(diagnosis, d: dict, *, title: str = "") -> str:
     body = "\n".join(parts)
     return (
         "<!DOCTYPE html><html><head><meta charset='utf-8'>"
-        f"<title>{html.escape(title or 'turntable-pin run report')}</title><style>{_STYLE}"
+        f"<title>{html.escape(title or 'turntable-pin run report')}</title><style>{PAGE_STYLE}"
         f"</style></head><body>{body}</body></html>\n"
     )
 
