@@ -27,7 +27,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..calibration.drift_fit import gravity_words
-from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.exceptions import InputError
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from ..core.units import DEG_PER_RAD
 from ..measurement.diagnosis import (
@@ -75,8 +75,6 @@ OUTLIER_RULE = (
     "model, then on the model with the accepted effects; at most 5 % of the outputs"
 )
 """The outlier rule of :func:`diagnose_run` in words (``turntable_pin.stats.outliers``)."""
-
-_MAX_SCREEN_ROUNDS = 20
 
 
 class RunFamily:
@@ -414,36 +412,15 @@ def _noise_per_channel(diagnosis: Diagnosis) -> tuple[np.ndarray, str] | None:
     )
 
 
-def _screen(run, effects, catalogue, first=None) -> tuple[np.ndarray, str | None]:
-    """The outlier cells (N, 2) of ``run`` under base + ``effects`` by the iterated rule."""
-    from ..stats.outliers import MAX_OUTLIER_FRACTION, screen_outliers
+def _screen(run, effects, catalogue) -> tuple[np.ndarray, str | None]:
+    """The outlier cells (N, 2) of ``run`` under base + ``effects`` by the iterated rule
+    (:func:`~turntable_pin.stats.outliers.screen_cells`), and its note."""
+    from ..stats.outliers import screen_cells
 
-    flagged = np.zeros((run.n_positions, 2), bool)
-    total = flagged.size
-    for _ in range(_MAX_SCREEN_ROUNDS):
-        try:
-            fit = first if first is not None and not flagged.any() else None
-            if fit is None:
-                family = RunFamily(run, catalogue, ~flagged)
-                fit = family.fit(effects)
-        except IdentifiabilityError:
-            return np.zeros_like(flagged), None
-        result = fit.result
-        groups = np.broadcast_to(np.arange(2), flagged.shape)[~flagged]
-        span = result.jacobian_weighted @ result.identifiability.basis
-        test = screen_outliers(result.residuals * result.weights, span, groups=groups)
-        if not test.flagged.size:
-            break
-        worst = test.flagged[test.studentized[test.flagged] >= 0.5 * test.studentized.max()]
-        cells = np.flatnonzero(~flagged.reshape(-1))[worst]
-        flagged.reshape(-1)[cells] = True
-        if flagged.sum() > MAX_OUTLIER_FRACTION * total:
-            return np.zeros_like(flagged), (
-                f"the outlier rule would leave out more than {MAX_OUTLIER_FRACTION:.0%} of the "
-                "outputs: these are not a handful of bad points but a model or a noise level "
-                "that does not fit, so none is left out"
-            )
-    return flagged, None
+    def fit_without(flagged):
+        return RunFamily(run, catalogue, ~flagged).fit(effects).result
+
+    return screen_cells(fit_without, np.ones((run.n_positions, 2), bool), "outputs")
 
 
 def _outlier_records(diagnosis: Diagnosis, run, cells: np.ndarray) -> list[dict]:

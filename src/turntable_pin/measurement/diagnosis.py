@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.exceptions import InputError
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..stats.least_squares import RANK_RTOL, fit_least_squares
@@ -613,8 +613,6 @@ OUTLIER_RULE = (
 )
 """The outlier rule of :func:`diagnose_measurements` in words (``turntable_pin.stats.outliers``)."""
 
-_MAX_SCREEN_ROUNDS = 20
-
 
 def _without(data: OrientationMeasurements, cells: np.ndarray) -> OrientationMeasurements:
     """``data`` with the cells ``cells`` (N, 3) left out (as not measured)."""
@@ -626,40 +624,18 @@ def _without(data: OrientationMeasurements, cells: np.ndarray) -> OrientationMea
 
 
 def _screen(data, effects, table, first=None) -> tuple[np.ndarray, str | None]:
-    """The outlier cells (N, 3) of ``data`` under base + ``effects`` by the iterated rule, and a
-    note when the rule would flag more than its share (then none is left out); ``first``: the
-    fit of base + ``effects`` on all of ``data`` when it is at hand."""
-    from ..stats.outliers import MAX_OUTLIER_FRACTION, screen_outliers
+    """The outlier cells (N, 3) of ``data`` under base + ``effects`` by the iterated rule
+    (:func:`~turntable_pin.stats.outliers.screen_cells`), and a note when the rule would flag
+    more than its share; ``first``: the fit of base + ``effects`` on all of ``data`` when it is
+    at hand."""
+    from ..stats.outliers import screen_cells
 
-    flagged = np.zeros(data.angles_rad.shape, bool)
-    total = int(data.measured.sum())
-    for _ in range(_MAX_SCREEN_ROUNDS):
-        clean = _without(data, flagged)
-        try:
-            fit = first if first is not None and not flagged.any() else None
-            fit = fit or fit_orientation(clean, effects, turntable=table)
-        except IdentifiabilityError:
-            return np.zeros_like(flagged), None
-        result = fit.result
-        angle_of = np.broadcast_to(np.arange(3), clean.angles_rad.shape)[clean.measured]
-        # The leverages need the span of the Jacobian only: its determined part is enough.
-        span = result.jacobian_weighted @ result.identifiability.basis
-        test = screen_outliers(result.residuals * result.weights, span, groups=angle_of)
-        if not test.flagged.size:
-            break
-        # Leave out the clearly worst ones only (at least half the largest |t|), then refit: a
-        # gross outlier pulls the fit and makes its neighbours look bad too (swamping), which
-        # the refit undoes.
-        worst = test.flagged[test.studentized[test.flagged] >= 0.5 * test.studentized.max()]
-        cells = np.flatnonzero(clean.measured.reshape(-1))[worst]
-        flagged.reshape(-1)[cells] = True
-        if flagged.sum() > MAX_OUTLIER_FRACTION * total:
-            return np.zeros_like(flagged), (
-                f"the outlier rule would leave out more than {MAX_OUTLIER_FRACTION:.0%} of the "
-                "measured angles: these are not a handful of bad points but a model or a noise "
-                "level that does not fit, so none is left out"
-            )
-    return flagged, None
+    def fit_without(flagged):
+        if first is not None and not flagged.any():
+            return first.result
+        return fit_orientation(_without(data, flagged), effects, turntable=table).result
+
+    return screen_cells(fit_without, data.measured, "measured angles")
 
 
 def _outlier_records(diagnosis: Diagnosis, data, cells: np.ndarray) -> list[dict]:

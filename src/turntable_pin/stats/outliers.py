@@ -26,6 +26,7 @@ __all__ = [
     "OutlierTest",
     "leverages",
     "outlier_threshold",
+    "screen_cells",
     "screen_outliers",
 ]
 
@@ -102,3 +103,52 @@ def screen_outliers(
     flagged = np.flatnonzero(t > z)
     scale = float(np.median(scales)) if r.size else 0.0
     return OutlierTest(t, scale, z, flagged[np.argsort(-t[flagged])])
+
+
+MAX_SCREEN_ROUNDS = 20
+"""Most refits of the iterated rule (:func:`screen_cells`)."""
+
+
+def screen_cells(fit_without, observed: np.ndarray, what: str) -> tuple[np.ndarray, str | None]:
+    """The iterated rule over a table of observations: the cells left out as gross outliers, and
+    a note (in words, ``what`` naming the observations) when the rule would leave out more than
+    :data:`MAX_OUTLIER_FRACTION` of them (then none is left out).
+
+    Args:
+        fit_without: ``flagged (R, K) bool -> FitResult`` of the model fitted without the cells
+            ``flagged`` (its observations the cells ``observed & ~flagged``, record-major); an
+            ``IdentifiabilityError`` there ends the rule with no outlier.
+        observed: (R, K) the cells that hold an observation; a column is a noise group.
+        what: the observations in words (``measured angles``, ``outputs``).
+
+    Each round fits, tests every observation (:func:`screen_outliers`, the columns as noise
+    groups) and leaves out the clearly worst ones only (at least half the largest ``|t|``)
+    before refitting: a gross outlier pulls the fit and makes its neighbours look bad too
+    (swamping), which the refit undoes.
+    """
+    from ..core.exceptions import IdentifiabilityError
+
+    observed = np.asarray(observed, bool)
+    flagged = np.zeros(observed.shape, bool)
+    total = int(observed.sum())
+    for _ in range(MAX_SCREEN_ROUNDS):
+        try:
+            result = fit_without(flagged)
+        except IdentifiabilityError:
+            return np.zeros_like(flagged), None
+        live = observed & ~flagged
+        groups = np.broadcast_to(np.arange(observed.shape[1]), observed.shape)[live]
+        # The leverages need the span of the Jacobian only: its determined part is enough.
+        span = result.jacobian_weighted @ result.identifiability.basis
+        test = screen_outliers(result.residuals * result.weights, span, groups=groups)
+        if not test.flagged.size:
+            break
+        worst = test.flagged[test.studentized[test.flagged] >= 0.5 * test.studentized.max()]
+        flagged.reshape(-1)[np.flatnonzero(live.reshape(-1))[worst]] = True
+        if flagged.sum() > MAX_OUTLIER_FRACTION * total:
+            return np.zeros_like(flagged), (
+                f"the outlier rule would leave out more than {MAX_OUTLIER_FRACTION:.0%} of the "
+                f"{what}: these are not a handful of bad points but a model or a noise "
+                "level that does not fit, so none is left out"
+            )
+    return flagged, None
