@@ -488,24 +488,16 @@ def _diagnose(run, until_explained, catalogue, outliers, per_channel=False) -> D
         family = RunFamily(run, catalogue, ~cells, per_channel)
         return diagnose(family, until_explained=until_explained)
 
-    empty = np.zeros((run.n_positions, 2), bool)
     if not outliers:
-        return go(empty)
-    cells, note = _screen(run, (), catalogue)
-    diagnosis = go(cells)
-    effects = list(diagnosis.best_fit.model.effects)
-    if effects:
-        again, note_again = _screen(run, effects, catalogue)
-        note = note_again or note
-        if not np.array_equal(again, cells):
-            cells = again
-            diagnosis = None
-            diagnosis = go(cells)
-    diagnosis.outliers = _outlier_records(diagnosis, run, cells)
-    diagnosis.outlier_rule = OUTLIER_RULE
-    if note:
-        diagnosis.warnings.append(note)
-    return diagnosis
+        return go(np.zeros((run.n_positions, 2), bool))
+    from ..stats.outliers import screened_diagnosis
+
+    return screened_diagnosis(
+        go,
+        lambda effects, first: _screen(run, effects, catalogue),
+        lambda diagnosis, cells: _outlier_records(diagnosis, run, cells),
+        OUTLIER_RULE,
+    )
 
 
 def run_diagnosis_residuals(diagnosis: Diagnosis):

@@ -862,21 +862,11 @@ def _diagnose(
 
     if not outliers:
         return run(np.zeros(data.angles_rad.shape, bool))
-    cells, note = _screen(data, (), table)
-    diagnosis = run(cells)
-    # Again with the accepted effects: points of a real effect the base model could not follow
-    # are not outliers, and an outlier the effects' fit shows up is.
-    effects = list(diagnosis.best_fit.model.effects)
-    if effects:
-        first = diagnosis.best_fit if not cells.any() else None  # the same fit, already made
-        again, note_again = _screen(data, effects, table, first)
-        note = note_again if note_again else note
-        if not np.array_equal(again, cells):
-            cells = again
-            diagnosis = None
-            diagnosis = run(cells)
-    diagnosis.outliers = _outlier_records(diagnosis, data, cells)
-    diagnosis.outlier_rule = OUTLIER_RULE
-    if note:
-        diagnosis.warnings.append(note)
-    return diagnosis
+    from ..stats.outliers import screened_diagnosis
+
+    return screened_diagnosis(
+        run,
+        lambda effects, first: _screen(data, effects, table, first),
+        lambda diagnosis, cells: _outlier_records(diagnosis, data, cells),
+        OUTLIER_RULE,
+    )

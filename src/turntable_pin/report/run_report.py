@@ -112,6 +112,15 @@ def write_run_plots(diagnosis, directory: str | Path) -> list[Path]:
                                                                            directory)]  # fmt: skip
 
 
+_FIT_HEADER = ["model", "rms (deg/h)", "chi2_reduced", "rank", "params"]
+
+
+def _fit_row(label: str, summary: dict) -> list:
+    """One row of a table of fits: its label, rms, chi2_reduced, rank and parameter count."""
+    return [label, summary["rms_dph"], summary["chi2_reduced"], summary["rank"],
+            summary["n_params"]]  # fmt: skip
+
+
 def run_diagnosis_html(diagnosis, d: dict, *, title: str = "") -> str:
     """The self-contained HTML page of a run diagnosis (``d``: its structured result)."""
     from ..instrument.diagnosis import run_diagnosis_residuals
@@ -137,18 +146,7 @@ def run_diagnosis_html(diagnosis, d: dict, *, title: str = "") -> str:
     parts += [f'<p class="verdict warn">warning: {html.escape(w)}</p>' for w in d["warnings"]]
     parts.append(
         "<h2>1. The base model: eq. 1's 2 x 7 coefficients</h2>"
-        + html_table(
-            ["model", "rms (deg/h)", "chi2_reduced", "rank", "params"],
-            [
-                [
-                    "base",
-                    d["base"]["rms_dph"],
-                    d["base"]["chi2_reduced"],
-                    d["base"]["rank"],
-                    d["base"]["n_params"],
-                ]
-            ],
-        )  # fmt: skip
+        + html_table(_FIT_HEADER, [_fit_row("base", d["base"])])
     )
     if not verdict["missing_effect"]:
         parts.append(img_tag(residual_figure([base_rs]), "base residuals"))
@@ -181,21 +179,10 @@ def run_diagnosis_html(diagnosis, d: dict, *, title: str = "") -> str:
         parts.append(
             "<h2>3. Add it and watch the error fall</h2>"
             + html_table(
-                ["model", "rms (deg/h)", "chi2_reduced", "rank", "params"],
-                [
-                    [
-                        "base",
-                        d["base"]["rms_dph"],
-                        d["base"]["chi2_reduced"],
-                        d["base"]["rank"],
-                        d["base"]["n_params"],
-                    ]
-                ]
-                + [
-                    [f"+ {s['added']}", s["rms_dph"], s["chi2_reduced"], s["rank"], s["n_params"]]
-                    for s in d["steps"]
-                ],
-            )  # fmt: skip
+                _FIT_HEADER,
+                [_fit_row("base", d["base"])]
+                + [_fit_row(f"+ {s['added']}", s) for s in d["steps"]],
+            )
             + img_tag(residual_figure([base_rs, best_rs]), "residuals before and after")
             + img_tag(
                 harmonics_figure([analyse_residuals(base_rs), analyse_residuals(best_rs)]),

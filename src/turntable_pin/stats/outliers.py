@@ -27,6 +27,7 @@ __all__ = [
     "leverages",
     "outlier_threshold",
     "screen_cells",
+    "screened_diagnosis",
     "screen_outliers",
 ]
 
@@ -152,3 +153,35 @@ def screen_cells(fit_without, observed: np.ndarray, what: str) -> tuple[np.ndarr
                 "level that does not fit, so none is left out"
             )
     return flagged, None
+
+
+def screened_diagnosis(diagnose_without, screen, records, rule: str):
+    """A diagnosis with gross outliers left out, in two passes: screened under the base model,
+    diagnosed without those cells, then screened again under the model with the accepted
+    effects (points of a real effect the base could not follow are not outliers, and an outlier
+    the effects' fit shows up is) and diagnosed again when the cells changed.
+
+    Args:
+        diagnose_without: ``cells -> Diagnosis`` without the cells ``cells`` (a bool table).
+        screen: ``(effects, first) -> (cells, note)``: the iterated rule under base +
+            ``effects`` (:func:`screen_cells`); ``first`` is the fit of that model on all the
+            data when it is at hand, else ``None``.
+        records: ``(diagnosis, cells) -> list`` of the outliers as the caller reports them.
+        rule: the rule in words (``Diagnosis.outlier_rule``).
+    """
+    cells, note = screen((), None)
+    diagnosis = diagnose_without(cells)
+    effects = list(diagnosis.best_fit.model.effects)
+    if effects:
+        first = diagnosis.best_fit if not cells.any() else None  # the same fit, already made
+        again, note_again = screen(effects, first)
+        note = note_again or note
+        if not np.array_equal(again, cells):
+            cells = again
+            diagnosis = None  # free the first one's fits before the second
+            diagnosis = diagnose_without(cells)
+    diagnosis.outliers = records(diagnosis, cells)
+    diagnosis.outlier_rule = rule
+    if note:
+        diagnosis.warnings.append(note)
+    return diagnosis
