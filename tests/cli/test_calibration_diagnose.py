@@ -118,3 +118,54 @@ def test_diagnose_on_the_vertical_outer_table_warns_instead_of_refusing(tmp_path
     out = json.loads(proc.stdout)
     assert any("gravity's x component" in w for w in out["warnings"])
     assert out["verdict"]["missing_effects"] == []
+
+
+USER_EFFECT = """
+import numpy as np
+
+from turntable_pin.instrument.effects import RunEffect
+from turntable_pin.instrument.effects.base import ParameterSpec
+
+
+class CableDrag(RunEffect):
+    name = "cable_drag"
+    side = "table"
+    title = "the slip-ring cable drags the inner frame"
+    explanation = "A cable wound around the inner axis pulls harder one way than the other."
+    confirm = "Turn the inner axis back and forth with the cable unplugged."
+
+    def parameters(self, run):
+        return (ParameterSpec("b", "deg/h", 1.0, "drag amplitude"),)
+
+    def columns(self, context):
+        out = np.zeros((context.run.n_positions, 2, 1))
+        out[:, 0, 0] = np.sin(context.run.joint_rad[:, 1]) * np.cos(context.run.joint_rad[:, 0])
+        return out
+"""
+
+
+def test_a_run_effect_the_user_writes_is_diagnosed_and_fitted(tmp_path):
+    import numpy as np
+
+    from turntable_pin.calibration.positions import PositionSet
+    from turntable_pin.core.csv_table import write_csv_table
+    from turntable_pin.instrument.simulate import simulate_calibration_run
+
+    module = write_file(tmp_path, USER_EFFECT, "cable.py")
+    positions = PositionSet.grid(30)
+    sim = simulate_calibration_run(positions, np.radians(45.75), noise_dph=0.002, seed=4)
+    columns = sim.columns()
+    a = positions.angles_rad
+    columns["out_x_dph"] = columns["out_x_dph"] + 0.006 * np.sin(a[:, 1]) * np.cos(a[:, 0])
+    path = write_csv_table(tmp_path / "run.csv", columns)
+    proc = cli("calibrate", str(path), "--diagnose", "--effects-module", str(module), "--json")
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout)["verdict"]["missing_effect"] == "cable_drag"
+    fit = cli("calibrate", str(path), "--effects", "cable_drag", "--effects-module", str(module),
+              "--json")  # fmt: skip
+    assert fit.returncode == 0, fit.stderr
+    value = json.loads(fit.stdout)["params"]["cable_drag.b"]
+    assert abs(value["value"] - 0.006) < 4 * value["std"]
+    empty = write_file(tmp_path, "X = 1\n", "none.py")
+    bad = cli("calibrate", str(path), "--diagnose", "--effects-module", str(empty))
+    assert bad.returncode == 2 and "turntable_pin.instrument.effects.RunEffect" in bad.stderr

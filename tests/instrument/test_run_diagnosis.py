@@ -144,3 +144,17 @@ def test_table1_from_the_clean_noise_free_run_through_the_diagnosis():
     model = GyroWheelModel.nominal()
     beta = np.stack([model.x.as_array(), model.y.as_array()])
     assert np.max(np.abs(fit_run(run).coefficients_dph - beta)) < 1e-9
+
+
+def test_outputs_with_different_noise_get_their_own_level_and_no_false_name():
+    """Without sigma, out_y three times noisier than out_x: the F test sees it, each output is
+    weighted by its own noise, and a clean run still has nothing named."""
+    positions = PositionSet.grid(30)
+    for seed, hidden in ((21, {}), (22, SCENARIOS["bias_drift"][0])):
+        sim = simulate_calibration_run(positions, LATITUDE_RAD, noise_dph=(NOISE, 3 * NOISE),
+                                       seed=seed, dwell_s=120.0, **hidden)  # fmt: skip
+        run = CalibrationRun(position_inputs(positions, LATITUDE_RAD), sim.outputs_dph, None,
+                             sim.time_s)  # fmt: skip
+        d = run_diagnosis_dict(diagnose_run(run))
+        assert any("the two outputs' noise differ" in w for w in d["warnings"])
+        assert d["verdict"]["missing_effects"] == ([] if not hidden else ["bias_drift"])

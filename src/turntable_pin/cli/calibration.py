@@ -121,6 +121,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "repeatable",
     )  # fmt: skip
     c.add_argument(
+        "--effects-module", action="append", default=[], type=input_path, metavar="FILE.py",
+        help="a Python file defining run effects (subclasses of turntable_pin.instrument."
+        "effects.RunEffect): they join the candidates of --diagnose and the names of --effects",
+    )  # fmt: skip
+    c.add_argument(
         "--until-explained",
         action="store_true",
         help="with --diagnose: name every effect the stepwise search accepts",
@@ -245,6 +250,8 @@ def run_calibrate(args: argparse.Namespace) -> int:
     table = table_from_args(args)
     only = [(f"--{k.replace('_', '-')}", getattr(args, k)) for k in
             ("until_explained", "keep_outliers", "report")]  # fmt: skip
+    if args.effects_module and not (args.diagnose or args.effects):
+        raise InputError("--effects-module goes with --diagnose or --effects")
     if not args.diagnose:
         for option, value in only:
             if value:
@@ -268,6 +275,14 @@ def run_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _user_run_effects(args: argparse.Namespace) -> tuple:
+    """The run effects of ``--effects-module`` files, in the order given."""
+    from ..instrument.effects import RunEffect
+    from ..measurement.user_effects import load_effects_module
+
+    return tuple(e for path in args.effects_module for e in load_effects_module(path, RunEffect))
+
+
 def _read_run(args: argparse.Namespace, table):
     from ..calibration.run import read_run, refuse_copied_rows
 
@@ -278,12 +293,15 @@ def _read_run(args: argparse.Namespace, table):
 
 def _diagnose_run(args: argparse.Namespace, table) -> int:
     from ..instrument.diagnosis import diagnose_run, run_diagnosis_dict
+    from ..instrument.effects import run_catalogue
     from ..report.run_report import run_report_lines, write_run_plots, write_run_report
 
     run = _read_run(args, table)
+    catalogue = (*run_catalogue(table), *_user_run_effects(args))
     diagnosis = diagnose_run(
-        run, until_explained=args.until_explained, outliers=not args.keep_outliers
-    )
+        run, until_explained=args.until_explained, outliers=not args.keep_outliers,
+        catalogue=catalogue,
+    )  # fmt: skip
     out = {**run_diagnosis_dict(diagnosis), **_table_keys(table)}
     if args.plots:
         out["plots"] = [str(p) for p in write_run_plots(diagnosis, args.plots)]
@@ -309,7 +327,7 @@ def _fit_run_effects(args: argparse.Namespace, table) -> int:
 
     run = _read_run(args, table)
     names = [n for group in args.effects for n in group.split(",") if n.strip()]
-    effects = resolve_run_effects(names, table)
+    effects = resolve_run_effects(names, table, _user_run_effects(args))
     for effect in effects:
         missing = effect.missing_columns(run)
         if missing:

@@ -208,24 +208,27 @@ def inline_effect(text: str, turntable=None) -> Effect:
     return DeclaredEffect(term.spec(), [term], source="inline term")
 
 
-def _effects_in(objects: Iterable, where: str) -> list[Effect]:
-    """The effects among ``objects``: instances, and subclasses built without arguments."""
+def _effects_in(objects: Iterable, where: str, base: type = Effect) -> list:
+    """The effects among ``objects``: instances of ``base``, and its subclasses built without
+    arguments."""
     out = []
     for obj in objects:
-        if isinstance(obj, type) and issubclass(obj, Effect) and obj is not Effect:
+        if isinstance(obj, type) and issubclass(obj, base) and obj is not base:
             try:
                 obj = obj()
             except Exception as exc:  # the user's code: any failure is one line
                 raise InputError(f"{where}: {obj.__name__}() failed: {type(exc).__name__}: "
                                  f"{exc}") from None  # fmt: skip
-        if isinstance(obj, Effect):
+        if isinstance(obj, base):
             out.append(obj)
     return out
 
 
-def load_effects_module(path: str | Path) -> tuple[Effect, ...]:
-    """The effects a Python file defines: instances of :class:`Effect`, and the subclasses
-    defined in the file (built without arguments), in the order they appear.
+def load_effects_module(path: str | Path, base: type = Effect) -> tuple:
+    """The effects a Python file defines: instances of :class:`Effect` (or of ``base``: the
+    run effects of :mod:`turntable_pin.instrument` use
+    :class:`~turntable_pin.instrument.effects.base.RunEffect`), and the subclasses defined in
+    the file (built without arguments), in the order they appear.
 
     Raises:
         InputError: the file cannot be read or imported, or defines no effect.
@@ -254,11 +257,11 @@ def load_effects_module(path: str | Path) -> tuple[Effect, ...]:
         obj for obj in vars(module).values()
         if not (isinstance(obj, type) and obj.__module__ != module_name)
     ]  # fmt: skip
-    effects = _effects_in(objects, str(path))
+    effects = _effects_in(objects, str(path), base)
     if not effects:
+        where = f"{base.__module__.replace('.base', '')}.{base.__name__}"
         raise InputError(
-            "defines no effect (expected subclasses of turntable_pin.measurement.effects.Effect "
-            "or instances of them)",
+            f"defines no effect (expected subclasses of {where} or instances of them)",
             path=path,
         )
     return tuple(effects)
