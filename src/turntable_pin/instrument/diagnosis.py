@@ -185,7 +185,9 @@ class RunFamily:
                 f"{reason}these coefficients cannot be told apart: "
                 + "; ".join(undetermined[:6])
                 + " (each is fitted as the combination the positions see; an effect that moves "
-                "the outputs the same way is indistinguishable from them)"
+                "the outputs the same way is indistinguishable from them; the table's effects are "
+                "judged at the minimum-norm coefficients, so a table verdict here is a caution, "
+                "not a finding: calibrate at positions that turn gravity through every axis)"
             )
         wrapped = np.round(np.mod(np.degrees(self.run.joint_rad), 360.0), 6) % 360.0
         for k in range(wrapped.shape[1]):
