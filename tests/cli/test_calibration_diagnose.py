@@ -166,6 +166,22 @@ def test_a_run_effect_the_user_writes_is_diagnosed_and_fitted(tmp_path):
     assert fit.returncode == 0, fit.stderr
     value = json.loads(fit.stdout)["params"]["cable_drag.b"]
     assert abs(value["value"] - 0.006) < 4 * value["std"]
+    design = cli(
+        "design",
+        "--separate",
+        "cable_drag,instrument_tilt",
+        "--run",
+        str(path),
+        "--effects-module",
+        str(module),
+        "-n",
+        "3",
+        "--candidates",
+        "300",
+        "--json",
+    )
+    assert design.returncode == 0, design.stderr
+    assert json.loads(design.stdout)["effects"] == ["cable_drag", "instrument_tilt"]
     empty = write_file(tmp_path, "X = 1\n", "none.py")
     bad = cli("calibrate", str(path), "--diagnose", "--effects-module", str(empty))
     assert bad.returncode == 2 and "turntable_pin.instrument.effects.RunEffect" in bad.stderr

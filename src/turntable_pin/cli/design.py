@@ -348,10 +348,12 @@ def _run_separate_run(args: argparse.Namespace) -> int:
     from ..calibration.run import read_run
     from ..core.csv_table import write_csv_table
     from ..core.units import deg_to_rad
+    from ..instrument.effects import RunEffect, run_catalogue
     from ..instrument.separate import design_run_separation
+    from ..measurement.user_effects import load_effects_module
 
     for option, given in (
-        ("--effects", args.effects or args.effects_module),
+        ("--effects", args.effects),
         ("--from", args.from_data),
         ("--amplitude", args.amplitude),
         ("--noise-arcsec", args.noise_arcsec is not None),
@@ -367,9 +369,11 @@ def _run_separate_run(args: argparse.Namespace) -> int:
         raise InputError(f"--separate takes two effects, A,B; got '{args.separate}'")
     space = _space(args, effects=())
     run = read_run(args.run, deg_to_rad(args.latitude_deg), space.table)
+    user = [e for path in args.effects_module for e in load_effects_module(path, RunEffect)]
     result = design_run_separation(
-        run, tuple(names), deg_to_rad(space.candidates_deg), args.positions_count, seed=args.seed
-    )
+        run, tuple(names), deg_to_rad(space.candidates_deg), args.positions_count,
+        seed=args.seed, catalogue=(*run_catalogue(space.table), *user),
+    )  # fmt: skip
     out = {**result.to_dict(), "run": str(args.run)}
     if args.output is not None and result.separable:
         comment = (
