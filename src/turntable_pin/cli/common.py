@@ -26,6 +26,7 @@ __all__ = [
     "latitude_deg",
     "one_line_errors",
     "positive_float",
+    "non_negative_int",
     "positive_int",
     "print_json",
     "seed",
@@ -45,15 +46,25 @@ def finite_float(text: str) -> float:
     return value
 
 
-def positive_int(text: str) -> int:
-    """argparse type: an integer >= 1."""
+def _whole_number(text: str, low: int) -> int:
+    """``text`` as a whole number >= ``low``, or an argparse error saying so."""
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got '{text}'")
+    if value < low:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= {low}, got '{text}'")
     return value
+
+
+def positive_int(text: str) -> int:
+    """argparse type: an integer >= 1."""
+    return _whole_number(text, 1)
+
+
+def non_negative_int(text: str) -> int:
+    """argparse type: an integer >= 0."""
+    return _whole_number(text, 0)
 
 
 def positive_float(text: str) -> float:

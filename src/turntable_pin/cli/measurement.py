@@ -16,6 +16,7 @@ from .common import (
     bounded_float,
     error_values_from_args,
     input_path,
+    non_negative_int,
     one_line_errors,
     positive_float,
     positive_int,
@@ -213,7 +214,7 @@ def _add_run_options(s: argparse.ArgumentParser) -> None:
     g.add_argument("--temperature", type=_temperature, metavar="START,RAMP_PER_H,SWING,PERIOD_H",
                    help="a temperature_c column: START degC + RAMP_PER_H degC/h * t + SWING degC "
                    "* sin(2 pi t / PERIOD_H h)")  # fmt: skip
-    g.add_argument("--outliers", type=_non_negative_int, metavar="N",
+    g.add_argument("--outliers", type=non_negative_int, metavar="N",
                    help="N rows (seeded) get a gross error on one channel")  # fmt: skip
     g.add_argument("--outlier-dph", type=positive_float, metavar="D",
                    help="size of an outlier, deg/h (default 30 sigma of its channel)")  # fmt: skip
@@ -246,17 +247,6 @@ def _temperature(text: str) -> tuple[float, float, float, float]:
     swing = bounded_float(-100.0, 100.0, "degC")(parts[2].strip())
     period = bounded_float(0.0, 1e4, "h", low_open=True)(parts[3].strip())
     return start, ramp, swing, period
-
-
-def _non_negative_int(text: str) -> int:
-    """argparse type: a whole number >= 0."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got '{text}'")
-    return value
 
 
 def _noise_arcsec(text: str) -> float | tuple[float, float, float]:
