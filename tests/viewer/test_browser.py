@@ -117,3 +117,38 @@ def test_no_browser_process_survives_a_normal_run(tmp_path):
     assert "hello" in run.stdout
     assert len(watch.browser_pids) >= 2
     assert watch.survivors() == []
+
+
+CRASHING_BROWSER = """#!/usr/bin/env python3
+import os, signal, sys, pathlib
+count = pathlib.Path({count!r})
+n = int(count.read_text()) if count.exists() else 0
+count.write_text(str(n + 1))
+if n < {crashes}:
+    os.kill(os.getpid(), signal.SIGABRT)  # a start-up abort, as Chromium's zygote does under load
+shot = next(a.split("=", 1)[1] for a in sys.argv if a.startswith("--screenshot="))
+pathlib.Path(shot).write_bytes(pathlib.Path({png!r}).read_bytes())
+"""
+
+
+@pytest.mark.parametrize("crashes, ok", [(2, True), (3, False)])
+def test_a_browser_that_aborts_at_start_is_started_again(tmp_path, crashes, ok):
+    """Chromium killed by a signal of its own before the picture: started again in a fresh
+    profile, up to CRASH_ATTEMPTS times in all; then the error names the exit."""
+    from turntable_pin.viewer.browser import CRASH_ATTEMPTS
+
+    png = _png(tmp_path / "ok.png", size_in=(8.0, 6.0), dpi=100)
+    fake = tmp_path / "chromium"
+    fake.write_text(CRASHING_BROWSER.format(count=str(tmp_path / "n"), crashes=crashes,
+                                            png=str(png)))  # fmt: skip
+    fake.chmod(0o755)
+    page = tmp_path / "page.html"
+    page.write_text("<html></html>")
+    assert crashes < CRASH_ATTEMPTS or not ok
+    if ok:
+        data, run = screenshot_html(page, chromium=str(fake))
+        assert png_size(data) == (800, 600) and run.returncode == 0
+    else:
+        with pytest.raises(BrowserError, match=r"wrote no screenshot \(exit -6\)"):
+            screenshot_html(page, chromium=str(fake))
+    assert int((tmp_path / "n").read_text()) == min(crashes + 1, CRASH_ATTEMPTS)

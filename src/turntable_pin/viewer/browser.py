@@ -28,6 +28,7 @@ from ..core.interrupts import deferred, register_cleanup, temporary_folder
 
 __all__ = [
     "CHROMIUM_ENV",
+    "CRASH_ATTEMPTS",
     "CHROMIUM_NAMES",
     "DEBIAN_PACKAGE",
     "BrowserError",
@@ -330,6 +331,11 @@ def png_size(data: bytes) -> tuple[int, int]:
     return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
 
 
+CRASH_ATTEMPTS = 3
+"""How many times :func:`screenshot_html` starts Chromium when it dies by a signal of its own
+before writing the picture (SIGABRT in its zygote under load), each in a fresh profile."""
+
+
 def screenshot_html(
     page: str | Path,
     *,
@@ -349,17 +355,23 @@ def screenshot_html(
         raise BrowserError(f"{page}: no such page to render")
     with temporary_folder("turntable-pin-shot-") as tmp:
         out = tmp / "shot.png"
-        run = run_chromium(
-            [
-                f"--virtual-time-budget={int(virtual_time_ms)}",
-                f"--screenshot={out}",
-                page.as_uri(),
-            ],
-            width=width,
-            height=height,
-            timeout_s=timeout_s,
-            chromium=chromium,
-        )
+        for _ in range(CRASH_ATTEMPTS):
+            run = run_chromium(
+                [
+                    f"--virtual-time-budget={int(virtual_time_ms)}",
+                    f"--screenshot={out}",
+                    page.as_uri(),
+                ],
+                width=width,
+                height=height,
+                timeout_s=timeout_s,
+                chromium=chromium,
+            )
+            # Killed by a signal of its own (it runs in its own session: an interruption of
+            # ours never reaches it): a start-up abort seen on busy machines; a fresh profile
+            # usually starts.
+            if run.returncode >= 0 or (out.is_file() and out.stat().st_size > 0):
+                break
         if not out.is_file() or out.stat().st_size == 0:
             raise BrowserError(
                 f"headless Chromium wrote no screenshot (exit {run.returncode}): "
