@@ -185,3 +185,16 @@ def test_a_run_effect_the_user_writes_is_diagnosed_and_fitted(tmp_path):
     empty = write_file(tmp_path, "X = 1\n", "none.py")
     bad = cli("calibrate", str(path), "--diagnose", "--effects-module", str(empty))
     assert bad.returncode == 2 and "turntable_pin.instrument.effects.RunEffect" in bad.stderr
+
+
+@pytest.mark.parametrize("option", ["--report", "--plots"])
+def test_an_output_onto_the_run_is_refused_and_the_run_kept(tmp_path, option):
+    import shutil
+
+    run = tmp_path / "run.csv"
+    shutil.copy(RUNS / "run_clean.csv", run)
+    before = run.read_bytes()
+    proc = cli("calibrate", str(run), "--diagnose", option, str(run))
+    assert proc.returncode == 2
+    assert "it is the data file" in proc.stderr and "Traceback" not in proc.stderr
+    assert run.read_bytes() == before

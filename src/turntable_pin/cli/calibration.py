@@ -103,7 +103,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "residuals per position.",
     )
     one_line_errors(c)
-    c.add_argument("run", type=input_path, metavar="RUN.csv")
+    c.add_argument("data", type=input_path, metavar="RUN.csv")
     _add_setup_options(c, positions=False)
     c.add_argument("--json", action="store_true", help="print one JSON object")
     c.add_argument(
@@ -267,7 +267,7 @@ def run_calibrate(args: argparse.Namespace) -> int:
         return _diagnose_run(args, table)
     if args.effects:
         return _fit_run_effects(args, table)
-    result = calibrate_run(args.run, deg_to_rad(args.latitude_deg), table)
+    result = calibrate_run(args.data, deg_to_rad(args.latitude_deg), table)
     if args.json:
         print_json({**result.to_dict(), **_table_keys(table)})
     else:
@@ -286,7 +286,7 @@ def _user_run_effects(args: argparse.Namespace) -> tuple:
 def _read_run(args: argparse.Namespace, table):
     from ..calibration.run import read_run, refuse_copied_rows
 
-    run = read_run(args.run, deg_to_rad(args.latitude_deg), table)
+    run = read_run(args.data, deg_to_rad(args.latitude_deg), table)
     refuse_copied_rows(run)
     return run
 
@@ -306,7 +306,7 @@ def _diagnose_run(args: argparse.Namespace, table) -> int:
     if args.plots:
         out["plots"] = [str(p) for p in write_run_plots(diagnosis, args.plots)]
     if args.report:
-        title = f"Calibration run {Path(args.run).name}: the table or the GyroWheel?"
+        title = f"Calibration run {Path(args.data).name}: the table or the GyroWheel?"
         out["report"] = str(write_run_report(diagnosis, out, args.report, title=title))
     if args.json:
         print_json(out)
@@ -333,12 +333,12 @@ def _fit_run_effects(args: argparse.Namespace, table) -> int:
         if missing:
             raise InputError(
                 f"effect '{effect.name}' needs the column(s) {', '.join(missing)}, absent "
-                "from the run", path=args.run,
+                "from the run", path=args.data,
             )  # fmt: skip
     after = fit_run(run, effects)
     before = fit_run(run, (), context=after.model.context)
     before = before.with_noise_variance(after.result.noise_variance)
-    out = {"run": str(args.run), **after.to_dict(), **_table_keys(table)}
+    out = {"run": str(args.data), **after.to_dict(), **_table_keys(table)}
     out["before"] = {k: before.result.to_dict()[k] for k in
                      ("rms_dph", "chi2_reduced", "p_value", "rank", "n_params")}  # fmt: skip
     analysis = analyse_residuals(run_residuals(after))
@@ -351,7 +351,7 @@ def _fit_run_effects(args: argparse.Namespace, table) -> int:
         return 0
     _print_table(table)
     sigma = "from the sigma_dph column" if out["sigma_source"] == "column" else "estimated"
-    print(f"{args.run}: {run.n_positions} positions, noise {sigma}")
+    print(f"{args.data}: {run.n_positions} positions, noise {sigma}")
     for label, summary in (("before: base", out["before"]),
                            ("after: base + " + " + ".join(after.effect_names), out)):  # fmt: skip
         p = summary["p_value"]

@@ -268,7 +268,7 @@ def print_json(payload: dict) -> None:
     sys.stdout.write("\n")
 
 
-OUTPUT_OPTIONS: tuple[str, ...] = ("output", "plots", "write_urdf", "truth")
+OUTPUT_OPTIONS: tuple[str, ...] = ("output", "plots", "write_urdf", "truth", "report")
 """Destinations of the options through which a command writes (a file, or a folder of files)."""
 
 
