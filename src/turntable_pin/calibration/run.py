@@ -103,27 +103,6 @@ class CalibrationRun:
         """A copy with some fields changed."""
         return replace(self, **changes)
 
-    def subset(self, keep: np.ndarray) -> CalibrationRun:
-        """The rows ``keep`` (a boolean mask or indices) of the run."""
-        positions = self.inputs.positions
-        inputs = PositionInputs(
-            positions=PositionSet(positions.angles_rad[keep], table=positions.table,
-                                  name=positions.name),
-            latitude_rad=self.inputs.latitude_rad,
-            specific_force_g=self.inputs.specific_force_g[keep],
-            earth_rate_dph=self.inputs.earth_rate_dph[keep],
-            payload_rotation=self.inputs.payload_rotation[keep],
-        )  # fmt: skip
-        return CalibrationRun(
-            inputs,
-            self.outputs_dph[keep],
-            None if self.sigma_dph is None else self.sigma_dph[keep],
-            None if self.time_s is None else self.time_s[keep],
-            {k: v[keep] for k, v in self.extra.items()},
-            self.rows[keep],
-            self.source,
-        )
-
 
 def read_run(path: str | Path, latitude_rad: float, table=None) -> CalibrationRun:
     """Read a calibration run CSV (module docstring), refusing out-of-range values by file, row

@@ -27,6 +27,7 @@ __all__ = [
     "one_line_errors",
     "positive_float",
     "non_negative_int",
+    "one_or_each",
     "positive_int",
     "print_json",
     "seed",
@@ -44,6 +45,20 @@ def finite_float(text: str) -> float:
     if not math.isfinite(value):
         raise argparse.ArgumentTypeError(f"expected a finite number, got '{text}'")
     return value
+
+
+def one_or_each(text: str, parse, names: tuple[str, ...]):
+    """``text`` as one value (``parse`` of it) or one per name, comma-separated (a tuple), for
+    the argparse types of options such as ``--noise-arcsec``; else an argparse error."""
+    parts = text.split(",")
+    if len(parts) == 1:
+        return parse(text)
+    if len(parts) != len(names):
+        count = {2: "two", 3: "three"}.get(len(names), str(len(names)))
+        raise argparse.ArgumentTypeError(
+            f"expected one value or {count} ({','.join(names)}), got {len(parts)}: '{text}'"
+        )
+    return tuple(parse(p.strip()) for p in parts)
 
 
 def _whole_number(text: str, low: int) -> int:

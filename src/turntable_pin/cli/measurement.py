@@ -9,6 +9,7 @@ from pathlib import Path
 from ..core.exceptions import InputError
 from ..measurement.data import MAX_TIME_S, MIN_SIGMA_ARCSEC, read_measurements
 from ..measurement.effects import EFFECT_NAMES, parse_effect_spec
+from ..model.angles import ANGLE_NAMES
 from ..model.errors import MAX_ORIENTATION_ERROR_DEG
 from .common import (
     add_error_options,
@@ -18,6 +19,7 @@ from .common import (
     input_path,
     non_negative_int,
     one_line_errors,
+    one_or_each,
     positive_float,
     positive_int,
     print_json,
@@ -224,15 +226,7 @@ def _noise_dph(text: str) -> float | tuple[float, float]:
     """argparse type of ``--noise-dph``: one number >= 0 or two (x, y), deg/h."""
     from ..calibration.run import MAX_RUN_OUTPUT_DPH
 
-    parse = bounded_float(0.0, MAX_RUN_OUTPUT_DPH / 100.0, "deg/h")
-    parts = text.split(",")
-    if len(parts) == 1:
-        return parse(text)
-    if len(parts) != 2:
-        raise argparse.ArgumentTypeError(
-            f"expected one value or two (x,y), got {len(parts)}: '{text}'"
-        )
-    return tuple(parse(p.strip()) for p in parts)
+    return one_or_each(text, bounded_float(0.0, MAX_RUN_OUTPUT_DPH / 100.0, "deg/h"), ("x", "y"))
 
 
 def _temperature(text: str) -> tuple[float, float, float, float]:
@@ -255,14 +249,7 @@ def _noise_arcsec(text: str) -> float | tuple[float, float, float]:
     from ..measurement.simulation import MAX_NOISE_ARCSEC
 
     parse = bounded_float(MIN_SIGMA_ARCSEC, MAX_NOISE_ARCSEC, "arcsec")
-    parts = text.split(",")
-    if len(parts) == 1:
-        return parse(text)
-    if len(parts) != 3:
-        raise argparse.ArgumentTypeError(
-            f"expected one value or three (dpsi,dtheta,dgamma), got {len(parts)}: '{text}'"
-        )
-    return tuple(parse(p.strip()) for p in parts)
+    return one_or_each(text, parse, ANGLE_NAMES)
 
 
 def _sweep_axes(text: str, table) -> tuple[str, ...]:

@@ -387,24 +387,20 @@ class RunFamily:
 
 
 def channel_variances(fit: RunFit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(variance deg^2/h^2, counts, degrees of freedom)`` of each output's residuals."""
-    residuals = fit.residuals_dph
-    counts = np.sum(np.isfinite(residuals), axis=0)
-    dof = counts * fit.result.dof / max(fit.result.n_obs, 1)
-    return np.nansum(residuals**2, axis=0) / np.maximum(dof, 1.0), counts, dof
+    """``(variance deg^2/h^2, counts, degrees of freedom)`` of each output's residuals
+    (:func:`~turntable_pin.stats.outliers.column_variances`)."""
+    from ..stats.outliers import column_variances
+
+    return column_variances(fit.residuals_dph, fit.result.dof, fit.result.n_obs)
 
 
 def _noise_per_channel(diagnosis: Diagnosis) -> tuple[np.ndarray, str] | None:
     """Without sigmas: the residual rms of each output under the best model and a sentence,
     when the two channels' noise differ (F test), else None."""
-    from scipy import special
+    from ..stats.outliers import variances_differ
 
     variance, counts, dof = channel_variances(diagnosis.best_fit)
-    if min(counts) < 10:
-        return None
-    hi, lo = (0, 1) if variance[0] >= variance[1] else (1, 0)
-    p = 2.0 * float(special.fdtrc(dof[hi], dof[lo], variance[hi] / max(variance[lo], 1e-300)))
-    if p >= NOISE_PER_CHANNEL_ALPHA:
+    if not variances_differ(variance, counts, dof, NOISE_PER_CHANNEL_ALPHA)[0]:
         return None
     sigma = np.sqrt(variance)
     return sigma, (

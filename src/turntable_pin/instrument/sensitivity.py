@@ -34,8 +34,7 @@ def drift_gradient(axis: str, specific_force_g: np.ndarray, coefficients) -> np.
         coefficients: the axis' seven coefficients in ``TERM_NAMES`` order (deg/h-based units).
     """
     a = np.asarray(specific_force_g, dtype=float)
-    df, bx, by, bz, bq, bzz, bxy = np.asarray(coefficients, dtype=float)
-    del df
+    _, bx, by, bz, bq, bzz, bxy = np.asarray(coefficients, dtype=float)  # DF has no gradient
     q = 0 if axis == "x" else 1
     grad = np.empty_like(a)
     grad[:, 0] = bx + bxy * a[:, 1]

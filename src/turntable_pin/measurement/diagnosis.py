@@ -673,12 +673,10 @@ def _refit(fit: OrientationFit, data: OrientationMeasurements) -> OrientationFit
 
 def _angle_variances(fit: OrientationFit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(variance rad^2, counts, degrees of freedom)`` of each measured angle's residuals
-    under ``fit``, the fit's degrees of freedom shared out by the angles' counts."""
-    residuals = fit.residuals_rad  # NaN where not measured or left out
-    counts = np.sum(np.isfinite(residuals), axis=0)
-    share = fit.result.dof / max(fit.result.n_obs, 1)
-    dof = counts * share
-    return np.nansum(residuals**2, axis=0) / np.maximum(dof, 1.0), counts, dof
+    under ``fit`` (:func:`~turntable_pin.stats.outliers.column_variances`)."""
+    from ..stats.outliers import column_variances
+
+    return column_variances(fit.residuals_rad, fit.result.dof, fit.result.n_obs)
 
 
 NOISE_ITERATIONS = 20
@@ -694,19 +692,10 @@ def _noise_per_angle(diagnosis: Diagnosis) -> tuple[np.ndarray, str] | None:
     """Without sigmas: the residual rms of each measured angle under the best model (rad) and a
     sentence, when the angles' noise differ (F test at :data:`NOISE_PER_ANGLE_ALPHA`), else None.
     """
-    from scipy import special
+    from ..stats.outliers import variances_differ
 
     variance, counts, dof = _angle_variances(diagnosis.best_fit)
-    present = [a for a in range(3) if counts[a] >= 10]
-    if len(present) < 2:
-        return None
-    pairs = [(a, b) for i, a in enumerate(present) for b in present[i + 1 :]]
-    alpha = NOISE_PER_ANGLE_ALPHA / len(pairs)
-    differ = False
-    for a, b in pairs:
-        hi, lo = (a, b) if variance[a] >= variance[b] else (b, a)
-        p = 2.0 * float(special.fdtrc(dof[hi], dof[lo], variance[hi] / max(variance[lo], 1e-300)))
-        differ |= p < alpha
+    differ, present = variances_differ(variance, counts, dof, NOISE_PER_ANGLE_ALPHA)
     if not differ:
         return None
     sigma = np.sqrt(variance)

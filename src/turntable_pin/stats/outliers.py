@@ -26,8 +26,10 @@ __all__ = [
     "OutlierTest",
     "leverages",
     "outlier_threshold",
+    "column_variances",
     "screen_cells",
     "screened_diagnosis",
+    "variances_differ",
     "screen_outliers",
 ]
 
@@ -185,3 +187,35 @@ def screened_diagnosis(diagnose_without, screen, records, rule: str):
     if note:
         diagnosis.warnings.append(note)
     return diagnosis
+
+
+def column_variances(residuals: np.ndarray, dof: float, n_obs: int):
+    """``(variance, counts, degrees of freedom)`` of each column of a residual table (R, K), NaN
+    where a cell holds no observation: each column's sum of squares over its share of the fit's
+    ``dof`` (shared out by the columns' counts of the ``n_obs`` observations)."""
+    counts = np.sum(np.isfinite(residuals), axis=0)
+    column_dof = counts * (dof / max(n_obs, 1))
+    return np.nansum(residuals**2, axis=0) / np.maximum(column_dof, 1.0), counts, column_dof
+
+
+MIN_NOISE_COUNT = 10
+"""Fewest observations of a column for :func:`variances_differ` to compare its noise."""
+
+
+def variances_differ(variance, counts, dof, alpha: float) -> tuple[bool, list[int]]:
+    """Whether the columns' noise differ: a two-sided F test of every pair of the columns with at
+    least :data:`MIN_NOISE_COUNT` observations, at ``alpha`` over the pairs (Bonferroni); and
+    those columns (fewer than two: never)."""
+    from scipy import special
+
+    present = [a for a in range(len(counts)) if counts[a] >= MIN_NOISE_COUNT]
+    if len(present) < 2:
+        return False, present
+    pairs = [(a, b) for i, a in enumerate(present) for b in present[i + 1 :]]
+    level = alpha / len(pairs)
+    differ = False
+    for a, b in pairs:
+        hi, lo = (a, b) if variance[a] >= variance[b] else (b, a)
+        p = 2.0 * float(special.fdtrc(dof[hi], dof[lo], variance[hi] / max(variance[lo], 1e-300)))
+        differ |= p < level
+    return differ, present
