@@ -57,6 +57,34 @@ def test_jacobian_matches_finite_differences_for_all_effects(seed):
         np.testing.assert_allclose(jac[:, :, k], fd, atol=tol, err_msg=model.parameter_names[k])
 
 
+@settings(max_examples=10, deadline=None)
+@given(st.integers(0, 10_000))
+def test_rows_without_the_roll_predict_the_boresight_and_their_jacobian_is_fd(seed):
+    # a row whose dgamma is not measured sees the x axis' direction: dpsi = -dR[2, 0] (the
+    # swing of dR), with the roll anywhere; other rows keep dR[0, 2]
+    rng = np.random.default_rng(seed)
+    v = _grid_variables(seed, n=25)
+    rows = rng.random(v.n) < 0.5
+    swing = PositionVariables(v.joint_rad, v.time_s, v.dirs, boresight_only=rows)
+    whole = OrientationModel(v, list(EFFECTS.values()))
+    model = OrientationModel(swing, list(EFFECTS.values()))
+    scale = np.where(np.array([u == "arcsec/h" for u in model.parameter_units]), 1e-7, 1e-3)
+    p = rng.normal(0, 1, model.n_params) * scale
+    d_r = whole.rotation_error(p)
+    predicted, expected = model.predict(p), whole.predict(p)
+    np.testing.assert_array_equal(predicted[~rows], expected[~rows])
+    np.testing.assert_allclose(predicted[rows, 0], -d_r[rows, 2, 0], atol=1e-17)
+    np.testing.assert_array_equal(predicted[rows, 1:], expected[rows, 1:])
+    jac = model.jacobian(p)
+    for k in range(model.n_params):
+        h = 1e-2 * scale[k]
+        step = np.zeros(model.n_params)
+        step[k] = h
+        fd = (model.predict(p + step) - model.predict(p - step)) / (2 * h)
+        tol = 1e-8 * max(1.0, np.abs(fd).max())
+        np.testing.assert_allclose(jac[:, :, k], fd, atol=tol, err_msg=model.parameter_names[k])
+
+
 def _reference_jacobian(model, params):
     """The Jacobian from prefix and suffix products of the chain's (N, 3, 3) matrices:
     ``d dR = P_f [a]x S_f`` for every rotation, the gains dense (the straightforward way)."""

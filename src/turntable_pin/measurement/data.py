@@ -236,7 +236,14 @@ class OrientationMeasurements:
         ref = self.__dict__.get(_VARIABLES)
         cached = ref() if ref is not None else None
         if cached is None:
-            cached = PositionVariables(self.joint_rad, self.time_s, self.dirs, dict(self.extra))
+            measured = self.measured
+            cached = PositionVariables(
+                self.joint_rad,
+                self.time_s,
+                self.dirs,
+                dict(self.extra),
+                boresight_only=measured[:, 0] & ~measured[:, 2],
+            )
             self.__dict__[_VARIABLES] = weakref.ref(cached)
         return cached
 

@@ -323,10 +323,25 @@ class OrientationModel:
         return np.ascontiguousarray(np.moveaxis(dR, -1, 0))
 
     def predict(self, params) -> np.ndarray:
-        """``[dpsi, dtheta, dgamma]`` (rad) at each position, (N, 3)."""
+        """``[dpsi, dtheta, dgamma]`` (rad) at each position, (N, 3); on the rows whose roll is
+        not measured (:attr:`PositionVariables.boresight_only`) ``dpsi`` is ``-dR[2, 0]``, the
+        entry (0, 2) of ``dR`` without its twist about x."""
         params = self._check(params)
         dR = self._forward(params, False)[0]
-        return self._with_added(np.stack([dR[i, j] for i, j in ANGLE_ENTRIES], axis=1), params)
+        return self._with_added(self._entries(dR), params)
+
+    def _entries(self, dR: np.ndarray, rows: slice = slice(None)) -> np.ndarray:
+        """The measured angles' entries of ``dR`` (entry-major, 3 x 3 x n) as (n, 3)."""
+        out = np.stack([dR[i, j] for i, j in ANGLE_ENTRIES], axis=1)
+        swing = self._boresight_only(rows)
+        if swing is not None:
+            out[swing, 0] = -dR[2, 0][swing]
+        return out
+
+    def _boresight_only(self, rows: slice = slice(None)) -> np.ndarray | None:
+        """The rows (of ``rows``) whose ``dpsi`` is the swing's, or ``None``."""
+        mask = self.variables.boresight_only
+        return None if mask is None else mask[rows]
 
     def jacobian(self, params) -> np.ndarray:
         """Exact derivative of :meth:`predict` with respect to the parameters, (N, 3, n)."""
@@ -349,10 +364,13 @@ class OrientationModel:
         jac = np.zeros((self.n_params, n, 3))
         entries = np.empty((n, 3))
         factors = [f for f in self._factors if f.fixed is None]
+        swing = self._boresight_only(rows)
         for factor, u in zip(factors, axes, strict=True):
             for e, (i, j) in enumerate(ANGLE_ENTRIES):
                 i1, i2 = (i + 1) % 3, (i + 2) % 3
                 np.subtract(u[i1] * dR[i2, j], u[i2] * dR[i1, j], out=entries[:, e])
+            if swing is not None:  # d(-dR[2, 0]) = -(u x dR[:, 0])_2
+                entries[swing, 0] = (u[1] * dR[0, 0] - u[0] * dR[1, 0])[swing]
             weights = factor.weights if factor.weights.shape[-1] == 1 else factor.weights[:, rows]
             for column, weight in zip(factor.columns, weights, strict=True):
                 if weight.size == 1 and weight[0] == 1.0:
@@ -363,8 +381,7 @@ class OrientationModel:
             for column, weight in gain.items():
                 w = np.asarray(weight, dtype=float)
                 jac[column][:, a] += w if w.ndim == 0 else w[rows]
-        predicted = np.stack([dR[i, j] for i, j in ANGLE_ENTRIES], axis=1)
-        return self._with_added(predicted, params, rows), jac.transpose(1, 2, 0)
+        return self._with_added(self._entries(dR, rows), params, rows), jac.transpose(1, 2, 0)
 
     def _with_added(self, predicted: np.ndarray, params, rows: slice = slice(None)) -> np.ndarray:
         """``predicted`` (N, 3) plus the terms added to a measured angle itself."""

@@ -31,11 +31,14 @@ The file (what is read; anything else is refused with the file and line named):
   alike; the star places are taken as apparent places of date.
 
 The conversion (the project's definition, docs/model.md): ``dR = Rd(raw)^T Rt``, with ``Rd`` the
-URDF's nominal chain and ``Rt`` the orientation that points at the star, taken as ``Rd(observed)``:
-``dtheta = dR[1,0]`` is the boresight's own error across the second axis' circle and exact;
-``dpsi = dR[0,2]`` uses the roll of the nominal chain at the observed angles, which a pointing run
-does not observe: exact for index errors, off by (roll error) x (cross-axis error) otherwise;
-``dgamma`` (the roll) is not measured and left empty.
+URDF's nominal chain and ``Rt`` the orientation that points at the star, taken as ``Rd(observed)``
+with the observed angles on the encoders' side of the pier (:func:`encoder_side`: on the far
+side of a German-equatorial pier ``(H + 180 deg, +-180 deg - dec)``). A pointing run measures the
+boresight's direction, not the tube's roll about it, so the rows hold the boresight's own
+components, exact whatever the roll: ``dtheta = dR[1,0]`` (across the second axis' circle) and
+``dpsi = -dR[2,0]``, which is ``dR[0,2]`` of ``dR`` without its twist about the boresight (its
+swing); ``dgamma`` (the roll) is not measured and left empty, and the fit compares such rows with
+the model's swing likewise (``docs/measurements.md``, section 1).
 
 Refraction: with ``refraction="apply"`` the observed position is lifted towards the zenith by the
 Saemundsson refraction at the run's temperature and pressure before ``Rd(observed)`` is formed;
@@ -72,6 +75,8 @@ __all__ = [
     "TpointConversion",
     "TpointRun",
     "convert_tpoint",
+    "encoder_side",
+    "far_side_rows",
     "mount_urdf_text",
     "read_tpoint",
     "saemundsson_refraction_arcsec",
@@ -211,6 +216,11 @@ class TpointConversion:
         else:
             out.append("hour angle = sidereal time - RA (positive West), star and raw alike; "
                        "star places taken as apparent places of date")  # fmt: skip
+            far = int(far_side_rows(run).sum())
+            out.append(
+                f"pier sides: {run.n_stars - far} rows near, {far} far (raw dec beyond +-90 deg: "
+                "the star taken at H + 180 deg, +-180 deg - dec, the encoders' side)"
+            )
         if self.refraction == "apply":
             r = self.refraction_arcsec
             out.append(
@@ -221,10 +231,9 @@ class TpointConversion:
             out.append("refraction: none (the observed positions used as given)")
         out += [
             f"phi1_deg, phi2_deg = raw (encoder) {first} and {second}: the commanded angles",
-            "dR = Rd(raw)^T Rd(observed) with the URDF's nominal chain; dpsi_arcsec = dR[0,2], "
+            "dR = Rd(raw)^T Rd(observed) with the URDF's nominal chain; the boresight's own "
+            "components, exact whatever the roll: dpsi_arcsec = -dR[2,0] (dR[0,2] of dR's swing), "
             "dtheta_arcsec = dR[1,0]; dgamma_arcsec empty (the roll is not measured); no sigma",
-            "dpsi takes the roll of the nominal chain at the observed angles (exact for index "
-            "errors; off by roll error x cross-axis error otherwise)",
             "source lines of the rows, in order: " + _ranges(run.lines),
         ]
         return out
@@ -615,6 +624,31 @@ def _angles_pointing_at(placements, target: np.ndarray, start_rad: np.ndarray) -
 
 
 # --- conversion -------------------------------------------------------------------------------
+def far_side_rows(run: TpointRun) -> np.ndarray:
+    """(N,) True where an equatorial run's raw declination is beyond +-90 deg: the tube was on
+    the far side of the pier (the mount turned past the pole); always False for alt-az runs."""
+    if run.mount != EQUATORIAL:
+        return np.zeros(run.n_stars, dtype=bool)
+    return np.abs(run.raw_deg[:, 1]) > 90.0
+
+
+def encoder_side(run: TpointRun) -> np.ndarray:
+    """(N, 2) the observed (star) angles on the encoders' side of the pier (deg).
+
+    On the far side of the pier the joint angles that point the tube at a star at (H, dec) are
+    (H + 180 deg, +-180 deg - dec), the sign that of the raw declination: the same direction with
+    the tube rolled 180 deg about it. The star's orientation is taken there, so that it is
+    compared with the encoders' orientation on the same side, not across the pier.
+    """
+    observed = run.observed_deg.copy()
+    far = far_side_rows(run)
+    if far.any():
+        sign = np.sign(run.raw_deg[far, 1])
+        observed[far, 0] = observed[far, 0] + 180.0
+        observed[far, 1] = sign * 180.0 - observed[far, 1]
+    return observed
+
+
 def convert_tpoint(
     run: TpointRun, *, refraction: str | None = None, latitude_deg: float | None = None
 ) -> TpointConversion:
@@ -652,7 +686,7 @@ def convert_tpoint(
         urdf.write_text(urdf_text, encoding="utf-8")
         placements = GenericTable(urdf).chain.placements()
     raw = np.radians(run.raw_deg).T  # (2, N)
-    obs = np.radians(run.observed_deg).T
+    obs = np.radians(encoder_side(run)).T
     refr = np.zeros(run.n_stars)
     if refraction == "apply":
         p = run.run_parameters
@@ -693,7 +727,7 @@ def convert_tpoint(
     return TpointConversion(
         run=run,
         phi_deg=run.raw_deg.copy(),
-        dpsi_arcsec=d_r[:, 0, 2] * ARCSEC_PER_RAD,
+        dpsi_arcsec=-d_r[:, 2, 0] * ARCSEC_PER_RAD,
         dtheta_arcsec=d_r[:, 1, 0] * ARCSEC_PER_RAD,
         refraction=refraction,
         refraction_arcsec=refr,

@@ -97,12 +97,18 @@ class PositionVariables:
         time_s: time of each measurement (N,), or ``None`` when the data have no ``time_s``.
         dirs: per joint, the approach direction (N,) of ``dirK`` (+1/-1), or ``None``.
         extra: other numeric columns of the data file (``temperature_c``, ...), ``{name: (N,)}``.
+        boresight_only: (N,) bool, or ``None`` (no such row): the rows whose roll about the
+            payload's x axis (``dgamma``) is not measured while ``dpsi`` is. Such a row measures
+            the direction of the x axis (a star's, an autocollimator's mirror normal), not a
+            whole rotation, so its ``dpsi`` is compared without the twist about x: ``dR``'s
+            swing, whose entry (0, 2) is ``-dR[2, 0]`` (``docs/measurements.md``, section 1).
     """
 
     joint_rad: np.ndarray
     time_s: np.ndarray | None = None
     dirs: tuple[np.ndarray | None, ...] = ()
     extra: Mapping[str, np.ndarray] = field(default_factory=dict)
+    boresight_only: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         joints = np.asarray(self.joint_rad, dtype=float)  # no copy of read-only data arrays
@@ -114,6 +120,14 @@ class PositionVariables:
         object.__setattr__(self, "joint_rad", joints)
         dirs = tuple(self.dirs) + (None,) * (joints.shape[1] - len(self.dirs))
         object.__setattr__(self, "dirs", dirs[: joints.shape[1]])
+        if self.boresight_only is not None:
+            rows = np.array(self.boresight_only, dtype=bool).reshape(-1)
+            if rows.shape[0] != joints.shape[0]:
+                raise ValueError(
+                    f"boresight_only has {rows.shape[0]} rows, the positions {joints.shape[0]}"
+                )
+            rows.setflags(write=False)
+            object.__setattr__(self, "boresight_only", rows if rows.any() else None)
 
     def memo(
         self, key: tuple, keep: tuple, compute: Callable[[], Any], *, weak: bool = False
