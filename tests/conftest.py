@@ -113,6 +113,48 @@ def cli(*args: str) -> subprocess.CompletedProcess:
     )
 
 
+# --- figures -------------------------------------------------------------------------------------
+REPORT_FIGURE_MODULES = (
+    "allocation_figures",
+    "design_figures",
+    "html_report",
+    "measurement_figures",
+    "requirement_figures",
+    "separation_figures",
+)
+"""The report modules that save figures (each through its own name of ``figures.save_png``)."""
+
+
+@pytest.fixture
+def drawn_figures(monkeypatch) -> list:
+    """Every matplotlib figure the report modules save while this fixture is active, in order
+    (closed by the saver, still readable: axes, texts, legends)."""
+    import importlib
+
+    from turntable_pin.report import figures
+
+    drawn, save = [], figures.save_png
+
+    def recording(fig, path=None, **kw):
+        drawn.append(fig)
+        return save(fig, path, **kw)
+
+    for name in REPORT_FIGURE_MODULES:
+        module = importlib.import_module(f"turntable_pin.report.{name}")
+        monkeypatch.setattr(module, "save_png", recording)
+    return drawn
+
+
+def figure_texts(fig) -> tuple[str, list[str]]:
+    """All the words on ``fig`` joined (titles, labels, notes, legends) and its legend labels."""
+    from matplotlib.text import Text
+
+    words = "\n".join(t.get_text() for t in fig.findobj(Text) if t.get_text())
+    legends = [t.get_text() for ax in fig.axes if ax.get_legend()
+               for t in ax.get_legend().get_texts()]  # fmt: skip
+    return words, legends
+
+
 # --- meshcat --------------------------------------------------------------------------------------
 def meshcat_transforms(scene, *angles_rad: float) -> tuple[dict[str, np.ndarray], int]:
     """Draw ``scene`` at ``angles_rad`` into a short-lived meshcat server: the 4x4 transforms its

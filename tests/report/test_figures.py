@@ -102,6 +102,40 @@ def test_the_report_s_figures_are_legible(tmp_path, checked):
     assert checked and [p for p in checked if p[1]] == []
 
 
+def _without_some_angles(kind: str, folder) -> list[str]:
+    """Data and table arguments of a run with angles not measured: the MMT pointing run (no
+    dgamma at all) or a simulated grid with dpsi and dgamma empty in some rows."""
+    if kind == "pointing":
+        run = folder / "mmt_run.csv"
+        tpoint = EXAMPLES_DIR / "mmt_pointing" / "k_and_e.dat"
+        assert cli("import-tpoint", str(tpoint), "-o", str(run)).returncode == 0
+        return [str(run), "--urdf", "altaz_mount"]
+    import dataclasses
+
+    import numpy as np
+
+    from turntable_pin import TurntableErrors
+    from turntable_pin.measurement.simulation import simulate_measurements
+
+    errors = TurntableErrors.from_arcsec(dalpha_x1=2)
+    sim = simulate_measurements(errors, {"gravity_sag": {"k": 3.0}}, seed=3)
+    angles = np.array(sim.data.angles_rad)
+    angles[::2, 0] = angles[::3, 2] = np.nan
+    data = dataclasses.replace(sim.data, angles_rad=angles)
+    return [str(dataclasses.replace(sim, data=data).write_csv(folder / "partial.csv"))]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", ["pointing", "partial"])
+def test_figures_of_angles_not_measured_are_legible(kind, tmp_path, checked):
+    data = _without_some_angles(kind, tmp_path)
+    result = cli("report", *data, "-o", str(tmp_path / "r.html"))
+    assert result.returncode == 0, result.stderr
+    result = cli("diagnose", *data, "--plots", str(tmp_path / "plots"))
+    assert result.returncode == 0, result.stderr
+    assert checked and [p for p in checked if p[1]] == []
+
+
 def test_the_check_sees_overlapping_and_escaping_texts():
     from turntable_pin.report.figures import pyplot
 

@@ -1,5 +1,6 @@
 """The HTML report: one self-contained page with every section and decodable embedded images,
-the one-line verdict on top, each figure once, a plot of each structure term the search finds."""
+the one-line verdict on top, each figure once, a plot of each structure term the search finds,
+and the angles not measured named on the page and its figures, never drawn."""
 
 import base64
 import dataclasses
@@ -8,7 +9,7 @@ import re
 import numpy as np
 import pytest
 
-from conftest import needs_chromium
+from conftest import figure_texts, needs_chromium
 from turntable_pin import TurntableErrors
 from turntable_pin.core.units import ARCSEC_PER_RAD
 from turntable_pin.measurement.diagnosis import diagnose_measurements
@@ -85,6 +86,30 @@ def test_the_page_opens_with_the_verdict_and_shows_each_figure_once(partial_page
                     "harmonics before and after", "residual map after"]  # fmt: skip
     assert all(base64.b64decode(i)[:8] == b"\x89PNG\r\n\x1a\n" for i in images)
     assert "Structure left in the residuals of base + gravity_sag" in page
+
+
+def test_the_page_names_the_angles_not_measured_and_draws_the_others(drawn_figures):
+    """dgamma empty in every row (a pointing run), dpsi in every other one."""
+    sim = simulate_measurements(
+        TurntableErrors.from_arcsec(deps_y=4), {"backlash": {"b1": 3.0, "b2": -2.0}}, seed=5
+    )
+    angles = np.array(sim.data.angles_rad)
+    angles[:, 2] = np.nan
+    angles[::2, 0] = np.nan
+    page = diagnosis_html(diagnose_measurements(dataclasses.replace(sim.data, angles_rad=angles)))
+    said = ("144 positions, 216 measured angles (dpsi: measured at 72 of 144 positions; dgamma: "
+            "not measured; the fits and plots use the measured angles only)")  # fmt: skip
+    assert said in page
+    assert len(_images(page)) == len(drawn_figures) == 5
+    for fig in drawn_figures:
+        words, legends = figure_texts(fig)
+        assert "dgamma: not measured" in words and "dpsi: measured at 72 of 144" in words
+        assert "dgamma" not in legends and "measured dgamma" not in words
+    data_panels = [ax for ax in drawn_figures[0].axes if ax.get_title()]
+    assert [ax.get_title() for ax in data_panels] == ["measured dpsi", "measured dtheta"]
+    assert len(data_panels[0].collections[0].get_offsets()) == 72
+    # the colour bar spans phi1, whichever panels are drawn
+    assert drawn_figures[0].axes[-1].get_ylim() == pytest.approx((0.0, 330.0))
 
 
 @pytest.mark.slow

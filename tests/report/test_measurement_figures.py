@@ -1,5 +1,6 @@
 """Plots that show what the text finds: a planted 3/rev term, projected, fitted, drawn; the map
-over both angles; forward and backward passes told apart."""
+over both angles; forward and backward passes told apart; angles not measured (empty cells)
+named on every figure and never drawn."""
 
 import dataclasses
 import io
@@ -7,12 +8,17 @@ import io
 import numpy as np
 import pytest
 
+from conftest import REPO_DIR, figure_texts
 from turntable_pin import TurntableErrors
 from turntable_pin.core.units import ARCSEC_PER_RAD
 from turntable_pin.measurement.diagnosis import OrientationFamily, diagnose_measurements
-from turntable_pin.measurement.residuals import orientation_residuals
+from turntable_pin.measurement.fit import fit_orientation
+from turntable_pin.measurement.residuals import analyse_residuals, orientation_residuals
 from turntable_pin.measurement.simulation import simulate_measurements
+from turntable_pin.measurement.user_effects import resolve_effects
+from turntable_pin.model.generic_table import GenericTable
 from turntable_pin.report.measurement_figures import (
+    _positions_mean,
     direction_of,
     map_limit,
     residual_figure,
@@ -101,8 +107,6 @@ def test_term_figure_and_maps_are_valid_pngs(planted):
 
 
 def test_the_map_shows_the_planted_phi2_structure_in_dtheta(planted):
-    from turntable_pin.report.measurement_figures import _positions_mean
-
     _, diagnosis = planted
     rs = orientation_residuals(diagnosis.base_fit)
     phi1, phi2, mean = _positions_mean(rs.angles_deg["phi1_deg"], rs.angles_deg["phi2_deg"],
@@ -136,3 +140,69 @@ def test_plot_files_exist_and_are_pngs(planted, tmp_path):
     for path in paths:
         assert path.is_file() and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
         _png_size(path.read_bytes())
+
+
+def _not_measured(data, rows, angle: int):
+    """``data`` with angle ``angle`` (0 dpsi, 1 dtheta, 2 dgamma) emptied at ``rows``."""
+    angles = np.array(data.angles_rad)
+    angles[rows, angle] = np.nan
+    return dataclasses.replace(data, angles_rad=angles)
+
+
+@pytest.mark.parametrize("urdf", [None, "single_axis_rate_table.urdf"])
+def test_an_angle_never_measured_is_named_on_every_figure_and_not_drawn(
+    urdf, tmp_path, drawn_figures
+):
+    """A pointing run has no roll: ``dgamma`` empty in every row (its harmonics are None, which
+    the harmonics figure once handed to matplotlib's bar and crashed)."""
+    table = None if urdf is None else GenericTable(REPO_DIR / "models" / urdf)
+    sim = simulate_measurements(turntable=table, seed=9)
+    data = _not_measured(sim.data, slice(None), 2)
+    base = orientation_residuals(fit_orientation(data, turntable=table))
+    harmonics = analyse_residuals(base).harmonics
+    assert harmonics and all(set(h["dgamma"]) == {None} for h in harmonics.values())
+    paths = write_residual_plots([base, base], tmp_path)
+    names = ["residuals.png", "harmonics.png"] + ([] if urdf else ["residual_maps.png"])
+    assert [p.name for p in paths] == names and all(p.stat().st_size > 0 for p in paths)
+    assert len(drawn_figures) == len(names)
+    for fig in drawn_figures:
+        words, legends = figure_texts(fig)
+        assert "dgamma: not measured" in words
+        assert "dgamma" not in legends and "dgamma residual" not in words
+    assert set(figure_texts(drawn_figures[0])[1]) == {"dpsi", "dtheta"}
+    if not urdf:  # the maps: two rows (the sets) of dpsi and dtheta, and the colour bar
+        assert len(drawn_figures[2].axes) == 2 * 2 + 1
+
+
+def test_an_angle_measured_at_some_positions_is_drawn_where_measured(tmp_path, drawn_figures):
+    sim = simulate_measurements(
+        TurntableErrors.from_arcsec(deps_y=4, dalpha_x1=2), {"gravity_sag": {"k": 3.0}}, seed=3
+    )
+    data = _not_measured(_not_measured(sim.data, slice(None, None, 2), 0), slice(None, None, 3), 2)
+    before = orientation_residuals(fit_orientation(data))
+    after = orientation_residuals(fit_orientation(data, resolve_effects(["gravity_sag"])))
+    paths = write_residual_plots([before, after], tmp_path)
+    assert [p.name for p in paths] == ["residuals.png", "harmonics.png", "residual_maps.png"]
+    residuals, harmonics, maps = drawn_figures
+    for fig in drawn_figures:
+        words, _ = figure_texts(fig)
+        assert "dpsi: measured at 72 of 144 positions" in words
+        assert "dgamma: measured at 96 of 144 positions" in words and "dtheta:" not in words
+    assert set(figure_texts(residuals)[1]) == set(figure_texts(harmonics)[1]) == {
+        "dpsi", "dtheta", "dgamma"
+    }  # fmt: skip
+    # against the measurement order: one point per measured dpsi
+    [dpsi] = [line for line in residuals.axes[0].get_lines() if line.get_label() == "dpsi"]
+    assert np.isfinite(dpsi.get_ydata()).sum() == 72
+    # the dpsi map: coloured squares where measured, hollow ones where not
+    hollow, coloured = maps.axes[0].collections
+    assert len(coloured.get_offsets()) == 72 and len(hollow.get_offsets()) == 72
+    assert "hollow grey squares" in figure_texts(maps)[0]
+
+
+def test_the_map_averages_the_measured_repeats_only():
+    x, y = np.array([0.0, 0.0, 90.0]), np.zeros(3)
+    values = np.array([[1.0, np.nan], [3.0, 2.0], [np.nan, np.nan]])
+    px, py, mean = _positions_mean(x, y, values)
+    assert px.tolist() == [0.0, 90.0] and py.tolist() == [0.0, 0.0]
+    np.testing.assert_array_equal(mean, [[2.0, 2.0], [np.nan, np.nan]])

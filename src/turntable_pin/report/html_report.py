@@ -12,6 +12,8 @@ import base64
 import html
 from pathlib import Path
 
+import numpy as np
+
 from ..core.files import write_text_atomic
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..measurement.data import ANGLE_NAMES
@@ -24,6 +26,7 @@ from .measurement_figures import (
     COLOURS,
     harmonics_figure,
     map_limit,
+    not_measured_note,
     residual_figure,
     residual_map_figure,
     structure_term_figure,
@@ -63,19 +66,32 @@ def html_table(header: list[str], rows: list[list], left: int = 1) -> str:
 
 def data_figure(data) -> bytes:
     """PNG: the measured angles against the last joint's angle (phi2 on a two-axis table), one
-    panel per angle, coloured by the first joint's (phi1); one joint: against phi1."""
+    panel per angle measured at some position, coloured by the first joint's (phi1); one joint:
+    against phi1. The angles not measured at every position are named on the figure."""
+    from matplotlib.colors import Normalize
+
     plt = pyplot()
 
-    fig, axes = plt.subplots(1, 3, figsize=(14, 3.6), layout="constrained")
+    counts = data.measured.sum(axis=0)
+    drawn = np.flatnonzero(counts > 0)  # a row measures at least one angle: never empty
+    fig, axes = plt.subplots(
+        1, len(drawn), figsize=(14 * len(drawn) / 3, 3.6), layout="constrained", squeeze=False
+    )
     last = data.n_joints
     x = data.joint_rad[:, last - 1] * DEG_PER_RAD
     colour = data.joint_rad[:, 0] * DEG_PER_RAD
-    for i, (ax, name) in enumerate(zip(axes, ANGLE_NAMES, strict=True)):
-        sc = ax.scatter(x, data.angles_rad[:, i] * ARCSEC_PER_RAD, c=colour, s=10, cmap="viridis")
+    norm = Normalize(float(colour.min()), float(colour.max()))  # one scale for every panel
+    for ax, i in zip(axes[0], drawn, strict=True):
+        name, ok = ANGLE_NAMES[i], data.measured[:, i]
+        sc = ax.scatter(x[ok], data.angles_rad[ok, i] * ARCSEC_PER_RAD, c=colour[ok], s=10,
+                        cmap="viridis", norm=norm)  # fmt: skip
         ax.set_xlabel(f"phi{last} (deg)")
         ax.set_ylabel(f"{name} (arcsec)")
         ax.set_title(f"measured {name}", fontsize=10, color=COLOURS[i])
-    fig.colorbar(sc, ax=axes, label="phi1 (deg)")
+    note = not_measured_note(ANGLE_NAMES, counts, data.n_positions)
+    if note:
+        fig.suptitle(note, fontsize=10)
+    fig.colorbar(sc, ax=axes[0].tolist(), label="phi1 (deg)")
     return save_png(fig)
 
 
@@ -131,9 +147,17 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
         f'<p class="verdict headline{"" if explained else " warn"}" id="verdict">'
         f"{html.escape(headline(d))}</p>"
     )
+    counts = data.measured.sum(axis=0)
+    unmeasured = not_measured_note(ANGLE_NAMES, counts, data.n_positions, separator="; ")
     parts.append(
         f"<p>Source: <code>{html.escape(data.source)}</code> &mdash; {data.n_positions} "
-        f"positions, {int(data.measured.sum())} measured angles; noise sigma "
+        f"positions, {int(data.measured.sum())} measured angles"
+        + (
+            f" ({html.escape(unmeasured)}; the fits and plots use the measured angles only)"
+            if unmeasured
+            else ""
+        )
+        + "; noise sigma "
         + (
             f"from the file's <code>sigma_arcsec</code> column (median {d['sigma_arcsec']:.3g} "
             "arcsec)."

@@ -20,6 +20,8 @@ __all__ = [
     "direction_of",
     "harmonics_figure",
     "map_limit",
+    "measured_counts",
+    "not_measured_note",
     "residual_figure",
     "residual_map_figure",
     "structure_term_figure",
@@ -45,6 +47,46 @@ def direction_of(rs: ResidualSet, variable: str) -> np.ndarray | None:
     return None if value is None else np.asarray(value, dtype=float)
 
 
+def measured_counts(sets: Sequence[ResidualSet]) -> np.ndarray:
+    """How many positions measured each component, (C,): the most over ``sets`` (a finite
+    residual, or an observation left out as an outlier, counts; an empty cell does not)."""
+    counts = []
+    for rs in sets:
+        seen = np.isfinite(rs.residuals)
+        if rs.outliers is not None:
+            seen |= np.isfinite(rs.outliers)
+        counts.append(seen.sum(axis=0))
+    return np.max(counts, axis=0)
+
+
+def not_measured_note(
+    components: Sequence[str], counts, n_positions: int, separator: str = "\n"
+) -> str:
+    """Words naming the components not measured at every position, one per ``separator`` (a
+    line of a figure's title by default), e.g. ``"dgamma: not measured"`` or ``"dpsi: measured
+    at 40 of 80 positions"``; ``""`` when every component was measured everywhere."""
+    words = []
+    for name, count in zip(components, counts, strict=True):
+        if count == 0:
+            words.append(f"{name}: not measured")
+        elif count < n_positions:
+            words.append(f"{name}: measured at {int(count)} of {n_positions} positions")
+    return separator.join(words)
+
+
+def _set_note(sets: Sequence[ResidualSet]) -> str:
+    """:func:`not_measured_note` of residual sets of one data set."""
+    first = sets[0]
+    return not_measured_note(first.components, measured_counts(sets), first.residuals.shape[0])
+
+
+def _finite_max(values) -> float:
+    """The largest finite value of ``values``; 0 when there is none (every cell not measured)."""
+    values = np.asarray(values, dtype=float)
+    values = values[np.isfinite(values)]
+    return float(values.max()) if values.size else 0.0
+
+
 def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
     """PNG: one column per residual set (side by side), rows: per position and per variable."""
     plt = pyplot()
@@ -54,7 +96,9 @@ def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
     fig, axes = plt.subplots(
         len(variables), len(sets), figsize=(5.2 * len(sets), 2.4 * len(variables)), squeeze=False
     )
-    limit = max(float(np.nanmax(np.abs(s.residuals), initial=0.0)) for s in sets) * 1.1 or 1.0
+    limit = _finite_max(np.concatenate([np.abs(s.residuals).ravel() for s in sets])) * 1.1 or 1.0
+    measured = measured_counts(sets) > 0  # a component no set measured is not drawn, but named
+    note = _set_note(sets)
     for col, rs in enumerate(sets):
         sigma = np.nanmedian(np.abs(rs.residuals / np.where(rs.normalised == 0, 1, rs.normalised)))
         for row, (name, _) in enumerate(variables):
@@ -64,6 +108,8 @@ def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
             )  # fmt: skip
             direction = direction_of(rs, name)
             for i, comp in enumerate(rs.components):
+                if not measured[i]:
+                    continue
                 jitter = 0.0 if name == "position" else (i - 1) * 0.01 * (np.ptp(x) or 1.0)
                 if direction is None:
                     ax.plot(x + jitter, rs.residuals[:, i], ".", ms=3, color=COLOURS[i],
@@ -96,7 +142,7 @@ def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
             ax.set_xlabel("position (measurement order)" if name == "position" else name)
             ax.set_ylabel(f"residual ({rs.unit})")
             if row == 0:
-                ax.set_title(rs.label, fontsize=10)
+                ax.set_title(rs.label + (f"\n{note}" if note else ""), fontsize=9 if note else 10)
                 ax.legend(fontsize=7, loc="upper right", ncol=3)
     fig.tight_layout()
     return save_png(fig)
@@ -107,6 +153,7 @@ def harmonics_figure(analyses: Sequence[ResidualAnalysis]) -> bytes:
     plt = pyplot()
 
     names = list(analyses[0].harmonics)
+    note = _set_note([an.residual_set for an in analyses])
     fig, axes = plt.subplots(
         max(len(names), 1), len(analyses), figsize=(5.2 * len(analyses), 2.6 * max(len(names), 1)),
         squeeze=False,
@@ -116,14 +163,20 @@ def harmonics_figure(analyses: Sequence[ResidualAnalysis]) -> bytes:
             ax = axes[row, col]
             table = an.harmonics.get(name, {})
             for i, comp in enumerate(an.residual_set.components):
-                amp = np.asarray(table.get(comp, []))
+                # None: not measured, or at too few positions for these harmonics: not drawn
+                amp = np.array([np.nan if a is None else a for a in table.get(comp, [])], float)
                 k = np.arange(1, amp.size + 1)
-                ax.bar(k + (i - 1) * 0.25, amp, width=0.25, color=COLOURS[i], label=comp)
+                ok = np.isfinite(amp)
+                if ok.any():
+                    ax.bar(k[ok] + (i - 1) * 0.25, amp[ok], width=0.25, color=COLOURS[i],
+                           label=comp)  # fmt: skip
             ax.set_xlabel(f"harmonic order in {name.replace('_deg', '')} (per rev)")
             ax.set_ylabel(f"amplitude ({an.residual_set.unit})")
             if row == 0:
-                ax.set_title(an.residual_set.label, fontsize=10)
-                ax.legend(fontsize=7)
+                title = an.residual_set.label + (f"\n{note}" if note else "")
+                ax.set_title(title, fontsize=9 if note else 10)
+                if ax.get_legend_handles_labels()[0]:
+                    ax.legend(fontsize=7)
     for row in range(axes.shape[0]):  # one scale per row, so the fall from left to right shows
         top = max(ax.get_ylim()[1] for ax in axes[row])
         for ax in axes[row]:
@@ -133,14 +186,18 @@ def harmonics_figure(analyses: Sequence[ResidualAnalysis]) -> bytes:
 
 
 def _positions_mean(x: np.ndarray, y: np.ndarray, values: np.ndarray):
-    """The mean of ``values`` (N, C) at each distinct (x, y) position (repeats averaged)."""
+    """The mean of ``values`` (N, C) at each distinct (x, y) position (repeats averaged; NaN
+    cells, not measured, left out of the mean; NaN where a component was never measured there)."""
     keys = np.round(np.stack([np.mod(x, 360.0), np.mod(y, 360.0)], axis=1), 6)
     unique, inverse = np.unique(keys, axis=0, return_inverse=True)
     inverse = inverse.reshape(-1)
+    finite = np.isfinite(values)
     sums = np.zeros((unique.shape[0], values.shape[1]))
-    np.add.at(sums, inverse, values)
-    counts = np.bincount(inverse, minlength=unique.shape[0])[:, None]
-    return unique[:, 0], unique[:, 1], sums / counts
+    counts = np.zeros((unique.shape[0], values.shape[1]))
+    np.add.at(sums, inverse, np.where(finite, values, 0.0))
+    np.add.at(counts, inverse, finite)
+    mean = np.where(counts > 0, sums / np.maximum(counts, 1), np.nan)
+    return unique[:, 0], unique[:, 1], mean
 
 
 def map_limit(sets: Sequence[ResidualSet]) -> float:
@@ -150,18 +207,20 @@ def map_limit(sets: Sequence[ResidualSet]) -> float:
         names = list(rs.angles_deg)
         if len(names) >= 2:
             x, y = rs.angles_deg[names[0]], rs.angles_deg[names[1]]
-            limits.append(float(np.abs(_positions_mean(x, y, rs.residuals)[2]).max()))
+            limits.append(_finite_max(np.abs(_positions_mean(x, y, rs.residuals)[2])))
     return max(limits, default=0.0) or 1.0
 
 
 def residual_map_figure(sets: Sequence[ResidualSet], limit: float | None = None) -> bytes | None:
     """PNG: the residual of each component over the first two angles (maps), or None.
 
-    One row per residual set, one panel per component (dpsi, dtheta, dgamma), the first angle
-    across, the second up, one square per measured position coloured by its residual (repeats
-    averaged), on one symmetric colour scale (``limit`` in the sets' unit; default: the largest
-    residual, :func:`map_limit`), so structure in both angles at once shows. None when the sets
-    have fewer than two angles (only the first two are mapped: the others are averaged over).
+    One row per residual set, one panel per measured component (dpsi, dtheta, dgamma; those no
+    set measured are named above the maps, not drawn), the first angle across, the second up,
+    one square per measured position coloured by its residual (repeats averaged; a hollow grey
+    square where the component was not measured), on one symmetric colour scale (``limit`` in
+    the sets' unit; default: the largest residual, :func:`map_limit`), so structure in both
+    angles at once shows. None when the sets have fewer than two angles (only the first two are
+    mapped: the others are averaged over).
     """
     names = list(sets[0].angles_deg)
     if len(names) < 2:
@@ -169,7 +228,9 @@ def residual_map_figure(sets: Sequence[ResidualSet], limit: float | None = None)
     plt = pyplot()
 
     limit = limit or map_limit(sets)
-    n_comp = len(sets[0].components)
+    counts, n_positions = measured_counts(sets), sets[0].residuals.shape[0]
+    drawn = np.flatnonzero(counts > 0)
+    n_comp = len(drawn)
     fig, axes = plt.subplots(
         len(sets), n_comp, figsize=(4.6 * n_comp, 4.0 * len(sets)), squeeze=False
     )
@@ -177,10 +238,14 @@ def residual_map_figure(sets: Sequence[ResidualSet], limit: float | None = None)
         x, y, mean = _positions_mean(rs.angles_deg[names[0]], rs.angles_deg[names[1]],
                                      rs.residuals)  # fmt: skip
         size = max(8.0, 9000.0 / max(len(x), 1))
-        for i, comp in enumerate(rs.components):
-            ax = axes[row, i]
-            image = ax.scatter(x, y, c=mean[:, i], s=size, marker="s", cmap="RdBu_r",
-                               vmin=-limit, vmax=limit)  # fmt: skip
+        for ax, i in zip(axes[row], drawn, strict=True):
+            comp = rs.components[i]
+            empty = ~np.isfinite(mean[:, i])
+            if empty.any():  # positions where this component was not measured: hollow squares
+                ax.scatter(x[empty], y[empty], s=size, marker="s", facecolors="none",
+                           edgecolors="0.75", linewidths=0.5)  # fmt: skip
+            image = ax.scatter(x[~empty], y[~empty], c=mean[~empty, i], s=size, marker="s",
+                               cmap="RdBu_r", vmin=-limit, vmax=limit)  # fmt: skip
             ax.set_xlim(-10, 370)
             ax.set_ylim(-10, 370)
             ax.set_xticks(range(0, 361, 90))
@@ -189,7 +254,14 @@ def residual_map_figure(sets: Sequence[ResidualSet], limit: float | None = None)
             ax.set_xlabel(names[0].replace("_deg", " (deg)"))
             ax.set_ylabel(names[1].replace("_deg", " (deg)"))
             ax.set_title(f"{comp} residual\n{rs.label}", fontsize=9, color=COLOURS[i])
-    fig.subplots_adjust(wspace=0.35, hspace=0.3)
+    note = not_measured_note(sets[0].components, counts, n_positions)
+    if ((counts > 0) & (counts < n_positions)).any():
+        note += "\n(hollow grey squares: positions where a component was not measured)"
+    top = 0.88  # matplotlib's; a note above the panels' two-line titles takes 0.16 in a line
+    if note:
+        fig.suptitle(note, fontsize=9, y=1.0)
+        top = min(top, 1.0 - (0.5 + 0.16 * (note.count("\n") + 1)) / fig.get_figheight())
+    fig.subplots_adjust(wspace=0.35, hspace=0.3, top=top)
     fig.colorbar(image, ax=axes.ravel().tolist(), label=f"residual ({sets[0].unit})",
                  shrink=0.85 if len(sets) == 1 else 0.6)  # fmt: skip
     return save_png(fig)
