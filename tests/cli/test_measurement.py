@@ -1,6 +1,7 @@
 """The measurement commands: simulate -> fit / diagnose / report, JSON keys, bad files exit 2."""
 
 import json
+import re
 
 import pytest
 
@@ -286,3 +287,81 @@ def test_simulate_sweep_by_joint_name_on_another_table(tmp_path):
     assert "sweep=phi2,phi1" in out.read_text()
     bad = cli("simulate", "--urdf", urdf, "--sweep", "elevation", "-o", str(tmp_path / "x.csv"))
     assert bad.returncode == 2 and "phi1, phi2, azimuth_axis, tilt_axis" in bad.stderr
+
+
+# --- a table is a telescope mount only when it says so (--mount, or the URDF's declaration) -------
+
+ZY_TURNTABLE = REPO_DIR / "tests" / "zy_turntable.urdf"
+"""A turntable whose outer axis turns about z and inner about -y (an alt-az mount's axes),
+declaring nothing."""
+NOT_OBSERVED = ("not observed", "roll about the boresight")
+
+
+@pytest.fixture(scope="module")
+def zy_run(tmp_path_factory):
+    """The z/-y turntable measured at 144 positions, all three angles."""
+    path = tmp_path_factory.mktemp("zy") / "zy_run.csv"
+    made = cli("simulate", "--urdf", str(ZY_TURNTABLE), "--error", "swivel.position=20",
+               "--error", "nod.tilt_a=5", "--error", "platen_mount.rot_x=8", "--seed", "3",
+               "-o", str(path))  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    rows = _rows(path)
+    assert len(rows) == 144 and all(r["dgamma_arcsec"] for r in rows)
+    return path
+
+
+def _declared_copy(folder, kind: str = "altaz"):
+    robot = '<robot name="zy_turntable">'
+    text = ZY_TURNTABLE.read_text().replace(robot, f'{robot}\n  <turntable_pin mount="{kind}"/>')
+    path = folder / "zy_declared.urdf"
+    path.write_text(text)
+    return path
+
+
+def test_a_turntable_with_a_mount_s_axes_gets_no_tpoint_terms(zy_run):
+    urdf = str(ZY_TURNTABLE)
+    diagnosis = cli("diagnose", str(zy_run), "--urdf", urdf, "--json")
+    assert diagnosis.returncode == 0, diagnosis.stderr
+    candidates = {c["effect"] for c in json.loads(diagnosis.stdout)["candidates"]}
+    assert candidates and not candidates & {"TF", "TX", "FO", "DAF"}
+    text = cli("diagnose", str(zy_run), "--urdf", urdf).stdout
+    assert "TX" not in text and "TF" not in text and "TPOINT" not in text
+    fit = cli("fit", str(zy_run), "--urdf", urdf, "--json")
+    assert fit.returncode == 0 and "pointing_terms" not in json.loads(fit.stdout)
+    text = cli("fit", str(zy_run), "--urdf", urdf).stdout
+    assert "TPOINT" not in text and not any(claim in text for claim in NOT_OBSERVED), text
+    listing = cli("effects", "--urdf", urdf).stdout
+    assert "TPOINT" not in listing and "\nTF:" not in listing
+
+
+@pytest.mark.parametrize("declared_by", ["option", "urdf"])
+def test_the_same_table_declared_alt_az_gets_them(zy_run, tmp_path, declared_by):
+    urdf = ["--urdf", str(ZY_TURNTABLE), "--mount", "altaz"]
+    if declared_by == "urdf":
+        urdf = ["--urdf", str(_declared_copy(tmp_path))]
+    diagnosis = json.loads(cli("diagnose", str(zy_run), *urdf, "--json").stdout)
+    candidates = {c["effect"]: c for c in diagnosis["candidates"]}
+    assert candidates["TF"]["testable"]
+    assert "infinite at phi2 0 deg" in candidates["TX"]["reason"]  # the grid holds E = 0
+    text = cli("fit", str(zy_run), *urdf).stdout
+    assert "TPOINT terms (altaz mount;" in text and re.search(r"^  IA +-20\.\d+ \+- ", text, re.M)
+    # dgamma was measured at every position: nothing says it was not
+    assert not any(claim in text for claim in NOT_OBSERVED), text
+    terms = json.loads(cli("fit", str(zy_run), *urdf, "--json").stdout)["pointing_terms"]
+    assert "dgamma" not in terms["note"]
+    # ... and --mount none makes the declared table a turntable again
+    undeclared = cli("fit", str(zy_run), *urdf, "--mount", "none").stdout
+    assert "TPOINT" not in undeclared
+
+
+def test_a_declared_mount_that_is_not_one_is_refused_naming_the_urdf(zy_run, tmp_path):
+    vertical = REPO_DIR / "models" / "two_axis_vertical_outer.urdf"
+    for args in (["--urdf", str(vertical), "--mount", "altaz"],
+                 ["--urdf", str(_declared_copy(tmp_path, "equatorial"))]):  # fmt: skip
+        for command in ("fit", "diagnose"):
+            proc = cli(command, str(zy_run), *args)
+            assert proc.returncode == 2, proc.stdout
+            assert args[1] in proc.stderr and "mount, but its payload orientation" in proc.stderr
+            assert len(proc.stderr.strip().splitlines()) == 1
+    bad = cli("fit", str(zy_run), "--urdf", str(ZY_TURNTABLE), "--mount", "alt-az")
+    assert bad.returncode == 2 and "--mount" in bad.stderr

@@ -436,3 +436,18 @@ def test_the_final_model_never_fits_worse_than_a_candidate_it_passed_over(monkey
     assert d["verdict"]["missing_effect"] == "inner_encoder_harmonics"
     assert d["best"]["effects"][0] == "inner_encoder_harmonics"
     assert d["best"]["chi2_reduced"] < 1.3
+
+
+def test_the_design_command_says_mount_only_when_the_table_is_not_what_its_urdf_declares():
+    from conftest import REPO_DIR
+    from turntable_pin.measurement.diagnosis import design_command, mount_option
+    from turntable_pin.model.generic_table import GenericTable
+
+    altaz, zy = REPO_DIR / "models" / "altaz_mount.urdf", REPO_DIR / "tests" / "zy_turntable.urdf"
+    assert mount_option(None) is None and mount_option(GenericTable(altaz)) is None
+    assert mount_option(GenericTable(zy)) is None
+    assert mount_option(GenericTable(altaz, telescope_mount="none")) == "none"
+    assert mount_option(GenericTable(zy, telescope_mount="altaz")) == "altaz"
+    assert design_command("d.csv", ("TF", "gravity_sag"), "zy.urdf", "altaz") == (
+        "turntable-pin design --separate TF,gravity_sag --from d.csv --urdf zy.urdf --mount altaz"
+    )

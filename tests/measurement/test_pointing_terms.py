@@ -1,4 +1,5 @@
-"""TPOINT's pointing terms on the bundled telescope mounts: the mount kind, the measured angles'
+"""TPOINT's pointing terms on the bundled telescope mounts: the mount kind (declared, never guessed
+from the axes; a declared mount not in the documented frames refused), the measured angles'
 signs against the chain, the rigid terms as combinations of the generic errors, the flexure
 effects against TPOINT's formulas, a run made with TPOINT's formulas read back, and the real MMT
 run against its published fit."""
@@ -25,6 +26,7 @@ from tpoint_runs import (
     read_tpoint_altaz,
     write_pointing_csv,
 )
+from turntable_pin.core.exceptions import InputError
 from turntable_pin.core.units import ARCSEC_PER_RAD
 from turntable_pin.measurement.catalogue import catalogue, resolve_effect
 from turntable_pin.measurement.data import read_measurements
@@ -34,16 +36,20 @@ from turntable_pin.measurement.fit import fit_orientation
 from turntable_pin.measurement.pointing_terms import (
     ALTAZ,
     EQUATORIAL,
+    SECOND_ORDER_NOTE,
+    UNOBSERVED_ROLL_NOTE,
     Mount,
     coordinate_offsets,
     fitted_pointing_terms,
     mount_kind,
     mount_terms,
+    pointing_note,
     rigid_term_map,
     term_signature,
 )
 from turntable_pin.model.chain import compose_rotation
 from turntable_pin.model.generic_table import GenericTable
+from turntable_pin.model.paper_table import table_of
 
 ARCSEC = 1.0 / ARCSEC_PER_RAD
 
@@ -65,10 +71,13 @@ def _positions(mount: Mount, n: int = 50, seed: int = 1) -> np.ndarray:
     return np.stack([rng.uniform(-np.pi, np.pi, n), rng.uniform(low, 1.3, n)], axis=1)
 
 
-# --- which table is a mount -----------------------------------------------------------------------
+# --- which table is a mount: the one that says so -------------------------------------------------
+
+ZY_TURNTABLE = ROOT / "tests" / "zy_turntable.urdf"
+"""A turntable with a mount's axes (z, then -y) that declares nothing."""
 
 
-def test_bundled_mounts_are_recognised_and_other_tables_are_not():
+def test_bundled_mounts_are_mounts_because_they_say_so_and_other_tables_are_not():
     assert mount_kind(GenericTable(ALTAZ_URDF)) == Mount(ALTAZ)
     eq = mount_kind(GenericTable(EQUATORIAL_URDF))
     assert eq.kind == EQUATORIAL and eq.latitude_deg == pytest.approx(45.75, abs=1e-12)
@@ -76,6 +85,49 @@ def test_bundled_mounts_are_recognised_and_other_tables_are_not():
                  "turntable"):  # fmt: skip
         assert mount_kind(GenericTable(ROOT / "models" / f"{name}.urdf")) is None
     assert mount_kind(None) is None  # the paper's table
+    # an alt-az mount's axes and frames, but no declaration: a turntable
+    assert mount_kind(GenericTable(ZY_TURNTABLE)) is None
+    assert rigid_term_map(GenericTable(ZY_TURNTABLE)) is None
+    assert mount_kind(GenericTable(ZY_TURNTABLE, telescope_mount=ALTAZ)) == Mount(ALTAZ)
+    assert mount_kind(GenericTable(ALTAZ_URDF, telescope_mount="none")) is None
+
+
+@pytest.mark.parametrize(
+    "urdf, kind, fragment",
+    [
+        (ROOT / "models" / "turntable.urdf", ALTAZ, "its payload orientation is not Rz(A) Ry(-E)"),
+        (ROOT / "models" / "two_axis_vertical_outer.urdf", ALTAZ, "is not Rz(A) Ry(-E)"),
+        (ALTAZ_URDF, EQUATORIAL, "is not Ry(lat - 90 deg) Rz(-H) Ry(-d)"),
+        (ROOT / "models" / "three_axis_imu_table.urdf", ALTAZ, "its chain has 3 joint(s)"),
+    ],
+)
+def test_a_declared_mount_whose_chain_is_not_the_documented_one_is_refused(urdf, kind, fragment):
+    table = table_of(urdf, telescope_mount=kind)
+    with pytest.raises(InputError, match=re.escape(fragment)) as caught:
+        mount_kind(table)
+    assert caught.value.path == str(table.urdf_path)
+    assert f"it was declared an {kind} mount" in str(caught.value)
+
+
+def test_a_declaration_in_the_urdf_is_named_in_the_refusal(tmp_path):
+    text = (ROOT / "models" / "two_axis_vertical_outer.urdf").read_text()
+    path = tmp_path / "declared.urdf"
+    path.write_text(re.sub(r"(<robot [^>]*>)", r'\1<turntable_pin mount="altaz"/>', text, count=1))
+    table = GenericTable(path)
+    with pytest.raises(InputError, match='its <turntable_pin mount="altaz"/> declares an altaz'):
+        catalogue(table)  # the catalogue, too, never treats it as a turntable
+    with pytest.raises(InputError, match=re.escape(str(path))):
+        rigid_term_map(table)
+
+
+def test_the_note_says_the_roll_is_not_observed_only_when_dgamma_is_empty():
+    measured = np.ones((5, 3), dtype=bool)
+    assert pointing_note(measured) == SECOND_ORDER_NOTE
+    measured[:, 2] = False
+    assert pointing_note(measured) == f"{SECOND_ORDER_NOTE} {UNOBSERVED_ROLL_NOTE}"
+    assert "dgamma" not in SECOND_ORDER_NOTE and "not observed" not in SECOND_ORDER_NOTE
+    measured[0, 2] = True  # measured at one position: observed
+    assert pointing_note(measured) == SECOND_ORDER_NOTE
 
 
 def test_catalogue_of_a_mount_has_tpoints_flexures_by_name():
@@ -83,8 +135,10 @@ def test_catalogue_of_a_mount_has_tpoints_flexures_by_name():
     assert [e.name for e in catalogue(altaz)][-2:] == ["TF", "TX"]
     assert [e.name for e in catalogue(eq)][-3:] == ["TF", "FO", "DAF"]
     assert resolve_effect("TX", altaz).name == "TX"
-    other = GenericTable(ROOT / "models" / "two_axis_vertical_outer.urdf")
-    assert not {"TF", "TX", "FO", "DAF"} & {e.name for e in catalogue(other)}
+    for other in (ROOT / "models" / "two_axis_vertical_outer.urdf", ZY_TURNTABLE):
+        assert not {"TF", "TX", "FO", "DAF"} & {e.name for e in catalogue(GenericTable(other))}
+    declared = GenericTable(ZY_TURNTABLE, telescope_mount=ALTAZ)
+    assert [e.name for e in catalogue(declared)][-2:] == ["TF", "TX"]
 
 
 # --- the measured angles' signs, verified with the chain ------------------------------------------
@@ -300,6 +354,7 @@ def test_mmt_fit_reports_the_published_terms(mmt_run):
     assert "TPOINT terms (altaz mount;" in text
     assert re.search(r"^  IA +1209\.\d+ \+- ", text, re.M)
     assert "second-order products" in text
+    assert "The roll about the boresight (dgamma) is not observed: its column is empty." in text
 
 
 def test_terms_do_not_depend_on_the_minimum_norm_split(mmt_run):

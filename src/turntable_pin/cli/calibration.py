@@ -18,6 +18,7 @@ from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from ..model.paper_table import is_paper_table
 from .common import (
     accuracy_dph,
+    add_mount_option,
     add_table_options,
     bounded_float,
     input_path,
@@ -105,6 +106,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     one_line_errors(c)
     c.add_argument("data", type=input_path, metavar="RUN.csv")
     _add_setup_options(c, positions=False)
+    add_mount_option(c)
     c.add_argument("--json", action="store_true", help="print one JSON object")
     c.add_argument(
         "--diagnose", action="store_true",

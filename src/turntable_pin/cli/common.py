@@ -19,6 +19,7 @@ __all__ = [
     "OUTPUT_OPTIONS",
     "accuracy_dph",
     "add_error_options",
+    "add_mount_option",
     "add_table_options",
     "bounded_float",
     "error_values_from_args",
@@ -201,6 +202,18 @@ def add_table_options(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def add_mount_option(parser: argparse.ArgumentParser) -> None:
+    """``--mount altaz|equatorial|none``: what the table is, overriding its URDF's declaration."""
+    from ..model.mount_declaration import MOUNT_KINDS, NO_MOUNT
+
+    parser.add_argument(
+        "--mount", choices=(*MOUNT_KINDS, NO_MOUNT),
+        help="what the table is: a telescope mount (altaz, equatorial: TPOINT terms and flexure "
+        "candidates) or none (a turntable); default: what its URDF declares "
+        '(<turntable_pin mount="altaz"/>), a turntable when it declares nothing',
+    )  # fmt: skip
+
+
 def add_error_options(parser: argparse.ArgumentParser) -> None:
     """``--error NAME=VALUE`` (repeatable), ``--errors FILE.yaml`` and ``--urdf FILE``."""
     parser.add_argument(
@@ -218,12 +231,18 @@ def add_error_options(parser: argparse.ArgumentParser) -> None:
 
 
 def table_from_args(args: argparse.Namespace):
-    """The table of ``--urdf``/``--payload-frame``: a
+    """The table of ``--urdf``/``--payload-frame`` (and ``--mount``, where a command takes it): a
     :class:`~turntable_pin.model.generic_table.GenericTable` in the paper's names (the bundled
-    table, or a URDF with the paper's joints and payload) or in the generic ones (any other)."""
+    table, or a URDF with the paper's joints and payload) or in the generic ones (any other).
+    A telescope mount is checked against the documented frames here, before any work."""
     from ..model.paper_table import table_of
 
-    return table_of(args.urdf, getattr(args, "payload_frame", None))
+    table = table_of(args.urdf, getattr(args, "payload_frame", None), getattr(args, "mount", None))
+    if table.telescope_mount is not None:
+        from ..measurement.pointing_terms import mount_kind
+
+        mount_kind(table)  # refuses a declared mount whose chain is not the documented one
+    return table
 
 
 def error_values_from_args(

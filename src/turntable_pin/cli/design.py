@@ -15,6 +15,7 @@ from pathlib import Path
 from ..core.exceptions import InputError
 from .common import (
     accuracy_dph,
+    add_mount_option,
     add_table_options,
     bounded_float,
     input_path,
@@ -52,6 +53,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     one_line_errors(p)
     add_table_options(p)
+    add_mount_option(p)
     mode = p.add_mutually_exclusive_group()
     mode.add_argument(
         "--separate", metavar="A,B", help="positions that tell effect A from effect B (T-optimal)"

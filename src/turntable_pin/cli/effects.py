@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from .common import input_path, one_line_errors, print_json
+from .common import add_mount_option, input_path, one_line_errors, print_json
 
 __all__ = ["register"]
 
@@ -24,6 +24,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--urdf", type=input_path, metavar="FILE.urdf", help="the table (default: bundled)"
     )
     p.add_argument("--payload-frame", metavar="NAME", help="the payload frame of the URDF")
+    add_mount_option(p)
     p.add_argument("--catalogue", action="append", default=[], type=input_path, metavar="FILE",
                    help="your effects (.yaml effect file or .py module); repeatable")  # fmt: skip
     p.add_argument("--json", action="store_true", help="print one JSON object")

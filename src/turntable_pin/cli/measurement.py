@@ -13,6 +13,7 @@ from ..model.angles import ANGLE_NAMES
 from ..model.errors import MAX_ORIENTATION_ERROR_DEG
 from .common import (
     add_error_options,
+    add_mount_option,
     add_table_options,
     bounded_float,
     error_values_from_args,
@@ -46,6 +47,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     one_line_errors(s)
     add_error_options(s)
+    add_mount_option(s)
     s.add_argument(
         "--effect",
         action="append",
@@ -165,6 +167,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     one_line_errors(r)
     r.add_argument("data", type=input_path, metavar="DATA.csv")
     add_table_options(r)
+    add_mount_option(r)
     r.add_argument("--ignore-sigma", action="store_true")
     r.add_argument("--until-explained", action="store_true")
     _add_outlier_option(r)
@@ -299,6 +302,7 @@ def _user_catalogue(args: argparse.Namespace, table=None):
 def _add_data_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("data", type=input_path, metavar="DATA.csv")
     add_table_options(p)
+    add_mount_option(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument(
         "--ignore-sigma",

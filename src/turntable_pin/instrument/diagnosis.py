@@ -509,18 +509,20 @@ def run_diagnosis_residuals(diagnosis: Diagnosis):
 
 
 def run_design_command(run, pair: tuple[str, str]) -> str:
-    """The ``turntable-pin design --separate A,B --run RUN`` command (with ``--urdf`` and
-    ``--latitude-deg`` when they are not the defaults) that chooses the calibration positions
+    """The ``turntable-pin design --separate A,B --run RUN`` command (with ``--urdf``, ``--mount``
+    and ``--latitude-deg`` when they are not the defaults) that chooses the calibration positions
     telling the two effects apart, or says that none do (:mod:`.separate`)."""
     import shlex
 
     from ..calibration.site import DEFAULT_LATITUDE_DEG
-    from ..measurement.diagnosis import urdf_option
+    from ..measurement.diagnosis import mount_option, urdf_option
 
     words = ["turntable-pin", "design", "--separate", ",".join(pair), "--run", run.source]
-    urdf = urdf_option(run.table)
+    urdf, mount = urdf_option(run.table), mount_option(run.table)
     if urdf:
         words += ["--urdf", urdf]
+    if mount:
+        words += ["--mount", mount]
     latitude = float(np.degrees(run.inputs.latitude_rad))
     if abs(latitude - DEFAULT_LATITUDE_DEG) > 1e-9:
         words += ["--latitude-deg", f"{latitude:g}"]

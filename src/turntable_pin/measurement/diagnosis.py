@@ -53,6 +53,7 @@ __all__ = [
     "dense_joint_grid",
     "harmonic_basis",
     "max_harmonic_order",
+    "mount_option",
     "polynomial_basis",
     "urdf_option",
 ]
@@ -758,9 +759,9 @@ def diagnose_measurements(
     diagnosis.doubt = _table_doubt(diagnosis, table)
     if diagnosis.separations:
         data_name = data.source if data.source and Path(data.source).is_file() else DATA_PLACEHOLDER
-        urdf = urdf_option(turntable)
+        urdf, mount = urdf_option(turntable), mount_option(turntable)
         diagnosis.separation_commands = {
-            name: design_command(data_name, (diagnosis.missing_effect, name), urdf)
+            name: design_command(data_name, (diagnosis.missing_effect, name), urdf, mount)
             for name in diagnosis.separations
         }
     return diagnosis
@@ -770,15 +771,20 @@ DATA_PLACEHOLDER = "DATA.csv"
 """The data file a command names when the data were not read from one (simulated in memory)."""
 
 
-def design_command(data: str, pair: tuple[str, str], urdf: str | None = None) -> str:
+def design_command(
+    data: str, pair: tuple[str, str], urdf: str | None = None, mount: str | None = None
+) -> str:
     """The ``turntable-pin design --separate A,B --from DATA`` command (with ``--urdf`` when the
-    table is not the paper's) that chooses the positions telling the two effects apart, or
-    says that none do (``turntable_pin.design.separate``)."""
+    table is not the paper's, ``--mount`` when the table is not what its URDF declares) that
+    chooses the positions telling the two effects apart, or says that none do
+    (``turntable_pin.design.separate``)."""
     import shlex
 
     words = ["turntable-pin", "design", "--separate", ",".join(pair), "--from", data]
     if urdf:
         words += ["--urdf", urdf]
+    if mount:
+        words += ["--mount", mount]
     return " ".join(shlex.quote(w) for w in words)
 
 
@@ -795,6 +801,18 @@ def urdf_option(turntable) -> str | None:
     if path == default_urdf_path().resolve():
         return None
     return path.stem if path.parent == models_dir().resolve() else str(path)
+
+
+def mount_option(turntable) -> str | None:
+    """What ``--mount`` says of the table: nothing when it is what its URDF declares, else its
+    mount kind or ``none`` (a turntable whose URDF declares a mount)."""
+    from ..model.mount_declaration import NO_MOUNT
+    from .table import measured_table
+
+    table = measured_table(turntable)
+    if table.telescope_mount == table.declared_mount:
+        return None
+    return table.telescope_mount or NO_MOUNT
 
 
 WRONG_TABLE_CHI2_REDUCED = 9.0

@@ -12,8 +12,10 @@ kinds are known, each in the frames of its bundled URDF (``models/altaz_mount.ur
 
 ``dA, dE, dH, dd`` are TPOINT's corrections *observed minus raw* (encoder) coordinates, first
 order in the coefficients, exactly as TPOINT's term formulas write them (the convention of the
-published MMT fit, ``obs = raw + D``). A table is a mount when its nominal payload orientation is
-the documented one at generic positions (:func:`mount_kind`).
+published MMT fit, ``obs = raw + D``). A table is a mount only when it says so: its URDF's
+``<turntable_pin mount="altaz"/>`` (or ``"equatorial"``) or the caller
+(:mod:`turntable_pin.model.mount_declaration`); its axes are never read to guess it. A declared
+mount's chain must be the documented one (:func:`mount_kind`), else it is refused.
 
 *Rigid* terms (IA IE NPAE CA AN AW; IH ID CH NP MA ME) are the rigid placement errors of the
 mount seen on the two measured angles: :func:`rigid_term_map` finds, numerically, each term as a
@@ -30,8 +32,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.exceptions import InputError
 from ..core.rotations import axis_rotation
 from ..core.units import ARCSEC_PER_RAD
+from ..model.angles import ANGLE_NAMES
+from ..model.mount_declaration import ALTAZ, EQUATORIAL, declaration_text
 from .table import measured_table
 
 __all__ = [
@@ -40,6 +45,7 @@ __all__ = [
     "MAP_RTOL",
     "POINTING_TERMS",
     "SECOND_ORDER_NOTE",
+    "UNOBSERVED_ROLL_NOTE",
     "Mount",
     "PointingTerm",
     "RigidTermMap",
@@ -48,27 +54,26 @@ __all__ = [
     "mount_kind",
     "mount_terms",
     "nominal_orientation",
+    "pointing_note",
     "rigid_term_map",
     "term_signature",
     "to_measured",
 ]
 
-ALTAZ = "altaz"
-"""An alt-azimuth mount (phi1 = azimuth, phi2 = elevation)."""
-EQUATORIAL = "equatorial"
-"""An equatorial mount (phi1 = hour angle positive West, phi2 = declination)."""
-
 MAP_RTOL = 1e-9
-"""Largest relative residual of the rigid map (and of the documented orientation) for a table to
-be taken for a mount: beyond it the table is not that mount in the documented frames."""
+"""Largest relative residual of the rigid map (and of the documented orientation) for a declared
+mount's chain: beyond it the table is not that mount in the documented frames (refused)."""
 
 SECOND_ORDER_NOTE = (
     "The chain is exact and TPOINT's formulas are first order, so the terms differ from a "
     "TPOINT fit by second-order products: a pure index offset is exact in both, but its "
-    "products with the other terms (IA 0.34 deg = 6e-3 rad times ~10 arcsec) give a few "
-    "hundredths of an arcsec; the roll about the boresight (dgamma) is not observed."
+    "products with the other terms (the MMT's IA of 0.34 deg = 6e-3 rad times ~10 arcsec) give "
+    "a few hundredths of an arcsec."
 )
 """Why fitted terms differ from TPOINT's published ones by a few arcsec (one sentence)."""
+
+UNOBSERVED_ROLL_NOTE = "The roll about the boresight (dgamma) is not observed: its column is empty."
+"""Added to the note when, and only when, the data's ``dgamma`` column is empty."""
 
 
 @dataclass(frozen=True)
@@ -378,27 +383,57 @@ def _first_axis_in_base(table) -> np.ndarray:
     raise AssertionError("a table has at least one joint")
 
 
-def mount_kind(turntable) -> Mount | None:
-    """The mount a table is, or ``None``.
+def _undocumented_mount(table, why: str) -> InputError:
+    """The refusal of a declared mount whose chain is not the documented one, naming its URDF."""
+    kind = table.telescope_mount
+    said = (
+        f"its {declaration_text(kind)} declares an {kind} mount"
+        if table.declared_mount == kind
+        else f"it was declared an {kind} mount"
+    )
+    bundled = "altaz_mount" if kind == ALTAZ else "german_equatorial_mount"
+    return InputError(
+        f"{said}, but {why}; the documented frames are those of the bundled {bundled}.urdf "
+        '(docs/measurements.md, "TPOINT terms on a mount"); a table that declares no mount is a '
+        "turntable",
+        path=table.urdf_path,
+    )
 
-    A two-joint table is an alt-az mount when its first axis is vertical, an equatorial one when
-    it is tilted (latitude: the elevation of the pole, ``asin(-a_z)`` for the axis ``a`` of
-    hour angles positive West), and in both cases only when its nominal payload orientation is
-    the documented one (:func:`nominal_orientation`) to :data:`MAP_RTOL` at generic positions
-    and the rigid terms map exactly onto its generic errors (:func:`rigid_term_map`).
+
+def mount_kind(turntable) -> Mount | None:
+    """The mount a table is declared to be, or ``None`` (a turntable: it declares nothing).
+
+    The kind comes from the declaration alone (the table's ``telescope_mount``: its URDF's
+    ``<turntable_pin mount="..."/>`` or the caller's word), never from its axes. An equatorial
+    mount's latitude is the elevation of its pole, ``asin(-a_z)`` for the first axis ``a``
+    (hour angles positive West).
+
+    Raises:
+        InputError: naming the URDF, when the declared mount's chain is not the documented one:
+            two joints, the nominal payload orientation :func:`nominal_orientation` to
+            :data:`MAP_RTOL` at generic positions and the rigid terms mapping exactly onto its
+            generic errors (:func:`rigid_term_map`).
     """
     table = measured_table(turntable)
-    if table.paper or table.n_joints != 2:
+    kind = table.telescope_mount
+    if kind is None:
         return None
-    axis = _first_axis_in_base(table)
-    if abs(abs(axis[2]) - 1.0) <= MAP_RTOL:
+    if table.n_joints != 2:
+        raise _undocumented_mount(table, f"its chain has {table.n_joints} joint(s), a mount two")
+    if kind == ALTAZ:
         mount = Mount(ALTAZ)
     else:
+        axis = _first_axis_in_base(table)
         mount = Mount(EQUATORIAL, float(np.arcsin(np.clip(-axis[2], -1.0, 1.0))))
     joints = _generic_positions()
-    if np.abs(table.rotation(joints) - nominal_orientation(mount, joints)).max() > MAP_RTOL:
-        return None
-    return mount if _rigid_map(table, mount) is not None else None
+    off = np.abs(table.rotation(joints) - nominal_orientation(mount, joints)).max()
+    if off > MAP_RTOL:
+        formula = "Rz(A) Ry(-E)" if kind == ALTAZ else "Ry(lat - 90 deg) Rz(-H) Ry(-d)"
+        why = f"its payload orientation is not {formula} (off by {off:.3g} at generic positions)"
+        raise _undocumented_mount(table, why)
+    if _rigid_map(table, mount) is None:
+        raise _undocumented_mount(table, "its errors do not map exactly onto TPOINT's rigid terms")
+    return mount
 
 
 @dataclass(frozen=True)
@@ -467,8 +502,8 @@ def fitted_pointing_terms(fit) -> dict | None:
 
     Returns:
         ``{mount, latitude_deg, convention, terms: [{name, value, std, unit, rigid, determined,
-        formula, of}], note}``, values in arcsec; ``of`` is the combination of base errors (rigid)
-        or the effect's parameter (flexure).
+        formula, of}], note}``, values in arcsec; ``of`` is the combination of base errors
+        (rigid) or the effect's parameter (flexure); ``note``: :func:`pointing_note`.
     """
     result = fit.result
     mapping = rigid_term_map(fit.model.table)
@@ -512,5 +547,13 @@ def fitted_pointing_terms(fit) -> dict | None:
         "latitude_deg": mapping.mount.latitude_deg,
         "convention": "TPOINT's first-order formulas, observed minus raw (obs = raw + D)",
         "terms": terms,
-        "note": SECOND_ORDER_NOTE,
+        "note": pointing_note(fit.data.measured),
     }
+
+
+def pointing_note(measured: np.ndarray) -> str:
+    """The note of :func:`fitted_pointing_terms`: :data:`SECOND_ORDER_NOTE`, and
+    :data:`UNOBSERVED_ROLL_NOTE` when the data's ``dgamma`` column is empty (``measured``: which
+    angles were measured, (N, 3) bool, dpsi, dtheta, dgamma)."""
+    roll = np.asarray(measured, dtype=bool)[:, ANGLE_NAMES.index("dgamma")]
+    return SECOND_ORDER_NOTE if roll.any() else f"{SECOND_ORDER_NOTE} {UNOBSERVED_ROLL_NOTE}"

@@ -49,6 +49,10 @@ class MeasuredTable:
         label: how reports name the table (``paper`` or the URDF file).
         paper: the paper's table (its catalogue and names).
         urdf_path: the nominal URDF the chain was read from.
+        telescope_mount: the telescope mount kind the table is (``"altaz"``, ``"equatorial"``;
+            ``None``: a turntable), as declared (``model/mount_declaration.py``), never guessed.
+        declared_mount: the kind its URDF declares (``None``: none), which ``telescope_mount``
+            may override.
     """
 
     def __init__(
@@ -60,9 +64,13 @@ class MeasuredTable:
         label: str,
         paper: bool = False,
         urdf_path=None,
+        telescope_mount: str | None = None,
+        declared_mount: str | None = None,
     ) -> None:
         self.chain = chain
         self.urdf_path = urdf_path
+        self.telescope_mount = telescope_mount
+        self.declared_mount = declared_mount
         self.joints = tuple(joints)
         self.descriptions = dict(descriptions)
         self.label = label
@@ -119,5 +127,6 @@ def measured_table(turntable=None) -> MeasuredTable:
         cached = _MEASURED[table] = MeasuredTable(
             table.chain, joints, table.descriptions, label=table.label,
             paper=is_paper_table(table), urdf_path=table.urdf_path,
+            telescope_mount=table.telescope_mount, declared_mount=table.declared_mount,
         )  # fmt: skip
     return cached

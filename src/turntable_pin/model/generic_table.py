@@ -41,6 +41,7 @@ from .chain import (
     apply_chain_errors,
     compose_rotation,
 )
+from .mount_declaration import read_mount_declaration, resolve_mount
 
 __all__ = [
     "MAX_JOINTS",
@@ -71,8 +72,9 @@ def perpendicular_directions(axis) -> tuple[np.ndarray, np.ndarray]:
     return u, np.cross(a, u)
 
 
-def _check_urdf_text(path: Path) -> None:
-    """Refuse what Pinocchio would silently accept: mimic joints, prismatic/floating/planar."""
+def _check_urdf_text(path: Path):
+    """Refuse what Pinocchio would silently accept: mimic joints, prismatic/floating/planar;
+    return the parsed ``<robot>`` element."""
     import xml.etree.ElementTree as ET
 
     try:
@@ -88,6 +90,7 @@ def _check_urdf_text(path: Path) -> None:
                 f"{path}: joint '{name}' is {kind}; a turntable has revolute (or continuous) "
                 "joints and fixed ones only"
             )
+    return root
 
 
 def _payload_frame(model, path: Path, payload_frame: str | None) -> str:
@@ -217,9 +220,15 @@ class GenericTable:
     Args:
         urdf_path: the nominal URDF.
         payload_frame: the payload frame (default: the only leaf of the chain).
+        layout: where the errors sit and what they are called (default: the module's rule).
+        telescope_mount: what the table is, overriding its URDF: ``"altaz"``, ``"equatorial"``
+            or ``"none"`` (a turntable); ``None`` (default): as the URDF declares
+            (:mod:`.mount_declaration`).
 
     Attributes:
         urdf_path, payload_frame, nominal_pin_model: the table as read.
+        declared_mount: the mount kind the URDF declares (``None``: it declares none).
+        telescope_mount: the mount kind the table is (``None``: a turntable).
         chain: its :class:`ErrorChain` with the generic factors.
         parameter_names: ``<joint>.position``, ``.tilt_a``, ``.tilt_b``, ``.offset_a``,
             ``.offset_b`` per joint from the base, then ``<mount>.rot_x``, ``.rot_y``, ``.rot_z``.
@@ -230,13 +239,16 @@ class GenericTable:
         urdf_path: str | Path,
         payload_frame: str | None = None,
         layout: ErrorLayout | None = None,
+        telescope_mount: str | None = None,
     ) -> None:
         import pinocchio as pin
 
         path = Path(urdf_path)
         if not path.is_file():
             raise InputError("no such URDF file", path=path)
-        _check_urdf_text(path)
+        root = _check_urdf_text(path)
+        self.declared_mount = read_mount_declaration(root, path)
+        self.telescope_mount = resolve_mount(self.declared_mount, telescope_mount)
         try:
             model = pin.buildModelFromUrdf(str(path))
         except (RuntimeError, ValueError) as exc:

@@ -73,23 +73,23 @@ PAPER_LAYOUT = ErrorLayout(
 
 
 @lru_cache(maxsize=8)
-def _paper_table(urdf: str):
+def _paper_table(urdf: str, telescope_mount: str | None = None):
     from .generic_table import GenericTable
 
-    return GenericTable(urdf, layout=PAPER_LAYOUT)
+    return GenericTable(urdf, layout=PAPER_LAYOUT, telescope_mount=telescope_mount)
 
 
-def paper_table(urdf_path: str | Path | None = None):
+def paper_table(urdf_path: str | Path | None = None, telescope_mount: str | None = None):
     """The paper's table: the :class:`~turntable_pin.model.generic_table.GenericTable` of
     ``urdf_path`` (default the bundled ``models/turntable.urdf``) under :data:`PAPER_LAYOUT`
-    (read once per file and process)."""
+    (read once per file, ``telescope_mount`` and process)."""
     from ..core.exceptions import InputError
     from ..core.resources import default_urdf_path
 
     path = Path(urdf_path) if urdf_path is not None else default_urdf_path()
     if not path.is_file():
         raise InputError("no such URDF file", path=path)
-    return _paper_table(str(path.resolve()))
+    return _paper_table(str(path.resolve()), telescope_mount)
 
 
 def is_paper_table(table) -> bool:
@@ -104,14 +104,21 @@ def has_paper_names(table) -> bool:
     return table.joint_names == (OUTER_JOINT, INNER_JOINT) and table.payload_frame == PAYLOAD_FRAME
 
 
-def table_of(urdf_path: str | Path | None = None, payload_frame: str | None = None):
+def table_of(
+    urdf_path: str | Path | None = None,
+    payload_frame: str | None = None,
+    telescope_mount: str | None = None,
+):
     """The table of a URDF: the paper's (:func:`paper_table`) when it is the bundled table or has
-    the paper's joints and payload frame, else the generic table under the generic rule."""
+    the paper's joints and payload frame, else the generic table under the generic rule;
+    ``telescope_mount`` says what it is, overriding its URDF (``None``: as the URDF declares;
+    :class:`~turntable_pin.model.generic_table.GenericTable`)."""
     from .generic_table import GenericTable
 
     if urdf_path is None and payload_frame in (None, PAYLOAD_FRAME):
-        return paper_table()
+        return paper_table(telescope_mount=telescope_mount)
     if payload_frame not in (None, PAYLOAD_FRAME):
-        return GenericTable(urdf_path or paper_table().urdf_path, payload_frame)
-    table = GenericTable(urdf_path, payload_frame)
-    return paper_table(urdf_path) if has_paper_names(table) else table
+        return GenericTable(urdf_path or paper_table().urdf_path, payload_frame,
+                            telescope_mount=telescope_mount)  # fmt: skip
+    table = GenericTable(urdf_path, payload_frame, telescope_mount=telescope_mount)
+    return paper_table(urdf_path, telescope_mount) if has_paper_names(table) else table
