@@ -451,3 +451,17 @@ def test_the_design_command_says_mount_only_when_the_table_is_not_what_its_urdf_
     assert design_command("d.csv", ("TF", "gravity_sag"), "zy.urdf", "altaz") == (
         "turntable-pin design --separate TF,gravity_sag --from d.csv --urdf zy.urdf --mount altaz"
     )
+
+
+def test_cells_left_out_as_outliers_are_not_called_not_measured():
+    sim = simulate_measurements(random_errors(np.random.default_rng(11)), seed=11)
+    angles = sim.data.angles_rad.copy()
+    angles[:, 2] = np.nan  # dgamma not measured anywhere
+    angles[7, 0] += 60.0 / ARCSEC_PER_RAD  # one gross outlier in dpsi
+    d = diagnose_measurements(sim.data.replace(angles_rad=angles)).to_dict()
+    assert any(o["angle"] == "dpsi" for o in d["outliers"])
+    warning = next(w for w in d["warnings"] if w.startswith("angles not measured"))
+    n = sim.data.n_positions
+    assert f"(dgamma at {n} of {n} positions; " in warning
+    assert "more left out as outliers" in warning
+    assert "dpsi at" not in warning

@@ -130,6 +130,17 @@ def test_the_note_says_the_roll_is_not_observed_only_when_dgamma_is_empty():
     assert pointing_note(measured) == SECOND_ORDER_NOTE
 
 
+def test_the_note_sizes_the_second_order_products_on_the_data():
+    terms = [{"name": "IH", "value": 18592.8}, {"name": "CH", "value": -1238.6},
+             {"name": "TF", "value": 21.0}]  # fmt: skip
+    note = pointing_note(np.ones((3, 3), dtype=bool), terms)
+    assert note.startswith(SECOND_ORDER_NOTE[:-1])
+    # 18592.8 arcsec = 5.16 deg = 0.0901 rad, times 1238.6 arcsec: 112 arcsec
+    assert "(here IH 5.16 deg = 9.0e-02 rad times up to 1.24e+03 arcsec: up to 1.1e+02 arcsec)" in (
+        note
+    )
+
+
 def test_catalogue_of_a_mount_has_tpoints_flexures_by_name():
     altaz, eq = GenericTable(ALTAZ_URDF), GenericTable(EQUATORIAL_URDF)
     assert [e.name for e in catalogue(altaz)][-2:] == ["TF", "TX"]

@@ -246,13 +246,20 @@ class OrientationFamily:
         warnings = []
         lost = base_fit.unobserved_combinations()
         if lost:
+            # empty in the file, not the cells the outlier rule left out of these data
+            left = np.zeros_like(data.measured)
+            if self.left_out_rad is not None:
+                left = ~np.isnan(self.left_out_rad)
+            empty = ~data.measured & ~left
             counts = ", ".join(
-                f"{name} at {int(np.sum(~data.measured[:, i]))}"
+                f"{name} at {int(np.sum(empty[:, i]))}"
                 for i, name in enumerate(ANGLE_NAMES)
-                if not data.measured[:, i].all()
+                if empty[:, i].any()
             )
+            outliers = int(left.sum())
+            besides = f"; {outliers} more left out as outliers" if outliers else ""
             warnings.append(
-                f"angles not measured ({counts} of {data.n_positions} positions): "
+                f"angles not measured ({counts} of {data.n_positions} positions{besides}): "
                 f"{'; '.join(lost)} {'is' if len(lost) == 1 else 'are'} not observed, so no "
                 "effect that acts only there can be tested; measure those angles to see it"
             )

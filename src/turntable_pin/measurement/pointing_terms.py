@@ -42,7 +42,9 @@ from .table import measured_table
 __all__ = [
     "ALTAZ",
     "EQUATORIAL",
+    "INDEX_TERMS",
     "MAP_RTOL",
+    "PIER_RULE",
     "POINTING_TERMS",
     "SECOND_ORDER_NOTE",
     "UNOBSERVED_ROLL_NOTE",
@@ -67,10 +69,19 @@ mount's chain: beyond it the table is not that mount in the documented frames (r
 SECOND_ORDER_NOTE = (
     "The chain is exact and TPOINT's formulas are first order, so the terms differ from a "
     "TPOINT fit by second-order products: a pure index offset is exact in both, but its "
-    "products with the other terms (the MMT's IA of 0.34 deg = 6e-3 rad times ~10 arcsec) give "
-    "a few hundredths of an arcsec."
+    "products with the other terms are not."
 )
-"""Why fitted terms differ from TPOINT's published ones by a few arcsec (one sentence)."""
+"""Why fitted terms differ from a TPOINT fit (one sentence; :func:`pointing_note` adds the size
+of the products on the data at hand)."""
+
+INDEX_TERMS = ("IA", "IH")
+"""The index terms whose products with the others are the largest second-order terms."""
+
+PIER_RULE = (
+    "ID, CH and NP are the mechanism's: on the far side of the pier (raw dec beyond +-90 deg) "
+    "their effect on the sky changes sign, TPOINT's rule"
+)
+"""How the equatorial terms read across the pier (stated in the convention of such a mount)."""
 
 UNOBSERVED_ROLL_NOTE = "The roll about the boresight (dgamma) is not observed: its column is empty."
 """Added to the note when, and only when, the data's ``dgamma`` column is empty."""
@@ -542,18 +553,34 @@ def fitted_pointing_terms(fit) -> dict | None:
                 "of": combinations.get(name, f"{name}.{name}"),
             }
         )
+    convention = "TPOINT's first-order formulas, observed minus raw (obs = raw + D)"
+    if mapping.mount.kind == EQUATORIAL:
+        convention += f"; {PIER_RULE}"
     return {
         "mount": mapping.mount.kind,
         "latitude_deg": mapping.mount.latitude_deg,
-        "convention": "TPOINT's first-order formulas, observed minus raw (obs = raw + D)",
+        "convention": convention,
         "terms": terms,
-        "note": pointing_note(fit.data.measured),
+        "note": pointing_note(fit.data.measured, terms),
     }
 
 
-def pointing_note(measured: np.ndarray) -> str:
-    """The note of :func:`fitted_pointing_terms`: :data:`SECOND_ORDER_NOTE`, and
-    :data:`UNOBSERVED_ROLL_NOTE` when the data's ``dgamma`` column is empty (``measured``: which
-    angles were measured, (N, 3) bool, dpsi, dtheta, dgamma)."""
+def pointing_note(measured: np.ndarray, terms=()) -> str:
+    """The note of :func:`fitted_pointing_terms`: :data:`SECOND_ORDER_NOTE` with the size of the
+    largest second-order product on these data (the index term times the largest other term,
+    from ``terms``, the rows of :func:`fitted_pointing_terms`), and :data:`UNOBSERVED_ROLL_NOTE`
+    when the data's ``dgamma`` column is empty (``measured``: which angles were measured, (N, 3)
+    bool, dpsi, dtheta, dgamma)."""
+    note = SECOND_ORDER_NOTE
+    index = [t for t in terms if t["name"] in INDEX_TERMS]
+    others = [abs(t["value"]) for t in terms if t["name"] not in INDEX_TERMS]
+    if index and others:
+        ia = index[0]
+        index_rad = abs(ia["value"]) / ARCSEC_PER_RAD
+        largest = max(others)
+        note = note[:-1] + (
+            f" (here {ia['name']} {np.degrees(index_rad):.2f} deg = {index_rad:.1e} rad times up "
+            f"to {largest:.3g} arcsec: up to {index_rad * largest:.2g} arcsec)."
+        )
     roll = np.asarray(measured, dtype=bool)[:, ANGLE_NAMES.index("dgamma")]
-    return SECOND_ORDER_NOTE if roll.any() else f"{SECOND_ORDER_NOTE} {UNOBSERVED_ROLL_NOTE}"
+    return note if roll.any() else f"{note} {UNOBSERVED_ROLL_NOTE}"

@@ -574,7 +574,9 @@ def mount_urdf_text(mount: str, latitude_deg: float | None = None, note: str = "
     )
     root.insert(0, comment)
     body = ET.tostring(root, encoding="unicode")
-    header = text[: text.index("<robot")]  # the XML declaration and the frames comment
+    # the XML declaration and the frames comment: up to the <robot> element's own line (the
+    # comment may name the element too)
+    header = text[: re.search(r"^\s*<robot\b", text, re.MULTILINE).start()]
     return header + body + "\n"
 
 
