@@ -6,6 +6,7 @@ import pytest
 
 from allocation_reference import pinocchio_sensitivity_matrix, sensitivity_matrix_fd
 from conftest import PAPER_TO_GENERIC, REPO_DIR, random_errors
+from rounding import chain_rounding, error_factors
 from turntable_pin import TurntableErrors, TurntableModel, small_angle_matrix
 from turntable_pin.allocation.sensitivity import (
     average_sensitivities,
@@ -42,9 +43,11 @@ def test_analytic_matches_central_differences_at_large_errors(rng):
 
 def test_analytic_at_zero_errors_is_the_small_angle_matrix(rng):
     model = TurntableModel()
+    # The chain's products against one rotation's sines and cosines: both round absolutely.
+    rounding = chain_rounding(error_factors(model.table)) + chain_rounding(1)
     for phi1, phi2 in rng.uniform(0, 2 * np.pi, (5, 2)):
         np.testing.assert_allclose(
-            sensitivity_matrix(model, phi1, phi2), small_angle_matrix(phi2), atol=1e-15
+            sensitivity_matrix(model, phi1, phi2), small_angle_matrix(phi2), rtol=0, atol=rounding
         )
 
 
@@ -164,6 +167,9 @@ def test_sensitivities_at_errors_equal_central_differences_of_the_exact_chain(ur
     axes = [rng.uniform(0, 2 * np.pi, 2) for _ in table.joint_names]
     sens = sensitivities(table, axes, error_values=values)
     names = angular_names(table)
+    # dR's rounding over the step h = 1e-6, and the truncation h^2 |f3| / 6
+    # (f3, a third derivative of unit-size rotation entries, is at most 1).
+    fd_tolerance = chain_rounding(error_factors(table)) / 1e-6 + 1e-12 / 6
     for p in range(sens.matrices.shape[0]):
         angles = [g[p] for g in sens.grid_rad]
         for col, name in enumerate(names):
@@ -174,7 +180,7 @@ def test_sensitivities_at_errors_equal_central_differences_of_the_exact_chain(ur
                 d_r = table.rotation_error(moved, angles)
                 sides.append(np.array([d_r[i, j] for i, j in ANGLE_ENTRIES]))
             fd = (sides[0] - sides[1]) / 2e-6
-            np.testing.assert_allclose(sens.matrices[p, :, col], fd, atol=1e-9)
+            np.testing.assert_allclose(sens.matrices[p, :, col], fd, rtol=0, atol=fd_tolerance)
     assert np.abs(sens.matrices - table_sensitivities(table, 90.0).matrices[:1]).max() > 1e-3
 
 

@@ -6,7 +6,7 @@ import pytest
 from turntable_pin import InputError
 from turntable_pin.calibration.positions import PositionSet
 from turntable_pin.calibration.rate_error import orientation_error_rotation, rate_errors_dph
-from turntable_pin.calibration.requirement import orientation_requirement
+from turntable_pin.calibration.requirement import _MARGIN, orientation_requirement
 
 LAT_RAD = np.radians(45.75)
 W_M = 0.01
@@ -91,7 +91,8 @@ def test_each_plane_rectangle_has_the_largest_area_brute_force(requirement):
 def test_theta_is_shared_from_the_binding_plane(requirement):
     theta_x = requirement.rectangles[0].half_widths_rad[1]
     theta_y = requirement.rectangles[1].half_widths_rad[0]
-    assert requirement.I_theta_rad == pytest.approx(min(theta_x, theta_y), rel=1e-9)
+    # The shared theta may be stepped in once by 2 _MARGIN (where rounding puts its corner out).
+    assert requirement.I_theta_rad == pytest.approx(min(theta_x, theta_y), rel=3 * _MARGIN, abs=0)
     assert requirement.binding_plane == ("psi_theta" if theta_x <= theta_y else "theta_gamma")
     # the free side of the other plane can only have grown
     if requirement.binding_plane == "psi_theta":

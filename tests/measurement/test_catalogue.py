@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import REPO_DIR
+from rounding import chain_rounding, error_factors
 from turntable_pin.core.exceptions import InputError
 from turntable_pin.core.units import ARCSEC_PER_RAD
 from turntable_pin.measurement.catalogue import catalogue, resolve_effect
@@ -73,11 +74,14 @@ def test_base_model_equals_the_generic_chain(table):
     np.testing.assert_allclose(model.predict(p), expected, atol=1e-13)
     # The analytic Jacobian against central differences.
     jac = model.jacobian(p)
+    # dR's rounding over the step h = 1e-7, and the truncation h^2 |f3| / 6
+    # (f3, a third derivative of unit-size rotation entries, is at most 1).
+    fd_tolerance = chain_rounding(error_factors(t)) / 1e-7 + 1e-14 / 6
     for k in range(model.n_params):
         step = np.zeros(model.n_params)
         step[k] = 1e-7
         fd = (model.predict(p + step) - model.predict(p - step)) / 2e-7
-        np.testing.assert_allclose(jac[:, :, k], fd, atol=1e-8)
+        np.testing.assert_allclose(jac[:, :, k], fd, rtol=0, atol=fd_tolerance)
 
 
 def test_clean_data_fit_to_the_noise_and_recover_the_errors(table):
