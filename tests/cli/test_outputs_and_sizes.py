@@ -16,6 +16,8 @@ DATA = EXAMPLES_DIR / "measurements_example.csv"
 BOUNDS = EXAMPLES_DIR.parent / "manufacturing_lower_bounds.yaml"
 URDF = EXAMPLES_DIR.parent / "turntable.urdf"
 MMT = EXAMPLES_DIR / "mmt_pointing" / "k_and_e.dat"
+EFFECT = EXAMPLES_DIR / "effects" / "inner_encoder_3rev.yaml"
+RUN = EXAMPLES_DIR / "gyrowheel_run_example.csv"
 
 
 def _copy(tmp_path, source):
@@ -42,6 +44,22 @@ WRITERS = [
     (["snapshot", "--errors", "{in}", "-o", "{in}"], ERRORS),
     (["design", "--urdf", "{in}", "-o", "{in}"], URDF),
     (["design", "--from", "{in}", "--plots", "{in}"], DATA),
+    # issue 27: files named inside an option's text are inputs too
+    (["fit", DATA.as_posix(), "--effects", "{in}", "--write-urdf", "{in}"], EFFECT),
+    (["fit", DATA.as_posix(), "--effects", "base_tilt,{in}", "--plots", "{in}"], EFFECT),
+    (["design", "--effects", "{in}", "-n", "12", "-o", "{in}"], EFFECT),
+    (
+        ["design", "--separate", "{in},base_tilt", "--amplitude", "base_tilt:x=1", "-o", "{in}"],
+        EFFECT,
+    ),  # fmt: skip
+    (["design", "--separate", "TF,base_tilt", "--amplitude", "{in}:c3=1", "-o", "{in}"], EFFECT),
+    (["simulate", "--effect", "{in}:c3=1", "-o", "{in}"], EFFECT),
+    (
+        ["simulate", "--catalogue", "{in}", "--effect", "inner_encoder_3rev:c3=1", "-o", "{in}"],
+        EFFECT,
+    ),  # fmt: skip
+    (["requirement", "--positions", "{in}", "--plots", "{in}"], DATA),
+    (["allocate", "--positions", "{in}", "--plots", "{in}"], DATA),
 ]
 
 
@@ -49,7 +67,7 @@ WRITERS = [
 def test_every_writer_refuses_an_output_that_is_an_input(tmp_path, argv, source):
     original = _copy(tmp_path, source)
     before = (original.read_bytes(), original.stat().st_mtime_ns)
-    proc = cli(*[str(original) if a == "{in}" else a for a in argv])
+    proc = cli(*[a.replace("{in}", str(original)) for a in argv])
     assert proc.returncode == 2
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "refusing to write" in lines[0] and str(original) in lines[0]
@@ -157,6 +175,35 @@ def _command_actions(command: str):
     return sub.choices[command]._actions
 
 
+def _argv(command: str, given: dict[str, str], tmp_path) -> list[str]:
+    """A command line of ``command`` with the options (dests) ``given``, every other positional a
+    file name in ``tmp_path`` and every other required option a value."""
+    argv = [command]
+    for action in _command_actions(command):
+        flag = action.option_strings[-1] if action.option_strings else None
+        if action.dest in given:
+            argv += [flag, given[action.dest]] if flag else [given[action.dest]]
+        elif flag is None and action.dest not in ("help",):  # another positional: a file
+            argv.append(str(tmp_path / f"other_{action.dest}.csv"))
+        elif action.required:
+            value = action.choices[0] if action.choices else str(tmp_path / f"{action.dest}.out")
+            argv += [flag, str(value)]
+    return argv
+
+
+def _main(argv: list[str]) -> tuple[int, str]:
+    """``turntable-pin ARGV`` in this process: the exit status and stderr."""
+    import contextlib
+    import io
+
+    from turntable_pin.cli import main
+
+    stderr = io.StringIO()
+    with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+        status = main(argv)
+    return status, stderr.getvalue()
+
+
 def _guard_cases():
     """(command, output option, input option or positional) for every command's parser."""
     from pathlib import Path
@@ -186,19 +233,236 @@ def test_every_output_option_of_every_command_refuses_every_input(
 
     target = tmp_path / "file.txt"
     target.write_text("an input that must survive\n")
-    argv = [command]
-    for action in _command_actions(command):
-        flag = action.option_strings[-1] if action.option_strings else None
-        if action.dest in (output, source):
-            argv += [flag, str(target)] if flag else [str(target)]
-        elif flag is None and action.dest not in ("help",):  # another positional: a file
-            argv.append(str(tmp_path / f"other_{action.dest}.csv"))
-        elif action.required:
-            value = action.choices[0] if action.choices else str(tmp_path / f"{action.dest}.out")
-            argv += [flag, str(value)]
+    argv = _argv(command, {output: str(target), source: str(target)}, tmp_path)
     stderr = io.StringIO()
     with contextlib.redirect_stderr(stderr):
         status = main(argv)
     assert status == 2, (argv, stderr.getvalue())
     assert "refusing to write" in stderr.getvalue(), stderr.getvalue()
     assert target.read_text() == "an input that must survive\n"
+
+
+# --- issue 27, second sweep: files named inside an option's text are inputs ---------------------
+def _text_input_cases():
+    """(command, output option, option whose text names input files, its text) for every
+    command's parser; {f} stands for the file."""
+    from turntable_pin.cli import COMMANDS
+    from turntable_pin.cli.common import OUTPUT_OPTIONS, effect_list, effect_spec, position_scheme
+
+    texts = {effect_list: "base_tilt,{f}", effect_spec: "{f}:c3=1", position_scheme: "{f}"}
+    cases = []
+    for command in COMMANDS:
+        actions = _command_actions(command)
+        outputs = [a.dest for a in actions if a.dest in OUTPUT_OPTIONS]
+        named = [(a.dest, texts[a.type]) for a in actions if a.type in texts]
+        cases += [(command, o, dest, text) for o in outputs for dest, text in named]
+    return cases
+
+
+def test_the_options_that_name_files_inside_their_text_are_all_known():
+    found = {(command, dest) for command, _, dest, _ in _text_input_cases()}
+    assert found == {
+        ("fit", "effects"),
+        ("design", "effects"),
+        ("design", "separate"),
+        ("design", "amplitude"),
+        ("simulate", "effect"),
+        ("requirement", "positions"),
+        ("allocate", "positions"),
+        ("montecarlo", "positions"),
+    }
+
+
+@pytest.mark.parametrize("command, output, source, text", _text_input_cases())
+def test_every_output_refuses_a_file_named_inside_an_option(
+    tmp_path, command, output, source, text
+):
+    name = "positions.csv" if source == "positions" else "mine.yaml"
+    target = tmp_path / name
+    target.write_text("an input that must survive\n")
+    given = {output: str(target), source: text.format(f=target)}
+    status, stderr = _main(_argv(command, given, tmp_path))
+    assert status == 2, stderr
+    assert f"refusing to write --{output.replace('_', '-')} {target}: it is --{source}" in stderr
+    assert target.read_text() == "an input that must survive\n"
+
+
+# --- every output checked before any is written ---------------------------------------------
+def _bad_output(tmp_path, kind: str, folder: bool):
+    """An output path that cannot be written, of ``kind``."""
+    path = tmp_path / f"bad_{kind}"
+    if kind == "wrong kind":  # a folder where a file is expected, or the reverse
+        path.mkdir() if not folder else path.write_text("a file\n")
+    elif kind == "under a file":
+        (tmp_path / "afile").write_text("a file\n")
+        path = tmp_path / "afile" / "out"
+    elif kind == "write-protected":
+        path.write_text("protected\n")
+        path.chmod(0o444)
+    elif kind == "link to nothing":
+        path.symlink_to(tmp_path / "nowhere")
+    return path
+
+
+BAD_OUTPUTS = ("wrong kind", "under a file", "write-protected", "link to nothing")
+MESSAGES = {
+    "wrong kind": "it is a f",
+    "under a file": "afile is a file, not a folder",
+    "write-protected": "permission denied (the file is write-protected, mode 0444)",
+    "link to nothing": "which does not exist",
+}
+
+
+def _output_cases():
+    from turntable_pin.cli import COMMANDS
+    from turntable_pin.cli.common import FOLDER_OUTPUTS, OUTPUT_OPTIONS
+
+    cases = []
+    for command in COMMANDS:
+        for action in _command_actions(command):
+            if action.dest in OUTPUT_OPTIONS:
+                folder = action.dest in FOLDER_OUTPUTS
+                kinds = [k for k in BAD_OUTPUTS if not (folder and k == "write-protected")]
+                cases += [(command, action.dest, kind) for kind in kinds]
+    return cases
+
+
+@pytest.mark.parametrize("command, output, kind", _output_cases())
+def test_every_output_of_every_command_is_checked_before_the_command_runs(
+    tmp_path, command, output, kind
+):
+    from turntable_pin.cli.common import FOLDER_OUTPUTS
+
+    bad = _bad_output(tmp_path, kind, output in FOLDER_OUTPUTS)
+    status, stderr = _main(_argv(command, {output: str(bad)}, tmp_path))
+    assert status == 2
+    lines = stderr.strip().splitlines()
+    assert (
+        len(lines) == 1 and f"error: --{output.replace('_', '-')} {bad}: cannot write" in lines[0]
+    )
+    assert MESSAGES[kind] in lines[0], lines[0]
+
+
+# Every command that writes two outputs (its own run: the data exist; {a} and {b} the outputs).
+TWO_OUTPUTS = {
+    "simulate": ["simulate", "--run", "-o", "{output}", "--truth", "{truth}"],
+    "fit": ["fit", DATA.as_posix(), "--plots", "{plots}", "--write-urdf", "{write_urdf}"],
+    "import-tpoint": [
+        "import-tpoint",
+        MMT.as_posix(),
+        "-o",
+        "{output}",
+        "--write-urdf",
+        "{write_urdf}",
+    ],  # fmt: skip
+    "design": ["design", "-n", "6", "-o", "{output}", "--plots", "{plots}"],
+    "calibrate": [
+        "calibrate",
+        RUN.as_posix(),
+        "--diagnose",
+        "--plots",
+        "{plots}",
+        "--report",
+        "{report}",
+    ],  # fmt: skip
+}
+
+
+def test_every_command_with_two_outputs_is_listed():
+    from turntable_pin.cli import COMMANDS
+    from turntable_pin.cli.common import OUTPUT_OPTIONS
+
+    two = {c for c in COMMANDS
+           if sum(a.dest in OUTPUT_OPTIONS for a in _command_actions(c)) > 1}  # fmt: skip
+    assert two == set(TWO_OUTPUTS)
+
+
+def _two_output_cases():
+    from turntable_pin.cli.common import FOLDER_OUTPUTS
+
+    cases = []
+    for command, argv in TWO_OUTPUTS.items():
+        outputs = [a[1:-1] for a in argv if a.startswith("{")]
+        for bad in outputs:
+            kinds = [
+                k for k in BAD_OUTPUTS if not (bad in FOLDER_OUTPUTS and k == "write-protected")
+            ]
+            cases += [(command, bad, kind) for kind in kinds]
+    return cases
+
+
+@pytest.mark.parametrize("command, bad, kind", _two_output_cases())
+def test_a_refused_output_leaves_the_other_output_as_it_was(tmp_path, command, bad, kind):
+    # simulate --run -o S.csv --truth DIR wrote S.csv, then refused DIR: S.csv's earlier contents
+    # were lost. Now nothing is written unless every output can be.
+    from turntable_pin.cli.common import FOLDER_OUTPUTS
+
+    argv = TWO_OUTPUTS[command]
+    good = next(a[1:-1] for a in argv if a.startswith("{") and a[1:-1] != bad)
+    earlier = tmp_path / "earlier"
+    if good in FOLDER_OUTPUTS:  # a folder of figures made earlier
+        earlier.mkdir()
+        (earlier / "residuals.png").write_text("an earlier figure\n")
+    else:
+        earlier.write_text("earlier contents\n")
+    snapshot = sorted(
+        (str(p), p.read_text()) for p in [earlier, *earlier.rglob("*")] if p.is_file()
+    )
+    path = _bad_output(tmp_path, kind, bad in FOLDER_OUTPUTS)
+    values = {good: str(earlier), bad: str(path)}
+    proc = cli(*[values[a[1:-1]] if a.startswith("{") else a for a in argv])
+    assert proc.returncode == 2, proc.stderr
+    assert f"--{bad.replace('_', '-')} {path}: cannot write" in proc.stderr
+    after = sorted((str(p), p.read_text()) for p in [earlier, *earlier.rglob("*")] if p.is_file())
+    assert after == snapshot
+
+
+# --- a write-protected output, an output through a link ------------------------------------
+def test_a_write_protected_output_is_refused_and_kept(tmp_path):
+    keep = tmp_path / "keep.csv"
+    keep.write_text("earlier run\n")
+    keep.chmod(0o444)
+    proc = cli("simulate", "--run", "-o", str(keep))
+    assert proc.returncode == 2
+    assert proc.stderr.strip() == (
+        f"turntable-pin simulate: error: --output {keep}: cannot write the file: permission "
+        "denied (the file is write-protected, mode 0444)"
+    )
+    assert keep.read_text() == "earlier run\n" and keep.stat().st_mode & 0o777 == 0o444
+    keep.chmod(0o640)  # writable: replaced, and its mode kept
+    assert cli("simulate", "--run", "-o", str(keep)).returncode == 0
+    assert keep.read_text().startswith("#") and keep.stat().st_mode & 0o777 == 0o640
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["urdf", "-o", "{link}"],
+        ["simulate", "-o", "{link}"],
+        ["simulate", "--run", "-o", "{link}"],
+        ["import-tpoint", MMT.as_posix(), "-o", "{link}"],
+        ["fit", DATA.as_posix(), "--write-urdf", "{link}"],
+        ["design", "-n", "6", "-o", "{link}"],
+        ["report", DATA.as_posix(), "-o", "{link}"],
+    ],
+)
+def test_an_output_that_is_a_link_is_written_through_to_its_target(tmp_path, argv):
+    real = tmp_path / "kept" / "real.out"
+    real.parent.mkdir()
+    real.write_text("earlier\n")
+    link = tmp_path / "link.out"
+    link.symlink_to(real)
+    proc = cli(*[str(link) if a == "{link}" else a for a in argv])
+    assert proc.returncode == 0, proc.stderr
+    assert link.is_symlink() and link.resolve() == real.resolve()
+    assert real.read_text() != "earlier\n"
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["kept", "link.out", "real.out"]
+
+
+def test_a_plots_folder_that_is_a_link_fills_its_target(tmp_path):
+    real = tmp_path / "figures"
+    real.mkdir()
+    (tmp_path / "plots").symlink_to(real)
+    proc = cli("fit", str(DATA), "--plots", str(tmp_path / "plots"))
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "plots").is_symlink() and (real / "residuals.png").is_file()

@@ -141,9 +141,9 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
         args.argv = tuple(argv)  # the command line as given (a simulation records it)
         command = args.command
-        from .common import refuse_inputs_as_outputs  # no output may be one of the inputs
+        from .common import check_outputs  # every output checked before any is written
 
-        refuse_inputs_as_outputs(args)
+        check_outputs(args)
         status = int(args.func(args) or 0)
         if first_signal() is not None:  # an interruption that some library swallowed
             raise Interrupted(first_signal())

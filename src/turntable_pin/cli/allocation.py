@@ -30,6 +30,7 @@ from .common import (
     input_path,
     latitude_deg,
     one_line_errors,
+    position_scheme,
     positive_float,
     positive_int,
     print_json,
@@ -95,6 +96,7 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--positions",
+        type=position_scheme,
         default=DEFAULT_POSITIONS,
         help=f"position scheme behind the default limits ({DEFAULT_POSITIONS})",
     )

@@ -24,6 +24,7 @@ from .common import (
     input_path,
     latitude_deg,
     one_line_errors,
+    position_scheme,
     print_json,
     table_from_args,
 )
@@ -34,7 +35,7 @@ __all__ = ["register"]
 def _add_setup_options(parser: argparse.ArgumentParser, *, positions: bool = True) -> None:
     if positions:
         parser.add_argument(
-            "--positions", default="grid:30", metavar="SCHEME|FILE.csv",
+            "--positions", type=position_scheme, default="grid:30", metavar="SCHEME|FILE.csv",
             help="test positions: grid:STEP (every joint in 0, STEP, ... < 360 deg, every "
             "combination), grid:STEP1xSTEP2[xSTEP3] (one step per joint), or a CSV with one angle "
             "column per joint: phi1_deg .. phiN_deg (chain order) or <joint>_deg (default grid:30)",

@@ -21,6 +21,12 @@ __all__ = [
     "add_error_options",
     "add_mount_option",
     "add_table_options",
+    "check_outputs",
+    "effect_list",
+    "effect_spec",
+    "FOLDER_OUTPUTS",
+    "NamesFiles",
+    "position_scheme",
     "bounded_float",
     "error_values_from_args",
     "finite_float",
@@ -304,6 +310,45 @@ def print_json(payload: dict) -> None:
 
 OUTPUT_OPTIONS: tuple[str, ...] = ("output", "plots", "write_urdf", "truth", "report")
 """Destinations of the options through which a command writes (a file, or a folder of files)."""
+FOLDER_OUTPUTS: tuple[str, ...] = ("plots",)
+"""The output options of :data:`OUTPUT_OPTIONS` that name a folder of files."""
+
+
+class NamesFiles(str):
+    """The text of an option that names input files among other words, as an argparse type
+    returns it: the text itself (a ``str``), with ``input_files`` the files it names (``--effects
+    base_tilt,mine.yaml`` names ``mine.yaml``). :func:`refuse_inputs_as_outputs` reads them."""
+
+    input_files: tuple[Path, ...] = ()
+
+    @classmethod
+    def of(cls, text: str, files) -> NamesFiles:
+        named = cls(text)
+        named.input_files = tuple(files)
+        return named
+
+
+def effect_list(text: str) -> NamesFiles:
+    """argparse type of ``--effects A,B`` and ``--separate A,B``: comma-separated catalogue
+    names, inline terms and effect files (``.yaml``/``.yml``, read as inputs)."""
+    from ..measurement.user_effects import effect_files_named
+
+    return NamesFiles.of(text, effect_files_named(text))
+
+
+def effect_spec(text: str) -> NamesFiles:
+    """argparse type of ``NAME:P=V,...`` (``simulate --effect``, ``design --amplitude``):
+    ``NAME`` may be an effect file (read as an input)."""
+    from ..measurement.user_effects import effect_files_named
+
+    return NamesFiles.of(text, effect_files_named(text.partition(":")[0]))
+
+
+def position_scheme(text: str) -> NamesFiles:
+    """argparse type of ``--positions SCHEME|FILE.csv``: a scheme starts with ``grid``; anything
+    else is a CSV file of positions (read as an input)."""
+    spec = text.strip()
+    return NamesFiles.of(text, () if spec.startswith("grid") else (Path(spec),))
 
 
 def _same_path(a: Path, b: Path) -> bool:
@@ -313,14 +358,9 @@ def _same_path(a: Path, b: Path) -> bool:
         return False
 
 
-def refuse_inputs_as_outputs(args: argparse.Namespace) -> None:
-    """Refuse a command whose output path is one of its inputs (every other path option), or
-    another of its outputs.
-
-    An output file may not be an input file (nor the same file under another name: links count);
-    a plots folder may not be an input file either; two outputs may not be one file. Raises
-    :class:`InputError` naming both.
-    """
+def _input_paths(args: argparse.Namespace) -> list[tuple[str, Path]]:
+    """``(option, path)`` of every input file of the command: every path option that is no
+    output, and every file named inside an option's text (:class:`NamesFiles`)."""
     inputs: list[tuple[str, Path]] = []
     for dest, value in vars(args).items():
         if dest in OUTPUT_OPTIONS:
@@ -328,6 +368,21 @@ def refuse_inputs_as_outputs(args: argparse.Namespace) -> None:
         for item in value if isinstance(value, (list, tuple)) else [value]:
             if isinstance(item, Path):
                 inputs.append((dest, item))
+            elif isinstance(item, NamesFiles):
+                inputs += [(dest, path) for path in item.input_files]
+    return inputs
+
+
+def refuse_inputs_as_outputs(args: argparse.Namespace) -> None:
+    """Refuse a command whose output path is one of its inputs (every other path option, and the
+    files named inside an option's text such as ``--effects A,mine.yaml``), or another of its
+    outputs.
+
+    An output file may not be an input file (nor the same file under another name: links count);
+    a plots folder may not be an input file either; two outputs may not be one file. Raises
+    :class:`InputError` naming both.
+    """
+    inputs = _input_paths(args)
     for dest in OUTPUT_OPTIONS:
         output = getattr(args, dest, None)
         if not isinstance(output, Path):
@@ -345,7 +400,28 @@ def refuse_inputs_as_outputs(args: argparse.Namespace) -> None:
     for i, (dest, output) in enumerate(outputs):
         for other, path in outputs[i + 1 :]:
             if output.resolve() == path.resolve() or _same_path(output, path):
+                first, second = (f"--{d.replace('_', '-')}" for d in (dest, other))
                 raise InputError(
-                    f"refusing to write --{dest} {output} and --{other.replace('_', '-')} {path}: "
+                    f"refusing to write {first} {output} and {second} {path}: "
                     "they are one file (choose two output names)"
                 )
+
+
+def check_outputs(args: argparse.Namespace) -> None:
+    """Check every output of the command before it writes any, so that a refused output never
+    comes after another has replaced what was there: no output is an input or another output
+    (:func:`refuse_inputs_as_outputs`), and each can be written
+    (:func:`~turntable_pin.core.files.output_target`: a folder where a file is expected or the
+    reverse, a parent that is a file, a write-protected file, a folder one may not write in, a
+    link to nothing). Raises :class:`InputError` naming the option."""
+    from ..core.files import output_target
+
+    refuse_inputs_as_outputs(args)
+    for dest in OUTPUT_OPTIONS:
+        output = getattr(args, dest, None)
+        if not isinstance(output, Path):
+            continue
+        try:
+            output_target(output, folder=dest in FOLDER_OUTPUTS)
+        except InputError as exc:
+            raise InputError(f"--{dest.replace('_', '-')} {exc}") from None

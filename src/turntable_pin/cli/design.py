@@ -18,6 +18,8 @@ from .common import (
     add_mount_option,
     add_table_options,
     bounded_float,
+    effect_list,
+    effect_spec,
     input_path,
     latitude_deg,
     one_line_errors,
@@ -56,12 +58,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_mount_option(p)
     mode = p.add_mutually_exclusive_group()
     mode.add_argument(
-        "--separate", metavar="A,B", help="positions that tell effect A from effect B (T-optimal)"
+        "--separate",
+        type=effect_list,
+        metavar="A,B",
+        help="positions that tell effect A from effect B (T-optimal)",
     )
     p.add_argument(
         "--amplitude",
         action="append",
         default=[],
+        type=effect_spec,
         metavar="A:P=V[,P=V...]",
         help="with --separate: an effect's parameters in its user units (arcsec, arcsec/g), e.g. "
         "TF:TF=10 (default: fitted with the base errors on --from data); repeatable",
@@ -94,6 +100,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--effects",
         action="append",
         default=[],
+        type=effect_list,
         metavar="A,B",
         help="effects to identify besides the base errors, as fit --effects takes "
         "them: catalogue names, effect files (.yaml), inline terms; repeatable",

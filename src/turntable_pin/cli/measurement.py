@@ -16,6 +16,8 @@ from .common import (
     add_mount_option,
     add_table_options,
     bounded_float,
+    effect_list,
+    effect_spec,
     error_values_from_args,
     input_path,
     non_negative_int,
@@ -52,6 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--effect",
         action="append",
         default=[],
+        type=effect_spec,
         metavar="NAME:P=V[,P=V...]",
         help="a hidden effect and its parameters in user units (arcsec, arcsec/g, arcsec/h), "
         "e.g. inner_encoder_harmonics:c1=3,s2=-2; repeatable",
@@ -122,7 +125,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     one_line_errors(f)
     _add_data_options(f)
-    f.add_argument("--effects", action="append", default=[], metavar="A,B",
+    f.add_argument("--effects", action="append", default=[], type=effect_list, metavar="A,B",
                    help="effects to add to the base: catalogue names, effect files (.yaml) and "
                    "inline terms (dphi_z2~h3(phi2), dpsi~poly1(temperature_c), "
                    "dphi_y1~sign(dir1)); comma-separated, repeatable")  # fmt: skip

@@ -5,42 +5,108 @@ from __future__ import annotations
 
 import functools
 import os
+import stat
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["read_text_file", "read_yaml", "write_atomic", "write_bytes_atomic", "write_text_atomic"]
+__all__ = [
+    "output_target",
+    "read_text_file",
+    "read_yaml",
+    "write_atomic",
+    "write_bytes_atomic",
+    "write_text_atomic",
+]
+
+
+def output_target(path: str | Path, *, folder: bool = False) -> Path:
+    """Where an output named ``path`` goes, checked before anything is written: ``path`` itself,
+    or the file a symbolic link at ``path`` points to (the link is kept and its target replaced).
+
+    ``folder``: the output is a folder of files (``--plots DIR``), not one file. Raises
+    :class:`InputError` naming ``path`` (``cannot write the file: ...``) where a plain write would
+    fail or would undo what the user protected:
+
+    - a link to nothing (its target does not exist) or a link that loops;
+    - a folder where a file is expected, a file where a folder is expected, a parent that is a file;
+    - an existing file that is write-protected: for a user, one this user may not write
+      (``os.access``); for root, who may write anything, one without any write permission bit
+      (mode ``0444``): the mode is the owner's say, and root keeps to it;
+    - a folder (the output's, or where it would be made) this user may not write in.
+    """
+    from .exceptions import InputError
+
+    path = Path(path)
+    kind = "folder" if folder else "file"
+
+    def refuse(why: str):
+        raise InputError(f"cannot write the {kind}: {why}", path=path)
+
+    target = path
+    if path.is_symlink():
+        try:
+            target = path.resolve(strict=True)
+        except FileNotFoundError:
+            refuse(f"it is a link to {os.readlink(path)}, which does not exist")
+        except (RuntimeError, OSError):  # RuntimeError: a loop, before Python 3.13
+            refuse("it is a link that loops")
+    if folder and target.exists() and not target.is_dir():
+        refuse("it is a file, not a folder")
+    if not folder and target.is_dir():
+        refuse("it is a folder")
+    blocking = next((p for p in target.parents if p.exists() and not p.is_dir()), None)
+    if blocking is not None:
+        refuse(f"{blocking} is a file, not a folder")
+    if not folder and target.exists() and _write_protected(target):
+        mode = stat.S_IMODE(target.stat().st_mode)
+        refuse(f"permission denied (the file is write-protected, mode {mode:04o})")
+    where = target if folder and target.is_dir() else target.parent
+    while not where.exists() and where != where.parent:
+        where = where.parent
+    if not _access(where, os.W_OK | os.X_OK):
+        refuse(f"permission denied (cannot write in the folder {where})")
+    return target
+
+
+def _access(path: Path, mode: int) -> bool:
+    """``os.access`` for the effective user (who the process writes as)."""
+    return os.access(path, mode, effective_ids=os.access in os.supports_effective_ids)
+
+
+def _write_protected(path: Path) -> bool:
+    """Whether a plain write to the existing file ``path`` would be refused (for root: whether
+    the file has no write permission bit at all, since the system lets root write anyway)."""
+    if getattr(os, "geteuid", lambda: -1)() == 0:
+        return not path.stat().st_mode & 0o222
+    return not _access(path, os.W_OK)
 
 
 def write_atomic(path: str | Path, write: Callable[[Path], None]) -> Path:
     """Call ``write(tmp_path)`` on a temporary file beside ``path``, then rename it into place.
 
     If ``write`` raises, the temporary file is removed and any existing ``path`` is untouched.
-    An operating-system error (a folder that is a file, no permission, a full disk) becomes an
-    :class:`InputError` naming the output path.
+    ``path`` is checked first (:func:`output_target`: a write-protected file is refused, a link is
+    written through to its target). A file replaced keeps its permission bits (and its owner,
+    where the system allows), as a plain write would; a new file gets the mode a plain ``open()``
+    gives. An operating-system error (a full disk) becomes an :class:`InputError` naming ``path``.
     """
     from .exceptions import InputError
 
     path = Path(path)
-    if path.is_dir():
-        raise InputError("cannot write the file: it is a folder", path=path)
-    blocking = next((p for p in path.parents if p.exists() and not p.is_dir()), None)
-    if blocking is not None:
-        raise InputError(f"cannot write the file: {blocking} is a file, not a folder", path=path)
+    target = output_target(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        previous = target.stat() if target.exists() else None
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     except OSError as exc:
         raise InputError(f"cannot write the file: {exc.strerror or exc}", path=path) from None
     os.close(fd)
     tmp = Path(tmp_name)
     try:
         write(tmp)
-        # mkstemp makes the file private (0600); give it the mode a plain open() would.
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
+        _give_mode(tmp, previous)
+        os.replace(tmp, target)
     except OSError as exc:
         tmp.unlink(missing_ok=True)
         raise InputError(f"cannot write the file: {exc.strerror or exc}", path=path) from None
@@ -48,6 +114,22 @@ def write_atomic(path: str | Path, write: Callable[[Path], None]) -> Path:
         tmp.unlink(missing_ok=True)
         raise
     return path
+
+
+def _give_mode(tmp: Path, previous: os.stat_result | None) -> None:
+    """Give ``tmp`` (made private, 0600, by mkstemp) the mode and owner of the file it replaces
+    (``previous``), or the mode a plain ``open()`` gives a new file."""
+    if previous is None:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        return
+    if hasattr(os, "chown"):
+        try:
+            os.chown(tmp, previous.st_uid, previous.st_gid)
+        except OSError:  # another user's file: a user cannot give it away; it becomes theirs
+            pass
+    os.chmod(tmp, stat.S_IMODE(previous.st_mode))
 
 
 def write_text_atomic(path: str | Path, text: str) -> Path:

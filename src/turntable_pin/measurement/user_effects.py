@@ -29,6 +29,7 @@ __all__ = [
     "TERM_KEYS",
     "check_user_effects",
     "describe_effects",
+    "effect_files_named",
     "inline_effect",
     "installed_effects",
     "load_catalogue",
@@ -337,6 +338,22 @@ def load_catalogue(paths: Sequence[str | Path], turntable=None) -> tuple[Effect,
     return check_user_effects([*effects, *installed_effects()], turntable)
 
 
+def _effect_items(text: str) -> list[str]:
+    """The items of one ``--effects`` text: comma-separated, stripped, empty ones left out."""
+    return [x for x in (x.strip() for x in str(text).split(",")) if x]
+
+
+def _is_effect_file(item: str) -> bool:
+    """Whether an item of ``--effects`` (not an inline term) names an effect file."""
+    return "~" not in item and item.lower().endswith(EFFECT_FILE_SUFFIXES)
+
+
+def effect_files_named(text: str) -> tuple[Path, ...]:
+    """The effect files an ``--effects`` text names (the items :func:`resolve_effects` reads as
+    files), for the command line's check that no output is written over an input."""
+    return tuple(Path(item) for item in _effect_items(text) if _is_effect_file(item))
+
+
 def resolve_effects(
     items: Sequence[str], turntable=None, extra: Sequence[Effect] = ()
 ) -> tuple[Effect, ...]:
@@ -348,10 +365,10 @@ def resolve_effects(
     out: list[Effect] = []
     installed: tuple[Effect, ...] | None = None
     for text in items:
-        for item in filter(None, (x.strip() for x in str(text).split(","))):
+        for item in _effect_items(text):
             if "~" in item:
                 effect = inline_effect(item, turntable)
-            elif item.lower().endswith(EFFECT_FILE_SUFFIXES):
+            elif _is_effect_file(item):
                 effect = read_effect_file(item, turntable)
                 check_user_effects([effect], turntable)
             else:
