@@ -1,6 +1,7 @@
 """Shared test helpers: seeded random error sets, the paper's errors on the generic parameters,
-the repository's paths, a file writer, the CLI runners (child process and in-process), the
-transforms a meshcat scene sets, and the skip of browser tests without Chromium.
+the repository's paths, a file writer (and a bundled run with its temperature cells changed), the
+CLI runners (child process and in-process), the transforms a meshcat scene sets, and the skip of
+browser tests without Chromium.
 
 The test folders mirror the package's subpackages (tests/core, tests/model, ...) and hold no
 ``__init__.py``: with pytest's default import mode every test module is imported by its basename,
@@ -71,6 +72,22 @@ def write_file(folder: Path, text: str, name: str = "data.csv") -> Path:
     path = folder / name
     path.write_text(text)
     return path
+
+
+def temperature_run(folder, cell=lambda row, text: text, note=None):
+    """``run_temperature.csv`` with each ``temperature_c`` cell replaced by ``cell(row, text)``
+    (spreadsheet row of the file) and, when given, a ``note`` column of ``note``."""
+    lines = (EXAMPLES_DIR / "runs" / "run_temperature.csv").read_text().splitlines()
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    column = lines[header].split(",").index("temperature_c")
+    out = lines[: header + 1]
+    if note is not None:
+        out[header] += ",note"
+    for row, line in enumerate(lines[header + 1 :], start=header + 2):
+        cells = line.split(",")
+        cells[column] = cell(row, cells[column])
+        out.append(",".join(cells) + ("" if note is None else f",{note}"))
+    return write_file(folder, "\n".join(out) + "\n", "run.csv")
 
 
 # --- command-line runners and the browser skip, shared by every test module -----------------------

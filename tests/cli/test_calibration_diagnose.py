@@ -7,7 +7,7 @@ import json
 
 import pytest
 
-from conftest import EXAMPLES_DIR, REPO_DIR, cli, write_file
+from conftest import EXAMPLES_DIR, REPO_DIR, cli, temperature_run, write_file
 
 RUNS = EXAMPLES_DIR / "runs"
 MODELS_DIR = REPO_DIR / "models"
@@ -198,3 +198,28 @@ def test_an_output_onto_the_run_is_refused_and_the_run_kept(tmp_path, option):
     assert proc.returncode == 2
     assert "it is the data file" in proc.stderr and "Traceback" not in proc.stderr
     assert run.read_bytes() == before
+
+
+def test_a_text_cell_among_temperatures_exits_2_instead_of_a_wrong_verdict(tmp_path):
+    """Issue 27: 'warm' in one temperature_c cell dropped the column: exit 0, verdict
+    bias_drift, and "temperature_c ... absent from the run"."""
+    path = temperature_run(tmp_path, lambda row, text: "warm" if row == 17 else text)
+    proc = cli("calibrate", str(path), "--diagnose")
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert "row 17, column 'temperature_c': 'warm' is not a number" in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_text_columns_are_warned_of_and_never_called_absent(tmp_path):
+    path = temperature_run(tmp_path, lambda row, text: "n/a", note="fine")
+    proc = cli("calibrate", str(path), "--diagnose")
+    assert proc.returncode == 0, proc.stderr
+    warning = f"warning: {path}: column(s) temperature_c, note ignored: not numbers"
+    assert warning in proc.stderr
+    line = next(s for s in proc.stdout.splitlines() if "temperature_coefficient " in s)
+    assert "not testable" in line and "present in the run but not numbers" in line
+    assert "absent" not in line
+    proc = cli("calibrate", str(path), "--effects", "temperature_coefficient")
+    assert proc.returncode == 2 and "present in the run but not numbers" in proc.stderr
+    proc = cli("calibrate", str(path), "--json")
+    assert proc.returncode == 0 and warning in proc.stderr

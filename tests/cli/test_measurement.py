@@ -79,6 +79,11 @@ BAD = {
         "phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec,sigma_arcsec\n0,0,1,1,1,0\n",
         "row 2, column 'sigma_arcsec'",
     ),
+    "text among numbers": (  # issue 27: the column was dropped without a word
+        "phi1_deg,phi2_deg,dpsi_arcsec,dtheta_arcsec,dgamma_arcsec,temperature_c\n"
+        "0,0,1,1,1,20.5\n0,30,1,1,1,warm\n0,60,1,1,1,21\n",
+        "row 3, column 'temperature_c': 'warm' is not a number",
+    ),
 }
 
 
@@ -96,6 +101,21 @@ def test_bad_files_exit_2_naming_row_and_column(kind, tmp_path, capsys):
     assert fragment in err.err and err.out == ""
     out = tmp_path / "r.html"
     assert main(["report", str(path), "-o", str(out)]) == 2 and not out.exists()
+
+
+def test_text_columns_are_warned_of_and_an_effect_on_one_is_told_it_is_text(tmp_path):
+    lines = EXAMPLE.read_text().splitlines()
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    lines[header] += ",temperature_c,note"
+    lines[header + 1 :] = [line + ",n/a,ok" for line in lines[header + 1 :]]
+    path = tmp_path / "noted.csv"
+    path.write_text("\n".join(lines) + "\n")
+    warning = f"diagnose: warning: {path}: column(s) temperature_c, note ignored: not numbers"
+    proc = cli("diagnose", str(path), "--json")
+    assert proc.returncode == 0 and warning in proc.stderr
+    proc = cli("fit", str(path), "--effects", "dpsi~poly1(temperature_c)")
+    assert proc.returncode == 2 and "absent" not in proc.stderr
+    assert "temperature_c, present in the data but not numbers" in proc.stderr
 
 
 def test_report_never_overwrites_its_input(sim_file, capsys):

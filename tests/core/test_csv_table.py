@@ -97,7 +97,8 @@ def test_repeated_rows_found_by_keys_equal_as_python_compares_them(tmp_path):
 
 def test_numpy_reading_of_a_clean_file_equals_cell_by_cell(tmp_path):
     """An unquoted, all-numeric file is read by numpy at once: the same numbers as ``float``
-    cell by cell (CRLF line ends, spaces, exponents, signs), extra columns kept or skipped."""
+    cell by cell (CRLF line ends, spaces, exponents, signs), extra columns kept, refused (a bad
+    cell among numbers) or skipped (text)."""
     import csv
 
     from turntable_pin.core import csv_table
@@ -108,6 +109,15 @@ def test_numpy_reading_of_a_clean_file_equals_cell_by_cell(tmp_path):
         cells = [f"{rng.normal():.17g}", f" {rng.uniform(-1e3, 1e3):.6e} ", f"+{k}", f"{k / 7!r}",
                  "inf" if k == 5 else "1"]  # fmt: skip
         lines.append(",".join(cells))
+    path = write_file(tmp_path, "\r\n".join(lines) + "\r\n", "n.csv")
+    # numpy reads 'inf' as a number: a numeric column with one bad cell, refused where it is
+    with pytest.raises(InputError, match="row 8, column 'bad': expected a finite number, found"):
+        read_csv_table(path, ("a", "b"), ("c",), extra=True)
+    lines[7] = lines[7].replace(",inf", ",x")  # now a text cell: still a numeric column
+    path = write_file(tmp_path, "\r\n".join(lines) + "\r\n", "n.csv")
+    with pytest.raises(InputError, match="row 8, column 'bad': 'x' is not a number"):
+        read_csv_table(path, ("a", "b"), ("c",), extra=True)
+    lines = [line if i < 2 else line[: line.rindex(",")] + ",x" for i, line in enumerate(lines)]
     path = write_file(tmp_path, "\r\n".join(lines) + "\r\n", "n.csv")
     table = read_csv_table(path, ("a", "b"), ("c",), extra=True)
     assert table.skipped == ("bad",) and list(table.extra) == ["temp"]
@@ -150,3 +160,50 @@ def test_a_missing_column_error_names_the_header_row_and_the_closest_column(tmp_
         read_measurements(path)
     message = str(caught.value)
     assert "row 2" in message and "is 'phi_2deg' a misspelling" in message
+
+
+@pytest.mark.parametrize("quoted", [False, True])
+@pytest.mark.parametrize(
+    "cell, fragment",
+    [
+        ("warm", "row 17, column 'temperature_c': 'warm' is not a number"),
+        ("", "row 17, column 'temperature_c': expected a number, found an empty cell"),
+        ("nan", "row 17, column 'temperature_c': expected a finite number, found 'nan'"),
+    ],
+)
+def test_a_numeric_other_column_with_a_bad_cell_is_refused_naming_row_and_column(
+    tmp_path, cell, fragment, quoted
+):
+    """Issue 27: one bad cell among numbers no longer drops the column without a word."""
+    rows = [f"{k},{20 + k / 10}" if k != 15 else f"{k},{cell}" for k in range(30)]
+    if quoted:
+        rows[0] = '"0",20.0'
+    path = write_file(tmp_path, "a,temperature_c\n" + "\n".join(rows) + "\n")
+    with pytest.raises(InputError) as info:
+        read_csv_table(path, ("a",), extra=True)
+    assert fragment in str(info.value) and str(path) in str(info.value)
+    assert "so it is a numeric column" in str(info.value)
+
+
+def test_the_boundary_between_a_numeric_and_a_text_column(tmp_path):
+    """Numeric when at least half of the filled cells are numbers; else text, named in
+    ``skipped`` (a ``note`` with a number in it, a column empty throughout)."""
+    text = "a,half,note,empty\n1,3,ok,\n2,hot,see log,\n3,,2,\n4,,checked,\n"
+    path = write_file(tmp_path, text)
+    with pytest.raises(InputError, match="row 3, column 'half': 'hot' is not a number"):
+        read_csv_table(path, ("a",), extra=True)
+    table = read_csv_table(write_file(tmp_path, text.replace(",3,ok", ",cold,ok")), ("a",),
+                           extra=True)  # fmt: skip
+    assert table.skipped == ("half", "note", "empty") and not table.extra
+
+
+def test_missing_columns_are_never_called_absent_when_present_as_text():
+    from turntable_pin.core.csv_table import ignored_columns_words, missing_columns_words
+
+    words = missing_columns_words(["time_s", "temperature_c"], ("temperature_c",), "the run")
+    assert words == (
+        "time_s, absent from the run; temperature_c, present in the run but not numbers "
+        "(text or empty throughout), so ignored"
+    )
+    assert missing_columns_words(["x"], (), "the data") == "x, absent from the data"
+    assert ignored_columns_words(["note"]).startswith("column(s) note ignored: not numbers")

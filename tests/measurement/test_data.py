@@ -142,6 +142,31 @@ def test_sigma_per_angle_and_extra_numeric_columns(tmp_path):
         read_measurements(write_file(tmp_path, text.replace("sigma_dpsi_arcsec", "sigma_arcsec")))
 
 
+def test_a_bad_cell_in_a_numeric_extra_column_is_refused_not_dropped(tmp_path):
+    """Issue 27: a 'warm' among temperatures used to drop the column (and the diagnosis said
+    it was absent); it is a numeric column with a bad cell, refused naming row and column."""
+    temperature = lambda i: ",warm" if i == 4 else f",{20 + i / 4}"  # noqa: E731
+    text = HEAD + ",temperature_c\n" + grid_rows(temperature)
+    with pytest.raises(InputError) as info:
+        read_measurements(write_file(tmp_path, text))
+    assert "row 6, column 'temperature_c': 'warm' is not a number" in str(info.value)
+
+
+def test_a_text_column_is_ignored_and_named_and_an_effect_on_it_is_told_so(tmp_path):
+    from turntable_pin.measurement.effect_model import OrientationModel
+    from turntable_pin.measurement.user_effects import resolve_effects
+
+    text = HEAD + ",temperature_c,note\n" + grid_rows(lambda i: ",n/a,ok" if i else ",21,ok")
+    data = read_measurements(write_file(tmp_path, text))
+    assert data.extra == {} and data.ignored_columns == ("temperature_c", "note")
+    assert data.select(np.arange(4)).ignored_columns == ("temperature_c", "note")
+    with pytest.raises(InputError) as info:
+        OrientationModel(data.variables(), resolve_effects(["dpsi~poly1(temperature_c)"]))
+    message = str(info.value)
+    assert "temperature_c, present in the data but not numbers" in message
+    assert "absent" not in message
+
+
 def test_the_python_api_refuses_nan_where_the_reader_would():
     from turntable_pin.measurement.data import OrientationMeasurements
 

@@ -42,6 +42,7 @@ from .run import (
     MIN_RUN_SIGMA_DPH,
     RUN_OPTIONAL_COLUMNS,
     RUN_REQUIRED_COLUMNS,
+    CalibrationRun,
     read_run,
     refuse_copied_rows,
 )
@@ -54,6 +55,7 @@ __all__ = [
     "AxisCalibration",
     "CalibrationResult",
     "calibrate",
+    "calibrate_read_run",
     "calibrate_run",
     "check_identifiable",
     "fit_axis",
@@ -345,11 +347,18 @@ def calibrate_run(path: str | Path, latitude_rad: float, table=None) -> Calibrat
     ``table``: the :class:`~turntable_pin.model.generic_table.GenericTable` whose run this is
     (default the paper's table).
     """
-    run = read_run(path, latitude_rad, table)
+    return calibrate_read_run(read_run(path, latitude_rad, table))
+
+
+def calibrate_read_run(run: CalibrationRun) -> CalibrationResult:
+    """Fit a calibration run already read (:func:`~.run.read_run`), as :func:`calibrate_run`
+    does: positions that cannot determine the coefficients are named first, then copied rows."""
     try:
         result = calibrate(run.inputs, run.outputs_dph[:, 0], run.outputs_dph[:, 1], run.sigma_dph)
     except IdentifiabilityError as exc:
-        raise IdentifiabilityError(f"{path}: {exc}") from None
+        if not run.source:
+            raise
+        raise IdentifiabilityError(f"{run.source}: {exc}") from None
     # After the fit: positions that cannot determine the coefficients are the first problem.
     refuse_copied_rows(run)
     return result

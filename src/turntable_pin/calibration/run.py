@@ -4,7 +4,10 @@ One row per position (``docs/measurements.md``, "GyroWheel calibration runs"): o
 per joint of the table (``phi1_deg .. phiN_deg`` in chain order or ``<joint>_deg``),
 ``out_x_dph, out_y_dph`` (deg/h) and optionally ``sigma_dph`` (1-sigma output noise of the row),
 ``time_s`` (s since the start of the run) and any other numeric column (``temperature_c``...),
-which is kept as a possible cause for the diagnosis of the run. The latitude is a parameter of
+which is kept as a possible cause for the diagnosis of the run. A column is numeric when at least
+half of its filled cells are numbers, and then every cell must be a finite number (a ``warm`` in a
+``temperature_c`` column is refused naming file, row and column); a column of text (a ``note``)
+is left out and named in :attr:`CalibrationRun.ignored_columns`. The latitude is a parameter of
 the run. :func:`read_run` is the one reader: ``calibrate`` fits what it returns, and the run
 diagnosis (:mod:`turntable_pin.instrument`) diagnoses it.
 """
@@ -16,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.csv_table import read_csv_table, refuse_repeated_rows
+from ..core.csv_table import missing_columns_words, read_csv_table, refuse_repeated_rows
 from ..core.exceptions import InputError
 from ..model.paper_table import paper_table
 from .positions import PositionInputs, PositionSet, position_inputs
@@ -59,6 +62,7 @@ class CalibrationRun:
         extra: other numeric columns ``{name: (N,)}`` (``temperature_c``...).
         rows: (N,) the file row of each position (header = row 1).
         source: the file it was read from ('' when made in memory).
+        ignored_columns: the file's columns left out as not numbers (text or empty throughout).
     """
 
     inputs: PositionInputs
@@ -68,6 +72,7 @@ class CalibrationRun:
     extra: dict[str, np.ndarray] = field(default_factory=dict)
     rows: np.ndarray | None = None
     source: str = ""
+    ignored_columns: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         outputs = np.asarray(self.outputs_dph, dtype=float)
@@ -99,6 +104,11 @@ class CalibrationRun:
         """``time_s``, an extra column, or ``None`` when the run has no such column."""
         return self.time_s if name == "time_s" else self.extra.get(name)
 
+    def missing_columns_words(self, missing) -> str:
+        """Why the columns ``missing`` cannot be used: absent from the run, or present but not
+        numbers (:func:`~turntable_pin.core.csv_table.missing_columns_words`)."""
+        return missing_columns_words(missing, self.ignored_columns, "the run")
+
     def replace(self, **changes) -> CalibrationRun:
         """A copy with some fields changed."""
         return replace(self, **changes)
@@ -127,6 +137,7 @@ def read_run(path: str | Path, latitude_rad: float, table=None) -> CalibrationRu
         extra,
         np.asarray(csv.rows),
         str(path),
+        csv.skipped,
     )
     object.__setattr__(run, "_csv", (csv, columns))
     return run

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..calibration.drift_fit import calibrate_run
+from ..calibration.drift_fit import calibrate_read_run
 from ..calibration.gyrowheel import GyroWheelModel
 from ..calibration.positions import PositionSet, position_inputs
 from ..calibration.rate_error import DEFINITIONS, rate_error
@@ -27,6 +27,7 @@ from .common import (
     position_scheme,
     print_json,
     table_from_args,
+    warn_ignored_columns,
 )
 
 __all__ = ["register"]
@@ -270,7 +271,11 @@ def run_calibrate(args: argparse.Namespace) -> int:
         return _diagnose_run(args, table)
     if args.effects:
         return _fit_run_effects(args, table)
-    result = calibrate_run(args.data, deg_to_rad(args.latitude_deg), table)
+    from ..calibration.run import read_run
+
+    run = read_run(args.data, deg_to_rad(args.latitude_deg), table)
+    warn_ignored_columns(args, run, args.data)
+    result = calibrate_read_run(run)
     if args.json:
         print_json({**result.to_dict(), **_table_keys(table)})
     else:
@@ -291,6 +296,7 @@ def _read_run(args: argparse.Namespace, table):
 
     run = read_run(args.data, deg_to_rad(args.latitude_deg), table)
     refuse_copied_rows(run)
+    warn_ignored_columns(args, run, args.data)
     return run
 
 
@@ -335,9 +341,9 @@ def _fit_run_effects(args: argparse.Namespace, table) -> int:
         missing = effect.missing_columns(run)
         if missing:
             raise InputError(
-                f"effect '{effect.name}' needs the column(s) {', '.join(missing)}, absent "
-                "from the run", path=args.data,
-            )  # fmt: skip
+                f"effect '{effect.name}' needs the column(s) {run.missing_columns_words(missing)}",
+                path=args.data,
+            )
     after = fit_run(run, effects)
     before = fit_run(run, (), context=after.model.context)
     before = before.with_noise_variance(after.result.noise_variance)

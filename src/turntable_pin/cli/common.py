@@ -40,6 +40,7 @@ __all__ = [
     "seed",
     "table_from_args",
     "refuse_inputs_as_outputs",
+    "warn_ignored_columns",
 ]
 
 
@@ -300,6 +301,16 @@ def _jsonable(value):
     if isinstance(value, Path):
         return str(value)
     return value
+
+
+def warn_ignored_columns(args: argparse.Namespace, data, path) -> None:
+    """One warning line on stderr naming the columns of ``path`` that ``data`` (measurements or
+    a calibration run) left out as not numbers, so that no column is dropped without a word."""
+    from ..core.csv_table import ignored_columns_words
+
+    if data.ignored_columns:
+        words = ignored_columns_words(data.ignored_columns)
+        print(f"turntable-pin {args.command}: warning: {path}: {words}", file=sys.stderr)
 
 
 def print_json(payload: dict) -> None:

@@ -27,6 +27,7 @@ from .common import (
     print_json,
     seed,
     table_from_args,
+    warn_ignored_columns,
 )
 
 __all__ = ["register"]
@@ -234,7 +235,9 @@ def _from_data(args: argparse.Namespace, table):
     from ..measurement.table import measured_table
 
     measured = measured_table(table)
-    return read_measurements(args.from_data, None if measured.paper else measured.joint_names)
+    data = read_measurements(args.from_data, None if measured.paper else measured.joint_names)
+    warn_ignored_columns(args, data, args.from_data)
+    return data
 
 
 def _finish(result, args: argparse.Namespace, write_plots=None) -> int:
@@ -378,6 +381,7 @@ def _run_separate_run(args: argparse.Namespace) -> int:
         raise InputError(f"--separate takes two effects, A,B; got '{args.separate}'")
     space = _space(args, effects=())
     run = read_run(args.run, deg_to_rad(args.latitude_deg), space.table)
+    warn_ignored_columns(args, run, args.run)
     user = [e for path in args.effects_module for e in load_effects_module(path, RunEffect)]
     result = design_run_separation(
         run, tuple(names), deg_to_rad(space.candidates_deg), args.positions_count,

@@ -28,6 +28,7 @@ from .common import (
     print_json,
     seed,
     table_from_args,
+    warn_ignored_columns,
 )
 
 __all__ = ["register"]
@@ -327,6 +328,7 @@ def _read(args: argparse.Namespace, table=None):
     """The measurements of ``args.data`` for ``table`` (angle columns ``phiK_deg`` or
     ``<joint>_deg`` of its joints; the paper's ``phi1_deg, phi2_deg`` when ``None``)."""
     data = read_measurements(args.data, _generic_joints(table))
+    warn_ignored_columns(args, data, args.data)
     return data.without_sigma() if args.ignore_sigma else data
 
 

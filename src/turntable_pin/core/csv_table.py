@@ -19,6 +19,8 @@ from .exceptions import InputError
 __all__ = [
     "CsvTable",
     "closest_column_hint",
+    "ignored_columns_words",
+    "missing_columns_words",
     "read_csv_table",
     "read_header",
     "refuse_repeated_rows",
@@ -35,8 +37,9 @@ class CsvTable:
         columns: ``{name: float array}`` of the required and the present optional columns.
         header: every column name of the file, in file order (unknown ones are kept, unused).
         rows: the spreadsheet row number of each data row (2 for the first).
-        extra: with ``extra=True``, the other columns whose every cell is a finite number.
-        skipped: with ``extra=True``, the other columns that are not (kept out, named here).
+        extra: with ``extra=True``, the other numeric columns (:func:`read_csv_table`).
+        skipped: with ``extra=True``, the other columns that are not numeric (text or empty
+            throughout): kept out, and named here so that the reader's caller can say so.
         header_row: the spreadsheet row of the header (1 unless ``#`` lines come before it).
     """
 
@@ -109,12 +112,15 @@ def read_csv_table(
         optional: column names that are read (and checked) when present.
         min_rows: fewest data rows accepted.
         blank: columns whose empty cells are read as NaN ("not measured") instead of refused.
-        extra: also read every other column whose cells are all finite numbers (into
-            :attr:`CsvTable.extra`); the others are named in :attr:`CsvTable.skipped`.
+        extra: also read every other column (into :attr:`CsvTable.extra`) that is numeric: at
+            least half of its filled cells are numbers (see :func:`_other_column`); every cell
+            of such a column must then be a finite number. The others (text or empty
+            throughout) are named in :attr:`CsvTable.skipped`.
 
     Raises:
         InputError: unreadable file, missing header, a missing column (with close matches named),
-            a duplicated column, a cell that is empty, not a number, NaN or infinite.
+            a duplicated column, a cell that is empty, not a number, NaN or infinite (in a
+            required, a present optional or, with ``extra``, a numeric other column).
     """
     path = Path(path)
     try:
@@ -186,14 +192,17 @@ def read_csv_table(
         )
     extra_columns, skipped = {}, []
     for name, cells in other_cells.items():
-        if isinstance(cells, np.ndarray):  # read whole: numbers; kept if all finite
-            column = cells if cells.size and np.all(np.isfinite(cells)) else None
-        else:
-            column = _numeric_column(cells)
-        if column is None:
+        if isinstance(cells, np.ndarray) and cells.size and np.all(np.isfinite(cells)):
+            extra_columns[name] = cells  # read whole: finite numbers throughout
+            continue
+        if isinstance(cells, np.ndarray):  # a NaN or inf: the cells as written, to name it
+            column = header.index(name)
+            cells = [row[column].strip() for row in csv.reader([line for _, line in lines[1:]])]
+        numbers = _other_column(path, name, cells, row_numbers)
+        if numbers is None:
             skipped.append(name)
         else:
-            extra_columns[name] = column
+            extra_columns[name] = numbers
     return CsvTable(
         path=path,
         columns={name: np.asarray(v, dtype=float) for name, v in values.items()},
@@ -280,13 +289,61 @@ def _cell_by_cell(path, lines, data_rows, header, index, others, blank_ok):
     return values, other_cells, row_numbers
 
 
-def _numeric_column(cells: Sequence[str]) -> np.ndarray | None:
-    """The cells as floats when every one is a finite number, else ``None``."""
-    try:
-        values = np.array([float(c) for c in cells], dtype=float)
-    except ValueError:
+def _other_column(path, name: str, cells: Sequence[str], rows: Sequence[int]) -> np.ndarray | None:
+    """A column other than the asked-for ones, as floats when it is numeric, ``None`` when it
+    is text (or empty throughout).
+
+    The rule: a column is numeric when at least half of its filled (non-empty) cells read as
+    numbers (Python's ``float``: ``nan`` and ``inf`` count as numbers here, and are refused
+    below). A numeric column is one the file means as numbers (``temperature_c`` with a cell
+    ``warm`` typed into it) and is then checked as a required one: the first cell that is empty,
+    not a number, NaN or infinite is refused naming file, row and column. A column of text with a
+    few numbers among it (a ``note`` column) stays text, and is left out.
+    """
+    numbers: list[float | None] = []
+    for text in cells:
+        try:
+            numbers.append(float(text))
+        except ValueError:
+            numbers.append(None)
+    filled = sum(1 for text in cells if text)
+    counted = sum(1 for number in numbers if number is not None)
+    if counted == 0 or 2 * counted < filled:
         return None
-    return values if values.size and np.all(np.isfinite(values)) else None
+    for text, number, row in zip(cells, numbers, rows, strict=True):
+        if number is not None and math.isfinite(number):
+            continue
+        why = f"{counted} of its {filled} filled cells are numbers, so it is a numeric column"
+        if number is not None:
+            found = f"expected a finite number, found '{text}'"
+        else:
+            found = (
+                f"'{text}' is not a number" if text else "expected a number, found an empty cell"
+            )
+        raise InputError(f"{found} ({why})", path=path, row=int(row), column=name)
+    return np.array(numbers, dtype=float)
+
+
+def ignored_columns_words(names: Sequence[str]) -> str:
+    """``"column(s) a, b ignored: not numbers (text or empty throughout)"``: what a reader
+    tells of the columns :attr:`CsvTable.skipped` names."""
+    return f"column(s) {', '.join(names)} ignored: not numbers (text or empty throughout)"
+
+
+def missing_columns_words(missing: Sequence[str], ignored: Sequence[str], where: str) -> str:
+    """Why the columns ``missing`` cannot be used, for ``"needs the column(s) <this>"``:
+    ``"a, absent from <where>"`` for those the file lacks, and ``"b, present in <where> but not
+    numbers (text or empty throughout), so ignored"`` for those among ``ignored`` (the file's
+    :attr:`CsvTable.skipped`): a column that is there is never called absent."""
+    absent = [c for c in missing if c not in ignored]
+    text = [c for c in missing if c in ignored]
+    parts = [f"{', '.join(absent)}, absent from {where}"] if absent else []
+    if text:
+        parts.append(
+            f"{', '.join(text)}, present in {where} but not numbers (text or empty "
+            "throughout), so ignored"
+        )
+    return "; ".join(parts)
 
 
 def refuse_repeated_rows(table: CsvTable, key_columns: Sequence[str], advice: str) -> None:

@@ -151,10 +151,11 @@ class RunFamily:
 
     # ---- what the diagnosis asks ------------------------------------------------------------
     def untestable_reason(self, effect: RunEffect) -> str | None:
-        """Why ``effect`` cannot be tested here (its columns are missing), or None."""
+        """Why ``effect`` cannot be tested here (its columns are missing, or not numbers), or
+        None."""
         missing = effect.missing_columns(self.run)
         if missing:
-            return f"needs the column(s) {', '.join(missing)}, absent from the run"
+            return f"needs the column(s) {self.run.missing_columns_words(missing)}"
         return None
 
     def effect(self, name: str) -> RunEffect:

@@ -54,7 +54,9 @@ def run_variables(run) -> PositionVariables:
     the run: the effects of one run share it)."""
     cached = run.__dict__.get("_variables")
     if cached is None:
-        cached = PositionVariables(run.joint_rad, run.time_s, (), dict(run.extra))
+        cached = PositionVariables(
+            run.joint_rad, run.time_s, (), dict(run.extra), ignored_columns=run.ignored_columns
+        )
         object.__setattr__(run, "_variables", cached)
     return cached
 

@@ -1,8 +1,12 @@
 """Orientation measurements: the CSV of ``docs/measurements.md``, read and validated.
 
 Required columns ``phi1_deg, phi2_deg, dpsi_arcsec, dtheta_arcsec, dgamma_arcsec``; optional
-``sigma_arcsec``, ``time_s``, ``dir1``, ``dir2``; other columns are ignored. Beyond the shared
-reader's checks (missing columns, non-numbers, NaN), a file is refused, naming row and column, when:
+``sigma_arcsec``, ``time_s``, ``dir1``, ``dir2``. Any other column is numeric when at least half
+of its filled cells are numbers: it is kept (:attr:`OrientationMeasurements.extra`, a suspect for
+the diagnosis) and every cell must be a finite number (a ``warm`` in a ``temperature_c`` column
+is refused naming row and column); a column of text (a ``note``) is left out and named in
+:attr:`OrientationMeasurements.ignored_columns`. Beyond the shared reader's checks (missing
+columns, non-numbers, NaN), a file is refused, naming row and column, when:
 
 - a value is outside its valid range: ``|phi1_deg|``, ``|phi2_deg|`` above
   :data:`MAX_COMMANDED_ANGLE_DEG`; ``|dpsi|, |dtheta|, |dgamma|`` above
@@ -103,6 +107,7 @@ class OrientationMeasurements:
         sigma_relative: ``sigma_rad`` gives only the relative noise of the angles (weights); the
             noise level itself is estimated from the fit (the diagnosis sets this when no sigma
             is given and the three angles' noise differ).
+        ignored_columns: the file's columns left out as not numbers (text or empty throughout).
     """
 
     joint_rad: np.ndarray
@@ -115,6 +120,7 @@ class OrientationMeasurements:
     source: str = ""
     joint_names: tuple[str, ...] = ()
     sigma_relative: bool = False
+    ignored_columns: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         joints = np.array(self.joint_rad, dtype=float)
@@ -146,6 +152,7 @@ class OrientationMeasurements:
         rows = np.arange(2, n + 2) if self.rows is None else np.reshape(self.rows, -1)
         object.__setattr__(self, "rows", _frozen(rows, int))
         object.__setattr__(self, "joint_names", tuple(self.joint_names))
+        object.__setattr__(self, "ignored_columns", tuple(self.ignored_columns))
         self._check_values()
 
     def _check_values(self) -> None:
@@ -243,6 +250,7 @@ class OrientationMeasurements:
                 self.dirs,
                 dict(self.extra),
                 boresight_only=measured[:, 0] & ~measured[:, 2],
+                ignored_columns=self.ignored_columns,
             )
             self.__dict__[_VARIABLES] = weakref.ref(cached)
         return cached
@@ -429,4 +437,5 @@ def read_measurements(
         rows=rows,
         source=str(table.path),
         joint_names=tuple(joint_names or ()),
+        ignored_columns=table.skipped,
     )

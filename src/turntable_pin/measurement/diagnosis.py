@@ -220,10 +220,12 @@ class OrientationFamily:
         return self._zero
 
     def untestable_reason(self, effect: Effect) -> str | None:
-        """Why ``effect`` cannot be tested here (its data columns are missing), or None."""
-        missing = effect.missing_columns(self.data.variables())
+        """Why ``effect`` cannot be tested here (its data columns are missing, or not numbers),
+        or None."""
+        variables = self.data.variables()
+        missing = effect.missing_columns(variables)
         if missing:
-            return f"needs the column(s) {', '.join(missing)}, absent from the data"
+            return f"needs the column(s) {variables.missing_columns_words(missing)}"
         return None
 
     def effect(self, name: str) -> Effect:

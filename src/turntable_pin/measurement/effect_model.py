@@ -197,8 +197,8 @@ class OrientationModel:
             missing = effect.missing_columns(variables)
             if missing:
                 raise InputError(
-                    f"effect '{effect.name}' needs the column(s) {', '.join(missing)}, "
-                    "which the data do not have"
+                    f"effect '{effect.name}' needs the column(s) "
+                    f"{variables.missing_columns_words(missing)}"
                 )
             for spec in effect.parameters(variables):
                 specs.append(spec)

@@ -137,7 +137,9 @@ class EffectTerm:
             return a + b if pair[2] == "+" else a - b
         values = variables.column(v)
         if values is None:
-            raise InputError(f"term '{self.spec()}' needs the column {v}, absent from the data")
+            raise InputError(
+                f"term '{self.spec()}' needs the column {variables.missing_columns_words([v])}"
+            )
         return np.asarray(values, dtype=float)
 
     def chain_term(self, variables: PositionVariables) -> ChainTerm:

@@ -19,12 +19,13 @@ factors of the chain and differentiates them analytically.
 from __future__ import annotations
 
 import weakref
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
 
+from ...core.csv_table import missing_columns_words
 from ...core.units import ARCSEC_PER_RAD
 
 __all__ = [
@@ -102,6 +103,8 @@ class PositionVariables:
             the direction of the x axis (a star's, an autocollimator's mirror normal), not a
             whole rotation, so its ``dpsi`` is compared without the twist about x: ``dR``'s
             swing, whose entry (0, 2) is ``-dR[2, 0]`` (``docs/measurements.md``, section 1).
+        ignored_columns: columns of the data file left out as not numbers (text or empty
+            throughout): present, so an effect that needs one is told so, not that it is absent.
     """
 
     joint_rad: np.ndarray
@@ -109,6 +112,7 @@ class PositionVariables:
     dirs: tuple[np.ndarray | None, ...] = ()
     extra: Mapping[str, np.ndarray] = field(default_factory=dict)
     boresight_only: np.ndarray | None = None
+    ignored_columns: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         joints = np.asarray(self.joint_rad, dtype=float)  # no copy of read-only data arrays
@@ -209,6 +213,11 @@ class PositionVariables:
     def has(self, column: str) -> bool:
         """Whether the data column ``column`` (``time_s``, ``dirK``, an extra one) is present."""
         return self.column(column) is not None
+
+    def missing_columns_words(self, missing: Sequence[str]) -> str:
+        """Why the columns ``missing`` cannot be used: absent from the data, or present but not
+        numbers (:func:`~turntable_pin.core.csv_table.missing_columns_words`)."""
+        return missing_columns_words(missing, self.ignored_columns, "the data")
 
 
 def harmonic_weights(angle_rad: np.ndarray, prefix: str = "") -> dict[str, np.ndarray]:
