@@ -227,3 +227,27 @@ def test_bad_noise_and_positions_for_the_table():
         simulate_measurements(schedule=Schedule(positions=((0, 0, 0),)))
     with pytest.raises(InputError, match="no axis phi3"):
         simulate_measurements(schedule=Schedule(sweep=("phi3",)))
+
+
+def test_angles_not_measured_are_empty_and_a_row_without_roll_sees_the_boresight():
+    from conftest import REPO_DIR
+    from turntable_pin.measurement.effects.base import PositionVariables
+    from turntable_pin.measurement.fit import fit_orientation
+    from turntable_pin.model.generic_table import GenericTable
+
+    table = GenericTable(REPO_DIR / "models" / "german_equatorial_mount.urdf")
+    errors = np.zeros(len(table.parameter_names))
+    for name, value_deg in (("hour_angle.position", 5.7), ("tube_mount.rot_z", 0.3)):
+        errors[table.parameter_names.index(name)] = np.radians(value_deg)
+    sim = simulate_measurements(errors, turntable=table, seed=4, not_measured=("dgamma",))
+    data = sim.data
+    assert np.isnan(data.angles_rad[:, 2]).all() and not np.isnan(data.angles_rad[:, :2]).any()
+    whole = OrientationModel(PositionVariables(data.joint_rad), (), table)
+    values = {"hour_angle.position": np.radians(5.7), "tube_mount.rot_z": np.radians(0.3)}
+    d_r = whole.rotation_error(whole.parameter_vector(values))
+    residual = (data.angles_rad[:, 0] + d_r[:, 2, 0]) * 206264.806  # noise of 1 arcsec
+    assert np.sqrt(np.mean(residual**2)) < 1.3
+    assert np.sqrt(np.mean((data.angles_rad[:, 0] - d_r[:, 0, 2]) ** 2)) * 206264.806 > 10.0
+    assert fit_orientation(data, turntable=table).result.chi2_reduced < 1.3
+    with pytest.raises(InputError, match="at least one measured angle"):
+        simulate_measurements(seed=1, not_measured=("dpsi", "dtheta", "dgamma"))

@@ -77,6 +77,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="uneven noise: each row's sigma drawn log-uniform in [sigma/F, sigma*F] (seeded)",
     )
     s.add_argument("--seed", type=seed, default=0, help="random seed (recorded in the file)")
+    s.add_argument(
+        "--not-measured",
+        type=_angle_list,
+        default=(),
+        metavar="A,B",
+        help="angles left empty at every position (dpsi, dtheta, dgamma; default: none): "
+        "'dgamma' makes a pointing run, whose dpsi is then the boresight's own component",
+    )
     s.add_argument("--phi1-step-deg", type=step, default=30.0)
     s.add_argument("--phi2-step-deg", type=step, default=30.0)
     s.add_argument("--phi3-step-deg", type=step, default=30.0, help="third axis (3-axis tables)")
@@ -526,10 +534,22 @@ def _run_simulate_orientation(args: argparse.Namespace) -> int:
         turntable=table,
         catalogue=user,
         noise_spread=args.noise_spread,
+        not_measured=args.not_measured,
     )
     path = sim.write_csv(args.output, with_sigma=not args.no_sigma, hide_truth=args.hide_truth)
     print(f"wrote {path}: {sim.data.n_positions} positions, seed {sim.seed}")
     return 0
+
+
+def _angle_list(text: str) -> tuple[str, ...]:
+    """``dgamma`` or ``dpsi,dgamma``: measured angles by name (argparse type)."""
+    names = tuple(a.strip() for a in text.split(",") if a.strip())
+    unknown = [a for a in names if a not in ANGLE_NAMES]
+    if unknown or not names:
+        raise argparse.ArgumentTypeError(
+            f"'{text}': expected angles among {', '.join(ANGLE_NAMES)}, comma-separated"
+        )
+    return names
 
 
 def _fit_line(label: str, summary: dict) -> str:

@@ -19,6 +19,7 @@ from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows, 
 from ..core.exceptions import InputError, check_seed
 from ..core.sizes import MAX_SIMULATED_ROWS, check_count, turn_grid_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
+from ..model.angles import ANGLE_NAMES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors
 from ..model.paper_table import paper_table
 from .catalogue import resolve_effect
@@ -457,6 +458,19 @@ class SimulatedMeasurements:
         return write_csv_table(path, columns, comment=self.comment(hide_truth=hide_truth))
 
 
+def _angle_names(names: Sequence[str]) -> tuple[str, ...]:
+    """``names`` checked to be measured angles, leaving at least one measured."""
+    names = tuple(dict.fromkeys(names))
+    unknown = [a for a in names if a not in ANGLE_NAMES]
+    if unknown:
+        raise InputError(
+            f"not_measured: unknown angle '{unknown[0]}'; the angles: {', '.join(ANGLE_NAMES)}"
+        )
+    if len(names) == len(ANGLE_NAMES):
+        raise InputError("not_measured: a row needs at least one measured angle")
+    return names
+
+
 def simulate_measurements(
     errors: TurntableErrors | np.ndarray | None = None,
     effects: Mapping[str, Mapping[str, float]] | None = None,
@@ -467,6 +481,7 @@ def simulate_measurements(
     turntable=None,
     catalogue: Sequence[Effect] = (),
     noise_spread: float = 1.0,
+    not_measured: Sequence[str] = (),
 ) -> SimulatedMeasurements:
     """Simulate a measurement run.
 
@@ -484,6 +499,11 @@ def simulate_measurements(
             every sigma stays within the noise range. 1 (the default): even noise.
         seed: seed of every random choice (order, directions, noise): a whole number
             0 <= seed < 2**63.
+
+        not_measured: angles left empty at every position (``dgamma`` for a pointing run or an
+            autocollimator's two tilts). Without ``dgamma`` a row measures the direction of the
+            payload's x axis, and its ``dpsi`` is that direction's own component (``-dR[2,0]``,
+            docs/measurements.md section 1), as a real run of that kind measures it.
 
     Every effect needs at least one parameter, each within +-18000 (the small-error limit
     ``MAX_ANGULAR_ERROR_DEG`` in arcsec) in its user unit; the run may last at most
@@ -555,10 +575,12 @@ def simulate_measurements(
             f"dwell_s {schedule.dwell_s:g}: the run of {n} measurements would last "
             f"{schedule.duration_s(n_joints):.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
         )
+    blank = [ANGLE_NAMES.index(a) for a in _angle_names(not_measured)]
     variables = PositionVariables(
         np.stack(angles_deg, axis=1) / DEG_PER_RAD,
         time_s=schedule.times_s(n),
         dirs=tuple(schedule.directions(a, rng, k) for k, a in enumerate(angles_deg, start=1)),
+        boresight_only=np.full(n, 2 in blank and 0 not in blank),
     )
     effect_objects = [resolve_effect(name, table, catalogue) for name in effects]
     effects = {e.name: effects[name] for e, name in zip(effect_objects, effects, strict=True)}
@@ -588,7 +610,8 @@ def simulate_measurements(
         sigma_rad = np.broadcast_to(sigma_rad, (n, noise.size)).copy()
         if noise.size == 1:
             sigma_rad = sigma_rad[:, 0]
-    largest = float(np.max(np.abs(measured))) * ARCSEC_PER_RAD
+    measured[:, blank] = np.nan
+    largest = float(np.nanmax(np.abs(measured))) * ARCSEC_PER_RAD
     if not largest <= limit:
         raise InputError(
             f"the simulated orientation errors reach {largest:g} arcsec, beyond the +-{limit:g} "
