@@ -138,3 +138,16 @@ def test_import_tpoint_loads_no_fitting_or_plotting_library(tmp_path):
     argv = ["import-tpoint", str(MMT), "-o", str(tmp_path / "mmt.csv")]
     assert _heavy_modules_loaded_by(argv, heavy) == []
     assert (tmp_path / "mmt.csv").is_file()
+
+
+def test_a_repeated_star_is_refused_at_import_naming_both_lines(tmp_path):
+    """Issue 27: a copied line was imported, and fit and diagnose then refused the CSV naming
+    its rows; the import now refuses it naming the lines of the TPOINT file."""
+    lines = MMT.read_text().splitlines()
+    assert lines[20].split() == "192.3860283 77.3468410111111 -167.2778909 77.3475476".split()
+    lines.insert(76, lines[20])  # line 77 repeats line 21
+    run = write_file(tmp_path, "\n".join(lines) + "\n", "repeated.dat")
+    out = tmp_path / "repeated.csv"
+    proc = cli("import-tpoint", str(run), "-o", str(out))
+    _one_line_exit_2(proc, "lines 21 and 77 are the same star at the same raw position")
+    assert not out.exists()

@@ -348,7 +348,12 @@ BAD = {
     "far apart": (HEADER + "10 20 60 20\n", "line 5: the observed and raw positions are"),
     "elevation": (HEADER + "10 95 10 20\n", "line 5: observed elevation 95"),
     "option late": (HEADER + "1 2 1 2\n: NODA\n", "line 6: option line"),
-}
+    # issue 27: the CSV would hold one position twice, which fit and diagnose refuse
+    "copied line": (HEADER + "1 2 1.01 2\n3 4 3 4\n1 2 1.01 2\n",
+                    "lines 5 and 7 are the same star at the same raw position"),
+    "same raw position": (HEADER + "1 2 1.01 2\n3 4 3 4\n1.02 2 1.01 2\n",
+                          "lines 5 and 7 have the same raw position (azimuth, elevation)"),
+}  # fmt: skip
 
 
 @pytest.mark.parametrize("case", sorted(BAD))
@@ -359,6 +364,20 @@ def test_bad_files_are_refused_naming_the_line(case, tmp_path):
         convert_tpoint(read_tpoint(path))
     assert fragment in str(info.value) and str(path) in str(info.value)
     assert "\n" not in str(info.value)
+
+
+def test_repeated_raw_positions_are_refused_by_the_rule_the_measurement_reader_applies(tmp_path):
+    """The import compares raw positions as the reader compares the CSV's phi columns (to
+    1e-9 deg): what it writes, fit and diagnose read; what it refuses, they would refuse."""
+    for delta, refused in ((4e-10, True), (2e-9, False)):
+        text = HEADER + f"1 2 1.01 2\n3 4 3 4\n1 2 {1.01 + delta!r} 2\n"
+        run = read_tpoint(write_file(tmp_path, text, "run.dat"))
+        if refused:
+            with pytest.raises(InputError, match="lines 5 and 7 are the same star"):
+                convert_tpoint(run)
+            continue
+        out = convert_tpoint(run).write_csv(tmp_path / "run.csv")
+        assert read_measurements(out, ("azimuth", "elevation")).n_positions == 3
 
 
 def test_mount_option_contradicting_the_file_and_refraction_without_weather(tmp_path):

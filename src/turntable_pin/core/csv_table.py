@@ -19,6 +19,7 @@ from .exceptions import InputError
 __all__ = [
     "CsvTable",
     "closest_column_hint",
+    "first_repeated_row",
     "ignored_columns_words",
     "missing_columns_words",
     "read_csv_table",
@@ -353,22 +354,34 @@ def refuse_repeated_rows(table: CsvTable, key_columns: Sequence[str], advice: st
     the columns compared, then ``advice`` (what makes repeats legitimate).
     """
     present = [c for c in key_columns if table.has(c)]
-    if present and len(table) > 1:
-        keys = np.stack([_rounded_9(table[c]) for c in present], axis=1)
+    found = first_repeated_row([table[c] for c in present], len(table))
+    if found is not None:
+        first, second = found
+        raise InputError(
+            f"the same position as row {int(table.rows[first])} ({', '.join(present)} all "
+            f"equal); {advice}",
+            path=table.path, row=int(table.rows[second]), column=present[0] if present else None,
+        )  # fmt: skip
+
+
+def first_repeated_row(columns: Sequence[np.ndarray], n_rows: int) -> tuple[int, int] | None:
+    """The first row equal to an earlier one in every column of ``columns``, each value rounded
+    to 1e-9 as Python's ``round`` does (so ``-0.0`` and ``0.0`` are equal), as the indices
+    ``(earlier, row)``; ``None`` when no row repeats. The rule of :func:`refuse_repeated_rows`,
+    for readers that name their own lines (a TPOINT file's)."""
+    if columns and n_rows > 1:
+        keys = np.stack([_rounded_9(np.asarray(c, dtype=float)) for c in columns], axis=1)
         ordered = keys[np.lexsort(keys.T)]
         if not np.any(np.all(ordered[1:] == ordered[:-1], axis=1)):
-            return
-    rounded = [[round(v, 9) for v in table[c].tolist()] for c in present]
-    keys = list(zip(*rounded, strict=True)) if present else [()] * len(table)
+            return None
+    rounded = [[round(v, 9) for v in np.asarray(c, dtype=float).tolist()] for c in columns]
+    keys = list(zip(*rounded, strict=True)) if columns else [()] * n_rows
     seen: dict[tuple, int] = {}
     for i, key in enumerate(keys):
-        row = int(table.rows[i])
         if key in seen:
-            raise InputError(
-                f"the same position as row {seen[key]} ({', '.join(present)} all equal); {advice}",
-                path=table.path, row=row, column=present[0],
-            )  # fmt: skip
-        seen[key] = row
+            return seen[key], i
+        seen[key] = i
+    return None
 
 
 def _rounded_9(values: np.ndarray) -> np.ndarray:

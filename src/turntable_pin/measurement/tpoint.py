@@ -58,6 +58,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.csv_table import first_repeated_row
 from ..core.exceptions import InputError
 from ..core.files import read_text_file, write_text_atomic
 from ..core.units import ARCSEC_PER_RAD
@@ -79,6 +80,7 @@ __all__ = [
     "far_side_rows",
     "mount_urdf_text",
     "read_tpoint",
+    "refuse_repeated_positions",
     "saemundsson_refraction_arcsec",
 ]
 
@@ -626,6 +628,41 @@ def _angles_pointing_at(placements, target: np.ndarray, start_rad: np.ndarray) -
 
 
 # --- conversion -------------------------------------------------------------------------------
+def refuse_repeated_positions(run: TpointRun) -> None:
+    """Refuse two records of ``run`` at the same raw position, naming both lines of the file.
+
+    The rows of the measurement CSV are the raw positions (``phi1_deg, phi2_deg``), and its
+    reader refuses two rows at one position (to 1e-9 deg) unless they differ in ``time_s`` or
+    approach direction (:func:`~turntable_pin.core.csv_table.refuse_repeated_rows`), which a
+    TPOINT run does not record: the rule is applied here, with the same comparison, so that the
+    import never writes a file that ``fit`` and ``diagnose`` refuse. A copied line (the same star
+    at the same raw position) and two pointings that read the same encoder position are told
+    apart in the message.
+    """
+    found = first_repeated_row(list(run.raw_deg.T), run.n_stars)
+    if found is None:
+        return
+    i, j = found
+    first, second = run.lines[i], run.lines[j]
+    axes = "azimuth, elevation" if run.mount == ALTAZ else "hour angle, declination"
+    same_star = first_repeated_row(list(run.observed_deg[[i, j]].T), 2) is not None
+    if same_star:
+        what = (
+            f"lines {first} and {second} are the same star at the same raw position: a copied "
+            "line counts one pointing twice"
+        )
+    else:
+        what = (
+            f"lines {first} and {second} have the same raw position ({axes}) and different "
+            "observed positions"
+        )
+    raise InputError(
+        f"{what}; the measurement CSV holds one row per position (repeats there must differ in "
+        "time_s or approach direction, which a TPOINT file does not record): keep one of them",
+        path=run.path,
+    )
+
+
 def far_side_rows(run: TpointRun) -> np.ndarray:
     """(N,) True where an equatorial run's raw declination is beyond +-90 deg: the tube was on
     the far side of the pier (the mount turned past the pole); always False for alt-az runs."""
@@ -663,14 +700,16 @@ def convert_tpoint(
         latitude_deg: the polar axis' latitude of an equatorial run (default: the file's).
 
     Raises:
-        InputError: refraction requested without temperature and pressure, or at an observed
-            elevation below 0 deg; an observed/raw pair farther apart on the sky than a
+        InputError: two records at the same raw position (:func:`refuse_repeated_positions`,
+            naming both lines); refraction requested without temperature and pressure, or at an
+            observed elevation below 0 deg; an observed/raw pair farther apart on the sky than a
             measurement file may hold (``MAX_MEASURED_ANGLE_ARCSEC``: not a pointing error),
             naming the line.
     """
     from ..model.chain import compose_rotation
     from ..model.generic_table import GenericTable
 
+    refuse_repeated_positions(run)
     if refraction is None:
         refraction = "none" if run.mount == ALTAZ else "apply"
     if refraction not in REFRACTION_MODES:
