@@ -95,9 +95,9 @@ def test_positions_from_csv_and_distinct_count(tmp_path):
 @pytest.mark.parametrize(
     "spec, fragment",
     [
-        ("grid:0", "grid step must be in (0, 360]"),
+        ("grid:0", "grid step must be in [1e-06, 360]"),
         ("grid:abc", "expected grid:STEP"),
-        ("grid:500", "grid step must be in (0, 360]"),
+        ("grid:500", "grid step must be in [1e-06, 360]"),
         ("nothing.csv", "neither a scheme (grid:STEP) nor an existing CSV file"),
         ("grid:30x30x30", "3 steps for the paper's table of 2 joints"),
         ("grid:30x", "expected grid:STEP"),
@@ -223,7 +223,7 @@ def test_a_grid_covers_every_joint(urdf, spec, count):
 
 @pytest.mark.parametrize("spec, fragment", [
     ("grid:30x30", "2 steps for a table of 3 joints"),
-    ("grid:0", "grid step must be in (0, 360]"),
+    ("grid:0", "grid step must be in [1e-06, 360]"),
     ("grid:1", "positions"),
     ("grid:a", "expected grid:STEP"),
     ("nowhere.csv", "neither a scheme"),

@@ -89,7 +89,7 @@ def test_calibrate_bad_runs_exit_2(tmp_path, content, fragment):
 @pytest.mark.parametrize(
     "args, fragment",
     [
-        (["rate-error", "--positions", "grid:0"], "grid step must be in (0, 360]"),
+        (["rate-error", "--positions", "grid:0"], "grid step must be in [1e-06, 360]"),
         (["rate-error", "--dpsi-deg", "nan"], "--dpsi-deg: expected a finite number"),
         (["requirement", "--accuracy-dph", "0"], "expected a number > 0"),
         (["requirement", "--positions", "grid:90", "--definition", "calibrated_coefficients"],

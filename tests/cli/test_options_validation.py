@@ -45,7 +45,7 @@ def _refused(proc, line: str):
         (["montecarlo", "--limits-arcmin", "1", "-n", "10", "--scale-bounds", "1e308"],
          "--scale-bounds 1e+308: the scaled bounds reach"),
         (["montecarlo", "--limits-arcmin", "1", "-n", "10", "--phi2-step-deg", "0"],
-         "argument --phi2-step-deg: expected a number in (0, 90] deg"),
+         "argument --phi2-step-deg: expected a number in [1e-06, 90] deg"),
         (["orientation", "--phi1-deg", "1e308"],
          "argument --phi1-deg: expected a number in [-3600, 3600] deg (ten turns)"),
         (["orientation", "--error", "dphi_y1=1e308"],

@@ -34,12 +34,17 @@ from ..core.blas_threads import blas_thread_controls, one_blas_thread
 from ..core.exceptions import InputError, check_seed
 from ..core.interrupts import deferred, register_cleanup, signals_blocked, worker_initializer
 from ..core.progress import Progress
-from ..core.sizes import MAX_MONTE_CARLO_TURNTABLES, check_count, turn_grid_count
+from ..core.sizes import (
+    MAX_MONTE_CARLO_TURNTABLES,
+    MIN_GRID_STEP_DEG,
+    check_count,
+    turn_grid_count,
+)
 from ..core.units import DEG_PER_RAD, arcmin_by_name
 from ..model.batch_field import ChainExpansion, joint_dependence, max_abs_on_grid
 from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES
 from ..model.paper_table import paper_table
-from .sensitivity import default_grid_step_deg, grid_angles_rad
+from .sensitivity import MAX_GRID_POINTS, default_grid_step_deg, grid_angles_rad
 from .solver import ORIENTATION_ANGLES, OrientationLimits
 
 __all__ = [
@@ -346,11 +351,16 @@ def run_chain_monte_carlo(
     check_count(n, MAX_MONTE_CARLO_TURNTABLES, "random turntables", TURNTABLE_BYTES)
     seed = check_seed(seed)
     steps = tuple(float(step) for step in grid_steps_deg)
-    if len(steps) != len(chain.joint_names) or not all(0.0 < s <= 90.0 for s in steps):
+    if len(steps) != len(chain.joint_names) or not all(
+        MIN_GRID_STEP_DEG <= s <= 90.0 for s in steps
+    ):
         raise InputError(
-            f"expected a grid step in (0, 90] degrees for each of {', '.join(chain.joint_names)}"
-            f", got {steps}"
+            f"expected a grid step in [{MIN_GRID_STEP_DEG:g}, 90] degrees for each of "
+            f"{', '.join(chain.joint_names)}, got {steps}"
         )
+    for joint, step in zip(chain.joint_names, steps, strict=True):
+        check_count(turn_grid_count(step), MAX_GRID_POINTS,
+                    f"grid angles of {joint} (a {step:g}-degree step)")  # fmt: skip
     expansion = ChainExpansion(chain)
     grids = [np.arange(turn_grid_count(step)) * step / DEG_PER_RAD for step in steps]
     sizes = [chunk_size] * (n // chunk_size) + ([n % chunk_size] if n % chunk_size else [])
@@ -416,8 +426,10 @@ def run_monte_carlo(
         urdf_path: nominal URDF (default bundled).
     """
     for name, step in (("phi2", phi2_step_deg), ("phi1", phi1_step_deg)):
-        if not 0.0 < step <= 90.0:
-            raise InputError(f"{name} grid step must be in (0, 90] degrees, got {step}")
+        if not MIN_GRID_STEP_DEG <= step <= 90.0:
+            raise InputError(
+                f"{name} grid step must be in [{MIN_GRID_STEP_DEG:g}, 90] degrees, got {step}"
+            )
     result = run_chain_monte_carlo(
         paper_table(urdf_path).chain,
         ANGULAR_ERROR_NAMES,

@@ -26,6 +26,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..core.exceptions import InputError
+from ..core.sizes import MIN_GRID_STEP_DEG, turn_grid_count
 from ..core.units import DEG_PER_RAD
 from ..model.angles import ANGLE_NAMES
 
@@ -86,8 +87,10 @@ def default_grid_step_deg(table) -> float:
 
 def _step(table, step_deg) -> float:
     step = default_grid_step_deg(table) if step_deg is None else float(step_deg)
-    if not (math.isfinite(step) and 0.0 < step <= 90.0):
-        raise InputError(f"the grid step must be in (0, 90] degrees, got {step_deg!r}")
+    if not (math.isfinite(step) and MIN_GRID_STEP_DEG <= step <= 90.0):
+        raise InputError(
+            f"the grid step must be in [{MIN_GRID_STEP_DEG:g}, 90] degrees, got {step_deg!r}"
+        )
     return step
 
 
@@ -105,16 +108,22 @@ def grid_axes_rad(table, step_deg: float | None = None, domain_rad=None) -> tupl
     default full turns); a joint the first-order model does not depend on: ``lo`` only."""
     step = _step(table, step_deg)
     domain = domain_rad or (FULL_TURN_RAD,) * len(table.joint_names)
-    axes = []
+    kinds = []  # (lo, hi, full turn or not, count) of each joint; counted before any is made
     for (lo, hi), moving in zip(domain, moving_joints(table), strict=True):
         if not moving:
-            axes.append(np.array([lo]))
+            kinds.append((lo, hi, False, 1))
         elif hi - lo >= 2.0 * math.pi * (1.0 - 1e-12):
-            axes.append(lo + np.arange(0.0, 360.0 - 1e-9, step) / DEG_PER_RAD)
+            kinds.append((lo, hi, True, turn_grid_count(step)))
         else:
             count = max(2, math.ceil((hi - lo) * DEG_PER_RAD / step - 1e-9) + 1)
-            axes.append(np.linspace(lo, hi, count))
-    _check_count(math.prod(a.size for a in axes), step, sum(moving_joints(table)))
+            kinds.append((lo, hi, False, count))
+    _check_count(math.prod(k[3] for k in kinds), step, sum(moving_joints(table)))
+    axes = []
+    for lo, hi, full, count in kinds:
+        if full:
+            axes.append(lo + np.arange(0.0, 360.0 - 1e-9, step) / DEG_PER_RAD)
+        else:
+            axes.append(np.array([lo]) if count == 1 else np.linspace(lo, hi, count))
     return tuple(axes)
 
 
@@ -122,8 +131,9 @@ def grid_angles_rad(table, step_deg: float | None = None) -> list[np.ndarray]:
     """A full grid over every joint, ``0, step, ... < 360`` degrees each: one flat array of
     radians per joint (chain order), every combination."""
     step = _step(table, step_deg)
+    joints = len(table.joint_names)
+    _check_count(turn_grid_count(step) ** joints, step, joints)  # before the angles are made
     axis = np.arange(0.0, 360.0 - 1e-9, step) / DEG_PER_RAD
-    _check_count(axis.size ** len(table.joint_names), step, len(table.joint_names))
     mesh = np.meshgrid(*([axis] * len(table.joint_names)), indexing="ij")
     return [m.ravel() for m in mesh]
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..core.csv_table import CsvTable, closest_column_hint, read_csv_table
 from ..core.exceptions import InputError
-from ..core.sizes import MAX_POSITIONS, check_count, turn_grid_count
+from ..core.sizes import MAX_POSITIONS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
 from ..core.units import deg_to_rad, rad_to_deg
 from ..model.paper_table import is_paper_table, paper_table
 from .site import DEFAULT_LATITUDE_DEG, MAX_LATITUDE_DEG  # noqa: F401  (re-exported)
@@ -91,11 +91,14 @@ def grid_angles_deg(steps_deg: Sequence[float]) -> tuple[np.ndarray, str]:
     (the last joint varies fastest) and the grid's name (``grid:30``, ``grid:30x45``).
 
     Raises:
-        InputError: a step outside (0, 360], or more positions than ``MAX_POSITIONS``.
+        InputError: a step outside [``MIN_GRID_STEP_DEG``, 360], or more positions than
+            ``MAX_POSITIONS``.
     """
     for step in steps_deg:
-        if not (np.isfinite(step) and 0 < step <= 360):
-            raise InputError(f"grid step must be in (0, 360] degrees, got {step!r}")
+        if not (np.isfinite(step) and MIN_GRID_STEP_DEG <= step <= 360):
+            raise InputError(
+                f"grid step must be in [{MIN_GRID_STEP_DEG:g}, 360] degrees, got {step!r}"
+            )
     same = all(s == steps_deg[0] for s in steps_deg)
     name = f"grid:{steps_deg[0]:g}" if same else "grid:" + "x".join(f"{s:g}" for s in steps_deg)
     count = 1.0
@@ -234,7 +237,12 @@ class PositionSet:
         text = str(spec).strip()
         steps = grid_steps(text)
         if steps is not None:
-            return cls.grid(*steps, table=table)
+            try:
+                return cls.grid(*steps, table=table)
+            except InputError as exc:
+                if "grid:" in exc.detail:  # it names the spec already
+                    raise
+                raise InputError(f"positions '{text}': {exc.detail}") from None
         path = Path(text)
         if not path.exists():
             raise InputError(

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..core.csv_table import missing_columns_words, read_csv_table, refuse_repeated_rows
 from ..core.exceptions import InputError
+from ..core.sizes import MAX_TIME_S
 from ..model.paper_table import paper_table
 from .positions import PositionInputs, PositionSet, position_inputs
 
@@ -176,3 +177,8 @@ def _check_run_values(table) -> None:
         )
     if table.has("time_s"):
         table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
+        table.refuse(
+            "time_s",
+            table["time_s"] > MAX_TIME_S,
+            f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
+        )

@@ -20,6 +20,7 @@ from ..allocation.solver import (
 )
 from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.exceptions import InfeasibleError, InputError
+from ..core.sizes import MIN_GRID_STEP_DEG
 from ..core.units import ARCMIN_PER_RAD, DEG_PER_RAD
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from .common import (
@@ -133,7 +134,7 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
     add_table_options(p)
     p.add_argument(
         "--grid-step-deg",
-        type=bounded_float(0.0, 90.0, "deg", low_open=True),
+        type=bounded_float(MIN_GRID_STEP_DEG, 90.0, "deg"),
         default=None,
         help="a table given by --urdf: step of the grid over every joint on which the "
         "sensitivities are averaged, the maxima of the constraints start (they hold between the "
@@ -168,7 +169,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     m.add_argument("--seed", type=seed, default=0, help="random seed, recorded in the output (0)")
     m.add_argument(
         "--phi2-step-deg",
-        type=bounded_float(0.0, 90.0, "deg", low_open=True),
+        type=bounded_float(MIN_GRID_STEP_DEG, 90.0, "deg"),
         default=None,
         help="phi2 grid step, degrees (1; the paper's table: --grid-step-deg for any other)",
     )

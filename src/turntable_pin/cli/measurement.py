@@ -7,6 +7,7 @@ import shlex
 from pathlib import Path
 
 from ..core.exceptions import InputError
+from ..core.sizes import MIN_GRID_STEP_DEG
 from ..measurement.data import MAX_TIME_S, MIN_SIGMA_ARCSEC, read_measurements
 from ..measurement.effects import EFFECT_NAMES, parse_effect_spec
 from ..model.angles import ANGLE_NAMES
@@ -61,7 +62,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "e.g. inner_encoder_harmonics:c1=3,s2=-2; repeatable",
     )
     _add_catalogue_option(s)
-    step = bounded_float(0.0, 360.0, "deg", low_open=True)
+    step = bounded_float(
+        MIN_GRID_STEP_DEG, 360.0, "deg", why="a finer grid exceeds every size limit"
+    )
     start = bounded_float(-3240.0, 3240.0, "deg")
     s.add_argument(
         "--noise-arcsec",

@@ -20,6 +20,8 @@ __all__ = [
     "MAX_MONTE_CARLO_TURNTABLES",
     "MAX_POSITIONS",
     "MAX_SIMULATED_ROWS",
+    "MAX_TIME_S",
+    "MIN_GRID_STEP_DEG",
     "check_count",
     "turn_grid_count",
 ]
@@ -29,6 +31,15 @@ MAX_POSITIONS = 200_000
 
 MAX_SIMULATED_ROWS = 1_000_000
 """Most rows ``simulate`` writes (about 100 MB of CSV)."""
+
+MAX_TIME_S = 366 * 86400.0
+"""Largest ``time_s`` of a measurement file and of a calibration run, seconds (a year): a longer
+run is a unit mix-up (ms written as s), and a time of 1e308 s would overflow the fits' squares."""
+
+MIN_GRID_STEP_DEG = 1e-6
+"""Smallest step of a grid over a turn, degrees (3.6e8 angles a turn, beyond every size limit
+here): a finer step is a typo, and the count ``360 / step`` of a step of 1e-320 is not even a
+number."""
 
 MAX_MONTE_CARLO_TURNTABLES = 10_000_000
 """Most random turntables of one Monte Carlo run (240 MB of per-turntable maxima)."""
@@ -53,8 +64,18 @@ inner_encoder_harmonics --json`` peaked at 292 MB on 100,000 rows (2.9 KB a row,
 
 
 def turn_grid_count(step_deg: float) -> int:
-    """Number of grid angles ``0, step, ... < 360`` degrees (the grids of the package)."""
-    return math.ceil((360.0 - 1e-9) / float(step_deg))
+    """Number of grid angles ``0, step, ... < 360`` degrees (the grids of the package).
+
+    Raises:
+        InputError: a step that is not a number of at least :data:`MIN_GRID_STEP_DEG`.
+    """
+    step = float(step_deg)
+    if not (math.isfinite(step) and step >= MIN_GRID_STEP_DEG):
+        raise InputError(
+            f"a grid step must be at least {MIN_GRID_STEP_DEG:g} deg (a finer grid exceeds every "
+            f"size limit), got {step_deg!r}"
+        )
+    return math.ceil((360.0 - 1e-9) / step)
 
 
 def check_count(count: float, limit: int, what: str, bytes_each: float = 0.0) -> int:

@@ -41,6 +41,7 @@ from ..calibration.run import MAX_RUN_OUTPUT_DPH, MIN_RUN_SIGMA_DPH
 from ..core.csv_table import write_csv_table
 from ..core.exceptions import InputError, check_seed
 from ..core.files import write_text_atomic
+from ..core.sizes import MAX_TIME_S
 from ..core.units import ARCSEC_PER_RAD, deg_to_rad, rad_to_deg
 from ..model.angles import ANGLE_ENTRIES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
@@ -64,8 +65,9 @@ DEFAULT_DWELL_S = 60.0
 """Time per position when no ``time_s`` is given, s."""
 DEFAULT_OUTLIER_SIGMAS = 30.0
 """Size of a gross outlier when ``outlier_dph`` is not given: this many sigma of its channel."""
-MAX_RUN_TIME_S = 366 * 86400.0
-"""Longest simulated run, s (a year): the measurement layer's ``MAX_TIME_S``."""
+MAX_RUN_TIME_S = MAX_TIME_S
+"""Longest simulated run, s (a year): a run file's ``time_s`` is at most that
+(:data:`~turntable_pin.core.sizes.MAX_TIME_S`)."""
 _MOUNT_LIMIT_ARCSEC = MAX_ANGULAR_ERROR_DEG * 3600.0
 
 

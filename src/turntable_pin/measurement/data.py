@@ -38,6 +38,7 @@ import numpy as np
 from ..calibration.positions import MAX_COMMANDED_ANGLE_DEG, angle_columns, check_commanded_angles
 from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows
 from ..core.exceptions import InputError
+from ..core.sizes import MAX_TIME_S
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.angles import ANGLE_NAMES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG, MAX_ORIENTATION_ERROR_DEG
@@ -76,8 +77,6 @@ error (:data:`~turntable_pin.model.errors.MAX_ANGULAR_ERROR_DEG`)."""
 MIN_SIGMA_ARCSEC = 1e-9
 """Smallest ``sigma_arcsec``, arc seconds: five femtoradians, the rounding of a double-precision
 angle; a smaller sigma is no noise level, and its weight 1/sigma^2 would overflow the fit."""
-MAX_TIME_S = 366 * 86400.0
-"""Largest ``time_s``, seconds (a year): a longer run is a unit mix-up (ms written as s)."""
 
 
 def _frozen(value, dtype=float) -> np.ndarray:

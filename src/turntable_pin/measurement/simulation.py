@@ -17,7 +17,7 @@ import numpy as np
 
 from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows, write_csv_table
 from ..core.exceptions import InputError, check_seed
-from ..core.sizes import MAX_SIMULATED_ROWS, check_count, turn_grid_count
+from ..core.sizes import MAX_SIMULATED_ROWS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.angles import ANGLE_NAMES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors
@@ -122,8 +122,8 @@ class Schedule:
     def __post_init__(self) -> None:
         for name in ("phi1_step_deg", "phi2_step_deg", "phi3_step_deg"):
             step = getattr(self, name)
-            if not 0 < step <= 360:
-                raise InputError(f"{name} must be in (0, 360], got {step:g}")
+            if not MIN_GRID_STEP_DEG <= step <= 360:
+                raise InputError(f"{name} must be in [{MIN_GRID_STEP_DEG:g}, 360], got {step:g}")
         for name in ("phi1_start_deg", "phi2_start_deg", "phi3_start_deg"):
             start = getattr(self, name)
             if not abs(start) <= MAX_COMMANDED_ANGLE_DEG - 360.0:
