@@ -50,6 +50,7 @@ _EXPORTS = {
     "TurntableErrors": "model.errors",
     "TurntableModel": "model.turntable",
     "TurntablePinError": "core.exceptions",
+    "UserCodeError": "core.exceptions",
     "YourdfpyTurntable": "model.urdf_io",
     "allocate_tolerances": "allocation.solver",
     "average_sensitivities": "allocation.sensitivity",
@@ -118,6 +119,7 @@ if TYPE_CHECKING:  # names for static checkers; nothing is imported at run time
         InputError,
         ModelError,
         TurntablePinError,
+        UserCodeError,
     )
     from .core.resources import default_urdf_path  # noqa: F401
     from .measurement.data import OrientationMeasurements, read_measurements  # noqa: F401

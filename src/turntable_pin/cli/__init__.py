@@ -4,9 +4,11 @@ Each subcommand lives in a module of this package with a ``register(subparsers)`
 one is a line in :data:`COMMANDS` (its module and one-line help) and the module. Only the module of
 the command being run is imported (``turntable-pin --help`` imports none), so start-up pays for
 nothing but what the command uses. Every :class:`TurntablePinError` becomes a one-line message on
-stderr and exit status 2, never a traceback; SIGINT and SIGTERM (:mod:`..core.interrupts`) end
-every command within a second with status 130 / 143 and a one-line message, leaving no helper
-process (meshcat server, Chromium, pool workers) and no temporary folder behind.
+stderr and exit status 2, never a traceback (unless ``TURNTABLE_PIN_TRACEBACK=1`` asks for one,
+:mod:`..core.user_code`: for an error inside a Python effect module you wrote); SIGINT and
+SIGTERM (:mod:`..core.interrupts`) end every command within a second with status 130 / 143 and a
+one-line message, leaving no helper process (meshcat server, Chromium, pool workers) and no
+temporary folder behind.
 """
 
 from __future__ import annotations
@@ -154,6 +156,7 @@ def main(argv: list[str] | None = None) -> int:
         if isinstance(exc, KeyboardInterrupt) or first_signal() is not None:
             return _interrupted(exc, command, console)
         if isinstance(exc, TurntablePinError):
+            _traceback_on_request(exc)
             print(f"turntable-pin {command}: error: {exc}", file=sys.stderr)
             return 2
         if isinstance(exc, BrokenPipeError):  # output piped into e.g. `head`: not our error
@@ -165,6 +168,17 @@ def main(argv: list[str] | None = None) -> int:
             exit_on_signal(f"turntable-pin {command}" if command else "turntable-pin")
         elif restore is not None:
             restore()
+
+
+def _traceback_on_request(exc: BaseException) -> None:
+    """With ``TURNTABLE_PIN_TRACEBACK=1``, the traceback of ``exc`` on stderr (an error raised
+    inside the user's code: theirs first, as its cause); nothing otherwise."""
+    from ..core.user_code import show_traceback
+
+    if show_traceback():
+        import traceback
+
+        traceback.print_exception(exc, file=sys.stderr)
 
 
 def _interrupted(exc: BaseException, command: str | None, console: bool) -> int:

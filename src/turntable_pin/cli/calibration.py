@@ -127,7 +127,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     c.add_argument(
         "--effects-module", action="append", default=[], type=input_path, metavar="FILE.py",
         help="a Python file defining run effects (subclasses of turntable_pin.instrument."
-        "effects.RunEffect): they join the candidates of --diagnose and the names of --effects",
+        "effects.RunEffect): they join the candidates of --diagnose and the names of --effects. "
+        "The file is code that runs: it is imported and its methods called (give only files you "
+        "trust); each effect is checked against its contract first "
+        "(TURNTABLE_PIN_TRACEBACK=1 shows the traceback of an error inside it)",
     )  # fmt: skip
     c.add_argument(
         "--until-explained",
@@ -283,12 +286,12 @@ def run_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _user_run_effects(args: argparse.Namespace) -> tuple:
-    """The run effects of ``--effects-module`` files, in the order given."""
-    from ..instrument.effects import RunEffect
-    from ..measurement.user_effects import load_effects_module
+def _user_run_effects(args: argparse.Namespace, run) -> tuple:
+    """The run effects of ``--effects-module`` files, in the order given, checked on ``run``
+    (names, and their contract on a probe and on the run) before any fit."""
+    from ..instrument.user_effects import load_run_effects_modules
 
-    return tuple(e for path in args.effects_module for e in load_effects_module(path, RunEffect))
+    return load_run_effects_modules(args.effects_module, run)
 
 
 def _read_run(args: argparse.Namespace, table):
@@ -306,7 +309,7 @@ def _diagnose_run(args: argparse.Namespace, table) -> int:
     from ..report.run_report import run_report_lines, write_run_plots, write_run_report
 
     run = _read_run(args, table)
-    catalogue = (*run_catalogue(table), *_user_run_effects(args))
+    catalogue = (*run_catalogue(table), *_user_run_effects(args, run))
     diagnosis = diagnose_run(
         run, until_explained=args.until_explained, outliers=not args.keep_outliers,
         catalogue=catalogue,
@@ -336,7 +339,7 @@ def _fit_run_effects(args: argparse.Namespace, table) -> int:
 
     run = _read_run(args, table)
     names = [n for group in args.effects for n in group.split(",") if n.strip()]
-    effects = resolve_run_effects(names, table, _user_run_effects(args))
+    effects = resolve_run_effects(names, table, _user_run_effects(args, run))
     for effect in effects:
         missing = effect.missing_columns(run)
         if missing:

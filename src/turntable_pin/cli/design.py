@@ -112,7 +112,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=[],
         type=input_path,
         metavar="FILE.py",
-        help="a Python file defining Effect subclasses; their names join --effects",
+        help="a Python file defining Effect subclasses (with --separate --run: RunEffect "
+        "subclasses); their names join --effects. The file is code that runs: it is imported "
+        "and its methods called (give only files you trust)",
     )
     p.add_argument(
         "--from",
@@ -209,10 +211,9 @@ def run_design(args: argparse.Namespace) -> int:
 
 def _effects(args: argparse.Namespace, table) -> tuple:
     """The effects of ``--effects`` (and ``--effects-module``) on ``table``."""
-    from ..measurement.user_effects import load_effects_module, resolve_effects
+    from ..measurement.user_effects import load_effects_modules, resolve_effects
 
-    modules = [e for path in args.effects_module for e in load_effects_module(path)]
-    return resolve_effects(args.effects, table, modules)
+    return resolve_effects(args.effects, table, load_effects_modules(args.effects_module, table))
 
 
 def _space(args: argparse.Namespace, effects=None):
@@ -286,7 +287,7 @@ def _run_separate(args: argparse.Namespace) -> int:
     one line (exit 0) when no positions within the limits separate them."""
     from ..design.separate import design_separate
     from ..measurement.effects import parse_effect_spec
-    from ..measurement.user_effects import load_effects_module, resolve_effects
+    from ..measurement.user_effects import load_effects_modules, resolve_effects
     from ..report.separation_figures import write_separate_plots
 
     if args.effects:
@@ -294,7 +295,7 @@ def _run_separate(args: argparse.Namespace) -> int:
             "--separate A,B names the two effects to tell apart; --effects is for the identify mode"
         )
     table = table_from_args(args)
-    modules = [e for path in args.effects_module for e in load_effects_module(path)]
+    modules = load_effects_modules(args.effects_module, table)
     names = [n.strip() for n in args.separate.split(",") if n.strip()]
     if len(names) != 2:
         raise InputError(f"--separate takes two effects, A,B; got '{args.separate}'")
@@ -360,9 +361,9 @@ def _run_separate_run(args: argparse.Namespace) -> int:
     from ..calibration.run import read_run
     from ..core.csv_table import write_csv_table
     from ..core.units import deg_to_rad
-    from ..instrument.effects import RunEffect, run_catalogue
+    from ..instrument.effects import run_catalogue
     from ..instrument.separate import design_run_separation
-    from ..measurement.user_effects import load_effects_module
+    from ..instrument.user_effects import load_run_effects_modules
 
     for option, given in (
         ("--effects", args.effects),
@@ -382,7 +383,7 @@ def _run_separate_run(args: argparse.Namespace) -> int:
     space = _space(args, effects=())
     run = read_run(args.run, deg_to_rad(args.latitude_deg), space.table)
     warn_ignored_columns(args, run, args.run)
-    user = [e for path in args.effects_module for e in load_effects_module(path, RunEffect)]
+    user = load_run_effects_modules(args.effects_module, run)
     result = design_run_separation(
         run, tuple(names), deg_to_rad(space.candidates_deg), args.positions_count,
         seed=args.seed, catalogue=(*run_catalogue(space.table), *user),

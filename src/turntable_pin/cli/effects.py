@@ -26,7 +26,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--payload-frame", metavar="NAME", help="the payload frame of the URDF")
     add_mount_option(p)
     p.add_argument("--catalogue", action="append", default=[], type=input_path, metavar="FILE",
-                   help="your effects (.yaml effect file or .py module); repeatable")  # fmt: skip
+                   help="your effects (.yaml effect file or .py module); repeatable. A .py "
+                   "module is code that runs: it is imported and its methods called (give only "
+                   "files you trust)")  # fmt: skip
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run_effects)
 

@@ -147,7 +147,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=[],
         type=Path,
         metavar="FILE.py",
-        help="a Python file defining Effect subclasses; their names join --effects",
+        help="a Python file defining Effect subclasses; their names join --effects. The file is "
+        "code that runs: it is imported and its methods called (give only files you trust)",
     )
     f.add_argument(
         "--write-urdf",
@@ -301,7 +302,8 @@ def _add_outlier_option(p: argparse.ArgumentParser) -> None:
 def _add_catalogue_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--catalogue", action="append", default=[], type=input_path, metavar="FILE",
                    help="your effects (a .yaml effect file or a .py module) join the candidates; "
-                   "repeatable")  # fmt: skip
+                   "repeatable. A .py module is code that runs: it is imported and its methods "
+                   "called (give only files you trust)")  # fmt: skip
 
 
 def _user_catalogue(args: argparse.Namespace, table=None):
@@ -567,12 +569,12 @@ def _fit_line(label: str, summary: dict) -> str:
 def run_fit(args: argparse.Namespace) -> int:
     from ..measurement.fit import fit_orientation, refuse_repeated_shapes
     from ..measurement.residuals import analyse_residuals, orientation_residuals
-    from ..measurement.user_effects import load_effects_module, resolve_effects
+    from ..measurement.user_effects import load_effects_modules, resolve_effects
     from ..report.measurement_figures import write_residual_plots
 
     table = table_from_args(args)
     data = _read(args, table)
-    modules = [e for path in args.effects_module for e in load_effects_module(path)]
+    modules = load_effects_modules(args.effects_module, table)
     effects = resolve_effects(args.effects, table, modules)
     refuse_repeated_shapes(data, effects, turntable=table)
     after = fit_orientation(data, effects, turntable=table)

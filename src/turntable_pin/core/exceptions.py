@@ -15,6 +15,7 @@ __all__ = [
     "InputError",
     "ModelError",
     "TurntablePinError",
+    "UserCodeError",
     "check_seed",
     "one_line",
 ]
@@ -71,6 +72,28 @@ class InputError(TurntablePinError, ValueError):
             where.append(f"column '{column}'")
         prefix = ", ".join(where)
         super().__init__(f"{prefix}: {message}" if prefix else message)
+
+
+class UserCodeError(TurntablePinError):
+    """Code the user brought (a Python effect module, an installed plug-in) raised an exception
+    or broke its contract (a shape, a non-finite value, a parameter name).
+
+    Not an :class:`InputError`: the fits that skip a candidate they cannot evaluate on the data
+    (``except InputError``) must not hide a broken plug-in as "cannot be fitted". The message
+    names the file (and the line when known), the effect and what went wrong; an exception raised
+    inside the user's code is kept as ``__cause__``, with its traceback.
+    """
+
+    def __init__(
+        self, message: str, *, path: str | Path | None = None, line: int | None = None
+    ) -> None:
+        self.path = None if path is None else str(path)
+        self.line = line
+        self.detail = message
+        where = ", ".join(
+            [*([self.path] if self.path else []), *([f"line {line}"] if line else [])]
+        )
+        super().__init__(f"{where}: {message}" if where else message)
 
 
 class ModelError(TurntablePinError):

@@ -19,9 +19,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..calibration.gyrowheel import AXES, N_COEFFICIENTS, TERM_NAMES
+from ..core.user_code import is_user_code
 from ..measurement.effects.base import PositionVariables
 from ..stats.least_squares import FitResult, fit_least_squares
 from .effects.base import RunContext, RunEffect
+from .effects.contract import check_run_effect
 from .sensitivity import drift_regressor, rate_sensitivity_dph
 
 __all__ = [
@@ -122,9 +124,8 @@ class RunModel:
         blocks = [_memo(context, ("base",), lambda: drift_regressor(run.inputs.specific_force_g))]
         names, units, scale = list(BASE_NAMES), list(BASE_UNITS), [1.0] * len(BASE_NAMES)
         for effect in self.effects:
-            specs = effect.parameters(run)
-            blocks.append(_memo(context, ("effect", effect.name, id(effect)),
-                                lambda e=effect: e.columns(context)))  # fmt: skip
+            specs, columns = _specs_and_columns(effect, context)
+            blocks.append(columns)
             names += [f"{effect.name}.{s.name}" for s in specs]
             units += [s.unit for s in specs]
             scale += [s.per_user_unit for s in specs]
@@ -162,6 +163,16 @@ class RunModel:
         """The outputs at every position (N, 2), the left-out ones too, deg/h."""
         run = self.run
         return run.inputs.earth_rate_dph[:, :2] + np.einsum("ncp,p->nc", self.columns, params)
+
+
+def _specs_and_columns(effect: RunEffect, context: RunContext):
+    """``effect``'s parameters and columns in ``context`` (the columns computed once per
+    context); a user's effect checked against its contract first
+    (:func:`~.effects.contract.check_run_effect`)."""
+    if is_user_code(effect):
+        return _memo(context, ("contract", id(effect)), lambda: check_run_effect(effect, context))
+    columns = _memo(context, ("effect", effect.name, id(effect)), lambda: effect.columns(context))
+    return effect.parameters(context.run), columns
 
 
 def _memo(context: RunContext, key: tuple, compute):

@@ -24,10 +24,12 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.rotations import AXIS_INDEX, axis_rotation
 from ..core.units import ARCSEC_PER_RAD
+from ..core.user_code import is_user_code
 from ..model.angles import ANGLE_ENTRIES, ANGLE_NAMES
 from ..model.chain import ROTATION
 from ..model.errors import ANGULAR_ERROR_NAMES
 from .effects.base import MEASURED, POST, PRE, Effect, ParameterSpec, PositionVariables
+from .effects.contract import check_effect
 from .table import MeasuredTable, measured_table
 
 __all__ = ["AXIS_INDEX", "BASE_PARAMETERS", "OrientationModel", "base_parameters"]
@@ -165,6 +167,19 @@ def _table_part(turntable: MeasuredTable, joint_rad: np.ndarray):
     return part, rd
 
 
+def _specs_and_terms(effect: Effect, variables: PositionVariables, base_names: tuple[str, ...]):
+    """``effect``'s parameters and chain terms on ``variables``; a user's effect checked against
+    its contract first (:func:`~.effects.contract.check_effect`, once per data set: the models of
+    one diagnosis share the result)."""
+    if not is_user_code(effect):
+        return effect.parameters(variables), effect.chain_terms(variables)
+    return variables.memo(
+        ("contract", id(effect), base_names),
+        (effect,),
+        lambda: check_effect(effect, variables, base_names),
+    )
+
+
 class OrientationModel:
     """``dpsi, dtheta, dgamma`` at N positions from the base errors and a set of effects.
 
@@ -200,10 +215,11 @@ class OrientationModel:
                     f"effect '{effect.name}' needs the column(s) "
                     f"{variables.missing_columns_words(missing)}"
                 )
-            for spec in effect.parameters(variables):
+            effect_specs, terms = _specs_and_terms(effect, variables, self.base_names)
+            for spec in effect_specs:
                 specs.append(spec)
                 names.append(f"{effect.name}.{spec.name}")
-            terms_by_effect.append((effect, effect.chain_terms(variables)))
+            terms_by_effect.append((effect, terms))
         self.parameter_specs = tuple(specs)
         self.parameter_names = tuple(names)
         self.parameter_units = tuple(s.unit for s in specs)

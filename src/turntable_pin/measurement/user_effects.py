@@ -17,7 +17,7 @@ problem is an :class:`InputError` of one line naming the file, the line or key, 
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 from ..core.exceptions import InputError
@@ -27,13 +27,16 @@ __all__ = [
     "ENTRY_POINT_GROUP",
     "EFFECT_FILE_KEYS",
     "TERM_KEYS",
+    "check_user_effect_names",
     "check_user_effects",
     "describe_effects",
+    "effect_definition",
     "effect_files_named",
     "inline_effect",
     "installed_effects",
     "load_catalogue",
     "load_effects_module",
+    "load_effects_modules",
     "read_effect_file",
     "resolve_effects",
 ]
@@ -209,17 +212,16 @@ def inline_effect(text: str, turntable=None) -> Effect:
     return DeclaredEffect(term.spec(), [term], source="inline term")
 
 
-def _effects_in(objects: Iterable, where: str, base: type = Effect) -> list:
+def _effects_in(objects: Iterable, where: str, base: type = Effect, path=None) -> list:
     """The effects among ``objects``: instances of ``base``, and its subclasses built without
-    arguments."""
+    arguments (the user's code: a failure is reported as theirs, :func:`call_user`)."""
+    from ..core.user_code import call_user
+
     out = []
     for obj in objects:
         if isinstance(obj, type) and issubclass(obj, base) and obj is not base:
-            try:
-                obj = obj()
-            except Exception as exc:  # the user's code: any failure is one line
-                raise InputError(f"{where}: {obj.__name__}() failed: {type(exc).__name__}: "
-                                 f"{exc}") from None  # fmt: skip
+            what = f"class {obj.__qualname__}: {obj.__qualname__}() (built without arguments)"
+            obj = call_user(what if path else f"{where}: {what}", obj, path=path)
         if isinstance(obj, base):
             out.append(obj)
     return out
@@ -229,43 +231,56 @@ def load_effects_module(path: str | Path, base: type = Effect) -> tuple:
     """The effects a Python file defines: instances of :class:`Effect` (or of ``base``: the
     run effects of :mod:`turntable_pin.instrument` use
     :class:`~turntable_pin.instrument.effects.base.RunEffect`), and the subclasses defined in
-    the file (built without arguments), in the order they appear.
+    the file (built without arguments), in the order they appear. Each effect's ``source`` is
+    the file.
+
+    The file is code that runs: importing it runs its top level
+    (:func:`~turntable_pin.core.user_code.import_module_file`). The effects are not checked
+    here: :func:`check_user_effects` (orientation effects) and
+    :func:`turntable_pin.instrument.effects.contract.check_user_run_effects` (run effects) do.
 
     Raises:
-        InputError: the file cannot be read or imported, or defines no effect.
+        InputError: the file cannot be read or defines no effect.
+        UserCodeError: importing it, or building an effect, raised an exception or called
+            ``sys.exit`` (the file, the line and the message).
     """
-    import importlib.util
-    import sys
+    from ..core.user_code import import_module_file
 
     path = Path(path)
     if not path.is_file():
         raise InputError("no such Python file", path=path)
     module_name = f"turntable_pin_user_effects_{abs(hash(str(path.resolve())))}"
-    spec = importlib.util.spec_from_file_location(module_name, path)
-    if spec is None or spec.loader is None:
-        raise InputError("cannot be loaded as a Python module (expected FILE.py)", path=path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[module_name] = module
-    try:
-        spec.loader.exec_module(module)
-    except Exception as exc:  # the user's code: any failure is one line
-        sys.modules.pop(module_name, None)
-        line = getattr(exc, "lineno", None)
-        text = str(exc).splitlines()[0] if str(exc) else ""
-        raise InputError(f"cannot import it: {type(exc).__name__}: {text}", path=path,
-                         line=line if isinstance(exc, SyntaxError) else None) from None  # fmt: skip
+    module = import_module_file(path, module_name)
     objects = [
         obj for obj in vars(module).values()
         if not (isinstance(obj, type) and obj.__module__ != module_name)
     ]  # fmt: skip
-    effects = _effects_in(objects, str(path), base)
+    effects = _effects_in(objects, str(path), base, path)
     if not effects:
         where = f"{base.__module__.replace('.base', '')}.{base.__name__}"
         raise InputError(
             f"defines no effect (expected subclasses of {where} or instances of them)",
             path=path,
         )
+    for effect in effects:
+        _set_source(effect, str(path))
     return tuple(effects)
+
+
+def _set_source(effect, source: str) -> None:
+    """Record where ``effect`` came from (for messages and listings), unless it says so itself."""
+    if not isinstance(getattr(effect, "source", None), str) or not effect.source:
+        try:
+            effect.source = source
+        except AttributeError:  # a read-only object: named by its class alone
+            pass
+
+
+def load_effects_modules(paths: Sequence[str | Path], turntable=None) -> tuple[Effect, ...]:
+    """The orientation effects of the Python files ``paths`` (:func:`load_effects_module`),
+    checked by :func:`check_user_effects` (names, and the contract on a probe)."""
+    effects = [e for path in paths for e in load_effects_module(path)]
+    return check_user_effects(effects, turntable)
 
 
 def installed_effects() -> tuple[Effect, ...]:
@@ -273,52 +288,122 @@ def installed_effects() -> tuple[Effect, ...]:
     (loaded now; nothing is loaded before this is called).
 
     Raises:
-        InputError: an entry point that fails to load or holds no effect.
+        InputError: an entry point that holds no effect.
+        UserCodeError: an entry point that fails to load (its code raised).
     """
     from importlib.metadata import entry_points
+
+    from ..core.user_code import call_user
 
     out: list[Effect] = []
     for ep in entry_points(group=ENTRY_POINT_GROUP):
         where = f"entry point '{ep.name}' ({ep.value}) of {ENTRY_POINT_GROUP}"
-        try:
-            obj = ep.load()
-        except Exception as exc:  # an installed package's code: any failure is one line
-            raise InputError(f"{where}: cannot load it: {type(exc).__name__}: {exc}") from None
+        obj = call_user(f"{where}: loading it", ep.load)
         objects = obj if isinstance(obj, list | tuple) else [obj]
         found = _effects_in(objects, where)
         if not found:
             raise InputError(f"{where}: holds no Effect subclass or instance")
         for effect in found:
-            if not getattr(effect, "source", ""):
-                try:
-                    effect.source = f"entry point {ep.name}"
-                except AttributeError:  # a read-only object: listed without its source
-                    pass
+            _set_source(effect, f"entry point {ep.name}")
         out += found
     return tuple(out)
 
 
-def check_user_effects(effects: Sequence[Effect], turntable=None) -> tuple[Effect, ...]:
-    """``effects`` if each has a usable name, unique and not one of the table's catalogue.
+def effect_definition(effect) -> str:
+    """Where ``effect`` is defined, for messages: ``FILE, line L`` (the ``name`` of an effect
+    file), ``FILE (class C)`` (a class of a module or plug-in), ``the inline term T`` or
+    ``module.Class`` (the package's own)."""
+    from ..core.user_code import class_file, is_user_code
+    from .effects.declared import DeclaredEffect
+
+    source = getattr(effect, "source", "")
+    source = source if isinstance(source, str) else ""
+    if isinstance(effect, DeclaredEffect):
+        if source.lower().endswith(EFFECT_FILE_SUFFIXES):
+            line = _name_line(Path(source))
+            return f"{source}, line {line}" if line else source
+        if source == "inline term":
+            return f"the inline term {effect.name}"
+        return source or "--effects"
+    cls = type(effect)
+    if is_user_code(effect):
+        return f"{source or class_file(cls) or 'Python'} (class {cls.__qualname__})"
+    return f"{cls.__module__}.{cls.__qualname__}"
+
+
+def _name_line(path: Path) -> int | None:
+    """The line of an effect file's top-level ``name:`` key (for a message: no YAML is parsed;
+    ``None`` when it is not written so, in a flow mapping for instance)."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
+    for number, line in enumerate(text.splitlines(), 1):
+        if re.match(r"""^["']?name["']?\s*:""", line):
+            return number
+    return None
+
+
+def check_user_effect_names(
+    effects: Sequence, turntable=None, others: Sequence = (), taken: Mapping | None = None
+) -> tuple:
+    """``effects`` if each has a usable name (letters, digits and ``_ . @ -``), taken neither by
+    the catalogue nor by another of ``effects`` or of ``others`` (user effects already
+    accepted). ``taken``: ``{name: effect}`` of the catalogue (default: the table's orientation
+    catalogue; a run's diagnosis passes its own).
 
     Raises:
-        InputError: an effect without a name, a name used twice or taken by the catalogue.
+        InputError: a bad name, or a name taken: naming both definitions (file and line of an
+            effect file, file and class of a module's effect).
     """
-    from .catalogue import catalogue
+    if taken is None:
+        from .catalogue import catalogue
 
-    taken = {e.name for e in catalogue(turntable)}
-    seen: dict[str, str] = {}
+        taken = {e.name: e for e in catalogue(turntable)}
+    seen: dict[str, Effect] = {e.name: e for e in others}
     for effect in effects:
-        where = getattr(effect, "source", "") or type(effect).__name__
+        where = effect_definition(effect)
         name = getattr(effect, "name", "")
-        if not isinstance(name, str) or not name.strip() or "," in name:
-            raise InputError(f"{where}: an effect needs a name without commas (its 'name')")
+        if not isinstance(name, str) or not _NAME.match(name):
+            shown = f"'{name}'" if isinstance(name, str) else f"{type(name).__name__} {name!r}"
+            raise InputError(f"{where}: an effect needs a name (its 'name'): letters, digits and "
+                             f"_ . @ - (no spaces, commas or '~'), starting with a letter; got "
+                             f"{shown}")  # fmt: skip
         if name in taken:
-            raise InputError(f"{where}: effect '{name}' is already in the catalogue; give yours "
-                             "another name")  # fmt: skip
+            raise InputError(f"{where}: effect '{name}' is already in the catalogue "
+                             f"({effect_definition(taken[name])}); give yours another "
+                             "name")  # fmt: skip
         if name in seen:
-            raise InputError(f"{where}: effect '{name}' is also defined by {seen[name]}")
-        seen[name] = where
+            raise InputError(f"{where}: effect '{name}' is also defined by "
+                             f"{effect_definition(seen[name])}; give one of them another "
+                             "name")  # fmt: skip
+        seen[name] = effect
+    return tuple(effects)
+
+
+def check_user_effects(effects: Sequence[Effect], turntable=None) -> tuple[Effect, ...]:
+    """``effects`` if their names pass :func:`check_user_effect_names` and each effect of the
+    user's code (a module's, a plug-in's, an object from Python) keeps its contract on a probe
+    (:func:`~.effects.contract.check_effect_on_probe`); the data are checked where they meet
+    the effects (:class:`~.effect_model.OrientationModel`).
+
+    Raises:
+        InputError: a bad or taken name.
+        UserCodeError: an effect that raises or breaks its contract (one line: file, effect,
+            method, what it returned and what was expected).
+    """
+    from ..core.user_code import is_user_code
+    from .effects.contract import check_effect_on_probe, check_story
+    from .table import measured_table
+
+    table = measured_table(turntable)
+    for effect in effects:
+        if is_user_code(effect):
+            check_story(effect, Effect)
+    check_user_effect_names(effects, table)
+    for effect in effects:
+        if is_user_code(effect):
+            check_effect_on_probe(effect, table)
     return tuple(effects)
 
 
@@ -370,7 +455,9 @@ def resolve_effects(
                 effect = inline_effect(item, turntable)
             elif _is_effect_file(item):
                 effect = read_effect_file(item, turntable)
-                check_user_effects([effect], turntable)
+                # the same file given as a catalogue too is the same definition
+                others = [e for e in extra if getattr(e, "source", None) != effect.source]
+                check_user_effect_names([effect], turntable, others=others)
             else:
                 try:
                     effect = resolve_effect(item, turntable, extra)
@@ -396,6 +483,7 @@ def describe_effects(effects: Sequence[Effect], turntable=None) -> list[dict]:
     import numpy as np
 
     from .effects.base import PositionVariables
+    from .effects.contract import checked_parameters
     from .table import measured_table
 
     table = measured_table(turntable)
@@ -410,7 +498,7 @@ def describe_effects(effects: Sequence[Effect], turntable=None) -> list[dict]:
         entry["source"] = getattr(effect, "source", "") or "catalogue"
         entry["parameters"] = [
             {"name": p.name, "unit": p.unit, "description": p.description}
-            for p in effect.parameters(variables)
+            for p in checked_parameters(effect, variables, "one position")
         ]
         out.append(entry)
     return out

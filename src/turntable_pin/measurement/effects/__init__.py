@@ -56,9 +56,11 @@ def parameter_names(effect: Effect) -> tuple[str, ...]:
 
 
 def _every_parameter(effect: Effect):
+    from .contract import checked_parameters
+
     one = np.zeros((1, 3))
     dirs = (one[:, 0] + 1,) * 3
-    return effect.parameters(PositionVariables(one, one[:, 0], dirs))
+    return checked_parameters(effect, PositionVariables(one, one[:, 0], dirs), "one position")
 
 
 def parse_effect_spec(text: str, resolve=None) -> tuple[str, dict[str, float]]:

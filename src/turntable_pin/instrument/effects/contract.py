@@ -1,0 +1,99 @@
+"""The contract of a :class:`~.base.RunEffect` plug-in, checked once where the user's effect
+enters.
+
+A run effect the user writes (a class of a Python module given to ``--effects-module``, an object
+passed from Python) must give, on a run of N positions:
+
+- its story as text (``name``, ``title``, ``definition``, ``explanation``, ``confirm``), its
+  ``side`` (``"table"`` or ``"instrument"``) and its ``required_columns`` as a tuple of names;
+- ``parameters(run)``: a tuple of at least one
+  :class:`~turntable_pin.measurement.effects.base.ParameterSpec`, names unique, ``per_user_unit``
+  a finite number > 0;
+- ``columns(context)``: ``d(out_x, out_y)/d(parameter)``, an array of finite numbers of shape
+  (N, 2, p), p the number of its parameters.
+
+:func:`check_run_effect` calls the methods (through
+:func:`~turntable_pin.core.user_code.call_user`) and raises a one-line
+:class:`~turntable_pin.core.exceptions.UserCodeError` naming the file, the effect, the method,
+what it returned and what was expected.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...core.user_code import call_user
+from ...measurement.effects.contract import (
+    check_parameters,
+    check_story,
+    contract_error,
+    described,
+    effect_file,
+    effect_label,
+)
+from .base import INSTRUMENT, TABLE, ParameterSpec, RunContext, RunEffect
+
+__all__ = ["SIDES", "check_run_effect", "check_run_story"]
+
+SIDES = (TABLE, INSTRUMENT)
+"""The sides a run effect may live on."""
+
+
+def check_run_story(effect) -> None:
+    """Refuse a run effect whose story is not text, whose ``side`` is not one of :data:`SIDES`
+    or whose ``required_columns`` is not a tuple of column names."""
+    check_story(effect, RunEffect)
+    side = getattr(effect, "side", None)
+    if side not in SIDES:
+        raise contract_error(
+            effect, f"its side is {described(side)}; expected '{TABLE}' or '{INSTRUMENT}'"
+        )
+
+
+def check_run_effect(
+    effect, context: RunContext, *, on: str | None = None
+) -> tuple[tuple[ParameterSpec, ...], np.ndarray]:
+    """``(parameters, columns)`` of the user's run ``effect`` in ``context``, each checked
+    against the contract (module docstring); ``on`` is how the message names the run (default:
+    ``the run (N positions)``).
+
+    Raises:
+        UserCodeError: a method raised, or returned something the contract does not allow: one
+            line naming the file, the effect, the method, what it returned and what was expected.
+    """
+    run = context.run
+    n = run.n_positions
+    on = on or f"the run ({n} positions)"
+    check_run_story(effect)
+    path, label = effect_file(effect), effect_label(effect)
+    specs = call_user(f"{label}: parameters(run) on {on}", effect.parameters, run, path=path)
+    specs = check_parameters(effect, specs, "parameters(run)", on)
+    columns = call_user(f"{label}: columns(context) on {on}", effect.columns, context, path=path)
+    expected = (f"an array of shape ({n}, 2, {len(specs)}): d(out_x, out_y)/d(parameter) at each "
+                f"of the {n} positions for its {len(specs)} parameter(s)")  # fmt: skip
+    try:
+        array = np.asarray(columns)
+    except Exception:  # an object numpy cannot read: reported as what it is
+        array = np.asarray(None)
+    if array.dtype.kind not in "biuf":
+        raise contract_error(
+            effect,
+            f"columns(context) returned {described(columns)} on {on}; expected {expected}",
+        )
+    if array.shape != (n, 2, len(specs)):
+        raise contract_error(
+            effect,
+            f"columns(context) returned {described(columns)} on {on}; expected {expected}",
+        )
+    array = array.astype(float)
+    bad = ~np.isfinite(array)
+    if bad.any():
+        kinds = " and ".join(w for w, hit in (("NaN", np.isnan(array).any()),
+                                              ("inf", np.isinf(array).any())) if hit)  # fmt: skip
+        rows = int(bad.any(axis=(1, 2)).sum())
+        raise contract_error(
+            effect,
+            f"columns(context) returned {kinds} at {rows} of {n} positions on "
+            f"{on}; expected finite numbers",
+        )
+    return specs, array
