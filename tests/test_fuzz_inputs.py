@@ -4,8 +4,9 @@ options of the command line.
 
 Whatever the input, the command ends with exit status 0 (or 1 for a Monte Carlo run that exceeds a
 limit), or with status 2 and exactly one line on stderr naming the place (the file or the option);
-never a traceback, never a warning, never an input file changed, never a file left behind. The CLI
-runs in this process (``conftest.cli``) to keep the examples cheap.
+never a traceback, never a warning, never an input file changed, never a file left behind
+(``fuzzing.run_and_check``). The CLI runs in this process (``conftest.cli``) to keep the examples
+cheap.
 """
 
 from __future__ import annotations
@@ -14,73 +15,23 @@ import math
 import shutil
 import string
 import tempfile
-import warnings
 from pathlib import Path
 
 import pytest
 import yaml
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from conftest import EXAMPLES_DIR, cli
+from fuzzing import example_folder, fuzz, run_and_check, scratch_folder
 
 pytestmark = pytest.mark.slow
-
-
-def fuzz(examples: int):
-    """Hypothesis settings of these tests: ``examples`` inputs, no deadline, no database."""
-    return settings(
-        max_examples=examples,
-        deadline=None,
-        database=None,  # nothing written into the checkout (.hypothesis/)
-        suppress_health_check=[HealthCheck.too_slow],
-    )
-
-
-# ---- running one command and judging what it did --------------------------------------------
-def _snapshot(folder: Path) -> dict[str, tuple[bytes, int]]:
-    return {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in folder.iterdir()}
-
-
-def run_and_check(folder: Path, args: list[str], place: str, *, outputs: tuple[str, ...] = ()):
-    """Run ``turntable-pin ARGS`` in-process and assert the rules of the module docstring.
-
-    ``place`` is what a refusal must name (a file name or an option); ``outputs`` are the names
-    of files the command may create in ``folder``.
-    """
-    before = _snapshot(folder)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        proc = cli(*args)
-    after = _snapshot(folder)
-    for name, content in before.items():
-        assert after.get(name) == content, f"input {name} changed by {args}"
-    left = set(after) - set(before) - set(outputs)
-    assert not left, f"{args} left {sorted(left)} behind"
-    assert "Traceback" not in proc.stderr, proc.stderr
-    assert not caught, f"{args}: warnings {[str(w.message) for w in caught]}"
-    if proc.returncode == 2:
-        lines = proc.stderr.splitlines()
-        assert len(lines) == 1, f"{args}: expected one stderr line, got {proc.stderr!r}"
-        assert place in lines[0], f"{args}: the message does not name {place!r}: {lines[0]!r}"
-        for name in outputs:
-            assert name not in after or name in before, f"{args} wrote {name} and failed"
-    else:
-        allowed = (0, 1) if args[0] == "montecarlo" else (0,)
-        assert proc.returncode in allowed, (args, proc.returncode, proc.stderr)
-    return proc
 
 
 @pytest.fixture(scope="module")
 def scratch():
     """A folder for the examples: each example gets (and removes) a subfolder of it."""
-    folder = Path(tempfile.mkdtemp(prefix="fuzz-inputs-"))
-    yield folder
-    shutil.rmtree(folder, ignore_errors=True)
-
-
-def _example_folder(scratch: Path) -> Path:
-    return Path(tempfile.mkdtemp(dir=scratch))
+    yield from scratch_folder()
 
 
 # ---- cell, value and key texts ----------------------------------------------------------------
@@ -157,7 +108,7 @@ RUN = (EXAMPLES_DIR / "gyrowheel_run_example.csv").read_text()
 @fuzz(60)
 @given(text=mutated_csv(MEASUREMENTS), ignore_sigma=st.booleans())
 def test_measurement_csv(scratch, text, ignore_sigma):
-    folder = _example_folder(scratch)
+    folder = example_folder(scratch)
     path = folder / "data.csv"
     path.write_text(text, encoding="utf-8")
     args = ["fit", str(path)] + (["--ignore-sigma"] if ignore_sigma else [])
@@ -167,7 +118,7 @@ def test_measurement_csv(scratch, text, ignore_sigma):
 @fuzz(60)
 @given(text=mutated_csv(RUN))
 def test_calibration_run_csv(scratch, text):
-    folder = _example_folder(scratch)
+    folder = example_folder(scratch)
     path = folder / "run.csv"
     path.write_text(text, encoding="utf-8")
     run_and_check(folder, ["calibrate", str(path)], "run.csv")
@@ -229,7 +180,7 @@ def _errors_mapping():
 @fuzz(60)
 @given(text=yaml_text(_errors_mapping()))
 def test_errors_yaml(scratch, text):
-    folder = _example_folder(scratch)
+    folder = example_folder(scratch)
     path = folder / "errors.yaml"
     path.write_text(text, encoding="utf-8")
     run_and_check(folder, ["orientation", "--errors", str(path), "--phi1-deg", "30"], "errors.yaml")
@@ -261,7 +212,7 @@ def _gyrowheel_mapping():
 @fuzz(40)
 @given(text=yaml_text(_gyrowheel_mapping()))
 def test_gyrowheel_yaml(scratch, text):
-    folder = _example_folder(scratch)
+    folder = example_folder(scratch)
     path = folder / "gyrowheel.yaml"
     path.write_text(text, encoding="utf-8")
     args = ["rate-error", "--gyrowheel", str(path), "--dpsi-deg", "0.01", "--positions", "grid:45"]
@@ -290,7 +241,7 @@ def _lower_bounds_mapping():
 @fuzz(15)
 @given(text=yaml_text(_lower_bounds_mapping()))
 def test_lower_bounds_yaml(scratch, text):
-    folder = _example_folder(scratch)
+    folder = example_folder(scratch)
     path = folder / "bounds.yaml"
     path.write_text(text, encoding="utf-8")
     args = ["allocate", "--limits-arcmin", "2", "--lower-bounds", str(path)]
@@ -337,7 +288,7 @@ def test_numeric_options(scratch, case, value):
         assume(number is None or not 0 < number < 30)
     if option == "--repeats":
         assume(_not_a_large_count(value, 20))
-    folder = _example_folder(scratch)
+    folder = example_folder(scratch)
     args = [*fixed, f"{option}={value}"]
     outputs = ()
     if fixed[0] == "simulate":
@@ -349,7 +300,7 @@ def test_numeric_options(scratch, case, value):
 @fuzz(25)
 @given(value=number_text)
 def test_fit_k_sigma(scratch, value):
-    folder = _example_folder(scratch)
+    folder = example_folder(scratch)
     path = folder / "data.csv"
     path.write_text(MEASUREMENTS)
     run_and_check(folder, ["fit", str(path), f"--k-sigma={value}"], "--k-sigma")
@@ -366,7 +317,7 @@ def test_fit_k_sigma(scratch, value):
     ),
 )
 def test_allocate_limits(scratch, option, value):
-    folder = _example_folder(scratch)
+    folder = example_folder(scratch)
     run_and_check(folder, ["allocate", f"{option}={value}"], option)
 
 
@@ -381,7 +332,7 @@ def test_montecarlo_options(scratch, option, value):
         assume(_not_a_large_count(value, 50))
     if option == "--phi2-step-deg":
         assume(number is None or not 0 < number < 5)
-    folder = _example_folder(scratch)
+    folder = example_folder(scratch)
     base = ["montecarlo", "--limits-arcmin", "1", "--quiet", "-n", "20"]
     run_and_check(folder, [*base, f"{option}={value}"], option)
 
@@ -394,5 +345,5 @@ def test_montecarlo_options(scratch, option, value):
     )
 )
 def test_error_option(scratch, item):
-    folder = _example_folder(scratch)
+    folder = example_folder(scratch)
     run_and_check(folder, ["orientation", f"--error={item}"], "--error")
