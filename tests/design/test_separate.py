@@ -167,7 +167,7 @@ def test_bad_input_is_one_line(three_axis, campaign):
                          amplitudes={"TZ": {"k": 1.0}}), "not one of TF, TX"),
         (lambda: _design(table, "TF", 4, candidates=200), "two different effects"),
         (lambda: _design(table, "TF,TX", 500, candidates=100,
-                         amplitudes={"TF": {"TF": 1.0}, "TX": {"TX": 1.0}}), "more --candidates"),
+                         amplitudes={"TF": {"TF": 1.0}, "TX": {"TX": 1.0}}), "^n_positions is 500"),
     ]  # fmt: skip
     for call, words in cases:
         with pytest.raises(InputError, match=words) as caught:

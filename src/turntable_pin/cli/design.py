@@ -228,6 +228,15 @@ def _space(args: argparse.Namespace, effects=None):
     )
 
 
+def _positions_count(args: argparse.Namespace, space) -> int:
+    """``-n``, checked against the candidates of ``space`` before any of the design's work (the
+    library checks its argument too, by its own name)."""
+    from ..core.sizes import check_positions_count
+
+    count = args.positions_count
+    return check_positions_count(count, space.candidates_deg.shape[0], "-n", "more --candidates")
+
+
 def _from_data(args: argparse.Namespace, table):
     """The measurements of ``--from`` (None when not given)."""
     if args.from_data is None:
@@ -271,7 +280,7 @@ def _run_identify(args: argparse.Namespace) -> int:
     space = _space(args)
     result = design_identify(
         space,
-        args.positions_count,
+        _positions_count(args, space),
         from_data=_from_data(args, space.table),
         noise_arcsec=args.noise_arcsec,
         dwell_s=args.dwell_s,
@@ -314,7 +323,7 @@ def _run_separate(args: argparse.Namespace) -> int:
     space = _space(args, pair)
     result = design_separate(
         space,
-        args.positions_count,
+        _positions_count(args, space),
         from_data=_from_data(args, space.table),
         amplitudes=amplitudes,
         noise_arcsec=args.noise_arcsec,
@@ -346,9 +355,10 @@ def _run_calibrate(args: argparse.Namespace) -> int:
                 f"design --calibrate: {option} is for identify and --separate; a GyroWheel "
                 "calibration design needs the table, its limits and -n only"
             )
+    space = _space(args, effects=())
     result = design_calibration(
-        _space(args, effects=()),
-        args.positions_count,
+        space,
+        _positions_count(args, space),
         accuracy_dph=args.accuracy_dph,
         min_efficiency=args.min_efficiency,
     )
@@ -381,11 +391,12 @@ def _run_separate_run(args: argparse.Namespace) -> int:
     if len(names) != 2:
         raise InputError(f"--separate takes two effects, A,B; got '{args.separate}'")
     space = _space(args, effects=())
+    count = _positions_count(args, space)
     run = read_run(args.run, deg_to_rad(args.latitude_deg), space.table)
     warn_ignored_columns(args, run, args.run)
     user = load_run_effects_modules(args.effects_module, run)
     result = design_run_separation(
-        run, tuple(names), deg_to_rad(space.candidates_deg), args.positions_count,
+        run, tuple(names), deg_to_rad(space.candidates_deg), count,
         seed=args.seed, catalogue=(*run_catalogue(space.table), *user),
     )  # fmt: skip
     out = {**result.to_dict(), "run": str(args.run)}

@@ -1,12 +1,16 @@
 """Reading numeric CSV tables with checks that name the file, row and column of every problem.
 
 Rows are counted as a spreadsheet shows them: the header is row 1, the first data row is row 2.
-Nothing is written; a file that fails a check raises :class:`InputError`.
+Nothing is written; a file that fails a check raises :class:`InputError`. A file is read only
+when it is a regular file of at most :data:`~turntable_pin.core.sizes.MAX_TABLE_FILE_BYTES`
+bytes, and only up to :data:`~turntable_pin.core.sizes.MAX_TABLE_ROWS` data rows of at most
+:data:`~turntable_pin.core.sizes.MAX_TABLE_COLUMNS` cells (:func:`read_lines`).
 """
 
 from __future__ import annotations
 
 import csv
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -15,6 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from .exceptions import InputError
+from .files import check_input_file
+from .sizes import MAX_TABLE_COLUMNS, MAX_TABLE_FILE_BYTES, MAX_TABLE_ROWS
 
 __all__ = [
     "CsvTable",
@@ -24,6 +30,7 @@ __all__ = [
     "missing_columns_words",
     "read_csv_table",
     "read_header",
+    "read_lines",
     "refuse_repeated_rows",
     "write_csv_table",
 ]
@@ -87,15 +94,70 @@ def read_header(path: str | Path) -> tuple[tuple[str, ...], int]:
     whole file (to choose which columns to ask for); ``((), 0)`` when the file is unreadable or
     empty, which :func:`read_csv_table` then reports."""
     try:
-        with Path(path).open(newline="", encoding="utf-8-sig") as handle:
+        path = check_input_file(path, "CSV", MAX_TABLE_FILE_BYTES)
+        with path.open(newline="", encoding="utf-8-sig") as handle:
             for row, line in enumerate(handle, start=1):
                 if line.strip() and not line.lstrip().startswith("#"):
                     return tuple(c.strip() for c in next(csv.reader([line]))), row
-    except (OSError, UnicodeDecodeError):
+    except (InputError, OSError, UnicodeDecodeError, csv.Error):
         pass
     return (), 0
 
 
+def read_lines(path: str | Path) -> list[tuple[int, str]]:
+    """The lines of the CSV file ``path`` that hold cells (blank and ``#`` lines left out), each
+    with its line number, header first.
+
+    Bounded before and while it reads: a regular file of at most ``MAX_TABLE_FILE_BYTES`` bytes
+    (:func:`~turntable_pin.core.files.check_input_file`), at most ``MAX_TABLE_ROWS`` data rows
+    and at most ``MAX_TABLE_COLUMNS`` cells a row (commas counted), so that no file, however its
+    lines are cut, holds more in memory than the largest table a command takes.
+
+    Raises:
+        InputError: naming the file (and the row where a bound is passed).
+    """
+    path = check_input_file(path, "CSV", MAX_TABLE_FILE_BYTES)
+    lines: list[tuple[int, str]] = []
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as handle:
+            for number, line in enumerate(handle, start=1):
+                if not line.strip() or line.lstrip().startswith("#"):
+                    continue
+                if line.count(",") >= MAX_TABLE_COLUMNS:
+                    raise InputError(
+                        f"more than {MAX_TABLE_COLUMNS:,} cells; a CSV table is read up to "
+                        f"{MAX_TABLE_COLUMNS:,} columns",
+                        path=path, row=number,
+                    )  # fmt: skip
+                if len(lines) > MAX_TABLE_ROWS:  # the header and MAX_TABLE_ROWS rows are in
+                    raise InputError(
+                        f"more than {MAX_TABLE_ROWS:,} data rows; a CSV table is read up to "
+                        f"{MAX_TABLE_ROWS:,}",
+                        path=path, row=number,
+                    )  # fmt: skip
+                lines.append((number, line))
+    except OSError as exc:
+        raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
+    except UnicodeDecodeError:
+        raise InputError("not a text (UTF-8) CSV file", path=path) from None
+    return lines
+
+
+def _csv_errors_named(read):
+    """``read`` (a reader whose first argument is the path) with the csv module's own errors (a
+    cell beyond its field size limit) said in one line naming the file."""
+
+    @functools.wraps(read)
+    def wrapper(path, *args, **kwargs):
+        try:
+            return read(path, *args, **kwargs)
+        except csv.Error as exc:
+            raise InputError(f"cannot read it as CSV: {exc}", path=path) from None
+
+    return wrapper
+
+
+@_csv_errors_named
 def read_csv_table(
     path: str | Path,
     required: Sequence[str],
@@ -124,14 +186,7 @@ def read_csv_table(
             required, a present optional or, with ``extra``, a numeric other column).
     """
     path = Path(path)
-    try:
-        with path.open(newline="", encoding="utf-8-sig") as handle:
-            lines = [(i, line) for i, line in enumerate(handle, start=1)]
-    except OSError as exc:
-        raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
-    except UnicodeDecodeError:
-        raise InputError("not a text (UTF-8) CSV file", path=path) from None
-    lines = [(i, line) for i, line in lines if line.strip() and not line.lstrip().startswith("#")]
+    lines = read_lines(path)
     if not lines:
         raise InputError("the file is empty (expected a header line)", path=path)
     # Without quotes a line's cells are its comma-separated fields: the header alone is parsed

@@ -1,5 +1,7 @@
 """Small I/O helpers shared by every layer: atomic writes that never leave half a file behind,
-and a YAML reader that refuses a key given twice."""
+the one check of an input file before it is read (a regular file, within the size its kind may
+have: :func:`check_input_file`), and a YAML reader that refuses a key given twice and a document
+whose aliases expand beyond :data:`~turntable_pin.core.sizes.MAX_YAML_VALUES` values."""
 
 from __future__ import annotations
 
@@ -10,10 +12,14 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
+from .sizes import MAX_YAML_FILE_BYTES, MAX_YAML_VALUES
+
 __all__ = [
+    "check_input_file",
     "output_target",
     "read_text_file",
     "read_yaml",
+    "read_yaml_lines",
     "write_atomic",
     "write_bytes_atomic",
     "write_text_atomic",
@@ -142,34 +148,122 @@ def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
     return write_atomic(path, lambda tmp: tmp.write_bytes(data))
 
 
-def read_text_file(path: str | Path, kind: str, encoding: str = "utf-8") -> str:
-    """The text of the file ``path``; an unreadable or non-UTF-8 file is an ``InputError``
-    naming it (``kind``: what the file should be, e.g. ``"YAML"``, for the message)."""
+_NOT_REGULAR = (
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISFIFO, "a named pipe"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def _megabytes(size: int) -> str:
+    return f"{size / 1e6:.4g} MB" if size < 1e9 else f"{size / 1e9:.4g} GB"
+
+
+def check_input_file(path: str | Path, kind: str, max_bytes: int) -> Path:
+    """``path`` (as a ``Path``) when it is a regular file (links followed) of at most ``max_bytes``
+    bytes; else :class:`InputError` naming it, before anything is read.
+
+    Every reader of an input file starts here. A device (``/dev/zero``), a pipe or a socket may
+    never end and cannot be read twice, and a file beyond the size its kind may have
+    (:mod:`~turntable_pin.core.sizes`) would fill the memory before any check of its contents: both
+    are refused, the size in the message. ``kind`` says what the file should be (``"CSV"``,
+    ``"YAML"``, ...), for the message.
+    """
     from .exceptions import InputError
 
     path = Path(path)
     try:
-        return path.read_text(encoding=encoding)
+        info = path.stat()
+    except OSError as exc:
+        raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
+    if stat.S_ISDIR(info.st_mode):
+        raise InputError(f"cannot read the file: it is a folder, not a {kind} file", path=path)
+    if not stat.S_ISREG(info.st_mode):
+        what = next((w for test, w in _NOT_REGULAR if test(info.st_mode)), "not a regular file")
+        raise InputError(
+            f"cannot read the file: it is {what}, not a {kind} file (give a regular file)",
+            path=path,
+        )
+    if info.st_size > max_bytes:
+        raise too_large(path, kind, max_bytes, info.st_size)
+    return path
+
+
+def too_large(path: str | Path, kind: str, max_bytes: int, size: int | None = None):
+    """The :class:`InputError` of a ``kind`` file larger than ``max_bytes`` (``size``: its size
+    in bytes, when known)."""
+    from .exceptions import InputError
+
+    has = f"{_megabytes(size)} ({size:,} bytes)" if size is not None else "larger"
+    return InputError(
+        f"the file is {has}; a {kind} file is read up to {_megabytes(max_bytes)}", path=path
+    )
+
+
+def read_text_file(
+    path: str | Path, kind: str, encoding: str = "utf-8", *, max_bytes: int = MAX_YAML_FILE_BYTES
+) -> str:
+    """The text of the file ``path``, checked first by :func:`check_input_file` (``max_bytes``:
+    the most its kind may have; never more is read); an unreadable or non-UTF-8 file is an
+    ``InputError`` naming it (``kind``: what the file should be, e.g. ``"YAML"``, for the
+    message). Newlines are universal, as with :meth:`Path.read_text`."""
+    from .exceptions import InputError
+
+    path = check_input_file(path, kind, max_bytes)
+    try:
+        with path.open(encoding=encoding) as handle:
+            text = handle.read(max_bytes + 1)  # a file that grew since, or says it is empty
     except OSError as exc:
         raise InputError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
     except UnicodeDecodeError:
         raise InputError(f"not a text (UTF-8) {kind} file", path=path) from None
+    if len(text) > max_bytes:
+        raise too_large(path, kind, max_bytes)
+    return text
 
 
 def read_yaml(path: str | Path):
     """Parse a YAML file; an unreadable file or invalid YAML raises :class:`InputError`.
 
     A key given twice in one mapping is refused, naming the file and the line of the second one
-    (plain YAML readers keep the last value and silently drop the first).
+    (plain YAML readers keep the last value and silently drop the first). The file may have at most
+    :data:`~turntable_pin.core.sizes.MAX_YAML_FILE_BYTES` bytes and its document at most
+    :data:`~turntable_pin.core.sizes.MAX_YAML_VALUES` values with its aliases expanded: an alias
+    is shared, never copied, but whoever walks the document walks it once per alias.
     """
+    return _load_yaml(path)[0]
+
+
+def read_yaml_lines(path: str | Path) -> tuple[object, dict[tuple, int]]:
+    """:func:`read_yaml`'s document and ``{key path: line}`` of its mapping keys and list items
+    (1-based lines; a key path is a tuple of keys and list indices, ``("terms", 0, "site")``).
+
+    Both come from one parse. The walk enters no value twice: the keys of a value reached through
+    an alias are listed once, under the path of its anchor.
+    """
+    data, node = _load_yaml(path)
+    return data, _key_lines(node)
+
+
+def _load_yaml(path: str | Path):
+    """The document of the YAML file ``path`` and its composed node (``None`` when empty)."""
     import yaml
 
     from .exceptions import InputError
 
     path = Path(path)
     text = read_text_file(path, "YAML")
+    loader = None
     try:
-        return yaml.load(text, Loader=_unique_key_loader())  # noqa: S506 (a SafeLoader)
+        loader = _unique_key_loader()(text)  # its reader refuses unprintable characters
+        node = loader.get_single_node()
+        if node is None:
+            return None, None
+        _check_values(node, path)
+        return loader.construct_document(node), node
+    except InputError:  # a ValueError, but said already
+        raise
     except _DuplicateKey as dup:
         raise InputError(
             f"key '{dup.key}' is given twice (first on line {dup.first_line}); give each key once",
@@ -180,6 +274,77 @@ def read_yaml(path: str | Path):
         raise InputError(f"not valid YAML: {str(exc).splitlines()[0]}", path=path) from None
     except (ValueError, OverflowError, RecursionError) as exc:  # e.g. a date 2020-13-45
         raise InputError(f"not valid YAML: {exc}", path=path) from None
+    finally:
+        if loader is not None:
+            loader.dispose()
+
+
+def _check_values(root, path: Path) -> None:
+    """Refuse a document of more than ``MAX_YAML_VALUES`` values with its aliases expanded, or
+    one that holds itself (an alias inside its own anchor). Counted on the composed nodes, each
+    once (an alias is the very node of its anchor): in time linear in the file."""
+    import yaml
+
+    from .exceptions import InputError
+
+    sizes: dict[int, int] = {}
+    inside: set[int] = set()
+
+    def size(node) -> int:
+        key = id(node)
+        if key in sizes:
+            return sizes[key]
+        if key in inside:
+            raise InputError(
+                "an alias (*name) inside the value it names: the document would contain itself",
+                path=path, line=node.start_mark.line + 1,
+            )  # fmt: skip
+        total = 1
+        if isinstance(node, yaml.CollectionNode):
+            inside.add(key)
+            pairs = node.value if isinstance(node, yaml.MappingNode) else ((c,) for c in node.value)
+            for pair in pairs:
+                total += sum(size(child) for child in pair)
+                if total > MAX_YAML_VALUES:
+                    raise InputError(
+                        f"more than {MAX_YAML_VALUES:,} values once its aliases (*name) are "
+                        "expanded; the YAML inputs of this package hold hundreds at most (use "
+                        "fewer aliases, or none)",
+                        path=path, line=node.start_mark.line + 1,
+                    )  # fmt: skip
+            inside.discard(key)
+        sizes[key] = total
+        return total
+
+    size(root)
+
+
+def _key_lines(root) -> dict[tuple, int]:
+    """``{key path: line}`` of the mapping keys and list items under ``root`` (1-based), each
+    node entered once."""
+    import yaml
+
+    lines: dict[tuple, int] = {}
+    entered: set[int] = set()
+
+    def walk(node, where: tuple) -> None:
+        if id(node) in entered:
+            return
+        entered.add(id(node))
+        if isinstance(node, yaml.MappingNode):
+            for key, value in node.value:
+                if isinstance(key, yaml.ScalarNode):
+                    here = (*where, key.value)
+                    lines.setdefault(here, key.start_mark.line + 1)
+                    walk(value, here)
+        elif isinstance(node, yaml.SequenceNode):
+            for i, item in enumerate(node.value):
+                lines.setdefault((*where, i), item.start_mark.line + 1)
+                walk(item, (*where, i))
+
+    if root is not None:
+        walk(root, ())
+    return lines
 
 
 class _DuplicateKey(Exception):

@@ -20,9 +20,18 @@ __all__ = [
     "MAX_MONTE_CARLO_TURNTABLES",
     "MAX_POSITIONS",
     "MAX_SIMULATED_ROWS",
+    "MAX_TABLE_COLUMNS",
+    "MAX_TABLE_FILE_BYTES",
+    "MAX_TABLE_ROWS",
+    "MAX_TPOINT_FILE_BYTES",
+    "MAX_TPOINT_OBSERVATIONS",
+    "MAX_URDF_FILE_BYTES",
+    "MAX_YAML_FILE_BYTES",
+    "MAX_YAML_VALUES",
     "MAX_TIME_S",
     "MIN_GRID_STEP_DEG",
     "check_count",
+    "check_positions_count",
     "turn_grid_count",
 ]
 
@@ -63,6 +72,45 @@ inner_encoder_harmonics --json`` peaked at 292 MB on 100,000 rows (2.9 KB a row,
 110 MB of interpreter and libraries); it was 4.6 KB a row with the dense per-factor gains."""
 
 
+# --- input files: refused before they are read (core.files.check_input_file) ----------------------
+MAX_TABLE_FILE_BYTES = 256_000_000
+"""Largest CSV file read (measurements, calibration runs, position lists), bytes. A measurement
+file of :data:`MAX_FITTED_ROWS` rows as ``simulate`` writes it (random angles, full-precision
+values, nine columns) is 113 MB; reading it takes about 4 s and 0.5 GB. The margin is for more
+columns (per-angle sigmas, a temperature log)."""
+
+MAX_TABLE_ROWS = MAX_FITTED_ROWS
+"""Most data rows of a CSV file (the most any command takes: a fit, a list of positions to
+simulate); counted while the file is read, so that short rows cannot pile up."""
+
+MAX_TABLE_COLUMNS = 1_000
+"""Most cells of a CSV row (header or data; a measurement file has about ten)."""
+
+MAX_TPOINT_FILE_BYTES = 16_000_000
+"""Largest TPOINT run file read, bytes: about 230,000 observations of 70 characters (pointing runs
+have hundreds to a few thousand), as many as a diagnosis takes rows."""
+
+MAX_TPOINT_OBSERVATIONS = MAX_DIAGNOSED_ROWS
+"""Most observations (data lines) of a TPOINT run, counted while it is read: lines of a few
+characters would otherwise put 2 million within ``MAX_TPOINT_FILE_BYTES`` (measured:
+``import-tpoint`` took 17 s and 820 MB over 2 million lines ``1 1 1 1``; with the count it stops
+at the 200,001st after 2.2 s and at most 260 MB)."""
+
+MAX_URDF_FILE_BYTES = 16_000_000
+"""Largest URDF file read, bytes (a turntable's URDF is a few kilobytes; a whole robot's, with its
+comments, well under a megabyte)."""
+
+MAX_YAML_FILE_BYTES = 1_000_000
+"""Largest YAML file read (errors, GyroWheel coefficients, lower bounds, effect files), bytes. The
+bundled ones are under 1 KB; the pure-Python YAML parser takes about 5 s a megabyte."""
+
+MAX_YAML_VALUES = 1_000_000
+"""Most values (scalars, lists and mappings) of a YAML document once its aliases are expanded: a
+document whose aliases nest ("a billion laughs") stays small as a file and as parsed, but grows
+without bound as soon as it is walked. Without aliases a file of ``MAX_YAML_FILE_BYTES`` holds
+fewer (a value takes at least two characters), so the limit only stops aliases."""
+
+
 def turn_grid_count(step_deg: float) -> int:
     """Number of grid angles ``0, step, ... < 360`` degrees (the grids of the package).
 
@@ -97,3 +145,29 @@ def check_count(count: float, limit: int, what: str, bytes_each: float = 0.0) ->
         shown = f"{count:,.0f}" if math.isfinite(count) and count < 1e18 else f"{count:.3g}"
         raise InputError(f"{shown} {what} would be needed{need}; at most {limit:,} are accepted")
     return int(count)
+
+
+def check_positions_count(
+    n_positions, available: int, name: str = "n_positions", more: str = "more candidates"
+) -> int:
+    """``n_positions`` as an int when it is a whole number from 1 to ``available``, the candidate
+    positions a design chooses among (each at most once); checked before any work, since a design
+    costs time with every position it chooses.
+
+    Raises:
+        InputError: naming the argument ``name`` (the command line says ``-n``) and how to choose
+            more (``more``: ``"more --candidates"`` on the command line).
+    """
+    import numbers
+
+    if isinstance(n_positions, bool) or not isinstance(n_positions, numbers.Integral):
+        raise InputError(f"{name} must be a whole number of positions, got {n_positions!r}")
+    count = int(n_positions)
+    if count < 1:
+        raise InputError(f"{name} must be at least 1, got {count}")
+    if count > available:
+        raise InputError(
+            f"{name} is {count:,}, more than the {available:,} candidate positions a design "
+            f"chooses among (each once); ask for fewer, or give {more}"
+        )
+    return count

@@ -457,9 +457,12 @@ def design_calibration(
     Raises:
         IdentifiabilityError: no position within the limits turns gravity so as to calibrate
             (e.g. a table that keeps gravity in a plane of the payload).
-        InputError: N below 7 or no grid of N to compare with; a precision floor no design
-            reaches.
+        InputError: N above the candidates of ``space`` (checked first), N below 7 or no grid
+            of N to compare with; a precision floor no design reaches.
     """
+    from ..core.sizes import check_positions_count
+
+    n_positions = check_positions_count(n_positions, space.candidates_deg.shape[0])
     accuracy_dph = check_accuracy_dph(accuracy_dph)
     if int(n_positions) < N_COEFFICIENTS:
         raise InputError(

@@ -386,14 +386,17 @@ def design_identify(
         dwell_s: time between measurements, seconds (the plan's ``time_s``).
 
     Raises:
-        InputError: no candidate where the effects are defined; fewer positions than the
-            combinations need; an effect that no position within the limits can see; positions
-            that cannot determine every combination.
+        InputError: ``n_positions`` not from 1 to the candidates (checked first); no candidate
+            where the effects are defined; fewer positions than the combinations need; an
+            effect that no position within the limits can see; positions that cannot determine
+            every combination.
     """
     from ..core.blas_threads import one_blas_thread
+    from ..core.sizes import check_positions_count
 
+    n_positions = check_positions_count(n_positions, space.candidates_deg.shape[0])
     with one_blas_thread():  # tall-by-small products: many threads on busy cores only wait
-        return _design_identify(space, int(n_positions), from_data, noise_arcsec, dwell_s)
+        return _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s)
 
 
 def _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s) -> IdentifyDesign:

@@ -493,15 +493,18 @@ def design_separate(
             given for.
 
     Raises:
-        InputError: not two distinct effects; an effect with neither an amplitude nor data to
+        InputError: ``n_positions`` not from 1 to the candidates (checked first); not two
+            distinct effects; an effect with neither an amplitude nor data to
             fit it on; an effect whose prediction no position within the limits sees beyond the
             base errors; more positions than candidates.
     """
     from ..core.blas_threads import one_blas_thread
+    from ..core.sizes import check_positions_count
 
+    n_positions = check_positions_count(n_positions, space.candidates_deg.shape[0])
     with one_blas_thread():  # tall-by-small products: many threads on busy cores only wait
         return _design_separate(
-            space, int(n_positions), from_data, amplitudes, noise_arcsec, dwell_s, target
+            space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s, target
         )
 
 

@@ -128,9 +128,17 @@ def design_run_separation(
     catalogue=None,
 ) -> RunSeparation:  # fmt: skip
     """The ``n`` positions among ``candidates_rad`` (C, J) that best tell the run effects
-    ``names`` apart (module docstring), each at the amplitude ``run`` fits it with."""
+    ``names`` apart (module docstring), each at the amplitude ``run`` fits it with.
+
+    Raises:
+        InputError: ``n`` not from 1 to C (checked first: each candidate is chosen at most once);
+            an unknown effect, the same one twice, one the run does not see.
+    """
     from ..calibration.positions import PositionSet, position_inputs
     from ..calibration.run import CalibrationRun
+    from ..core.sizes import check_positions_count
+
+    n = check_positions_count(n, len(candidates_rad), "n")
 
     family = RunFamily(run, catalogue)
     known = {e.name: e for e in family.catalogue}
@@ -172,7 +180,6 @@ def design_run_separation(
 
     directions = [direction(fit_a, a, b), direction(fit_b, b, a)]
     before = tuple(float(d.misfit(np.zeros(0, int))) for d in directions)
-    n = min(int(n), len(positions))
     exchange = t_optimal_exchange(directions, n, seed=seed)
     after = tuple(float(v) for v in exchange.noncentralities)
     scales = [float(np.sum(d.signal[exchange.chosen] ** 2)) for d in directions]

@@ -231,10 +231,18 @@ def temperature_profile(
 
 def random_positions(n: int, table, seed: int) -> PositionSet:
     """``n`` positions uniform over every joint's turn [0, 360) deg (rounded to 1e-6 deg), drawn
-    from their own stream of ``seed`` (not the noise's)."""
+    from their own stream of ``seed`` (not the noise's).
+
+    Raises:
+        InputError: ``n`` below 1 or above ``MAX_POSITIONS`` (checked before anything is drawn).
+    """
+    from ..calibration.positions import POSITION_BYTES
+    from ..core.sizes import MAX_POSITIONS, check_count
+
     seed = check_seed(seed)
     if n < 1:
         raise InputError(f"random positions: expected N >= 1, got {n}")
+    check_count(n, MAX_POSITIONS, "random positions of a calibration run", POSITION_BYTES)
     rng = np.random.default_rng([seed, 1])
     angles = np.round(rng.uniform(0.0, 360.0, (int(n), len(table.joint_names))), 6)
     return PositionSet(deg_to_rad(angles), table=table, name=f"random:{n}")

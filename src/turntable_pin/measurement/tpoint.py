@@ -61,6 +61,7 @@ import numpy as np
 from ..core.csv_table import first_repeated_row
 from ..core.exceptions import InputError
 from ..core.files import read_text_file, write_text_atomic
+from ..core.sizes import MAX_TPOINT_FILE_BYTES, MAX_TPOINT_OBSERVATIONS
 from ..core.units import ARCSEC_PER_RAD
 from .data import MAX_MEASURED_ANGLE_ARCSEC
 
@@ -333,7 +334,9 @@ def read_tpoint(
             states another origin ("North = 0") or direction ("West = 90") is refused.
 
     Raises:
-        InputError: naming the file and line of the first problem.
+        InputError: naming the file and line of the first problem; a file that is not a regular
+            one of at most ``MAX_TPOINT_FILE_BYTES`` (16 MB), or that holds more than
+            ``MAX_TPOINT_OBSERVATIONS`` (200,000) observations.
     """
     path = Path(path)
     if mount is not None and mount not in MOUNTS:
@@ -343,7 +346,7 @@ def read_tpoint(
             f"azimuth convention '{azimuth_origin}, {azimuth_direction}': expected origin "
             f"{'|'.join(AZIMUTH_ORIGINS)} and direction {'|'.join(AZIMUTH_DIRECTIONS)}"
         )
-    text = read_text_file(path, "TPOINT", encoding="utf-8-sig")
+    text = read_text_file(path, "TPOINT", encoding="utf-8-sig", max_bytes=MAX_TPOINT_FILE_BYTES)
 
     caption = None
     options: list[str] = []
@@ -442,6 +445,13 @@ def read_tpoint(
             continue
         kind = file_mount or mount
         expected = _RECORD_NUMBERS[kind]
+        if len(lines) >= MAX_TPOINT_OBSERVATIONS:
+            raise InputError(
+                f"more than {MAX_TPOINT_OBSERVATIONS:,} observations; a TPOINT run is read up to "
+                f"{MAX_TPOINT_OBSERVATIONS:,} (as many as a diagnosis takes rows)",
+                path=path,
+                line=number,
+            )
         if len(tokens) != expected:
             raise InputError(
                 f"expected {expected} numbers ({_RECORD_LAYOUT[kind]}), got {len(tokens)} fields",

@@ -36,6 +36,7 @@ __all__ = [
     "installed_effects",
     "load_catalogue",
     "load_effects_module",
+    "MAX_EFFECT_TERMS",
     "load_effects_modules",
     "read_effect_file",
     "resolve_effects",
@@ -48,31 +49,11 @@ EFFECT_FILE_KEYS = ("format", "name", "title", "explanation", "confirm", "terms"
 TERM_KEYS = ("site", "harmonics", "polynomial", "sign", "of", "prefix")
 """The keys of a term of an effect file (``site`` and one of harmonics/polynomial/sign)."""
 EFFECT_FILE_SUFFIXES = (".yaml", ".yml")
+MAX_EFFECT_TERMS = 100
+"""Most terms of one effect file. An effect is one physical story (a few terms: a harmonic of
+two sites, a drift and its sign); each term may bring up to 200 parameters, and every fit and
+diagnosis carries them all."""
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_.@-]*$")
-
-
-def _key_lines(path: Path) -> dict[tuple, int]:
-    """``{key path: line}`` of every mapping key and list item of a YAML file (1-based)."""
-    import yaml
-
-    lines: dict[tuple, int] = {}
-
-    def walk(node, where):
-        if isinstance(node, yaml.MappingNode):
-            for key, value in node.value:
-                here = (*where, key.value)
-                lines[here] = key.start_mark.line + 1
-                walk(value, here)
-        elif isinstance(node, yaml.SequenceNode):
-            for i, item in enumerate(node.value):
-                lines[(*where, i)] = item.start_mark.line + 1
-                walk(item, (*where, i))
-
-    try:
-        walk(yaml.compose(path.read_text(encoding="utf-8"), Loader=yaml.SafeLoader), ())
-    except (yaml.YAMLError, OSError, UnicodeDecodeError):
-        pass
-    return lines
 
 
 def _key_text(where: tuple) -> str:
@@ -86,18 +67,19 @@ def read_effect_file(path: str | Path, turntable=None) -> Effect:
     """The effect declared in the YAML file ``path`` for ``turntable`` (default: the paper's).
 
     Raises:
-        InputError: unreadable or invalid YAML, a key given twice, an unknown or missing key, a
-            bad value; one line naming the file, the line and the key.
+        InputError: unreadable or invalid YAML (:func:`~turntable_pin.core.files.read_yaml`:
+            a file of at most 1 MB), a key given twice, an unknown or missing key, a bad value,
+            more than :data:`MAX_EFFECT_TERMS` terms; one line naming the file, the line and the
+            key.
     """
-    from ..core.files import read_yaml
+    from ..core.files import read_yaml_lines
     from .effect_terms import EffectTerm, parse_term
     from .effects.declared import DeclaredEffect
     from .table import measured_table
 
     path = Path(path)
     table = measured_table(turntable)
-    doc = read_yaml(path)
-    lines = _key_lines(path)
+    doc, lines = read_yaml_lines(path)
 
     def fail(where: tuple, message: str):
         key = _key_text(where)
@@ -128,6 +110,10 @@ def read_effect_file(path: str | Path, turntable=None) -> Effect:
     items = doc["terms"]
     if not isinstance(items, list) or not items:
         raise fail(("terms",), "expected a list of at least one term")
+    if len(items) > MAX_EFFECT_TERMS:
+        raise fail(("terms",), f"{len(items):,} terms; an effect file holds at most "
+                               f"{MAX_EFFECT_TERMS} (one physical effect; write several files "
+                               "for several effects)")  # fmt: skip
     terms = []
     for i, item in enumerate(items):
         where = ("terms", i)
@@ -171,14 +157,22 @@ def read_effect_file(path: str | Path, turntable=None) -> Effect:
             terms.append(term.check(table))
         except InputError as exc:
             raise fail(where, exc.detail) from None
-    names = [s.name for t in terms for s in t.parameters()]
-    twice = sorted({n for n in names if names.count(n) > 1})
+    twice = _repeated(s.name for t in terms for s in t.parameters())
     if twice:
         raise fail(("terms",), f"parameter(s) {', '.join(twice)} would be defined twice; give "
                                "the terms different 'prefix' values (e.g. x_, z_)")  # fmt: skip
     return DeclaredEffect(story["name"], terms, title=story["title"],
                           explanation=story["explanation"], confirm=story["confirm"],
                           source=str(path))  # fmt: skip
+
+
+def _repeated(names: Iterable[str]) -> list[str]:
+    """The names that occur more than once, sorted (in time linear in their number)."""
+    seen: set[str] = set()
+    twice: set[str] = set()
+    for name in names:
+        (twice if name in seen else seen).add(name)
+    return sorted(twice)
 
 
 def _file_orders(value, shape: str) -> tuple[int, ...] | str:
@@ -189,7 +183,11 @@ def _file_orders(value, shape: str) -> tuple[int, ...] | str:
     if shape == "polynomial":
         if isinstance(value, bool) or not isinstance(value, int):
             return f"expected the degree, a whole number 1..{MAX_POLYNOMIAL_DEGREE}"
-        return tuple(range(1, value + 1)) if value >= 1 else "the degree must be >= 1"
+        if value < 1:
+            return "the degree must be >= 1"
+        if value > MAX_POLYNOMIAL_DEGREE:  # before a range of that many powers
+            return f"polynomial degree {value}: expected 1..{MAX_POLYNOMIAL_DEGREE}"
+        return tuple(range(1, value + 1))
     if isinstance(value, str):
         try:
             return _orders(value.strip(), "orders")

@@ -33,6 +33,8 @@ from pathlib import Path
 import numpy as np
 
 from ..core.exceptions import InputError, ModelError
+from ..core.files import check_input_file
+from ..core.sizes import MAX_URDF_FILE_BYTES
 from .angles import ANGLE_ENTRIES
 from .chain import (
     ROTATION,
@@ -244,8 +246,9 @@ class GenericTable:
         import pinocchio as pin
 
         path = Path(urdf_path)
-        if not path.is_file():
+        if not path.exists():
             raise InputError("no such URDF file", path=path)
+        check_input_file(path, "URDF", MAX_URDF_FILE_BYTES)
         root = _check_urdf_text(path)
         self.declared_mount = read_mount_declaration(root, path)
         self.telescope_mount = resolve_mount(self.declared_mount, telescope_mount)

@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from ..core.exceptions import InputError, ModelError
-from ..core.files import write_atomic
+from ..core.files import check_input_file, write_atomic
+from ..core.sizes import MAX_URDF_FILE_BYTES
 from .chain import ErrorChain
 
 __all__ = ["YourdfpyTurntable", "write_error_urdf"]
@@ -21,6 +22,7 @@ __all__ = ["YourdfpyTurntable", "write_error_urdf"]
 def _load_yourdfpy(path: str | Path):
     import yourdfpy
 
+    check_input_file(path, "URDF", MAX_URDF_FILE_BYTES)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
