@@ -91,21 +91,23 @@ def test_a_distinct_output_is_written(tmp_path):
 
 
 @pytest.mark.parametrize(
-    "argv, what",
+    "argv, what, limit",
     [
-        (["simulate", "--phi1-step-deg", "1e-3", "-o", "{out}"], "rows of simulated"),
-        (["rate-error", "--positions", "grid:0.1", "--dpsi-deg", "0.01"], "positions"),
-        (["rate-error", "--positions", "grid:1e-300", "--dpsi-deg", "0.01"], "positions"),
-        (["requirement", "--positions", "grid:0.5"], "positions"),
-        (["montecarlo", "-n", "1000000000000", "--seed", "1"], "random turntables"),
+        (["simulate", "--phi1-step-deg", "1e-3", "-o", "{out}"], "rows of simulated", "at most"),
+        (["rate-error", "--positions", "grid:0.1", "--dpsi-deg", "0.01"], "positions", "at most"),
+        # below the finest grid step there is no count to estimate: the step itself is refused
+        (["rate-error", "--positions", "grid:1e-300", "--dpsi-deg", "0.01"], "grid:1e-300",
+         "grid step must be in [1e-06, 360] degrees"),
+        (["requirement", "--positions", "grid:0.5"], "positions", "at most"),
+        (["montecarlo", "-n", "1000000000000", "--seed", "1"], "random turntables", "at most"),
     ],
-)
-def test_runaway_sizes_are_refused_up_front_with_what_they_need(tmp_path, argv, what):
+)  # fmt: skip
+def test_runaway_sizes_are_refused_up_front_with_what_they_need(tmp_path, argv, what, limit):
     out = tmp_path / "never.csv"
     proc = cli(*[str(out) if a == "{out}" else a for a in argv])
     assert proc.returncode == 2, proc.stderr
     line = proc.stderr.strip()
-    assert "\n" not in line and what in line and "at most" in line
+    assert "\n" not in line and what in line and limit in line
     assert not out.exists()
 
 
