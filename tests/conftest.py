@@ -142,6 +142,16 @@ REPORT_FIGURE_MODULES = (
 """The report modules that save figures (each through its own name of ``figures.save_png``)."""
 
 
+def refused(proc: subprocess.CompletedProcess, *words: str) -> str:
+    """Assert a command ended with exit status 2 and one line on stderr, no traceback, holding
+    every one of ``words``; the line."""
+    assert proc.returncode == 2, (proc.returncode, proc.stdout[-300:], proc.stderr[-2000:])
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert all(w in lines[0] for w in words), lines[0]
+    return lines[0]
+
+
 @pytest.fixture
 def drawn_figures(monkeypatch) -> list:
     """Every matplotlib figure the report modules save while this fixture is active, in order

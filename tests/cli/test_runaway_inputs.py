@@ -15,7 +15,7 @@ import time
 
 import pytest
 
-from conftest import EXAMPLES_DIR, cli, cli_env
+from conftest import EXAMPLES_DIR, cli, cli_env, refused
 from runaway import time_limit
 
 RUN = EXAMPLES_DIR / "runs" / "run_clean.csv"
@@ -32,15 +32,6 @@ def laughs(folder, levels: int = 9, name: str = "laughs.yaml"):
     path = folder / name
     path.write_text("\n".join(lines) + "\n")
     return path
-
-
-def _one_line(proc, *words):
-    assert proc.returncode == 2, (proc.returncode, proc.stderr)
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1, proc.stderr
-    for word in words:
-        assert word in lines[0], lines[0]
-    return lines[0]
 
 
 # (command line, {zero} standing for a link to /dev/zero with the suffix the option wants)
@@ -74,7 +65,7 @@ def test_every_reader_refuses_a_device_before_reading_it(tmp_path, argv):
         args.append(a.replace("{out}", str(tmp_path / "out")))
     with time_limit(20):  # it read /dev/zero until the memory ran out
         proc = cli(*args)
-    line = _one_line(proc, "cannot read the file: it is a character device", str(zero))
+    line = refused(proc, "cannot read the file: it is a character device", str(zero))
     assert "(give a regular file)" in line
     assert not any(p.name.startswith("out") for p in tmp_path.iterdir())
 
@@ -96,7 +87,7 @@ def test_a_billion_laughs_effect_file_is_refused_at_once(tmp_path, argv):
     args = [str(path) if a == "{laughs}" else str(out) if a == "{out}" else a for a in argv]
     with time_limit(20):
         proc = cli(*args)
-    _one_line(proc, str(path), "more than 1,000,000 values once its aliases")
+    refused(proc, str(path), "more than 1,000,000 values once its aliases")
     assert not out.exists()
 
 
@@ -127,7 +118,7 @@ def test_design_checks_n_against_the_candidates_before_any_work(argv, shown):
     # --separate --run -n 1000000 returned all 10,144 candidates after 90 s.
     with time_limit(20):
         proc = cli(*argv)
-    line = _one_line(proc)
+    line = refused(proc)
     assert line.endswith(
         f"error: -n is {shown}, more than the 10,144 candidate positions a design chooses among "
         "(each once); ask for fewer, or give more --candidates"
@@ -138,7 +129,7 @@ def test_simulate_run_checks_its_random_positions_before_drawing_them(tmp_path):
     out = tmp_path / "run.csv"
     with time_limit(20):  # it allocated 16 GB of angles first
         proc = cli("simulate", "--run", "--random-positions", "1000000000", "-o", str(out))
-    line = _one_line(proc)
+    line = refused(proc)
     assert "1,000,000,000 random positions of a calibration run would be needed" in line
     assert "at most 200,000 are accepted" in line and not out.exists()
 
@@ -149,7 +140,7 @@ def test_a_huge_input_file_is_refused_with_its_size(tmp_path):
         handle.truncate(200_000_000)
     with time_limit(20):
         proc = cli("import-tpoint", str(tpoint), "-o", str(tmp_path / "out.csv"))
-    line = _one_line(proc)
+    line = refused(proc)
     assert line.endswith(
         "the file is 200 MB (200,000,000 bytes); a TPOINT file is read up to 16 MB"
     )

@@ -5,7 +5,7 @@ catalogued one is refused, naming both definitions."""
 
 import pytest
 
-from conftest import EXAMPLES_DIR, REPO_DIR, cli, write_file
+from conftest import EXAMPLES_DIR, REPO_DIR, cli, refused, write_file
 from effect_modules import (
     ORIENTATION_PARAMETERS,
     ORIENTATION_TERMS,
@@ -59,14 +59,6 @@ ORIENTATION_COMMANDS = {
 }
 
 
-def _one_line(proc, *words):
-    assert proc.returncode == 2, (proc.returncode, proc.stdout[-300:], proc.stderr[-2000:])
-    lines = proc.stderr.splitlines()
-    assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
-    assert all(w in lines[0] for w in words), lines[0]
-    return lines[0]
-
-
 @pytest.mark.parametrize("command", RUN_COMMANDS)
 @pytest.mark.parametrize("break_", RUN_BREAKS)
 def test_a_broken_run_effect_module_is_one_line(tmp_path, command, break_):
@@ -75,7 +67,7 @@ def test_a_broken_run_effect_module_is_one_line(tmp_path, command, break_):
     args = [*RUN_COMMANDS[command], "--effects-module", str(module)]
     if command.startswith("design"):
         args += ["-o", str(out)]
-    line = _one_line(cli(*args), str(module), "effect 'cable_drag' (class CableDrag)")
+    line = refused(cli(*args), str(module), "effect 'cable_drag' (class CableDrag)")
     assert ("raised ValueError: oops" in line) == (break_ == "raises")
     assert not out.exists()
 
@@ -84,7 +76,7 @@ def test_a_broken_run_effect_module_is_one_line(tmp_path, command, break_):
 @pytest.mark.parametrize("break_", ORIENTATION_BREAKS)
 def test_a_broken_orientation_effect_module_is_one_line(tmp_path, command, break_):
     module = write_file(tmp_path, orientation_module(*ORIENTATION_BREAKS[break_]), "lobes.py")
-    line = _one_line(cli(*ORIENTATION_COMMANDS[command], str(module)), str(module),
+    line = refused(cli(*ORIENTATION_COMMANDS[command], str(module)), str(module),
                      "effect 'lobes' (class Lobes)")  # fmt: skip
     if break_ == "raises":
         assert f"{module}, line 15: " in line and "raised ValueError: oops" in line
@@ -93,7 +85,7 @@ def test_a_broken_orientation_effect_module_is_one_line(tmp_path, command, break
 def test_the_traceback_only_on_request(tmp_path, monkeypatch):
     module = write_file(tmp_path, orientation_module(terms="raise ValueError('oops')"), "lobes.py")
     args = ["fit", str(DATA), "--effects", "lobes", "--effects-module", str(module)]
-    line = _one_line(cli(*args), "TURNTABLE_PIN_TRACEBACK=1 shows the traceback")
+    line = refused(cli(*args), "TURNTABLE_PIN_TRACEBACK=1 shows the traceback")
     monkeypatch.setenv("TURNTABLE_PIN_TRACEBACK", "1")
     proc = cli(*args)
     assert proc.returncode == 2 and proc.stderr.splitlines()[-1] == line
@@ -109,7 +101,7 @@ def test_a_module_that_calls_sys_exit_at_import_is_refused(tmp_path, command):
         "diagnose": ["diagnose", str(DATA), "--catalogue", str(module)],
         "calibrate": ["calibrate", str(RUN), "--diagnose", "--effects-module", str(module)],
     }[command]
-    _one_line(cli(*args), f"{module}, line 3: cannot import it: it called sys.exit(0) while being "
+    refused(cli(*args), f"{module}, line 3: cannot import it: it called sys.exit(0) while being "
               "imported")  # fmt: skip
 
 
@@ -123,7 +115,7 @@ def test_a_run_effect_named_like_a_catalogued_one_no_longer_relabels_the_side(tm
     module = write_file(tmp_path, run_module(name="bias_drift"), "drift.py")
     proc = cli("calibrate", str(EXAMPLES_DIR / "runs" / "run_bias_drift.csv"), "--diagnose",
                "--effects-module", str(module))  # fmt: skip
-    _one_line(proc, f"{module} (class CableDrag): effect 'bias_drift' is already in the "
+    refused(proc, f"{module} (class CableDrag): effect 'bias_drift' is already in the "
               "catalogue (turntable_pin.instrument.effects.bias_drift.BiasDrift)")  # fmt: skip
 
 
@@ -132,14 +124,14 @@ def test_orientation_effects_of_one_name_are_refused_naming_both(tmp_path, where
     module = write_file(tmp_path, orientation_module(name="backlash"), "lobes.py")
     if where == "module":
         proc = cli("fit", str(DATA), "--effects-module", str(module), "--effects", "backlash")
-        _one_line(proc, f"{module} (class Lobes): effect 'backlash' is already in the catalogue")
+        refused(proc, f"{module} (class Lobes): effect 'backlash' is already in the catalogue")
         return
     mine = write_file(tmp_path, orientation_module(), "mine.py")
     yaml = write_file(tmp_path, "name: lobes\nterms: [dphi_z2~h3(phi2)]\n", "lobes.yaml")
     proc = cli("diagnose", str(DATA), "--catalogue", str(yaml), "--catalogue", str(mine))
-    _one_line(proc, f"{mine} (class Lobes): effect 'lobes' is also defined by {yaml}, line 1")
+    refused(proc, f"{mine} (class Lobes): effect 'lobes' is also defined by {yaml}, line 1")
     proc = cli("fit", str(DATA), "--effects-module", str(mine), "--effects", str(yaml))
-    _one_line(proc, f"{yaml}, line 1: effect 'lobes' is also defined by {mine} (class Lobes)")
+    refused(proc, f"{yaml}, line 1: effect 'lobes' is also defined by {mine} (class Lobes)")
 
 
 def test_the_docs_and_the_help_say_a_module_is_code_that_runs():

@@ -30,6 +30,7 @@ from ...measurement.effects.contract import (
     described,
     effect_file,
     effect_label,
+    numbers_returned,
 )
 from .base import INSTRUMENT, TABLE, ParameterSpec, RunContext, RunEffect
 
@@ -71,11 +72,8 @@ def check_run_effect(
     columns = call_user(f"{label}: columns(context) on {on}", effect.columns, context, path=path)
     expected = (f"an array of shape ({n}, 2, {len(specs)}): d(out_x, out_y)/d(parameter) at each "
                 f"of the {n} positions for its {len(specs)} parameter(s)")  # fmt: skip
-    try:
-        array = np.asarray(columns)
-    except Exception:  # an object numpy cannot read: reported as what it is
-        array = np.asarray(None)
-    if array.dtype.kind not in "biuf":
+    array = numbers_returned(columns)
+    if array is None:
         raise contract_error(
             effect,
             f"columns(context) returned {described(columns)} on {on}; expected {expected}",

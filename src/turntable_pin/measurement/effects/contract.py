@@ -42,6 +42,7 @@ __all__ = [
     "contract_error",
     "described",
     "effect_file",
+    "numbers_returned",
     "effect_label",
     "probe_variables",
 ]
@@ -86,6 +87,16 @@ def described(value) -> str:
     text = repr(value)
     text = text if len(text) <= 60 else text[:57] + "..."
     return f"{type(value).__name__} {text}"
+
+
+def numbers_returned(value) -> np.ndarray | None:
+    """What the user's code returned as a numeric array, or ``None`` when it is not numbers
+    (text, objects, an object numpy cannot read)."""
+    try:
+        array = np.asarray(value)
+    except Exception:  # an object numpy cannot read: reported as what it is by the caller
+        return None
+    return array if array.dtype.kind in "biuf" else None
 
 
 def check_story(effect, base: type) -> None:
@@ -221,11 +232,8 @@ def _check_site(effect, term: ChainTerm, where: str, base_names) -> None:
 def _check_weight(effect, value, where: str, n: int, on: str) -> None:
     """One weight: a finite number, or a finite array of shape (n,)."""
     expected = f"a number or an array of shape ({n},), one value per position"
-    try:
-        array = np.asarray(value)
-    except Exception:  # an object numpy cannot read: reported as what it is
-        array = np.asarray(None)
-    if array.dtype.kind not in "biuf":
+    array = numbers_returned(value)
+    if array is None:
         raise contract_error(
             effect,
             f"{where} is {described(value)} on {on}; expected {expected}",
