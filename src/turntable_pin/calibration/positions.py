@@ -31,6 +31,7 @@ import numpy as np
 from ..core.csv_table import CsvTable, closest_column_hint, read_csv_table
 from ..core.exceptions import InputError
 from ..core.sizes import MAX_POSITIONS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
+from ..core.turn_grid import full_turn_grid_deg
 from ..core.units import deg_to_rad, rad_to_deg
 from ..model.paper_table import is_paper_table, paper_table
 from .site import DEFAULT_LATITUDE_DEG, MAX_LATITUDE_DEG  # noqa: F401  (re-exported)
@@ -105,9 +106,7 @@ def grid_angles_deg(steps_deg: Sequence[float]) -> tuple[np.ndarray, str]:
     for step in steps_deg:
         count *= float(turn_grid_count(step))
     check_count(count, MAX_POSITIONS, f"positions of {name}", POSITION_BYTES)
-    axes = [np.arange(0.0, 360.0 - 1e-9, s) for s in steps_deg]
-    mesh = np.meshgrid(*axes, indexing="ij")
-    return np.stack([m.ravel() for m in mesh], axis=1), name
+    return full_turn_grid_deg(*steps_deg), name
 
 
 @dataclass(frozen=True, init=False)

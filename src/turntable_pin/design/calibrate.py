@@ -53,6 +53,7 @@ from ..calibration.requirement import (
 from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.turn_grid import every_combination, full_turn_grid_deg
 from ..core.units import DEG_PER_RAD
 from ..model.angles import ANGLE_SYMBOLS
 from ..stats.design import d_optimal_design, fedorov_exchange, log_det
@@ -99,7 +100,7 @@ def _evenly_spaced_deg(joint_range, count: int) -> np.ndarray:
     """``count`` angles evenly spaced over a joint's range: a full turn in steps of
     ``360/count`` from its start, a limited range from end to end (its middle for one)."""
     if joint_range.full_turn:
-        return joint_range.low_deg + np.arange(count) * (360.0 / count)
+        return full_turn_grid_deg(360.0 / count, starts_deg=(joint_range.low_deg,))[:, 0]
     if count == 1:
         return np.array([0.5 * (joint_range.low_deg + joint_range.high_deg)])
     return np.linspace(joint_range.low_deg, joint_range.high_deg, count)
@@ -124,8 +125,7 @@ def comparison_grid(
         if all(r.full_turn and r.low_deg == 0.0 for r in ranges):
             grid = PositionSet.grid(*(360.0 / c for c in shape), table=space.table)
         else:
-            mesh = np.meshgrid(*axes, indexing="ij")
-            angles = np.stack([m.ravel() for m in mesh], axis=1) / DEG_PER_RAD
+            angles = every_combination(axes) / DEG_PER_RAD
             name = "x".join(str(c) for c in shape) + " evenly spaced within the limits"
             grid = PositionSet(angles, table=space.table, name=name)
         tried.append(grid.name)

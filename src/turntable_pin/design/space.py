@@ -22,6 +22,7 @@ import numpy as np
 
 from ..core.exceptions import InputError, check_seed
 from ..core.sizes import check_count
+from ..core.turn_grid import RANDOM_ROUND_DECIMALS, every_combination, full_turn_grid_deg
 from ..core.units import DEG_PER_RAD
 from .schedule import Visits, candidate_visits
 
@@ -48,9 +49,6 @@ MAX_CANDIDATES = 200_000
 CANDIDATE_BYTES = 4_000
 """Memory of one candidate while a design runs (its Jacobian rows and their products), bytes."""
 
-_ROUND_DEG = 6
-"""Candidate angles are rounded to 1e-6 deg (a CSV holds them exactly)."""
-
 
 @dataclass(frozen=True)
 class JointRange:
@@ -74,7 +72,7 @@ class JointRange:
         """The multiples of ``step_deg`` within the range (a full turn: [0, 360)); a range that
         holds none gives its two ends (its one angle when they are equal)."""
         if self.full_turn:
-            return np.arange(0.0, 360.0 - 1e-9, step_deg)
+            return full_turn_grid_deg(step_deg)[:, 0]
         first = math.ceil(self.low_deg / step_deg - 1e-9)
         last = math.floor(self.high_deg / step_deg + 1e-9)
         if last >= first:
@@ -84,7 +82,7 @@ class JointRange:
     def draw_deg(self, rng: np.random.Generator, count: int) -> np.ndarray:
         """``count`` angles uniform in the range, rounded to 1e-6 deg."""
         high = self.low_deg + 360.0 if self.full_turn else self.high_deg
-        return np.round(rng.uniform(self.low_deg, high, count), _ROUND_DEG)
+        return np.round(rng.uniform(self.low_deg, high, count), RANDOM_ROUND_DECIMALS)
 
     def describe(self) -> str:
         """``outer_axis (phi1): full turn`` or ``elevation (phi2): 0 .. 90 deg (urdf)``."""
@@ -305,8 +303,7 @@ def design_space(
     ranges = joint_ranges(table, limits_deg)
     rng = np.random.default_rng(seed)
     drawn = np.stack([r.draw_deg(rng, candidates) for r in ranges], axis=1)
-    axes = np.meshgrid(*(r.grid_deg() for r in ranges), indexing="ij")
-    grid = np.stack([a.ravel() for a in axes], axis=1)
+    grid = every_combination([r.grid_deg() for r in ranges])
     check_count(grid.shape[0], MAX_CANDIDATES, "grid positions", CANDIDATE_BYTES)
     all_deg = np.concatenate([drawn, grid])
     visits = candidate_visits(

@@ -42,6 +42,7 @@ from ..core.csv_table import write_csv_table
 from ..core.exceptions import InputError, check_seed
 from ..core.files import write_text_atomic
 from ..core.sizes import MAX_TIME_S
+from ..core.turn_grid import random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, deg_to_rad, rad_to_deg
 from ..model.angles import ANGLE_ENTRIES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
@@ -244,7 +245,7 @@ def random_positions(n: int, table, seed: int) -> PositionSet:
         raise InputError(f"random positions: expected N >= 1, got {n}")
     check_count(n, MAX_POSITIONS, "random positions of a calibration run", POSITION_BYTES)
     rng = np.random.default_rng([seed, 1])
-    angles = np.round(rng.uniform(0.0, 360.0, (int(n), len(table.joint_names))), 6)
+    angles = random_turn_positions_deg(rng, n, len(table.joint_names))
     return PositionSet(deg_to_rad(angles), table=table, name=f"random:{n}")
 
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..core.exceptions import InputError
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
+from ..core.turn_grid import every_combination, full_turn_grid_deg
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..stats.least_squares import RANK_RTOL, fit_least_squares
 from ..stats.model_selection import Diagnosis, diagnose
@@ -110,14 +111,13 @@ def dense_joint_grid(table) -> np.ndarray:
     limits, the same number of angles at the centres of equal cells (the ends, where a term such
     as cot(elevation) may be infinite, are not positions)."""
     step = 30.0 if table.n_joints > 2 else 15.0
-    count = int(round(360.0 / step))
-    g = np.radians(np.arange(0.0, 360.0, step))
+    g = np.radians(full_turn_grid_deg(step)[:, 0])
+    count = g.size
     axes = [
         g if limits is None else limits[0] + (np.arange(count) + 0.5) * np.ptp(limits) / count
         for limits in table.joint_limits_rad
     ]
-    grids = np.meshgrid(*axes, indexing="ij")
-    return np.stack([x.ravel() for x in grids], axis=1)
+    return every_combination(axes)
 
 
 def max_harmonic_order(angle_rad: np.ndarray) -> int:

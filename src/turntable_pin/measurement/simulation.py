@@ -18,6 +18,7 @@ import numpy as np
 from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows, write_csv_table
 from ..core.exceptions import InputError, check_seed
 from ..core.sizes import MAX_SIMULATED_ROWS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
+from ..core.turn_grid import full_turn_grid_deg, random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.angles import ANGLE_NAMES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors
@@ -252,13 +253,12 @@ class Schedule:
                     "joints"
                 )
             return [rows[:, k] for k in range(n_joints)]
+        starts = [start for start, _ in steps]
         if self.random_positions:
-            starts = np.array([start for start, _ in steps])
-            draws = rng.uniform(0.0, 360.0, (self.random_positions, n_joints))
-            rows = np.round(starts + draws, 6)
+            rows = random_turn_positions_deg(rng, self.random_positions, n_joints, starts)
             return [rows[:, k] for k in range(n_joints)]
-        axes = [start + np.arange(0.0, 360.0 - 1e-9, step) for start, step in steps]
         if self.sweep:
+            axes = [full_turn_grid_deg(step, starts_deg=(start,))[:, 0] for start, step in steps]
             out: list[list[np.ndarray]] = [[] for _ in range(n_joints)]
             for label in self.sweep:
                 swept = int(label[3:]) - 1
@@ -268,8 +268,8 @@ class Schedule:
                     size = axes[swept].size
                     out[k].append(axes[k] if k == swept else np.full(size, steps[k][0]))
             return [np.concatenate(parts) for parts in out]
-        grids = np.meshgrid(*axes, indexing="ij")
-        return [g.ravel() for g in grids]
+        rows = full_turn_grid_deg(*(step for _, step in steps), starts_deg=starts)
+        return [rows[:, k] for k in range(n_joints)]
 
     def _pass_sign(self, size: int) -> np.ndarray | None:
         """+1 on forward and -1 on backward rows of ``passes`` (``size`` rows per traversal)."""
