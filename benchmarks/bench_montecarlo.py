@@ -34,7 +34,6 @@ import numpy as np
 
 from turntable_pin.allocation.monte_carlo import (
     CHUNK_SIZE,
-    TABLE_CHUNK_SIZE,
     run_chain_monte_carlo,
     sample_errors,
 )
@@ -72,6 +71,7 @@ def _setup(case: str) -> dict:
             "limits": allocation.limits,
             "steps": (10.0, 1.0),
             "chunk": CHUNK_SIZE,
+            "phi1_drops": True,
         }
     table = GenericTable(models_dir() / THREE_AXIS)
     allocation = allocate_table_tolerances(
@@ -84,7 +84,8 @@ def _setup(case: str) -> dict:
         "lower": allocation.lower_bounds_rad,
         "limits": allocation.limits,
         "steps": (15.0,) * 3,
-        "chunk": TABLE_CHUNK_SIZE,
+        "chunk": CHUNK_SIZE,
+        "phi1_drops": False,
     }
 
 
@@ -164,7 +165,7 @@ def _old_chunk(setup: dict, values: np.ndarray) -> np.ndarray:
     paper's table; one product with the Kronecker basis of 1024 grid positions at a time)."""
     c = _old_coefficients(setup["chain"], values)
     grids = [np.radians(np.arange(0.0, 360.0, step)) for step in setup["steps"]]
-    if setup["chunk"] == CHUNK_SIZE:  # the paper's: phi2 grid at phi1 = 0
+    if setup["phi1_drops"]:  # the paper's: phi2 grid at phi1 = 0
         per_phi2 = np.einsum("m,kemn->ken", trig_basis(0.0), c.reshape(-1, 3, 5, 5))
         angles = per_phi2 @ trig_basis(grids[1]).T
         return np.maximum(angles.max(axis=2), -angles.min(axis=2))

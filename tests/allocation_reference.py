@@ -64,7 +64,8 @@ class LinearAngleModel:
             ((lo, hi),),
             (axis,),
             ("phi2",),
-            paper_terms=True,
+            ("phi2",),
+            (0,),
         )
 
 

@@ -78,3 +78,15 @@ def test_the_readme_s_sample_outputs_are_what_the_commands_print(tmp_path):
                 assert norm(sample) in printed, (command, sample)
     finally:
         os.chdir(here)
+
+
+def test_the_version_is_the_changelog_s_newest_release():
+    """pyproject.toml's version is the first release the changelog lists, and a major version
+    (a renamed JSON key) says what it renamed."""
+    version = re.search(r'^version = "(.+)"', (REPO_DIR / "pyproject.toml").read_text(), re.M)[1]
+    changelog = (REPO_DIR / "README.md").read_text().split("\n## Changelog\n", 1)[1]
+    releases = re.findall(r"^- \*\*([0-9]+\.[0-9]+\.[0-9]+)\b", changelog, re.M)
+    assert releases and releases[0] == version, (version, releases[:3])
+    entry = changelog.split(f"- **{version}", 1)[1].split("\n- **", 1)[0]
+    if version.endswith(".0.0"):
+        assert "old -> new" in entry and "->" in entry

@@ -1,7 +1,7 @@
 """Monte Carlo on the exact chain of any table: within the allocated box, beyond it, the draws in
 the box, each table's worst angles equal to its chain evaluated at every grid position (over
 several chunks), reproducible from the seed alone whatever the number of workers; phi1 drops out
-on the paper's table."""
+on the paper's table, which runs the one path of every table."""
 
 import numpy as np
 import pytest
@@ -88,7 +88,7 @@ def test_samples_lie_in_the_box_with_both_signs(allocation):
 
 def test_worst_values_match_pinocchio_directly(allocation):
     """Re-draw the first turntables and evaluate them with TurntableModel on the same grid."""
-    result = run(allocation, n=4, seed=9, phi2_step_deg=10.0)
+    result = run(allocation, n=4, seed=9, grid_step_deg=10.0)
     seq = np.random.SeedSequence(9).spawn(1)[0]
     values = sample_errors(
         np.random.default_rng(seq), 4, allocation.upper_bounds_rad,
@@ -113,19 +113,21 @@ def test_worst_values_match_pinocchio_directly(allocation):
 
 
 def test_phi1_drops_out_and_the_phi1_path_gives_the_same(allocation, monkeypatch):
-    plain = run(allocation, n=500, seed=2, phi2_step_deg=5.0)
-    assert plain.max_phi1_dependence < 1e-15
-    assert plain.phi1_evaluated_deg == (0.0,)
+    plain = run(allocation, n=500, seed=2, grid_step_deg=5.0)
+    assert plain.max_dependence[0] < 1e-15
+    assert plain.evaluated_deg[0] == (0.0,)
+    assert plain.to_dict()["held_at_deg"] == {"phi1": 0.0}
+    assert plain.to_dict()["max_dependence"]["phi1"] < 1e-15
     # Force the phi1 grid (as an angle-dependent effect would): same worst values.
     monkeypatch.setattr(mc, "DEPENDENCE_TOLERANCE", -1.0)
-    forced = run(allocation, n=500, seed=2, phi2_step_deg=5.0, phi1_step_deg=30.0)
-    assert len(forced.phi1_evaluated_deg) == 12
+    forced = run(allocation, n=500, seed=2, grid_step_deg=5.0)
+    assert len(forced.evaluated_deg[0]) == 72 and forced.to_dict()["held_at_deg"] == {}
     np.testing.assert_allclose(forced.worst_rad, plain.worst_rad, rtol=0, atol=1e-15)
 
 
 @pytest.mark.parametrize(
     "kw, fragment",
-    [({"n": 0}, "at least 1"), ({"phi2_step_deg": 0.0}, "phi2 grid step")],
+    [({"n": 0}, "at least 1"), ({"grid_step_deg": 0.0}, "grid step must be in")],
 )
 def test_bad_arguments(allocation, kw, fragment):
     args = {"n": 10, **kw}
@@ -297,11 +299,18 @@ def test_a_three_axis_run_does_not_depend_on_the_number_of_workers():
 
 def test_the_paper_run_is_the_run_of_the_papers_chain(allocation):
     upper, lower = allocation.upper_bounds_rad, allocation.capability.lower_bounds_rad
-    paper = run(allocation, n=300, seed=4, phi2_step_deg=2.0)
+    paper = run(allocation, n=300, seed=4, grid_step_deg=2.0)
     chain = run_chain_monte_carlo(
         TurntableModel().chain, ANGULAR_ERROR_NAMES, upper, allocation.limits, 300, 4,
         grid_steps_deg=(10.0, 2.0), lower_bounds_rad=lower, progress=False,
     )  # fmt: skip
     np.testing.assert_array_equal(paper.worst_rad, chain.worst_rad)
-    assert paper.phi2_step_deg == 2.0 and "phi2_step_deg" in paper.to_dict()
-    assert "grid_step_deg" in chain.to_dict() and "phi2_step_deg" not in chain.to_dict()
+    assert paper.grid_steps_deg == (2.0, 2.0) and paper.to_dict()["grid_step_deg"] == 2.0
+    assert paper.to_dict()["urdf"].endswith("turntable.urdf")
+    assert chain.to_dict()["grid_step_deg"] == {"outer_axis": 10.0, "inner_axis": 2.0}
+    # one schema: the paper's run and a URDF table's have the same keys
+    other = run_table_monte_carlo(
+        GenericTable(MODELS / "single_axis_rate_table.urdf"),
+        np.full(6, 1e-5), LIMITS, 10, 0, progress=False,
+    )  # fmt: skip
+    assert set(other.to_dict()) == set(paper.to_dict())

@@ -382,12 +382,14 @@ def test_table4_from_the_one_allocation_of_the_papers_table_and_its_urdf():
 def test_the_papers_quarter_turns_give_what_the_whole_turns_give(monkeypatch):
     """|cos| and |sin| are symmetric: the semi-infinite constraint over every phi2 (the generic
     problem) has the paper's quarter-turn optimum, so Table 4 does not rest on the intervals."""
-    from turntable_pin.allocation import solver
+    from dataclasses import replace
+
+    from turntable_pin.model.generic_table import GenericTable
+    from turntable_pin.model.paper_table import PAPER_LAYOUT
 
     quarter = allocate_tolerances(PAPER_LIMITS, "paper")
-    whole = dict.fromkeys(ORIENTATION_ANGLES, (0.0, 2 * np.pi))
-    monkeypatch.setattr(solver, "PHI2_INTERVALS_RAD", whole)
-    turn = allocate_tolerances(PAPER_LIMITS, "paper")
+    whole = GenericTable(paper_table().urdf_path, layout=replace(PAPER_LAYOUT, domains_deg={}))
+    turn = allocate_tolerances(PAPER_LIMITS, "paper", table=whole)
     assert turn.subproblems["psi"].interval_rad == (0.0, 2 * np.pi)
     np.testing.assert_allclose(turn.upper_bounds_rad, quarter.upper_bounds_rad, rtol=1e-12)
 

@@ -176,5 +176,7 @@ def test_bad_grid_and_weights_are_refused():
         grid_angles_rad(table, 1.0)
     with pytest.raises(InputError, match=r"\[1e-06, 90\] degrees"):
         grid_angles_rad(table, 0.0)
-    with pytest.raises(InputError, match="choose one of model, equal"):
-        allocate_table_tolerances(table, LIMITS, weights="paper")
+    with pytest.raises(InputError, match="choose one of model, paper, equal"):
+        allocate_table_tolerances(table, LIMITS, weights="figure8")
+    # the paper's Figure 8 rule is one rule: any table takes it
+    assert allocate_table_tolerances(table, LIMITS, weights="paper").weights_scheme == "paper"

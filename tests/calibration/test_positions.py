@@ -222,7 +222,7 @@ def test_a_grid_covers_every_joint(urdf, spec, count):
 
 
 @pytest.mark.parametrize("spec, fragment", [
-    ("grid:30x30", "2 steps for a table of 3 joints"),
+    ("grid:30x30", "2 steps for three_axis_imu_table.urdf of 3 joints"),
     ("grid:0", "grid step must be in [1e-06, 360]"),
     ("grid:1", "positions"),
     ("grid:a", "expected grid:STEP"),

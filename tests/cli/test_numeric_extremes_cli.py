@@ -37,10 +37,10 @@ URDF = str(REPO_DIR / "models" / "three_axis_imu_table.urdf")
             ["requirement", "--accuracy-dph", "0.01", "--positions", "grid:1e-320x30"],
             ["grid:1e-320x30"],
         ),  # fmt: skip
-        (["montecarlo", "--limits-arcmin", "1", "--phi2-step-deg", "1e-320"], ["--phi2-step-deg"]),
+        (["montecarlo", "--limits-arcmin", "1", "--grid-step-deg", "1e-320"], ["--grid-step-deg"]),
         (
-            ["montecarlo", "--limits-arcmin", "1", "--quiet", "--phi2-step-deg", "1e-6"],
-            ["grid angles of inner_axis (a 1e-06-degree step)", "at most 200,000"],
+            ["montecarlo", "--limits-arcmin", "1", "--quiet", "--grid-step-deg", "1e-6"],
+            ["a 1e-06-degree grid over 1 joints", "choose a coarser --grid-step-deg"],
         ),  # fmt: skip
         (
             ["allocate", "--limits-arcmin", "2", "--urdf", URDF, "--grid-step-deg", "1e-320"],

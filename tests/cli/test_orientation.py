@@ -29,8 +29,10 @@ def test_orientation_json_matches_the_library():
     np.testing.assert_allclose(out["dR"], expected.dR, atol=1e-15)
     assert out["dpsi_arcsec"] == pytest.approx(expected.dpsi_rad * ARCSEC_PER_RAD, abs=1e-9)
     # small-angle value of eq. 26: 3 cos45 - (-2) sin45 ... = (3 + 2)*0.7071 for dpsi
-    assert out["dpsi_small_angle_arcsec"] == pytest.approx(5 * np.sqrt(0.5), rel=1e-12)
-    assert out["dtheta_small_angle_arcsec"] == 0.0
+    assert out["dpsi_first_order_arcsec"] == pytest.approx(5 * np.sqrt(0.5), rel=1e-12)
+    assert out["dtheta_first_order_arcsec"] == 0.0  # eq. 26's closed form: an exact zero
+    assert out["angles_deg"] == {"phi1": 30.0, "phi2": 45.0}
+    assert out["urdf"].endswith("turntable.urdf") and out["payload_frame"] == "gyrowheel"
     # deta = 0.2 mm along x of the outer frame, turned by phi1 + dphi_y1 about y
     turn = np.radians(30) + 3 / ARCSEC_PER_RAD
     np.testing.assert_allclose(
@@ -163,4 +165,8 @@ def test_the_paper_table_keeps_its_names_with_angles_deg():
                        "--json").stdout)  # fmt: skip
     b = json.loads(cli("orientation", "--phi1-deg", "30", "--phi2-deg", "45", "--error",
                        "dphi_y1=3", "--json").stdout)  # fmt: skip
-    assert a == b and "dpsi_small_angle_arcsec" in a
+    assert a == b and "dpsi_first_order_arcsec" in a
+    # one schema: the paper's table and a URDF table give the same keys
+    c = json.loads(cli("orientation", "--urdf", "altaz_mount", "--angles-deg", "30,45",
+                       "--json").stdout)  # fmt: skip
+    assert set(a) == set(c)

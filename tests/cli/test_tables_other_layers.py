@@ -142,7 +142,7 @@ def test_montecarlo_scaled_beyond_the_bounds_exceeds_a_limit():
 def test_the_paper_urdf_given_explicitly_is_the_paper_path():
     a = _json("rate-error", "--dpsi-deg", "0.01", "--positions", "grid:45")
     b = _json("rate-error", "--dpsi-deg", "0.01", "--positions", "grid:45", "--urdf", PAPER)
-    assert a == b and "joints" not in a
+    assert a == b and a["joints"] == ["outer_axis", "inner_axis"]
     c = _json("allocate", "--limits-arcmin", LIMITS)
     d = _json("allocate", "--limits-arcmin", LIMITS, "--urdf", PAPER)
     assert c == d and "dphi_y1" in c["upper_bounds_arcmin"]
@@ -151,16 +151,11 @@ def test_the_paper_urdf_given_explicitly_is_the_paper_path():
 @pytest.mark.parametrize(
     "argv, fragment",
     [
-        (["allocate", "--grid-step-deg", "5"], "--grid-step-deg is for a table given by --urdf"),
-        (["allocate", "--urdf", TWO, "--limits-arcmin", "1", "--weights", "paper"],
-         "--weights paper"),
-        (["allocate", "--urdf", TWO, "--limits-arcmin", "1", "--plots", "figs"], "--plots"),
         (["allocate", "--urdf", TWO], "no default limits for this table"),
-        (["montecarlo", "--urdf", ONE, "--limits-arcmin", "1", "--phi2-step-deg", "2"],
-         "--grid-step-deg"),
         (["allocate", "--urdf", THREE, "--limits-arcmin", "1", "--grid-step-deg", "1"],
          "coarser --grid-step-deg"),
-        (["rate-error", "--urdf", THREE, "--positions", "grid:30x30"], "2 steps for a table"),
+        (["rate-error", "--urdf", THREE, "--positions", "grid:30x30"],
+         "2 steps for three_axis_imu_table.urdf of 3 joints"),
         (["snapshot", "--urdf", THREE, "--angles-deg", "1,2", "-o", "x.png"],
          "this table has 3 joint(s)"),
         (["snapshot", "--urdf", THREE, "--phi1-deg", "1", "-o", "x.png"], "give --angles-deg"),
@@ -168,6 +163,23 @@ def test_the_paper_urdf_given_explicitly_is_the_paper_path():
 )  # fmt: skip
 def test_bad_use_on_a_table_is_one_line_exit_2(argv, fragment):
     _one_line_exit_2(cli(*argv), fragment)
+
+
+@pytest.mark.parametrize("urdf", [None, TWO])
+def test_every_allocation_option_works_on_every_table(urdf, tmp_path):
+    """--grid-step-deg, --weights paper and --plots, once refused off (or on) the paper's table,
+    are one path: the same keys, the figures written, on the paper's table and a URDF's."""
+    table = ["--urdf", urdf] if urdf else []
+    common = [*table, "--limits-arcmin", LIMITS, "--grid-step-deg", "30", "--weights", "paper"]
+    out = _json("allocate", *common, "--plots", str(tmp_path / "a"))
+    assert out["grid_step_deg"] == 30.0 and out["weights"] == "paper"
+    assert (tmp_path / "a" / "figure8_sensitivities.png").is_file()
+    proc = cli("montecarlo", *common, "-n", "50", "--plots", str(tmp_path / "m"), "--json")
+    assert proc.returncode in (0, 1), proc.stderr
+    mc = json.loads(proc.stdout)
+    assert mc["grid_step_deg"] == 30.0 and (tmp_path / "m" / "figure9_montecarlo.png").is_file()
+    paper = _json("allocate", "--limits-arcmin", LIMITS)
+    assert set(out) - {"plot"} == set(paper)
 
 
 # --- bad URDFs: every command turns the model's refusal into one line, exit 2 -------------------

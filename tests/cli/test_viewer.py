@@ -133,5 +133,5 @@ def test_snapshot_command_writes_the_png_and_reports_json(tmp_path):
     report = json.loads(proc.stdout)
     assert report["width_px"] == 320 and report["height_px"] == 240
     assert report["exaggeration"] == {"angle_factor": 5000.0, "length_factor": 5000.0}
-    assert report["phi1_deg"] == 60.0
+    assert report["angles_deg"] == {"phi1": 60.0, "phi2": 10.0}
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

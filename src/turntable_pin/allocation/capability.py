@@ -1,10 +1,10 @@
 """Manufacturing capability: the lower bounds ``LB_i`` of a table's angular errors (paper eq. 29).
 
 A turntable cannot be made arbitrarily accurate; the allocation must not ask for an error component
-smaller than what manufacturing reaches. The bundled defaults of the paper's table live in
-``models/manufacturing_lower_bounds.yaml`` with the reasoning behind each value; users pass their
-own YAML file of the same form, in their table's error names (another table has no bundled
-bounds: 0 unless given).
+smaller than what manufacturing reaches. A table's layout may name a bundled file of them (the
+paper's: ``models/manufacturing_lower_bounds.yaml``, with the reasoning behind each value;
+:meth:`ManufacturingCapability.of_table`); users pass their own YAML file of the same form, in
+their table's error names (a table with none bundled: 0 unless given).
 """
 
 from __future__ import annotations
@@ -17,14 +17,9 @@ import numpy as np
 
 from ..core.exceptions import InputError
 from ..core.files import read_yaml
-from ..core.resources import default_lower_bounds_path
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
-from ..model.errors import (
-    ANGULAR_ERROR_NAMES,
-    ERROR_NAMES,
-    MAX_ANGULAR_ERROR_DEG,
-    parse_error_value,
-)
+from ..model.errors import ANGULAR_ERROR_NAMES, MAX_ANGULAR_ERROR_DEG, parse_error_value
+from ..model.paper_table import resolve_table
 
 __all__ = ["ManufacturingCapability", "read_lower_bounds_file"]
 
@@ -86,15 +81,25 @@ class ManufacturingCapability:
         return cls(np.zeros(len(error_names)), {}, "none (all lower bounds 0)", error_names)
 
     @classmethod
+    def of_table(cls, table=None) -> ManufacturingCapability:
+        """The lower bounds bundled with ``table`` (default the bundled table): the file its
+        layout names (``GenericTable.lower_bounds_path``; the paper's
+        ``models/manufacturing_lower_bounds.yaml``), else none (every lower bound 0)."""
+        table = resolve_table(table)
+        if table.lower_bounds_path is None:
+            return cls.none(tuple(table.angular_names))
+        return cls.from_yaml(table.lower_bounds_path, table)
+
+    @classmethod
     def default(cls) -> ManufacturingCapability:
-        """The bundled defaults of the paper's table (:func:`default_lower_bounds_path`)."""
-        return cls.from_yaml(default_lower_bounds_path())
+        """The lower bounds bundled with the bundled table (:meth:`of_table`)."""
+        return cls.of_table()
 
     @classmethod
     def from_yaml(cls, path: str | Path, table=None) -> ManufacturingCapability:
         """Read ``lower_bounds: {name[_unit]: value}`` and optional ``reasoning: {name: text}``
         in the names of ``table`` (a :class:`~turntable_pin.model.generic_table.GenericTable`;
-        default the paper's).
+        default the bundled table).
 
         Names without a unit suffix are arc seconds; missing names get no lower bound (0). Values
         are at most ``MAX_ANGULAR_ERROR_DEG`` (5 deg), like every angular error.
@@ -106,8 +111,8 @@ class ManufacturingCapability:
         """
         path = Path(path)
         data = read_lower_bounds_file(path)
-        names = ERROR_NAMES if table is None else table.parameter_names
-        angular = ANGULAR_ERROR_NAMES if table is None else table.angular_names
+        table = resolve_table(table)
+        names, angular = table.parameter_names, table.angular_names
         lengths = [n for n in names if n not in angular]
         values = np.zeros(len(angular))
         given: dict[str, str] = {}

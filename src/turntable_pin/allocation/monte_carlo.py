@@ -11,13 +11,13 @@ depends on (the paper's outer axis phi1 with the errors of its Table 2: every ha
 zero) is evaluated at 0 only; :data:`DEPENDENCE_TOLERANCE` says what zero is.
 
 :func:`run_chain_monte_carlo` is the run, for any :class:`~turntable_pin.model.chain.ErrorChain`;
-:func:`run_monte_carlo` gives it the paper's table (a phi2 grid, phi1 checked) and
-:func:`run_table_monte_carlo` a table read from a URDF (the same grid over every joint).
+:func:`run_monte_carlo` gives it a table (default the bundled one) over the same grid on every
+joint.
 
-Chunks draw their samples from ``SeedSequence(seed).spawn(...)``, so the result depends on the seed
-only, not on the number of worker processes. Worker processes never outlive the run: on an error or
-an interruption (SIGINT, SIGTERM) they are killed at once, not waited for; Ctrl-C, which reaches
-the whole process group, is left to the parent.
+Chunks of :data:`CHUNK_SIZE` tables draw their samples from ``SeedSequence(seed).spawn(...)``, so
+the result depends on the seed only, not on the number of worker processes. Worker processes
+never outlive the run: on an error or an interruption (SIGINT, SIGTERM) they are killed at once,
+not waited for; Ctrl-C, which reaches the whole process group, is left to the parent.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ import os
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -43,17 +43,15 @@ from ..core.sizes import (
 from ..core.units import DEG_PER_RAD, arcmin_by_name
 from ..model.batch_field import ChainExpansion, joint_dependence, max_abs_on_grid
 from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES
-from ..model.paper_table import paper_table
+from ..model.paper_table import resolve_table
 from .sensitivity import MAX_GRID_POINTS, default_grid_step_deg, grid_angles_rad
 from .solver import ORIENTATION_ANGLES, OrientationLimits
 
 __all__ = [
     "CHUNK_SIZE",
     "DEPENDENCE_TOLERANCE",
-    "TABLE_CHUNK_SIZE",
     "TURNTABLE_BYTES",
     "MonteCarloResult",
-    "PaperMonteCarloResult",
     "run_chain_monte_carlo",
     "run_monte_carlo",
     "run_table_monte_carlo",
@@ -62,11 +60,8 @@ __all__ = [
 ]
 
 CHUNK_SIZE = 2000
-"""Tables drawn from one spawned seed (one task) in a run on the paper's table."""
-
-TABLE_CHUNK_SIZE = 500
-"""Tables drawn from one spawned seed in a run on a table given by URDF. The two sizes are part
-of what a seed means (they fix which tables it draws), kept as they were."""
+"""Tables drawn from one spawned seed (one task), on every table: part of what a seed means (it
+fixes which tables the seed draws)."""
 
 TURNTABLE_BYTES = 64
 """Memory a turntable of the run keeps (its three worst angles, its share of the tasks), bytes."""
@@ -196,7 +191,9 @@ class MonteCarloResult:
             table's ``dR`` depends on the joint.
         max_dependence: each joint's largest harmonic in any table's dpsi, dtheta, dgamma.
         elapsed_s: wall time.  workers: processes used.
+        zero_names: the errors held at 0 (the lengths: the paper's ``deta``, a table's offsets).
         urdf, payload_frame: the table, when it was read from a URDF.
+        angle_names: the joints' angles in keys (the table's; default the joint names).
     """
 
     worst_rad: np.ndarray
@@ -212,8 +209,10 @@ class MonteCarloResult:
     max_dependence: tuple[float, ...]
     elapsed_s: float
     workers: int
+    zero_names: tuple[str, ...] = ()
     urdf: str = ""
     payload_frame: str = ""
+    angle_names: tuple[str, ...] = ()
 
     @property
     def max_abs_rad(self) -> np.ndarray:
@@ -235,74 +234,47 @@ class MonteCarloResult:
         """Table x position evaluations done."""
         return self.n * int(np.prod([len(angles) for angles in self.evaluated_deg]))
 
-    def _parts(self, sampling: str) -> tuple[dict, dict, dict]:
-        """The verdict, the box and the timing, JSON-ready (arcmin, s)."""
+    @property
+    def _keys(self) -> tuple[str, ...]:
+        return self.angle_names or self.joint_names
+
+    @property
+    def held_at_deg(self) -> dict[str, float]:
+        """``{angle: degrees}`` of each joint evaluated at one angle only (no drawn table's
+        ``dR`` depends on it: the paper's phi1)."""
+        return {
+            key: angles[0]
+            for key, angles in zip(self._keys, self.evaluated_deg, strict=True)
+            if len(angles) == 1
+        }
+
+    def to_dict(self) -> dict:
+        """The outcome as a JSON-ready dict (angles in arcmin, steps in degrees, time in s): the
+        table, the verdict, the box sampled, the grid, the joints held and each joint's largest
+        harmonic, the timing; one schema for every table."""
         limits = self.limits.as_array()
         exceeding = map(int, np.sum(self.worst_rad > limits, axis=0))
-        verdict = {
+        zeros = f"; {', '.join(self.zero_names)} = 0" if self.zero_names else ""
+        steps = dict(zip(self._keys, self.grid_steps_deg, strict=True))
+        return {
+            "urdf": self.urdf,
+            "payload_frame": self.payload_frame,
             "max_abs_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.max_abs_rad),
             "limits_arcmin": self.limits.to_dict(),
             "all_within": self.all_within,
             "n_exceeding": dict(zip(ORIENTATION_ANGLES, exceeding, strict=True)),
             "n": self.n,
             "seed": self.seed,
-        }
-        box = {
-            "sampling": f"magnitude uniform in [lower, upper] bound, random sign; {sampling}",
+            "sampling": f"magnitude uniform in [lower, upper] bound, random sign{zeros}",
             "upper_bounds_arcmin": arcmin_by_name(self.error_names, self.upper_bounds_rad),
             "lower_bounds_arcmin": arcmin_by_name(self.error_names, self.lower_bounds_rad),
-        }
-        timing = {
+            "grid_step_deg": self.grid_steps_deg[0] if len(set(steps.values())) == 1 else steps,
+            "n_grid_points": self.n_grid_points,
+            "held_at_deg": self.held_at_deg,
+            "max_dependence": dict(zip(self._keys, self.max_dependence, strict=True)),
             "elapsed_s": self.elapsed_s,
             "evaluations_per_s": self.evaluations / max(self.elapsed_s, 1e-12),
             "workers": self.workers,
-        }
-        return verdict, box, timing
-
-    def to_dict(self) -> dict:
-        """The outcome as a JSON-ready dict (angles in arcmin, steps in degrees, time in s)."""
-        verdict, box, timing = self._parts("offsets 0")
-        steps = set(self.grid_steps_deg)
-        return {
-            "urdf": self.urdf,
-            "payload_frame": self.payload_frame,
-            **verdict,
-            **box,
-            "grid_step_deg": steps.pop() if len(steps) == 1 else list(self.grid_steps_deg),
-            "n_grid_points": self.n_grid_points,
-            **timing,
-        }
-
-
-class PaperMonteCarloResult(MonteCarloResult):
-    """:class:`MonteCarloResult` of the paper's table, said in its terms: a phi2 grid, phi1
-    evaluated at 0 only when it drops out (it does, with the errors of Table 2)."""
-
-    @property
-    def phi2_step_deg(self) -> float:
-        """Grid step of phi2 (the inner axis), degrees."""
-        return self.grid_steps_deg[1]
-
-    @property
-    def phi1_evaluated_deg(self) -> tuple[float, ...]:
-        """The phi1 values evaluated, degrees."""
-        return self.evaluated_deg[0]
-
-    @property
-    def max_phi1_dependence(self) -> float:
-        """Largest phi1 harmonic in any turntable's dpsi, dtheta, dgamma."""
-        return self.max_dependence[0]
-
-    def to_dict(self) -> dict:
-        """The outcome as a JSON-ready dict (angles in arcmin, steps in degrees, time in s)."""
-        verdict, box, timing = self._parts("deta = 0")
-        return {
-            **verdict,
-            **box,
-            "phi2_step_deg": self.phi2_step_deg,
-            "phi1_evaluated_deg": list(self.phi1_evaluated_deg),
-            "max_phi1_dependence": self.max_phi1_dependence,
-            **timing,
         }
 
 
@@ -387,6 +359,7 @@ def run_chain_monte_carlo(
         for g, step, d in zip(grids, steps, dependence, strict=True)
     )
     return MonteCarloResult(
+        zero_names=tuple(name for name in chain.error_names if name not in names),
         worst_rad=worst,
         error_names=names,
         upper_bounds_rad=upper,
@@ -409,64 +382,26 @@ def run_monte_carlo(
     n: int,
     seed: int,
     *,
-    lower_bounds_rad=None,
-    phi2_step_deg: float = 1.0,
-    phi1_step_deg: float = 10.0,
-    workers: int = 1,
-    progress: bool = True,
-    urdf_path=None,
-) -> PaperMonteCarloResult:
-    """:func:`run_chain_monte_carlo` on the paper's table (its eight angular errors, ``deta``
-    0) over a phi2 grid; phi1 on its grid only if some table's ``dR`` depends on it.
-
-    Args:
-        upper_bounds_rad, lower_bounds_rad: (8,) bounds in ``ANGULAR_ERROR_NAMES`` order.
-        limits, n, seed, workers, progress: as :func:`run_chain_monte_carlo`.
-        phi2_step_deg, phi1_step_deg: the grid steps, degrees.
-        urdf_path: nominal URDF (default bundled).
-    """
-    for name, step in (("phi2", phi2_step_deg), ("phi1", phi1_step_deg)):
-        if not MIN_GRID_STEP_DEG <= step <= 90.0:
-            raise InputError(
-                f"{name} grid step must be in [{MIN_GRID_STEP_DEG:g}, 90] degrees, got {step}"
-            )
-    result = run_chain_monte_carlo(
-        paper_table(urdf_path).chain,
-        ANGULAR_ERROR_NAMES,
-        upper_bounds_rad,
-        limits,
-        n,
-        seed,
-        grid_steps_deg=(phi1_step_deg, phi2_step_deg),
-        lower_bounds_rad=lower_bounds_rad,
-        workers=workers,
-        progress=progress,
-    )
-    return PaperMonteCarloResult(**{f.name: getattr(result, f.name) for f in fields(result)})
-
-
-def run_table_monte_carlo(
-    table,
-    upper_bounds_rad,
-    limits: OrientationLimits,
-    n: int,
-    seed: int,
-    *,
+    table=None,
     lower_bounds_rad=None,
     grid_step_deg: float | None = None,
     workers: int = 1,
     progress: bool = True,
 ) -> MonteCarloResult:
     """:func:`run_chain_monte_carlo` on a
-    :class:`~turntable_pin.model.generic_table.GenericTable` (its angular errors, offsets 0)
-    over the same grid on every joint.
+    :class:`~turntable_pin.model.generic_table.GenericTable` (its angular errors drawn, its lengths
+    0) over the same grid on every joint; a joint no drawn table depends on is evaluated at 0
+    only.
 
     Args:
-        table: the table.  upper_bounds_rad, lower_bounds_rad: (P,) bounds of its angular errors
+        upper_bounds_rad, lower_bounds_rad: (P,) bounds of the table's angular errors
             (``table.angular_names`` order; lower default 0), radians.
-        grid_step_deg: the grid step (default by joint count).
+        table: the table (default the bundled one).
+        grid_step_deg: the grid step (default by table: 1, 5, 15 deg when its first-order model
+            depends on 1, 2, 3 joints).
         limits, n, seed, workers, progress: as :func:`run_chain_monte_carlo`.
     """
+    table = resolve_table(table)
     step = default_grid_step_deg(table) if grid_step_deg is None else float(grid_step_deg)
     grid_angles_rad(table, step)  # checks the step and the grid's size
     result = run_chain_monte_carlo(
@@ -478,8 +413,15 @@ def run_table_monte_carlo(
         seed,
         grid_steps_deg=(step,) * len(table.joint_names),
         lower_bounds_rad=lower_bounds_rad,
-        chunk_size=TABLE_CHUNK_SIZE,
         workers=workers,
         progress=progress,
     )
-    return replace(result, urdf=str(table.urdf_path), payload_frame=table.payload_frame)
+    return replace(
+        result, urdf=str(table.urdf_path), payload_frame=table.payload_frame,
+        angle_names=tuple(table.angle_names),
+    )  # fmt: skip
+
+
+def run_table_monte_carlo(table, upper_bounds_rad, limits, n, seed, **options) -> MonteCarloResult:
+    """:func:`run_monte_carlo` of ``table`` (its earlier name, the table first)."""
+    return run_monte_carlo(upper_bounds_rad, limits, n, seed, table=table, **options)

@@ -7,9 +7,10 @@ errors that move it (eqs. 29-33) is
     min  J_k = sum_i W_ki^2 / x_i^2    s.t.  sum_i |C_ki(q)| x_i <= I_k   for every q in Omega_k,
 
 the left side being the largest first-order ``|d angle_k|`` errors of magnitudes x reach at q over
-every sign. ``Omega_k`` is every joint's whole turn, except on the paper's table: there it is the
-paper's (eqs. 31-33, :data:`PHI2_INTERVALS_RAD`), where every term of eq. 26 is non-negative, so
-the left side is the paper's ``f_k(phi2, x)`` and the problem is the paper's.
+every sign. ``Omega_k`` is every joint's whole turn, except where the table's layout gives the
+joint's interval for angle k (``GenericTable.angle_domains_rad``): on the paper's table the phi2
+intervals of eqs. 31-33 (:data:`PHI2_INTERVALS_RAD`), where every term of eq. 26 is non-negative,
+so that the left side is the paper's ``f_k(phi2, x)`` and the problem is the paper's.
 
 The constraint holds on the continuous domain (semi-infinite). ``C_ki`` is a trigonometric
 polynomial of degree one in every joint angle (:class:`AngleRows`), so along one joint the left
@@ -38,7 +39,8 @@ from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.exceptions import InfeasibleError, InputError, ModelError
 from ..core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, arcmin_by_name
 from ..model.angles import ANGLE_SYMBOLS
-from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors
+from ..model.errors import MAX_ANGULAR_ERROR_DEG
+from ..model.paper_table import PHI2_INTERVALS_DEG, resolve_table
 from .capability import ManufacturingCapability
 from .sensitivity import (
     FULL_TURN_RAD,
@@ -80,13 +82,12 @@ __all__ = [
 ORIENTATION_ANGLES = ANGLE_SYMBOLS  # the limit names: psi_rad, theta_rad, gamma_rad
 """Names of the three orientation angles dpsi, dtheta, dgamma as used in keys and options."""
 PHI2_INTERVALS_RAD: dict[str, tuple[float, float]] = {
-    "gamma": (0.0, 0.5 * math.pi),  # eq. 31
-    "theta": FULL_TURN_RAD,  # eq. 32 has no phi2; the whole turn is the same constraint
-    "psi": (1.5 * math.pi, 2.0 * math.pi),  # eq. 33
+    angle: (math.radians(lo), math.radians(hi)) for angle, (lo, hi) in PHI2_INTERVALS_DEG.items()
 }
-"""The paper's Omega_k: the phi2 interval ``(lo, hi)`` of each angle's constraint, radians."""
+"""The paper's Omega_k: the phi2 interval ``(lo, hi)`` of each angle's constraint, radians (its
+layout's data, :data:`~turntable_pin.model.paper_table.PHI2_INTERVALS_DEG`)."""
 WEIGHT_SCHEMES: tuple[str, ...] = ("model", "paper", "equal")
-"""The weight schemes :func:`allocation_weights` knows (``paper``: the paper's table only)."""
+"""The weight schemes :func:`allocation_weights` knows."""
 MIN_LIMIT_ARCSEC = 1e-6
 """Smallest orientation limit accepted, arcsec (a micro-arcsecond; turntables work in arcsec)."""
 DEFAULT_ACCURACY_DPH = 0.01
@@ -178,7 +179,7 @@ def default_orientation_limits(
 
     It is the calibration layer's requirement (eqs. 15-16, :func:`orientation_requirement`) for
     calibration accuracy ``accuracy_dph`` (deg/h) on the position scheme ``positions`` of
-    ``table`` (default the paper's) at ``latitude_deg`` (degrees), with the paper's Table 1
+    ``table`` (default the bundled table) at ``latitude_deg`` (degrees), with the paper's Table 1
     GyroWheel: its box that holds (``requirement="box"``) or the paper's planes (``"planes"``,
     :data:`REQUIREMENT_KINDS`). The paper's own numbers are :func:`paper_eq16_limits`.
 
@@ -193,18 +194,12 @@ def default_orientation_limits(
             f"unknown requirement '{requirement}'; expected one of {REQUIREMENT_KINDS}"
         )
     result = orientation_requirement(
-        accuracy_dph, PositionSet.parse(positions, table), math.radians(latitude_deg)
+        accuracy_dph, PositionSet.parse(positions, resolve_table(table)), math.radians(latitude_deg)
     )
     return OrientationLimits(*(result.box if requirement == "box" else result).limits_rad)
 
 
 # ---- the rows of one angle and their maximum over a domain ----------------------------------
-def _is_paper(table) -> bool:
-    from ..model.paper_table import is_paper_table
-
-    return is_paper_table(table)
-
-
 def _basis(t) -> np.ndarray:
     """``(1, cos t, sin t)`` along a last axis."""
     return np.stack([np.ones_like(t), np.cos(t), np.sin(t)], axis=-1)
@@ -221,7 +216,10 @@ class AngleRows:
         domain_rad: Omega_k, one ``(lo, hi)`` per joint.
         axes_rad: the starting grid, one per joint inside the domain (a single value: a joint the
             rows do not depend on, never moved).
-        joint_names: the joints.  paper_terms: say it in the paper's terms (over phi2).
+        joint_names: the joints.  angle_names: their angles' names in words (the paper's phi1,
+            phi2).
+        named: the joints the constraint's words name (chain indices): those whose interval the
+            table's layout gives for this angle, else every joint.
     """
 
     angle: str
@@ -230,7 +228,8 @@ class AngleRows:
     domain_rad: tuple[tuple[float, float], ...]
     axes_rad: tuple[np.ndarray, ...] = field(repr=False)
     joint_names: tuple[str, ...] = ()
-    paper_terms: bool = False
+    angle_names: tuple[str, ...] = ()
+    named: tuple[int, ...] = ()
 
     def values(self, points, keep: int | None = None) -> np.ndarray:
         """The signed rows (K, m) at points (K, joints), radians; with ``keep``, their ``(c, a,
@@ -254,9 +253,10 @@ class AngleRows:
 def angle_rows(
     table, grid_step_deg: float | None = None, whole_turns: bool = False
 ) -> dict[str, AngleRows]:
-    """The :class:`AngleRows` of psi, theta, gamma on ``table`` over Omega_k (``whole_turns``:
-    every joint's whole turn), starting grid of step ``grid_step_deg`` (default by table). ``T`` is
-    read off the regressor at 0, 90, 180 degrees of every joint and checked on random positions.
+    """The :class:`AngleRows` of psi, theta, gamma on ``table`` over Omega_k (the joint intervals
+    of ``table.angle_domains_rad``, else whole turns; ``whole_turns``: every joint's whole turn),
+    starting grid of step ``grid_step_deg`` (default by table). ``T`` is read off the regressor at
+    0, 90, 180 degrees of every joint and checked on random positions.
 
     Raises:
         ModelError: the regressor is not of degree one in every joint angle.
@@ -268,7 +268,6 @@ def angle_rows(
     coefficients = coefficients.reshape((3,) * d + coefficients.shape[1:])
     for j in range(d):
         coefficients = np.moveaxis(np.tensordot(_TO_COEFFICIENTS, coefficients, ([1], [j])), 0, j)
-    full = (FULL_TURN_RAD,) * d
     probe = np.random.default_rng(0).uniform(-math.pi, math.pi, (16, d))  # generic positions
     exact = table.regressor(list(probe.T))[:, :, columns]
     out = {}
@@ -276,9 +275,9 @@ def angle_rows(
         block = coefficients[..., k, :]
         peak = np.abs(block).reshape(-1, block.shape[-1]).max(axis=0)
         members = np.flatnonzero(peak > 1e-12 * max(float(peak.max()), 1e-300))
-        domain = (
-            full if whole_turns or not _is_paper(table) else (full[0], PHI2_INTERVALS_RAD[name])
-        )
+        given = {} if whole_turns else table.angle_domains_rad(name)
+        domain = tuple(given.get(joint, FULL_TURN_RAD) for joint in table.joint_names)
+        named = [j for j, joint in enumerate(table.joint_names) if joint in given]
         out[name] = AngleRows(
             name,
             tuple(table.angular_names[i] for i in members),
@@ -286,7 +285,8 @@ def angle_rows(
             domain,
             grid_axes_rad(table, grid_step_deg, domain),
             tuple(table.joint_names),
-            _is_paper(table),
+            tuple(table.angle_names),
+            tuple(named or range(d)),
         )
         if np.max(np.abs(out[name].values(probe) - exact[:, k, members]), initial=0) > 1e-12:
             raise ModelError(f"{table.urdf_path}: the first-order model is not of degree one")
@@ -518,7 +518,8 @@ class SubproblemResult:
             at ``at_angles_rad`` (one angle per joint).
         multiplier: the constraint's (x in arcmin, summed over its active points).
         kkt_residual: largest relative stationarity error.
-        paper_terms: say it in the paper's terms (over phi2, the last joint).
+        angle_names: the joints' angles in words.  named: the joints the words name (chain
+            indices; :class:`AngleRows`).
     """
 
     angle: str
@@ -534,7 +535,8 @@ class SubproblemResult:
     at_angles_rad: tuple[float, ...]
     multiplier: float
     kkt_residual: float
-    paper_terms: bool = False
+    angle_names: tuple[str, ...] = ()
+    named: tuple[int, ...] = ()
 
     @property
     def J(self) -> float:
@@ -552,19 +554,36 @@ class SubproblemResult:
         return self.domain_rad[-1]
 
     @property
+    def _words(self) -> tuple[str, ...]:
+        """The angle names of the named joints (the joint names where none are given)."""
+        names = self.angle_names or self.joint_names
+        return tuple(names[j] for j in self.named)
+
+    @property
+    def domain_deg(self) -> dict[str, list[float]]:
+        """``{angle name: [lo, hi]}`` of the named joints' intervals, degrees."""
+        return {
+            w: [v * DEG_PER_RAD for v in self.domain_rad[j]]
+            for w, j in zip(self._words, self.named, strict=True)
+        }
+
+    @property
+    def at_max_deg(self) -> dict[str, float]:
+        """``{angle name: degrees}`` of the named joints where the constraint peaks."""
+        return {
+            w: self.at_angles_rad[j] * DEG_PER_RAD
+            for w, j in zip(self._words, self.named, strict=True)
+        }
+
+    @property
     def active(self) -> tuple[str, ...]:
-        """The active constraints in words."""
-        deg = [a * DEG_PER_RAD for a in self.at_angles_rad]
+        """The active constraints in words (the domain and the peak over the named joints)."""
         out = []
-        if self.constraint_rad >= self.limit_rad * (1.0 - 1e-9) and self.paper_terms:
-            lo, hi = (v * DEG_PER_RAD for v in self.interval_rad)
-            out.append(
-                f"max d{self.angle} over phi2 in [{lo:g}, {hi:g}] deg = limit (at phi2 = "
-                f"{deg[-1]:.4f} deg)"
-            )
-        elif self.constraint_rad >= self.limit_rad * (1.0 - 1e-9):
-            where = ", ".join(f"{j} = {a:g}" for j, a in zip(self.joint_names, deg, strict=True))
-            out.append(f"first-order max |d{self.angle}| = limit (at {where} deg)")
+        if self.constraint_rad >= self.limit_rad * (1.0 - 1e-9):
+            over = " and ".join(f"{w} in [{lo:g}, {hi:g}] deg" for w, (lo, hi) in
+                                self.domain_deg.items())  # fmt: skip
+            at = ", ".join(f"{w} = {a:.4f} deg" for w, a in self.at_max_deg.items())
+            out.append(f"max d{self.angle} over {over} = limit (at {at})")
         lower = self.solution_rad <= self.lower_bounds_rad * (1.0 + 1e-9)
         return (
             *out,
@@ -572,29 +591,20 @@ class SubproblemResult:
         )
 
     def to_dict(self) -> dict:
-        """The optimum, JSON-ready: angle, solution (arcmin), weights, J, limit (arcmin), where
-        the constraint peaks (in the paper's terms also the phi2 interval, the multiplier and the
-        KKT residual), active constraints and method."""
-        if self.paper_terms:
-            details = {
-                "phi2_interval_deg": [v * DEG_PER_RAD for v in self.interval_rad],
-                "constraint_arcmin": self.constraint_rad * ARCMIN_PER_RAD,
-                "phi2_at_max_deg": self.at_angles_rad[-1] * DEG_PER_RAD,
-                "multiplier": self.multiplier,
-                "kkt_residual": self.kkt_residual,
-            }
-        else:
-            details = {
-                "worst_case_arcmin": self.constraint_rad * ARCMIN_PER_RAD,
-                "at_angles_deg": [a * DEG_PER_RAD for a in self.at_angles_rad],
-            }
+        """The optimum, JSON-ready: angle, solution (arcmin), weights, J, limit (arcmin), the
+        domain of the named joints (degrees), the constraint's maximum (arcmin) and where it
+        peaks, its multiplier and the KKT residual, active constraints and method."""
         return {
             "angle": self.angle,
             "solution_arcmin": arcmin_by_name(self.error_names, self.solution_rad),
             "weights": dict(zip(self.error_names, map(float, self.weights), strict=True)),
             "J": self.J,
             "limit_arcmin": self.limit_rad * ARCMIN_PER_RAD,
-            **details,
+            "domain_deg": self.domain_deg,
+            "constraint_arcmin": self.constraint_rad * ARCMIN_PER_RAD,
+            "at_max_deg": self.at_max_deg,
+            "multiplier": self.multiplier,
+            "kkt_residual": self.kkt_residual,
             "active_constraints": list(self.active),
             "method": self.method,
         }
@@ -620,27 +630,21 @@ def solve_subproblem(rows: AngleRows, limit_rad: float, weights, lower_bounds_ra
     return SubproblemResult(
         rows.angle, rows.error_names, w, lower, x, float(limit_rad), method, rows.domain_rad,
         rows.joint_names, peak * limit_rad, tuple(map(float, at)), multiplier, residual,
-        rows.paper_terms,
+        rows.angle_names, rows.named,
     )  # fmt: skip
 
 
 # ---- weights and the whole allocation ------------------------------------------------------
 def allocation_weights(scheme: str, sensitivities: Sensitivities | None = None, table=None):
-    """Weights W (3, P) of ``table``'s angular errors (default the paper's), rows
+    """Weights W (3, P) of ``table``'s angular errors (default the bundled table), rows
     :data:`ORIENTATION_ANGLES`: ``model``, the inverse of the average sensitivities (Figure 8;
-    default on the table's grid); ``paper`` (its table only), the inverse of the paper's Figure 8
-    value 0.6481 for every term that varies with the angles and 1 for the constant ones;
-    ``equal``, 1 everywhere (the "traditional" allocation).
+    default on the table's grid); ``paper``, the inverse of the paper's Figure 8 value 0.6481 for
+    every term that varies with the angles and 1 for the constant ones (the paper's rule, on any
+    table); ``equal``, 1 everywhere (the "traditional" allocation).
     """
-    from ..model.paper_table import paper_table
-
-    table = table or paper_table()
+    table = resolve_table(table)
     if scheme not in WEIGHT_SCHEMES:
         raise InputError(f"unknown weights '{scheme}'; choose one of {', '.join(WEIGHT_SCHEMES)}")
-    if scheme == "paper" and not _is_paper(table):
-        raise InputError(
-            f"weights '{scheme}' are the paper table's; for this table choose one of model, equal"
-        )
     if scheme == "equal":
         return np.ones((3, len(table.angular_names)))
     sens = sensitivities or table_sensitivities(table)
@@ -689,47 +693,42 @@ class Allocation:
         out = {name: self.subproblems[name].J for name in ORIENTATION_ANGLES}
         return {**out, "total": float(sum(out.values()))}
 
-    def errors(self) -> TurntableErrors:
-        """The upper bounds as an error set of the paper's table (every error at its bound)."""
-        return TurntableErrors.from_array(self.upper_bounds_rad)
+    def errors(self) -> np.ndarray:
+        """The upper bounds as an error vector of the table (its ``parameter_names`` order; rad,
+        m): every angular error at its bound, 0 for one that moves no angle (an infinite bound)
+        and for the lengths, which never turn the payload. What ``table.orientation_error``,
+        ``table.write_urdf`` and ``TurntableErrors.from_array`` (on the paper's table) take."""
+        values = np.zeros(len(self.table.parameter_names))
+        columns = [self.table.parameter_names.index(n) for n in self.error_names]
+        values[columns] = np.where(np.isfinite(self.upper_bounds_rad), self.upper_bounds_rad, 0.0)
+        return values
 
     def to_dict(self) -> dict:
-        """Bounds (arcmin), objectives, worst case, sub-problems and sensitivities, JSON-ready;
-        the paper's table also gives its lower bounds' reasoning, any other its URDF, joints and
-        grid step."""
-        summary = {
+        """The table (URDF, payload frame, joints), the bounds (upper in arcmin; the lower ones
+        with their source and reasoning), objectives, worst case, limits, grid step, sub-problems
+        and sensitivities, JSON-ready: one schema for every table."""
+        return {
+            "urdf": str(self.table.urdf_path),
+            "payload_frame": self.table.payload_frame,
+            "joints": list(self.table.joint_names),
+            "upper_bounds_arcmin": arcmin_by_name(self.error_names, self.upper_bounds_rad),
             "J": self.J,
             "J_unit": "1/arcmin^2 (errors in arc minutes)",
             "worst_case_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.worst_case_rad),
             "limits_arcmin": self.limits.to_dict(),
             "weights": self.weights_scheme,
-        }
-        subproblems = {
+            "lower_bounds": self.capability.to_dict(),
+            "grid_step_deg": self.sensitivities.grid_step_deg,
             "active_constraints": {n: list(self.subproblems[n].active) for n in ORIENTATION_ANGLES},
             "subproblems": {n: self.subproblems[n].to_dict() for n in ORIENTATION_ANGLES},
-        }
-        upper = arcmin_by_name(self.error_names, self.upper_bounds_rad)
-        if _is_paper(self.table):
-            return {"upper_bounds_arcmin": upper, **summary,
-                    "lower_bounds": self.capability.to_dict(), **subproblems,
-                    "sensitivities": self.sensitivities.by_angle()}  # fmt: skip
-        return {
-            "urdf": str(self.table.urdf_path),
-            "payload_frame": self.table.payload_frame,
-            "joints": list(self.table.joint_names),
-            "upper_bounds_arcmin": upper,
-            "lower_bounds_arcsec": self.capability.arcsec_by_name(),
-            **summary,
-            "grid_step_deg": self.sensitivities.grid_step_deg,
-            **subproblems,
-            "sensitivities": self.sensitivities.by_angle(ORIENTATION_ANGLES),
+            "sensitivities": self.sensitivities.by_angle(),
         }
 
     def report(self) -> str:
         """As text: the bounds (upper in arc minutes and seconds, lower in arc seconds), each
         angle's worst case against its limit, each sub-problem's J, method and active
         constraints."""
-        name = "the paper's table" if _is_paper(self.table) else Path(self.table.urdf_path).name
+        name = self.table.title
         step = self.sensitivities.grid_step_deg
         width = max(12, *(len(n) + 2 for n in self.error_names))
         lines = [
@@ -772,13 +771,14 @@ def allocate_tolerances(
     table=None,
     grid_step_deg: float | None = None,
 ) -> Allocation:
-    """Allocate the angular errors of ``table`` (default the paper's) to meet ``limits``
+    """Allocate the angular errors of ``table`` (default the bundled table) to meet ``limits``
     (eqs. 29-34; see the module).
 
     Args:
         limits: orientation limits (default :func:`default_orientation_limits` of the table).
         weights: ``model`` (default), ``paper`` or ``equal`` (:func:`allocation_weights`).
-        capability: lower bounds (default: the bundled ones on the paper's table, else none).
+        capability: lower bounds (default: the table's bundled ones,
+            :meth:`ManufacturingCapability.of_table`; none bundled: 0).
         sensitivities: the averages behind ``model`` weights (default on the table's grid).
         grid_step_deg: the grid of the sensitivities and of the maxima's starting points (default
             by table: 1, 5, 15 deg when the model depends on 1, 2, 3 joints).
@@ -786,16 +786,11 @@ def allocate_tolerances(
     Raises:
         InfeasibleError: the lower bounds alone violate a limit.
     """
-    from ..model.paper_table import paper_table
-
-    table = table or paper_table()
+    table = resolve_table(table)
     names = tuple(table.angular_names)
-    limits = limits or default_orientation_limits(table=None if _is_paper(table) else table)
+    limits = limits or default_orientation_limits(table=table)
     if capability is None:
-        paper = _is_paper(table)
-        capability = (
-            ManufacturingCapability.default() if paper else ManufacturingCapability.none(names)
-        )
+        capability = ManufacturingCapability.of_table(table)
     if capability.error_names != names:
         raise InputError(f"the lower bounds must be of this table's errors: {', '.join(names)}")
     sensitivities = sensitivities or table_sensitivities(table, grid_step_deg)

@@ -33,7 +33,7 @@ from ..core.exceptions import InputError
 from ..core.sizes import MAX_POSITIONS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
 from ..core.turn_grid import full_turn_grid_deg
 from ..core.units import deg_to_rad, rad_to_deg
-from ..model.paper_table import is_paper_table, paper_table
+from ..model.paper_table import resolve_table
 from .site import DEFAULT_LATITUDE_DEG, MAX_LATITUDE_DEG  # noqa: F401  (re-exported)
 
 __all__ = [
@@ -128,7 +128,7 @@ class PositionSet:
     name: str = ""
 
     def __init__(self, *angles_rad, table=None, name: str = "") -> None:
-        table = paper_table() if table is None else table
+        table = resolve_table(table)
         n_joints = len(table.joint_names)
         if len(angles_rad) == 1 and np.ndim(angles_rad[0]) == 2:
             angles = np.array(angles_rad[0], dtype=float)
@@ -169,11 +169,10 @@ class PositionSet:
 
     @property
     def column_names(self) -> tuple[str, ...]:
-        """The key of each joint's angle (degrees) in reports: the paper's ``phi1_deg,
-        phi2_deg`` on its table, ``<joint>_deg`` on any other."""
-        if is_paper_table(self.table):
-            return tuple(f"phi{k + 1}_deg" for k in range(len(self.joint_names)))
-        return tuple(f"{j}_deg" for j in self.joint_names)
+        """The key of each joint's angle (degrees) in reports: ``<angle>_deg`` of the table's
+        angle names (the paper's ``phi1_deg, phi2_deg``; ``<joint>_deg`` on a table whose layout
+        names no angles)."""
+        return tuple(f"{a}_deg" for a in self.table.angle_names)
 
     @property
     def phi1_rad(self) -> np.ndarray:
@@ -190,12 +189,11 @@ class PositionSet:
     def grid(cls, *steps_deg: float, table=None) -> PositionSet:
         """Every joint in {0, step, ..., < 360} degrees, every combination (one step for all
         joints, or one per joint in chain order)."""
-        table = paper_table() if table is None else table
+        table = resolve_table(table)
         n_joints = len(table.joint_names)
         if len(steps_deg) not in (1, n_joints):
-            which = "the paper's table" if is_paper_table(table) else "a table"
             raise InputError(
-                f"grid: {len(steps_deg)} steps for {which} of {n_joints} "
+                f"grid: {len(steps_deg)} steps for {table.title} of {n_joints} "
                 f"joint{'s' if n_joints > 1 else ''} ({', '.join(table.joint_names)}); give one "
                 "step, or one per joint"
             )
@@ -205,7 +203,7 @@ class PositionSet:
     @classmethod
     def from_csv(cls, path: str | Path, table=None) -> PositionSet:
         """Read the angle columns (``phi1_deg .. phiN_deg`` or ``<joint>_deg``) of a CSV file."""
-        table = paper_table() if table is None else table
+        table = resolve_table(table)
         csv = read_csv_table(path, (), cls.candidate_columns(table))
         return cls.from_csv_table(csv, cls.columns_of(csv, table), table, str(path))
 

@@ -22,7 +22,7 @@ import numpy as np
 from ..core.csv_table import missing_columns_words, read_csv_table, refuse_repeated_rows
 from ..core.exceptions import InputError
 from ..core.sizes import MAX_TIME_S
-from ..model.paper_table import paper_table
+from ..model.paper_table import resolve_table
 from .positions import PositionInputs, PositionSet, position_inputs
 
 __all__ = [
@@ -123,7 +123,7 @@ def read_run(path: str | Path, latitude_rad: float, table=None) -> CalibrationRu
     ``table``: the :class:`~turntable_pin.model.generic_table.GenericTable` the run was made on
     (default the paper's table).
     """
-    table = paper_table() if table is None else table
+    table = resolve_table(table)
     optional = PositionSet.candidate_columns(table) + RUN_OPTIONAL_COLUMNS
     csv = read_csv_table(path, RUN_REQUIRED_COLUMNS, optional, extra=True)
     columns = PositionSet.columns_of(csv, table)

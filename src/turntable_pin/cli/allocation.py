@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..allocation.capability import ManufacturingCapability
-from ..allocation.monte_carlo import run_monte_carlo, run_table_monte_carlo
+from ..allocation.monte_carlo import run_monte_carlo
 from ..allocation.solver import (
     DEFAULT_ACCURACY_DPH,
     DEFAULT_POSITIONS,
@@ -120,25 +120,24 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
         choices=WEIGHT_SCHEMES,
         default="model",
         help="W = 1/sensitivity from the exact model (default), from the paper's Figure 8 "
-        "(0.6481 for sin/cos terms, 1 for constants; the paper's table only), or equal weights "
-        "(traditional method)",
+        "(0.6481 for sin/cos terms, 1 for constants), or equal weights (traditional method)",
     )
     p.add_argument(
         "--lower-bounds",
         type=input_path,
         metavar="FILE.yaml",
-        help="manufacturing lower bounds (default: the bundled "
-        "models/manufacturing_lower_bounds.yaml; a table given by --urdf: its error names, "
-        "default 0)",
+        help="manufacturing lower bounds in the table's error names (default: the table's "
+        "bundled ones, the paper's models/manufacturing_lower_bounds.yaml; none bundled: 0)",
     )
     add_table_options(p)
     p.add_argument(
         "--grid-step-deg",
         type=bounded_float(MIN_GRID_STEP_DEG, 90.0, "deg"),
         default=None,
-        help="a table given by --urdf: step of the grid over every joint on which the "
-        "sensitivities are averaged, the maxima of the constraints start (they hold between the "
-        "grid points too) and the Monte Carlo runs (default 1, 5, 15 deg for 1, 2, 3 joints)",
+        help="step of the grid over every joint on which the sensitivities are averaged, the "
+        "maxima of the constraints start (they hold between the grid points too) and the Monte "
+        "Carlo runs (default 1, 5, 15 deg when the first-order model depends on 1, 2, 3 joints: "
+        "1 deg on the paper's table)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -149,9 +148,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "allocate",
         description="Error allocation of paper section 4.2 (eqs. 29-34) on the table's "
         "first-order model: three weighted problems whose constraints hold over every angle of "
-        "their domain (the paper's phi2 intervals on its table) solved exactly, combined by eq. "
-        "34. Prints the upper bounds, J, the active constraints and the worst-case orientation "
-        "error the bounds allow.",
+        "their domain (the joint intervals the table's layout gives: the paper's phi2 intervals "
+        "on its table; else whole turns) solved exactly, combined by eq. 34. Prints the upper "
+        "bounds, J, the active constraints and the worst-case orientation error the bounds "
+        "allow.",
     )
     _add_allocation_options(a)
     a.add_argument("--plots", type=Path, metavar="DIR", help="write Figure 8 (sensitivities) here")
@@ -161,18 +161,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "montecarlo",
         description="Allocate as `allocate` does, draw N turntables with error magnitudes uniform "
         "in [lower, upper] bound and random signs, evaluate the exact orientation error over a "
-        "phi2 grid and compare the largest |dpsi|, |dtheta|, |dgamma| with the limits (Figure 9). "
-        "Exit status 1 if a limit is exceeded.",
+        "grid of every joint (--grid-step-deg; a joint no drawn table depends on at 0 only) and "
+        "compare the largest |dpsi|, |dtheta|, |dgamma| with the limits (Figure 9). Exit status "
+        "1 if a limit is exceeded.",
     )
     _add_allocation_options(m)
     m.add_argument("-n", type=positive_int, default=10000, help="number of turntables (10000)")
     m.add_argument("--seed", type=seed, default=0, help="random seed, recorded in the output (0)")
-    m.add_argument(
-        "--phi2-step-deg",
-        type=bounded_float(MIN_GRID_STEP_DEG, 90.0, "deg"),
-        default=None,
-        help="phi2 grid step, degrees (1; the paper's table: --grid-step-deg for any other)",
-    )
     m.add_argument(
         "--scale-bounds",
         type=positive_float,
@@ -186,9 +181,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     m.set_defaults(func=run_montecarlo)
 
 
-def _limits_from_args(args: argparse.Namespace, table=None) -> tuple[OrientationLimits, str]:
+def _limits_from_args(args: argparse.Namespace, table) -> tuple[OrientationLimits, str]:
     """The orientation limits of the options and how they were given; the default limits come
-    from the calibration layer's requirement on ``table``'s positions (the paper's: None)."""
+    from the calibration layer's requirement on ``table``'s positions."""
     if args.limits_arcmin is not None:
         return parse_limits(args.limits_arcmin, "arcmin"), f"--limits-arcmin {args.limits_arcmin}"
     if args.limits_deg is not None:
@@ -201,57 +196,29 @@ def _limits_from_args(args: argparse.Namespace, table=None) -> tuple[Orientation
             args.accuracy_dph, args.positions, args.latitude_deg, table, args.requirement
         )
     except IdentifiabilityError as exc:
-        if table is None:
-            raise
         raise IdentifiabilityError(
             f"no default limits for this table ({exc}); give --limits-arcmin or --limits-deg"
         ) from None
     return limits, given
 
 
-def _table(args: argparse.Namespace):
-    """The :class:`GenericTable` of ``--urdf``, or None for the paper's table (whose options
-    ``--grid-step-deg`` does not take)."""
-    from ..model.paper_table import is_paper_table
-
-    table = table_from_args(args)
-    if not is_paper_table(table):
-        return table
-    if args.grid_step_deg is not None:
-        raise InputError(
-            "--grid-step-deg is for a table given by --urdf; the paper's table averages over "
-            "phi2 (montecarlo: --phi2-step-deg)"
-        )
-    return None
-
-
-def _allocation_from_args(args: argparse.Namespace, table=None) -> Allocation:
-    """The allocation the options ask for, of ``table`` (None: the paper's, from ``--urdf``)."""
-    if table is not None and args.weights == "paper":
-        raise InputError(
-            "--weights paper: the paper's Figure 8 values belong to its table; for a table given "
-            "by --urdf choose --weights model or --weights equal"
-        )
-    if table is not None and args.plots:
-        raise InputError("--plots: the figures are drawn for the paper's table only")
+def _allocation_from_args(args: argparse.Namespace, table) -> Allocation:
+    """The allocation the options ask for, of ``table``."""
     limits, given = _limits_from_args(args, table)
     capability = None
     if args.lower_bounds:
         capability = ManufacturingCapability.from_yaml(args.lower_bounds, table)
-    elif table is None:
-        capability = ManufacturingCapability.default()
-    table = table or table_from_args(args)
     try:
         return allocate_tolerances(
             limits, args.weights, capability, table=table, grid_step_deg=args.grid_step_deg
         )
     except InfeasibleError as exc:  # name the two inputs that conflict
-        source = capability.source if capability else "no lower bounds"
+        source = (capability or ManufacturingCapability.of_table(table)).source
         raise InfeasibleError(f"{given} with the lower bounds of {source}: {exc}") from None
 
 
 def run_allocate(args: argparse.Namespace) -> int:
-    allocation = _allocation_from_args(args, _table(args))
+    allocation = _allocation_from_args(args, table_from_args(args))
     figure = None
     if args.plots:
         from ..report.allocation_figures import plot_sensitivities
@@ -288,39 +255,19 @@ def _scaled_bounds(args: argparse.Namespace, upper, lower):
 def run_montecarlo(args: argparse.Namespace) -> int:
     if args.scale_bounds <= 0.0:
         raise InputError(f"--scale-bounds must be positive, got {args.scale_bounds}")
-    table = _table(args)
-    options = {"workers": args.workers, "progress": not (args.quiet or args.json)}
-    if table is not None:
-        if args.phi2_step_deg is not None:
-            raise InputError(
-                "--phi2-step-deg is the paper table's; for this table: --grid-step-deg"
-            )
-        allocation = _allocation_from_args(args, table)
-        upper, lower = _scaled_bounds(
-            args, allocation.upper_bounds_rad, allocation.lower_bounds_rad
-        )
-        result = run_table_monte_carlo(
-            table, upper, allocation.limits, args.n, args.seed, lower_bounds_rad=lower,
-            grid_step_deg=allocation.sensitivities.grid_step_deg, **options,
-        )  # fmt: skip
-        title = (
-            f"Monte Carlo on {table.urdf_path.name}: {result.n} tables (seed {result.seed}), "
-            f"grid {result.grid_steps_deg[0]:g} deg over {', '.join(table.joint_names)} "
-            f"({result.n_grid_points} positions), exact chain, {result.elapsed_s:.1f} s"
-        )
-    else:
-        allocation = _allocation_from_args(args)
-        upper, lower = _scaled_bounds(
-            args, allocation.upper_bounds_rad, allocation.capability.lower_bounds_rad
-        )
-        result = run_monte_carlo(
-            upper, allocation.limits, args.n, args.seed, lower_bounds_rad=lower,
-            phi2_step_deg=args.phi2_step_deg or 1.0, **options,
-        )  # fmt: skip
-        title = (
-            f"Monte Carlo: {result.n} turntables (seed {result.seed}), phi2 step "
-            f"{result.phi2_step_deg:g} deg, exact chain, {result.elapsed_s:.1f} s"
-        )
+    table = table_from_args(args)
+    allocation = _allocation_from_args(args, table)
+    upper, lower = _scaled_bounds(args, allocation.upper_bounds_rad, allocation.lower_bounds_rad)
+    result = run_monte_carlo(
+        upper, allocation.limits, args.n, args.seed, table=table, lower_bounds_rad=lower,
+        grid_step_deg=allocation.sensitivities.grid_step_deg, workers=args.workers,
+        progress=not (args.quiet or args.json),
+    )  # fmt: skip
+    title = (
+        f"Monte Carlo on {table.title}: {result.n} tables (seed {result.seed}), "
+        f"grid {result.grid_steps_deg[0]:g} deg over {', '.join(table.joint_names)} "
+        f"({result.n_grid_points} positions), exact chain, {result.elapsed_s:.1f} s"
+    )
     report = result.to_dict()
     report["weights"] = args.weights
     report["scale_bounds"] = args.scale_bounds

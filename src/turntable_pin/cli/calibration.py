@@ -15,7 +15,6 @@ from ..core.exceptions import InputError
 from ..core.units import deg_to_rad
 from ..model.angles import ANGLE_NAMES, ANGLE_SYMBOLS
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
-from ..model.paper_table import is_paper_table
 from .common import (
     accuracy_dph,
     add_mount_option,
@@ -158,9 +157,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _table_keys(table) -> dict:
-    """What a report of a table other than the paper's adds: URDF, payload frame and joints."""
-    if is_paper_table(table):
-        return {}
+    """The table a report is of: its URDF, payload frame and joints (every table alike)."""
     return {
         "urdf": str(table.urdf_path),
         "payload_frame": table.payload_frame,
@@ -168,9 +165,9 @@ def _table_keys(table) -> dict:
     }
 
 
-def _print_table(table) -> None:
-    """The line naming a table other than the paper's in a text report."""
-    if not is_paper_table(table):
+def _print_table(args: argparse.Namespace, table) -> None:
+    """The line naming the table in a text report, when the user named one (``--urdf``)."""
+    if args.urdf is not None:
         print(f"table {table.urdf_path.name}: joints {', '.join(table.joint_names)}")
 
 
@@ -191,7 +188,7 @@ def run_rate_error(args: argparse.Namespace) -> int:
     if args.json:
         print_json(report)
         return 0
-    _print_table(table)
+    _print_table(args, table)
     print(
         f"positions {report['positions']} ({report['n_positions']}), latitude "
         f"{report['latitude_deg']:g} deg, {'exact rotation' if args.exact else 'eq. 7 dR'}, "
@@ -216,7 +213,7 @@ def run_requirement(args: argparse.Namespace) -> int:
     if args.json:
         print_json(report)
         return 0
-    _print_table(table)
+    _print_table(args, table)
     print(
         f"accuracy {args.accuracy_dph:g} deg/h, positions {report['positions']} "
         f"({report['n_positions']}), latitude {report['latitude_deg']:g} deg, "
@@ -323,7 +320,7 @@ def _diagnose_run(args: argparse.Namespace, table) -> int:
     if args.json:
         print_json(out)
         return 0
-    _print_table(table)
+    _print_table(args, table)
     print("\n".join(run_report_lines(out)))
     for path in [*out.get("plots", []), *([out["report"]] if "report" in out else [])]:
         print(f"wrote {path}")
@@ -361,7 +358,7 @@ def _fit_run_effects(args: argparse.Namespace, table) -> int:
     if args.json:
         print_json(out)
         return 0
-    _print_table(table)
+    _print_table(args, table)
     sigma = "from the sigma_dph column" if out["sigma_source"] == "column" else "estimated"
     print(f"{args.data}: {run.n_positions} positions, noise {sigma}")
     for label, summary in (("before: base", out["before"]),

@@ -245,7 +245,7 @@ def _from_data(args: argparse.Namespace, table):
     from ..measurement.table import measured_table
 
     measured = measured_table(table)
-    data = read_measurements(args.from_data, None if measured.paper else measured.joint_names)
+    data = read_measurements(args.from_data, measured.joint_names)
     warn_ignored_columns(args, data, args.from_data)
     return data
 

@@ -12,7 +12,6 @@ from ..calibration.positions import MAX_COMMANDED_ANGLE_DEG
 from ..core.exceptions import InputError
 from ..core.units import M_PER_MM, deg_to_rad, rad_to_arcsec
 from ..model.angles import ANGLE_NAMES
-from ..model.small_angle import small_angle_orientation_error
 from .common import (
     add_error_options,
     bounded_float,
@@ -93,55 +92,37 @@ def joint_angles_deg(
 
 
 def position_fields(table, angles_deg) -> dict:
-    """How a command's JSON names the table and its position: on the paper's table its angles
-    ``phi1_deg``, ``phi2_deg`` (the table implied); on any other its URDF, payload frame and
-    ``angles_deg``, ``{joint: degrees}``."""
+    """How a command's JSON names the table and its position: its URDF, payload frame and
+    ``angles_deg``, ``{angle: degrees}`` under the table's angle names (the paper's phi1, phi2;
+    the joint names on a table whose layout names no angles)."""
     angles = [float(a) for a in angles_deg]
-    from ..model.paper_table import is_paper_table
-
-    if is_paper_table(table):
-        return {f"phi{k}_deg": a for k, a in enumerate(angles, start=1)}
     return {
         "urdf": str(table.urdf_path),
         "payload_frame": table.payload_frame,
-        "angles_deg": dict(zip(table.joint_names, angles, strict=True)),
+        "angles_deg": dict(zip(table.angle_names, angles, strict=True)),
     }
 
 
-def position_text(fields: dict) -> str:
-    """The position of :func:`position_fields` in words (``phi1 = 30 deg, ...``)."""
-    angles = fields.get("angles_deg") or {
-        k.removesuffix("_deg"): v for k, v in fields.items() if k.startswith("phi")
-    }
-    text = ", ".join(f"{j} = {a:g} deg" for j, a in angles.items())
-    frame = fields.get("payload_frame")
-    return text if frame is None else f"{text} (payload frame {frame})"
-
-
-def _first_order(table, error_values, angles_rad) -> tuple[str, str, np.ndarray]:
-    """``(key, label, [dpsi, dtheta, dgamma] in rad)`` of the table's first-order model: on the
-    paper's table eq. 26 in closed form (exact zeros where its matrix has them), else the exact
-    regressor at zero errors times the errors (the same numbers to rounding on the paper's)."""
-    from ..model.paper_table import is_paper_table
-
-    if is_paper_table(table):
-        return "small_angle", "eq. 26", small_angle_orientation_error(error_values, angles_rad[1])
-    first = table.regressor([np.array([a]) for a in angles_rad])[0] @ error_values
-    return "first_order", "first order", first
+def position_text(fields: dict, payload_frame: bool = True) -> str:
+    """The position of :func:`position_fields` in words (``phi1 = 30 deg, ...``), with the
+    payload frame (``payload_frame``: where the user named the table)."""
+    text = ", ".join(f"{j} = {a:g} deg" for j, a in fields["angles_deg"].items())
+    return f"{text} (payload frame {fields['payload_frame']})" if payload_frame else text
 
 
 def orientation_report(table, error_values, angles_deg) -> dict:
     """The dictionary the ``orientation`` command prints (units in the key names): the exact
-    angles (Pinocchio) beside the first-order ones, the payload origin and the errors."""
+    angles (Pinocchio) beside the first-order ones (the table's closed form where its layout
+    has one, eq. 26 on the paper's), the payload origin and the errors."""
     angles_rad = [deg_to_rad(a) for a in angles_deg]
     result = table.orientation_error(error_values, angles_rad)
-    key, _, first = _first_order(table, error_values, angles_rad)
+    first = table.first_order_error_rad(error_values, angles_rad)
     report = {**position_fields(table, angles_deg), "dR": result.dR}
     for name, value in zip(ANGLE_NAMES, (result.dpsi_rad, result.dtheta_rad, result.dgamma_rad),
                            strict=True):  # fmt: skip
         report[f"{name}_arcsec"] = rad_to_arcsec(value)
     for name, value in zip(ANGLE_NAMES, first, strict=True):
-        report[f"{name}_{key}_arcsec"] = rad_to_arcsec(float(value))
+        report[f"{name}_first_order_arcsec"] = rad_to_arcsec(float(value))
     report["payload_origin_mm"] = np.asarray(result.payload_origin_m) / M_PER_MM
     report["errors"] = table.to_user_units(error_values)
     return report
@@ -155,15 +136,14 @@ def run_orientation(args: argparse.Namespace) -> int:
     if args.json:
         print_json(report)
         return 0
-    key, label, _ = _first_order(table, values, [deg_to_rad(a) for a in angles])
-    print(f"position: {position_text(report)}")
+    print(f"position: {position_text(report, payload_frame=args.urdf is not None)}")
     print("dR = Rd^T Rt:")
     for row in report["dR"]:
         print("  [" + "  ".join(f"{v: .12f}" for v in row) + "]")
-    label = f"{label} (arcsec)"
+    label = f"{table.first_order_label} (arcsec)"
     print(f"{'':8s}{'exact (arcsec)':>16s}{label:>{len(label) + 3}s}")
     for name in ANGLE_NAMES:
-        exact, approx = report[f"{name}_arcsec"], report[f"{name}_{key}_arcsec"]
+        exact, approx = report[f"{name}_arcsec"], report[f"{name}_first_order_arcsec"]
         print(f"{name:8s}{exact:16.6f}{approx:{len(label) + 3}.6f}")
     x, y, z = report["payload_origin_mm"]
     print(f"payload origin (mm): x = {x:.6f}, y = {y:.6f}, z = {z:.6f}")

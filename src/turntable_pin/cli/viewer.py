@@ -185,8 +185,9 @@ def run_snapshot(args: argparse.Namespace) -> int:
         print_json({**result.to_dict(position), **scene.to_dict()})
         return 0
     k = scene.exaggeration
+    where = position_text(position, payload_frame=args.urdf is not None)
     print(
-        f"wrote {result.path} ({result.width}x{result.height} px; {position_text(position)}; "
+        f"wrote {result.path} ({result.width}x{result.height} px; {where}; "
         f"errors magnified x{k.angle_factor:.4g}, {scene.length_label} x{k.length_factor:.4g}; "
         f"{result.scene_seconds + result.browser_seconds:.1f} s)"
     )

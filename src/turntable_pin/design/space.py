@@ -290,9 +290,9 @@ def design_space(
         candidates: how many random candidate positions (the grid joins them).
         seed: seed of the random candidates (0 <= seed < 2**63).
     """
-    from ..model.paper_table import paper_table
+    from ..model.paper_table import resolve_table
 
-    table = paper_table() if table is None else table
+    table = resolve_table(table)
     seed = check_seed(seed)
     candidates = int(
         check_count(candidates, MAX_CANDIDATES, "candidate positions", CANDIDATE_BYTES)

@@ -46,7 +46,6 @@ from ..core.turn_grid import random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, deg_to_rad, rad_to_deg
 from ..model.angles import ANGLE_ENTRIES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
-from ..model.paper_table import is_paper_table
 
 __all__ = [
     "DEFAULT_DWELL_S",
@@ -577,7 +576,7 @@ def simulate_calibration_run(
     truth = {
         "simulator": "turntable_pin.instrument.simulate_calibration_run",
         "seed": seed,
-        "table": "paper" if is_paper_table(table) else str(table.urdf_path),
+        "table": table.label,
         "positions": positions.name,
         "n_positions": n,
         "latitude_deg": float(rad_to_deg(latitude_rad)),

@@ -10,8 +10,9 @@
 Which entries of ``K`` and which base axes are kept is found like the base errors: QR with column
 pivoting of the effect's columns, after projecting out the base errors, on generic positions.
 
-The paper's table has the same catalogue under the paper's nine names (data:
-:data:`~.effects.paper_names.PAPER_EFFECTS`); on any table ``<kind>@<joint>`` is the catalogue's
+A table whose layout names effects (the paper's nine names, data:
+:data:`~turntable_pin.model.paper_table.PAPER_EFFECTS`) has the same catalogue under those names;
+on any table ``<kind>@<joint>`` is the catalogue's
 effect of that kind on that joint alone (``encoder_harmonics@outer_axis`` is
 ``outer_encoder_harmonics``).
 """
@@ -24,13 +25,13 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..core.exceptions import InputError
+from ..model.named_effects import NamedEffect
 from .effect_model import OrientationModel
 from .effects.backlash import Backlash
 from .effects.base import Effect, PositionVariables
 from .effects.base_rotation import BaseRotation
 from .effects.encoder_harmonics import EncoderHarmonics
 from .effects.gravity_compliance import COMPLIANCE_ENTRIES, GravityCompliance
-from .effects.paper_names import PAPER_EFFECTS, NamedEffect
 from .effects.payload_mount import PayloadMount
 from .effects.thermal_drift import ThermalDrift
 from .effects.wobble_harmonics import WobbleHarmonics
@@ -56,7 +57,7 @@ def catalogue(turntable=None) -> tuple[Effect, ...]:
     cached = _CATALOGUES.get(table)
     if cached is not None:
         return cached
-    names = PAPER_EFFECTS if table.paper else ()
+    names = table.named_effects
     slots = (
         *(("encoder_harmonics", j) for j in table.joints),
         *(("wobble_harmonics", j) for j in table.joints),

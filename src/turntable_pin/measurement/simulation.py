@@ -22,7 +22,7 @@ from ..core.turn_grid import full_turn_grid_deg, random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.angles import ANGLE_NAMES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors
-from ..model.paper_table import paper_table
+from ..model.paper_table import resolve_table
 from .catalogue import resolve_effect
 from .data import (
     MAX_COMMANDED_ANGLE_DEG,
@@ -536,7 +536,7 @@ def simulate_measurements(
             f"{MAX_NOISE_ARCSEC:g}] arcsec (noise_arcsec / spread .. noise_arcsec * spread)"
         )
     seed = check_seed(seed)
-    source = paper_table() if turntable is None else getattr(turntable, "table", turntable)
+    source = resolve_table(turntable)
     table = measured_table(source)
     n_joints = table.n_joints
     if isinstance(errors, TurntableErrors):
@@ -625,7 +625,7 @@ def simulate_measurements(
         time_s=variables.time_s,
         dirs=variables.dirs,
         source=f"simulated (seed {seed})",
-        joint_names=() if table.paper else table.joint_names,
+        joint_names=table.joint_names,
     )
     return SimulatedMeasurements(
         data=data,

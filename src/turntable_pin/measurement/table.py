@@ -1,7 +1,8 @@
 """The turntable as the measurement layer sees it: its error chain, base errors, joints, effects.
 
 One class, :class:`MeasuredTable`, serves the paper's table and any URDF table alike; the paper's
-table is the same model under the names of its Table 2 (a name map, ``model/paper_table.py``).
+table is the same model under the names of its Table 2 and of its effects (its layout,
+``model/paper_table.py``).
 
 - The *base errors* are the chain's rotation errors (offsets move the payload, never turn it).
 - Each joint has a *position error* and two *tilts* (generic: ``<joint>.position``,
@@ -47,7 +48,8 @@ class MeasuredTable:
         joints: each joint's errors, from the base.
         descriptions: ``{base error: what it is}``.
         label: how reports name the table (``paper`` or the URDF file).
-        paper: the paper's table (its catalogue and names).
+        named_effects: the catalogue's effects under the table's own names (its layout's
+            :class:`~turntable_pin.model.named_effects.NamedEffect`; none: the generic names).
         urdf_path: the nominal URDF the chain was read from.
         telescope_mount: the telescope mount kind the table is (``"altaz"``, ``"equatorial"``;
             ``None``: a turntable), as declared (``model/mount_declaration.py``), never guessed.
@@ -62,7 +64,7 @@ class MeasuredTable:
         descriptions: dict[str, str],
         *,
         label: str,
-        paper: bool = False,
+        named_effects: Sequence = (),
         urdf_path=None,
         telescope_mount: str | None = None,
         declared_mount: str | None = None,
@@ -74,7 +76,7 @@ class MeasuredTable:
         self.joints = tuple(joints)
         self.descriptions = dict(descriptions)
         self.label = label
-        self.paper = paper
+        self.named_effects = tuple(named_effects)
         rotations = [f.error for link in chain.links for f in link.factors if f.kind == ROTATION]
         self.base_names = tuple(n for n in chain.error_names if n in rotations)
 
@@ -99,6 +101,12 @@ class MeasuredTable:
         radians, else ``None`` (see :class:`~turntable_pin.model.chain.ChainLink`)."""
         return tuple(link.limits_rad for link in self.chain.joints)
 
+    @property
+    def paper(self) -> bool:
+        """Whether the table tells its base errors in the paper's words (its effects carry the
+        paper's names); read by ``report/html_report.py`` alone."""
+        return bool(self.named_effects) and self.label == "paper"
+
     def angle_label(self, k: int) -> str:
         """``phiK``, the name of joint K's angle in data files and reports."""
         return f"phi{k}"
@@ -113,11 +121,11 @@ def measured_table(turntable=None) -> MeasuredTable:
     :class:`~turntable_pin.model.generic_table.GenericTable` (in its layout's names: the paper's
     on the paper's table), a :class:`~turntable_pin.model.turntable.TurntableModel` (its table)
     or a :class:`MeasuredTable` (returned as it is)."""
-    from ..model.paper_table import is_paper_table, paper_table
+    from ..model.paper_table import resolve_table
 
     if isinstance(turntable, MeasuredTable):
         return turntable
-    table = paper_table() if turntable is None else getattr(turntable, "table", turntable)
+    table = resolve_table(turntable)
     cached = _MEASURED.get(table)
     if cached is None:
         joints = [
@@ -126,7 +134,7 @@ def measured_table(turntable=None) -> MeasuredTable:
         ]
         cached = _MEASURED[table] = MeasuredTable(
             table.chain, joints, table.descriptions, label=table.label,
-            paper=is_paper_table(table), urdf_path=table.urdf_path,
+            named_effects=table.layout.effects, urdf_path=table.urdf_path,
             telescope_mount=table.telescope_mount, declared_mount=table.declared_mount,
         )  # fmt: skip
     return cached

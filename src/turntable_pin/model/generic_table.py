@@ -25,8 +25,9 @@ every layer written for a ``GenericTable`` reproduces the paper when given the p
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 
@@ -44,9 +45,11 @@ from .chain import (
     compose_rotation,
 )
 from .mount_declaration import read_mount_declaration, resolve_mount
+from .named_effects import NamedEffect
 
 __all__ = [
     "MAX_JOINTS",
+    "ClosedForm",
     "ErrorLayout",
     "GenericTable",
     "Identifiable",
@@ -116,9 +119,26 @@ def _payload_frame(model, path: Path, payload_frame: str | None) -> str:
     return leaves[0]
 
 
+@dataclass(frozen=True)
+class ClosedForm:
+    """A table's first-order orientation error written out (the paper's eq. 26).
+
+    Attributes:
+        label: how texts cite it (``eq. 26``).
+        orientation_error_rad: ``(error_values, angles_rad) -> (dpsi, dtheta, dgamma)``, radians:
+            the error vector in the layout's order (rad, m) and one angle per joint (chain order).
+    """
+
+    label: str
+    orientation_error_rad: Callable[[np.ndarray, Sequence[float]], np.ndarray]
+
+
 @dataclass(frozen=True, eq=False)
 class ErrorLayout:
     """Where a table's errors sit and what they are called: the table-specific part as data.
+
+    Every field past ``joint_errors`` is optional: a table without it is named and told by the
+    generic rule (its URDF file, its joint names, the regressor, whole turns, no bounds).
 
     Attributes:
         factors: ``{placement (joint or fixed joint): ((kind, axis, error name), ...)}``, the
@@ -129,6 +149,19 @@ class ErrorLayout:
         joint_errors: ``{joint: (position error, tilt a, tilt b)}``, from the base.
         label: how reports name the table (``None``: its URDF file).
         payload_frame: the payload frame the layout is written for (``None``: any).
+        title: how a sentence names the table (``the paper's table``; ``None``: its URDF file's
+            name).
+        angle_names: the name of each joint's angle in keys and texts, from the base (``phi1``,
+            ``phi2``; empty: the joint names).
+        first_order: the first-order model in closed form (``None``: the regressor at zero
+            errors, :meth:`GenericTable.regressor`).
+        domains_deg: ``{orientation angle (psi, theta, gamma): {joint: (lo, hi)}}``, degrees: the
+            joint angles over which the allocation bounds that angle (the paper's eqs. 31-33;
+            a joint not named, or an angle not given: its whole turn).
+        lower_bounds_file: the file of the bundled models folder holding the table's
+            manufacturing lower bounds (``None``: none bundled).
+        effects: the catalogue's effects under the table's own names
+            (:class:`~turntable_pin.model.named_effects.NamedEffect`).
     """
 
     factors: Mapping[str, tuple[tuple, ...]]
@@ -137,6 +170,19 @@ class ErrorLayout:
     joint_errors: Mapping[str, tuple[str, str, str]]
     label: str | None = None
     payload_frame: str | None = None
+    title: str | None = None
+    angle_names: tuple[str, ...] = ()
+    first_order: ClosedForm | None = None
+    domains_deg: Mapping[str, Mapping[str, tuple[float, float]]] = field(default_factory=dict)
+    lower_bounds_file: str | None = None
+    effects: tuple[NamedEffect, ...] = ()
+
+    def fits(self, joint_names: Sequence[str], payload_frame: str) -> bool:
+        """Whether the layout is written for a chain of these joints to this payload frame."""
+        return tuple(joint_names) == tuple(self.joint_errors) and self.payload_frame in (
+            None,
+            payload_frame,
+        )
 
     @property
     def length_names(self) -> tuple[str, ...]:
@@ -333,6 +379,50 @@ class GenericTable:
     def label(self) -> str:
         """How reports name the table: the layout's label (``paper``) or the URDF file."""
         return self.layout.label or str(self.urdf_path)
+
+    @property
+    def title(self) -> str:
+        """How a sentence names the table: the layout's title (``the paper's table``) or the
+        URDF file's name."""
+        return self.layout.title or self.urdf_path.name
+
+    @property
+    def angle_names(self) -> tuple[str, ...]:
+        """The name of each joint's angle in keys and texts, chain order: the layout's
+        (``phi1``, ``phi2``) or the joint names."""
+        return tuple(self.layout.angle_names) or self.joint_names
+
+    @property
+    def first_order_label(self) -> str:
+        """How texts cite the first-order model: the layout's closed form (``eq. 26``) or
+        ``first order``."""
+        return self.layout.first_order.label if self.layout.first_order else "first order"
+
+    def first_order_error_rad(self, error_values, angles_rad: Sequence[float]) -> np.ndarray:
+        """``(dpsi, dtheta, dgamma)`` of the first-order model at one position (chain order,
+        radians), radians: the layout's closed form (exact zeros where its matrix has them), else
+        the regressor at zero errors times the errors (the same numbers to rounding)."""
+        values = np.asarray(error_values, dtype=float)
+        angles = [float(a) for a in self._angles(angles_rad)]
+        if self.layout.first_order is not None:
+            return np.asarray(self.layout.first_order.orientation_error_rad(values, angles))
+        return self.regressor([np.array([a]) for a in angles])[0] @ values
+
+    def angle_domains_rad(self, angle: str) -> dict[str, tuple[float, float]]:
+        """``{joint: (lo, hi)}``, radians: the joint angles over which the allocation bounds the
+        orientation angle ``angle`` (psi, theta or gamma), as the layout gives them (the paper's
+        eqs. 31-33); the joints not named turn whole."""
+        given = self.layout.domains_deg.get(angle, {})
+        return {j: (math.radians(lo), math.radians(hi)) for j, (lo, hi) in given.items()}
+
+    @property
+    def lower_bounds_path(self) -> Path | None:
+        """The bundled file of the table's manufacturing lower bounds (``None``: none)."""
+        if self.layout.lower_bounds_file is None:
+            return None
+        from ..core.resources import models_dir
+
+        return models_dir() / self.layout.lower_bounds_file
 
     def errors_from_user_units(
         self, entries: Mapping[str, object], *, max_angle_deg: float | None = None

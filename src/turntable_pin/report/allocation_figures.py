@@ -39,17 +39,20 @@ def plot_monte_carlo(result: MonteCarloResult, path):
     plt = pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.8))
     limits = result.limits.as_array() * ARCMIN_PER_RAD
+    keys = result.angle_names or result.joint_names
+    over = ", ".join(k for k in keys if k not in result.held_at_deg) or "the positions"
+    step = ", ".join(sorted({f"{s:g}" for s in result.grid_steps_deg}))
     for k, (ax, name) in enumerate(zip(axes, ORIENTATION_ANGLES, strict=True)):
         values = result.worst_rad[:, k] * ARCMIN_PER_RAD
         ax.hist(values, bins=60, color="tab:blue", alpha=0.85)
         ax.axvline(limits[k], color="tab:red", linestyle="--", label=f"limit {limits[k]:.4f}'")
-        ax.set_xlabel(f"max |d{name}| over phi2 (arcmin)")
+        ax.set_xlabel(f"max |d{name}| over {over} (arcmin)")
         ax.set_title(f"d{name}: max {values.max():.4f}'")
         ax.legend(fontsize=8)
     axes[0].set_ylabel("turntables")
     fig.suptitle(
         f"Monte Carlo: {result.n} turntables inside the allocated bounds (seed {result.seed}), "
-        f"exact chain, phi2 step {result.phi2_step_deg:g} deg"
+        f"exact chain, grid {step} deg over {', '.join(keys)}"
     )
     fig.tight_layout()
     return save_png(fig, path)

@@ -34,6 +34,7 @@ from ..core.interrupts import temporary_folder
 from ..core.rotations import rot_x, rot_z
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD, M_PER_MM
 from ..model.errors import TurntableErrors
+from ..model.paper_table import resolve_table
 
 __all__ = [
     "ACTUAL_AXIS_COLOR",
@@ -80,12 +81,6 @@ FALLBACK_BOX_M = 0.05
 """Edge of the box drawn in place of a mesh whose file is missing, metres."""
 
 
-def _paper_table():
-    from ..model.paper_table import paper_table
-
-    return paper_table()
-
-
 def _error_vector(table, errors) -> np.ndarray:
     """``errors`` (a :class:`TurntableErrors`, a vector in the table's order, or None) as the
     table's error vector (rad, m)."""
@@ -128,7 +123,7 @@ class Exaggeration:
         vector of ``table``, default the paper's; see the module docstring); either factor given
         is used as is. A perfect table is shown at true size; a table whose only errors are
         lengths shows the largest as ``display_offset_m``."""
-        table = table if table is not None else _paper_table()
+        table = resolve_table(table)
         values = np.abs(_error_vector(table, errors))
         is_length = _is_length(table)
         largest = float(np.max(values[~is_length], initial=0.0))
@@ -154,7 +149,7 @@ class Exaggeration:
         ``table`` (default the paper's)."""
         if isinstance(errors, TurntableErrors):
             return TurntableErrors.from_array(self.apply(errors.as_array()))
-        table = table if table is not None else _paper_table()
+        table = resolve_table(table)
         return _error_vector(table, errors) * self.factors(table)
 
     def to_dict(self) -> dict:
@@ -339,7 +334,7 @@ class SetupScene:
         camera_target_m=None,
         camera_offset_m=None,
     ) -> None:
-        self.table = table if table is not None else _paper_table()
+        self.table = resolve_table(table)
         self.error_values = _error_vector(self.table, errors)
         self.exaggeration = exaggeration or Exaggeration.for_errors(
             self.error_values, table=self.table

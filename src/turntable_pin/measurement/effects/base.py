@@ -27,6 +27,7 @@ import numpy as np
 
 from ...core.csv_table import missing_columns_words
 from ...core.units import ARCSEC_PER_RAD
+from ...model.named_effects import EffectText, Labels
 
 __all__ = [
     "ARCSEC",
@@ -239,23 +240,6 @@ def harmonic_parameters(prefix: str, what: str, angle: str) -> tuple[ParameterSp
         ParameterSpec(f"{prefix}c2", "arcsec", ARCSEC, f"{what}: cos(2 {angle}) coefficient"),
         ParameterSpec(f"{prefix}s2", "arcsec", ARCSEC, f"{what}: sin(2 {angle}) coefficient"),
     )
-
-
-@dataclass(frozen=True)
-class EffectText:
-    """An effect's story as the reports tell it (the attributes of :class:`Effect` of the same
-    names); a table may tell an effect in its own words (the paper's, :mod:`.paper_names`): what
-    it leaves ``None`` stays as the effect's class tells it."""
-
-    title: str | None = None
-    definition: str | None = None
-    explanation: str | None = None
-    confirm: str | None = None
-
-
-Labels = tuple[tuple[str, str], ...]
-"""``(parameter name or prefix of a harmonic series, description)`` of each parameter (or series)
-of an effect, as a table names them (the paper's, :mod:`.paper_names`)."""
 
 
 class Effect:
