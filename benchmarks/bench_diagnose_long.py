@@ -63,9 +63,7 @@ def main() -> None:
     parser.add_argument("--keep", help="write the files to this directory and keep them")
     args = parser.parse_args()
     n1, n2 = _grid(args.rows)
-    schedule = Schedule(
-        phi1_step_deg=360.0 / n1, phi2_step_deg=360.0 / n2, order="random", dwell_s=30.0
-    )
+    schedule = Schedule(360.0 / n1, 360.0 / n2, order="random", dwell_s=30.0)
     errors = TurntableErrors.from_arcsec(
         dphi_y1=5, dphi_z2=-3, dalpha_x1=2, dalpha_z1=4, dalpha_x2=-6, dalpha_y2=3, deps_x=7,
         deps_y=-2,

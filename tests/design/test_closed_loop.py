@@ -47,7 +47,7 @@ def _rate(table, truths, schedule) -> dict[str, float]:
 @pytest.mark.slow
 def test_design_settles_what_a_one_axis_sweep_leaves_to_chance():
     table = table_of(REPO_DIR / "models" / "three_axis_imu_table.urdf")
-    sweep = Schedule(sweep=("phi3",), phi3_step_deg=15.0)
+    sweep = Schedule(30.0, 30.0, 15.0, sweep=("phi3",))
     sag = {SAG: {"k_xy": -3.0}}
     # The encoder error that makes the same data on the sweep (fitted to the sag's prediction).
     clean = simulate_measurements(None, sag, schedule=sweep, seed=0, turntable=table)

@@ -25,7 +25,7 @@ from turntable_pin.model.paper_table import table_of
 
 MODELS = REPO_DIR / "models"
 ENCODER, SAG = "encoder_harmonics@inner_gimbal", "gravity_sag"
-SWEEP = Schedule(sweep=("phi3",), phi3_step_deg=15.0)
+SWEEP = Schedule(30.0, 30.0, 15.0, sweep=("phi3",))
 
 
 @pytest.fixture(scope="module")

@@ -27,7 +27,7 @@ MODELS = REPO_DIR / "models"
 CASES = {
     "two_axis_vertical_outer": (Schedule(30, 30), "encoder_harmonics@tilt_axis"),
     "three_axis_imu_table": (
-        Schedule(60, 60, phi3_step_deg=60, repeats=1),
+        Schedule(60, 60, 60, repeats=1),
         "wobble_harmonics@middle_gimbal",
     ),
     "single_axis_rate_table": (Schedule(10, repeats=3), "encoder_harmonics@spindle"),

@@ -30,7 +30,7 @@ DESIGNS = {
     "grid45": {"schedule": Schedule(45, 45)},
     "grid30": {"schedule": Schedule(30, 30)},
     "random_positions": {"schedule": Schedule(random_positions=40)},
-    "sweeps": {"schedule": Schedule(30, 30, sweep=("phi1", "phi2"), phi2_start_deg=90)},
+    "sweeps": {"schedule": Schedule(30, 30, sweep=("phi1", "phi2"), starts_deg=(0, 90))},
     "passes": {"schedule": Schedule(60, 60, passes=1)},
     "unknown_noise": {"schedule": Schedule(60, 60), "sigma": False},
     "uneven_noise": {"schedule": Schedule(60, 60), "noise_spread": 3.0},
@@ -139,7 +139,7 @@ def test_no_remainder_probe_on_a_sweep_without_dtheta():
     """With dtheta not measured, dphi_z2 (seen in dtheta alone) enters dpsi and dgamma only to
     second order: its probes are left out (an unresponsive error), where a 3/rev of that
     remainder was once accepted with an amplitude of ~3e4 arcsec."""
-    schedule = Schedule(30, 30, sweep=("phi1", "phi2"), phi2_start_deg=90)
+    schedule = Schedule(30, 30, sweep=("phi1", "phi2"), starts_deg=(0, 90))
     sim = simulate_measurements(random_errors(np.random.default_rng(1019)), seed=19,
                                 schedule=schedule)  # fmt: skip
     angles = sim.data.angles_rad.copy()
@@ -232,7 +232,7 @@ def test_second_harmonics_on_a_90_degree_grid_are_said_to_alias():
 
 
 def test_a_sweep_that_holds_phi2_cannot_test_effects_of_phi2_and_says_so():
-    schedule = Schedule(30, 30, sweep=("phi1",), phi2_start_deg=90)
+    schedule = Schedule(30, 30, sweep=("phi1",), starts_deg=(0, 90))
     d = _diagnosis(schedule, {"inner_encoder_harmonics": {"c1": 3.0, "s2": -2.5}})
     verdict = d["verdict"]
     assert verdict["missing_effect"] is None
@@ -244,13 +244,13 @@ def test_a_sweep_that_holds_phi2_cannot_test_effects_of_phi2_and_says_so():
     assert "--sweep phi1,phi2" in text
     assert "so effects that vary with phi2 cannot be tested" in text  # the rank warning, precise
     # the reverse sweep added (one command: --sweep phi1,phi2) sees it
-    both = _diagnosis(Schedule(30, 30, sweep=("phi1", "phi2"), phi2_start_deg=90),
+    both = _diagnosis(Schedule(30, 30, sweep=("phi1", "phi2"), starts_deg=(0, 90)),
                       {"inner_encoder_harmonics": {"c1": 3.0, "s2": -2.5}})  # fmt: skip
     assert both["verdict"]["missing_effect"] == "inner_encoder_harmonics"
 
 
 def test_single_axis_sweeps_say_they_cannot_see_coupled_terms():
-    schedule = Schedule(30, 30, sweep=("phi1", "phi2"), phi2_start_deg=90)
+    schedule = Schedule(30, 30, sweep=("phi1", "phi2"), starts_deg=(0, 90))
     d = _diagnosis(schedule, {"dpsi~h1(phi1+phi2)": {"c1": 4.0}})
     [warning] = [w for w in d["warnings"] if "single-axis sweeps" in w]
     assert "phi1 swept at phi2 90 deg, phi2 swept at phi1 0 deg" in warning

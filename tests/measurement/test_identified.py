@@ -49,7 +49,7 @@ def test_plain_pinocchio_on_the_written_urdf_reproduces_the_fit(tmp_path, urdf, 
     rng = np.random.default_rng(3)
     if isinstance(table, GenericTable):
         errors = rng.normal(0, 20, len(table.parameter_names)) / ARCSEC_PER_RAD
-        schedule = Schedule(45, 45, phi3_step_deg=90)
+        schedule = Schedule(45, 45, 90)
     else:
         errors, schedule = None, Schedule()
     sim = simulate_measurements(errors, schedule=schedule, seed=4, turntable=table)

@@ -123,7 +123,7 @@ def test_explicit_positions_are_measured_in_their_order_with_their_dirs_and_time
 
 
 def test_sweeps_move_one_axis_at_a_time_and_hold_the_others_at_their_start():
-    schedule = Schedule(90, 120, phi2_start_deg=90, sweep=("phi1", "phi2"), approach="motion")
+    schedule = Schedule(90, 120, starts_deg=(0, 90), sweep=("phi1", "phi2"), approach="motion")
     sim = simulate_measurements(schedule=schedule)
     assert _deg(sim).tolist() == [
         [0, 90], [90, 90], [180, 90], [270, 90],  # phi1 swept at phi2 = 90
@@ -207,7 +207,7 @@ def test_the_existing_options_draw_the_same_numbers():
         ({"positions": ((0, 4000),)}, "within +-3600"),
         ({"positions": ((0, 0), (1, 2)), "positions_time_s": (0, -1)}, "positions_time_s"),
         ({"random_positions": 600_000, "passes": 1}, "1,200,000 rows"),
-        ({"phi1_start_deg": 5000.0}, "phi1_start_deg"),
+        ({"starts_deg": (5000.0,)}, "phi1_start_deg"),
     ],
 )
 def test_bad_designs_are_refused(kwargs, fragment):

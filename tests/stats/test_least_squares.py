@@ -127,7 +127,7 @@ def _simulated(effects=None, n_step=30.0):
     from turntable_pin.measurement.simulation import Schedule
 
     errors = TurntableErrors.from_arcsec(dphi_y1=5, dalpha_x2=-6, deps_x=7, dalpha_z1=4)
-    schedule = Schedule(phi1_step_deg=n_step, phi2_step_deg=n_step, order="random")
+    schedule = Schedule(n_step, n_step, order="random")
     return simulate_measurements(errors, effects or {}, schedule=schedule, seed=4).data
 
 

@@ -273,8 +273,9 @@ def _noise_arcsec(text: str) -> float | tuple[float, float, float]:
 
 def _sweep_axes(text: str, table) -> tuple[str, ...]:
     """``--sweep``: comma-separated axes (``phiK`` or the table's joint names) as ``phiK``."""
-    names = _joints(table)
-    known = {f"phi{k}": f"phi{k}" for k in range(1, len(names) + 1)}
+    names = _generic_joints(table) or ()
+    n_joints = len(names) if names else 2
+    known = {f"phi{k}": f"phi{k}" for k in range(1, n_joints + 1)}
     known.update({name: f"phi{k}" for k, name in enumerate(names, start=1)})
     out = []
     for part in text.split(","):
@@ -305,7 +306,7 @@ def _add_catalogue_option(p: argparse.ArgumentParser) -> None:
                    "called (give only files you trust)")  # fmt: skip
 
 
-def _user_catalogue(args: argparse.Namespace, table):
+def _user_catalogue(args: argparse.Namespace, table=None):
     """The table's catalogue plus the effects of ``--catalogue`` (and installed ones), or
     ``None`` when there are none besides the catalogue."""
     from ..measurement.catalogue import catalogue
@@ -327,22 +328,24 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
     )
 
 
-def _joints(table) -> tuple[str, ...]:
-    """The table's joints from the base (its angle columns are ``phiK_deg`` or ``<joint>_deg``)."""
+def _generic_joints(table) -> tuple[str, ...] | None:
+    """The joints of a table other than the paper's (its angle columns ``phiK_deg`` or
+    ``<joint>_deg``), or ``None`` for the paper's table (``phi1_deg, phi2_deg``)."""
     from ..measurement.table import measured_table
 
-    return measured_table(table).joint_names
+    measured = measured_table(table)
+    return None if measured.paper else measured.joint_names
 
 
-def _read(args: argparse.Namespace, table):
+def _read(args: argparse.Namespace, table=None):
     """The measurements of ``args.data`` for ``table`` (angle columns ``phiK_deg`` or
-    ``<joint>_deg`` of its joints)."""
-    data = read_measurements(args.data, _joints(table))
+    ``<joint>_deg`` of its joints; the paper's ``phi1_deg, phi2_deg`` when ``None``)."""
+    data = read_measurements(args.data, _generic_joints(table))
     warn_ignored_columns(args, data, args.data)
     return data.without_sigma() if args.ignore_sigma else data
 
 
-def _parse_effect_options(texts: list[str], table, user=()) -> dict[str, dict[str, float]]:
+def _parse_effect_options(texts: list[str], table=None, user=()) -> dict[str, dict[str, float]]:
     """The ``--effect`` options as ``{effect: {parameter: value}}``; each effect at most once.
     Names may be the table's catalogue's, of the effects ``user`` or inline terms."""
     from ..measurement.user_effects import resolve_effects
@@ -470,7 +473,7 @@ def _run_simulate_orientation(args: argparse.Namespace) -> int:
     from ..measurement.user_effects import inline_effect, load_catalogue
 
     table = table_from_args(args)
-    joints = _joints(table)
+    joints = _generic_joints(table)
     user = load_catalogue(args.catalogue, table)
     effects = _parse_effect_options(args.effect, table, user)
     user = (*user, *(inline_effect(name, table) for name in effects if "~" in name))
@@ -508,12 +511,8 @@ def _run_simulate_orientation(args: argparse.Namespace) -> int:
                 f"[{MIN_SIGMA_ARCSEC:g}, {MAX_NOISE_ARCSEC:g}] arcsec"
             )
     schedule = Schedule(
-        phi1_step_deg=args.phi1_step_deg,
-        phi2_step_deg=args.phi2_step_deg,
-        phi3_step_deg=args.phi3_step_deg,
-        phi1_start_deg=args.phi1_start_deg,
-        phi2_start_deg=args.phi2_start_deg,
-        phi3_start_deg=args.phi3_start_deg,
+        *(getattr(args, f"phi{k}_step_deg") for k in (1, 2, 3)),
+        starts_deg=tuple(getattr(args, f"phi{k}_start_deg") for k in (1, 2, 3)),
         order=args.order,
         repeats=args.repeats,
         dwell_s=args.dwell_s,

@@ -22,7 +22,7 @@ from ..core.turn_grid import full_turn_grid_deg, random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.angles import ANGLE_NAMES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors
-from ..model.paper_table import resolve_table
+from ..model.paper_table import paper_table
 from .catalogue import resolve_effect
 from .data import (
     MAX_COMMANDED_ANGLE_DEG,
@@ -65,7 +65,11 @@ ROW_BYTES = 1024
 """Memory a simulated row costs while it is built and written (rough upper bound), bytes."""
 
 
-@dataclass(frozen=True)
+DEFAULT_GRID_STEP_DEG = 30.0
+"""Grid step of a joint a :class:`Schedule` gives no step for, degrees."""
+
+
+@dataclass(frozen=True, init=False)
 class Schedule:
     """Which positions are measured, in which order, when, and from which side.
 
@@ -74,11 +78,16 @@ class Schedule:
     (``random_positions``). The list is then measured ``repeats`` times over, and with ``passes``
     K > 0 it is measured forward and then backward, K times.
 
+    ``Schedule(45, 30, order="random")``: the grid steps are given one per joint from the base
+    (``phi1``, ``phi2``, ...), as the positional arguments.
+
     Attributes:
-        phi1_step_deg, phi2_step_deg, phi3_step_deg: grid steps of each joint (a table with
-            fewer joints ignores the others); the grid covers [start, start + 360).
-        phi1_start_deg, phi2_start_deg, phi3_start_deg: first grid angles; in a sweep, the angle
-            at which the joints not being swept are held.
+        steps_deg: grid step of each joint from the base, degrees (a joint beyond the sequence:
+            :data:`DEFAULT_GRID_STEP_DEG`; a table with fewer joints ignores the rest); the grid
+            covers [start, start + 360). Reported as ``phiK_step_deg``.
+        starts_deg: first grid angle of each joint from the base, degrees (beyond the sequence:
+            0); in a sweep, the angle at which the joints not being swept are held. Reported as
+            ``phiK_start_deg``.
         order: ``grid`` (phi1 outer loop, the last joint's angle inner loop) or ``random``
             (shuffled; grids only).
         repeats: how many times each position is measured.
@@ -102,12 +111,8 @@ class Schedule:
         passes: K > 0: the positions forward then backward, K times (2K traversals).
     """
 
-    phi1_step_deg: float = 30.0
-    phi2_step_deg: float = 30.0
-    phi1_start_deg: float = 0.0
-    phi2_start_deg: float = 0.0
-    phi3_step_deg: float = 30.0
-    phi3_start_deg: float = 0.0
+    steps_deg: tuple[float, ...] = ()
+    starts_deg: tuple[float, ...] = ()
     order: str = "grid"
     repeats: int = 1
     dwell_s: float = 60.0
@@ -120,17 +125,45 @@ class Schedule:
     random_positions: int = 0
     passes: int = 0
 
-    def __post_init__(self) -> None:
-        for name in ("phi1_step_deg", "phi2_step_deg", "phi3_step_deg"):
-            step = getattr(self, name)
+    def __init__(
+        self,
+        *steps_deg: float,
+        starts_deg: Sequence[float] = (),
+        order: str = "grid",
+        repeats: int = 1,
+        dwell_s: float = 60.0,
+        approach: str | None = None,
+        positions: tuple[tuple[float, ...], ...] | None = None,
+        positions_time_s: tuple[float, ...] | None = None,
+        positions_dirs: tuple[tuple[float, ...] | None, ...] = (),
+        positions_source: str = "",
+        sweep: tuple[str, ...] = (),
+        random_positions: int = 0,
+        passes: int = 0,
+    ) -> None:
+        given = dict(locals())  # the arguments are the fields, by name
+        given["steps_deg"] = tuple(float(s) for s in steps_deg)
+        given["starts_deg"] = tuple(float(s) for s in starts_deg)
+        for name in self.__dataclass_fields__:
+            object.__setattr__(self, name, given[name])
+        self._check_grid()
+        self._check_design()
+
+    def _check_grid(self) -> None:
+        for k, step in enumerate(self.steps_deg, start=1):
             if not MIN_GRID_STEP_DEG <= step <= 360:
-                raise InputError(f"{name} must be in [{MIN_GRID_STEP_DEG:g}, 360], got {step:g}")
-        for name in ("phi1_start_deg", "phi2_start_deg", "phi3_start_deg"):
-            start = getattr(self, name)
+                raise InputError(
+                    f"phi{k}_step_deg (steps_deg[{k - 1}]) must be in [{MIN_GRID_STEP_DEG:g}, "
+                    f"360], got {step:g}"
+                )
+        for k, start in enumerate(self.starts_deg, start=1):
             if not abs(start) <= MAX_COMMANDED_ANGLE_DEG - 360.0:
                 raise InputError(
-                    f"{name} must be within +-{MAX_COMMANDED_ANGLE_DEG - 360.0:g} deg, got {start}"
+                    f"phi{k}_start_deg (starts_deg[{k - 1}]) must be within "
+                    f"+-{MAX_COMMANDED_ANGLE_DEG - 360.0:g} deg, got {start}"
                 )
+
+    def _check_design(self) -> None:
         if self.order not in ORDERS:
             raise InputError(f"order must be one of {', '.join(ORDERS)}, got '{self.order}'")
         if self.approach is None:
@@ -212,9 +245,13 @@ class Schedule:
             raise InputError(f"sweep: an axis is swept twice in {','.join(joints)}")
 
     def _steps(self, n_joints: int) -> list[tuple[float, float]]:
+        """``(start_deg, step_deg)`` of each of ``n_joints`` joints from the base."""
         return [
-            (getattr(self, f"phi{k}_start_deg"), getattr(self, f"phi{k}_step_deg"))
-            for k in range(1, n_joints + 1)
+            (
+                self.starts_deg[k] if k < len(self.starts_deg) else 0.0,
+                self.steps_deg[k] if k < len(self.steps_deg) else DEFAULT_GRID_STEP_DEG,
+            )
+            for k in range(n_joints)
         ]
 
     def _base_count(self, n_joints: int) -> int:
@@ -317,12 +354,10 @@ class Schedule:
 
     def describe(self, n_joints: int) -> str:
         """The schedule in one line (the ``# schedule:`` comment of a simulated file)."""
-        steps = " ".join(
-            f"phi{k}_step_deg={getattr(self, f'phi{k}_step_deg'):g}" for k in range(1, n_joints + 1)
-        )
+        grid = self._steps(n_joints)
+        steps = " ".join(f"phi{k}_step_deg={step:g}" for k, (_, step) in enumerate(grid, start=1))
         starts = " ".join(
-            f"phi{k}_start_deg={getattr(self, f'phi{k}_start_deg'):g}"
-            for k in range(1, n_joints + 1)
+            f"phi{k}_start_deg={start:g}" for k, (start, _) in enumerate(grid, start=1)
         )
         tail = f"repeats={self.repeats} dwell_s={self.dwell_s:g} approach={self.approach}"
         if self.positions is not None:
@@ -339,7 +374,7 @@ class Schedule:
             head = f"sweep={','.join(self.sweep)} {steps} held at {starts}"
         else:
             head = f"{steps} order={self.order}"
-            if any(getattr(self, f"phi{k}_start_deg") for k in range(1, n_joints + 1)):
+            if any(start for start, _ in grid):
                 head += f" {starts}"
         return f"{head} {tail}" + (f" passes={self.passes}" if self.passes else "")
 
@@ -536,7 +571,7 @@ def simulate_measurements(
             f"{MAX_NOISE_ARCSEC:g}] arcsec (noise_arcsec / spread .. noise_arcsec * spread)"
         )
     seed = check_seed(seed)
-    source = resolve_table(turntable)
+    source = paper_table() if turntable is None else getattr(turntable, "table", turntable)
     table = measured_table(source)
     n_joints = table.n_joints
     if isinstance(errors, TurntableErrors):
@@ -625,7 +660,7 @@ def simulate_measurements(
         time_s=variables.time_s,
         dirs=variables.dirs,
         source=f"simulated (seed {seed})",
-        joint_names=table.joint_names,
+        joint_names=() if table.paper else table.joint_names,
     )
     return SimulatedMeasurements(
         data=data,
