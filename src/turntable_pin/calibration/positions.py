@@ -174,15 +174,29 @@ class PositionSet:
         names no angles)."""
         return tuple(f"{a}_deg" for a in self.table.angle_names)
 
+    def joint_rad(self, k: int) -> np.ndarray:
+        """The angles of joint ``k`` from the base (1 = the first), radians.
+
+        Raises:
+            InputError: the table has no joint ``k``.
+        """
+        if not 1 <= k <= len(self.joint_names):
+            raise InputError(
+                f"positions of {self.table.title} have no joint {k}: its joints are "
+                f"{', '.join(self.joint_names)}"
+            )
+        return self.angles_rad[:, k - 1]
+
     @property
     def phi1_rad(self) -> np.ndarray:
         """The angles of the first joint (the paper's phi1, outer axis), radians."""
-        return self.angles_rad[:, 0]
+        return self.joint_rad(1)
 
     @property
     def phi2_rad(self) -> np.ndarray:
-        """The angles of the second joint (the paper's phi2, inner axis), radians."""
-        return self.angles_rad[:, 1]
+        """The angles of the second joint (the paper's phi2, inner axis), radians; refused
+        (:class:`InputError`) on a one-joint table."""
+        return self.joint_rad(2)
 
     # ---- construction -------------------------------------------------------------------------
     @classmethod
