@@ -252,11 +252,11 @@ def average_sensitivities(model=None, phi1_grid_deg=None, phi2_grid_deg=None) ->
     """:func:`sensitivities` of the paper's table over every (phi1, phi2) pair of the grids, in
     degrees (default 4 phi1 and 360 phi2 values per turn), at the errors of ``model`` (a
     :class:`~turntable_pin.model.turntable.TurntableModel`; default none)."""
-    from ..model.paper_table import paper_table
+    from ..model.paper_table import resolve_table
 
     phi1 = uniform_grid_deg(4) if phi1_grid_deg is None else np.asarray(phi1_grid_deg, float)
     phi2 = uniform_grid_deg(360) if phi2_grid_deg is None else np.asarray(phi2_grid_deg, float)
-    table = paper_table() if model is None else model.table
+    table = resolve_table(model)
     errors = None if model is None else model.errors.as_array()
     return sensitivities(table, (phi1 / DEG_PER_RAD, phi2 / DEG_PER_RAD), error_values=errors)
 
