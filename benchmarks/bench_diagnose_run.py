@@ -25,7 +25,7 @@ import numpy as np  # noqa: E402
 
 from turntable_pin.calibration.positions import PositionSet  # noqa: E402
 from turntable_pin.calibration.run import read_run  # noqa: E402
-from turntable_pin.instrument.diagnosis import diagnose_run, run_diagnosis_dict  # noqa: E402
+from turntable_pin.instrument.diagnosis import diagnose_run  # noqa: E402
 from turntable_pin.instrument.simulate import simulate_calibration_run  # noqa: E402
 
 LATITUDE_RAD = np.radians(45.75)
@@ -57,7 +57,7 @@ def main() -> None:
             for _ in range(args.repeats):
                 start = time.perf_counter()
                 run = read_run(path, LATITUDE_RAD)
-                result = run_diagnosis_dict(diagnose_run(run))
+                result = diagnose_run(run).to_dict()
                 times.append(time.perf_counter() - start)
             print(
                 f"{args.positions} positions, hidden {name:16s}: best {min(times):.2f} s, "

@@ -16,7 +16,7 @@ import numpy as np
 
 from turntable_pin.calibration.run import read_run
 from turntable_pin.core.resources import examples_dir
-from turntable_pin.instrument.diagnosis import diagnose_run, run_diagnosis_dict
+from turntable_pin.instrument.diagnosis import diagnose_run
 from turntable_pin.report.run_report import write_run_plots, write_run_report
 
 
@@ -25,7 +25,7 @@ def main(out_dir: Path, fast: bool = False) -> list[Path]:
     run = read_run(examples_dir() / "runs" / "run_mount.csv", np.radians(45.75))
     diagnosis = diagnose_run(run)
     paths = [Path(p) for p in write_run_plots(diagnosis, out_dir)]
-    write_run_report(diagnosis, run_diagnosis_dict(diagnosis), out_dir / "run_report.html",
+    write_run_report(diagnosis, diagnosis.to_dict(), out_dir / "run_report.html",
                      title="bundled calibration run")  # fmt: skip
     return paths
 

@@ -125,8 +125,8 @@ def test_turn_grid_count_is_the_length_of_the_grids(step):
 
 
 def test_diagnosis_and_fit_refuse_more_rows_than_their_limit(monkeypatch, tmp_path):
-    import turntable_pin.measurement.diagnosis as diagnosis
     import turntable_pin.measurement.fit as fit
+    import turntable_pin.stats.diagnosis_engine as diagnosis
 
     monkeypatch.setattr(diagnosis, "MAX_DIAGNOSED_ROWS", 100)
     monkeypatch.setattr(fit, "MAX_FITTED_ROWS", 100)

@@ -13,7 +13,7 @@ import pytest
 from conftest import EXAMPLES_DIR, cli
 from turntable_pin.calibration.run import read_run
 from turntable_pin.core.files import read_yaml
-from turntable_pin.instrument.diagnosis import diagnose_run, run_diagnosis_dict
+from turntable_pin.instrument.diagnosis import diagnose_run
 
 TRUTHS = sorted((EXAMPLES_DIR / "truth" / "runs").glob("*.yaml"))
 TABLE_ALIKE = {"deps_x": {"table:deps_x", "table:dalpha_x1"}}
@@ -39,7 +39,7 @@ def _expected(truth) -> tuple[set[str], dict]:
 def test_the_run_diagnosis_names_the_hidden_effect(path):
     truth = read_yaml(path)
     run = read_run(EXAMPLES_DIR / "runs" / truth["data"], np.radians(truth["latitude_deg"]))
-    d = run_diagnosis_dict(diagnose_run(run))
+    d = diagnose_run(run).to_dict()
     names, values = _expected(truth)
     verdict = d["verdict"]
     if not names:

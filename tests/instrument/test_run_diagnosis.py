@@ -10,7 +10,7 @@ import pytest
 from turntable_pin.calibration.positions import PositionSet, position_inputs
 from turntable_pin.calibration.run import CalibrationRun
 from turntable_pin.core.units import arcsec_to_rad
-from turntable_pin.instrument.diagnosis import diagnose_run, run_diagnosis_dict
+from turntable_pin.instrument.diagnosis import diagnose_run
 from turntable_pin.instrument.simulate import (
     TemperatureProfile,
     random_positions,
@@ -60,7 +60,7 @@ SCENARIOS = {
 def test_each_scenario_names_the_right_effect_on_the_right_side(scenario):
     hidden, side, names = SCENARIOS[scenario]
     diagnosis = diagnose_run(_run(seed=7, **hidden))
-    d = run_diagnosis_dict(diagnosis)
+    d = diagnosis.to_dict()
     verdict = d["verdict"]
     assert verdict["missing_effect"] in names, verdict["missing_effect"]
     assert verdict["missing_effects"] == [verdict["missing_effect"]]
@@ -74,7 +74,7 @@ def test_each_scenario_names_the_right_effect_on_the_right_side(scenario):
 
 def test_the_orthogonality_is_said_to_be_confounded_with_the_outer_wobble():
     hidden, _, _ = SCENARIOS["orthogonality"]
-    d = run_diagnosis_dict(diagnose_run(_run(seed=7, **hidden)))
+    d = diagnose_run(_run(seed=7, **hidden)).to_dict()
     # deps_x and dalpha_x1 turn the payload alike at every position (only their sum is seen)
     assert {"table:deps_x", "table:dalpha_x1"} <= {d["verdict"]["missing_effect"],
                                                    *d["verdict"]["alternatives"]}  # fmt: skip
@@ -88,7 +88,7 @@ def test_a_tilted_mount_is_said_to_be_the_tables_payload_rotation_too():
     """On the paper's table dalpha_x2, dalpha_y2 are rotations in the payload frame, exactly a
     mounting tilt: the run cannot say which side it is, and no position separates them."""
     hidden, _, _ = SCENARIOS["tilted_mount"]
-    d = run_diagnosis_dict(diagnose_run(_run(seed=3, **hidden)))
+    d = diagnose_run(_run(seed=3, **hidden)).to_dict()
     rivals = {r["effect"]: r for r in d["verdict"]["other_side"]}
     assert "table:errors" in rivals
     assert rivals["table:errors"]["chi2_dense"] < 1e-6
@@ -104,7 +104,7 @@ def test_three_outliers_are_left_out_and_the_run_is_clean():
     bad = run.outputs_dph.copy()
     rows = [10, 50, 99]
     bad[rows, [0, 1, 0]] += np.array([30, -30, 30]) * NOISE
-    d = run_diagnosis_dict(diagnose_run(run.replace(outputs_dph=bad)))
+    d = diagnose_run(run.replace(outputs_dph=bad)).to_dict()
     assert sorted(o["row"] for o in d["outliers"]) == sorted(int(run.rows[i]) for i in rows)
     assert d["verdict"]["missing_effect"] is None
     assert not d["verdict"]["unexplained"]
@@ -121,14 +121,14 @@ def test_no_false_name_on_twenty_clean_runs(design):
     named = []
     for seed in range(20):
         diagnosis = diagnose_run(_run(DESIGNS[design](seed), seed=seed))
-        verdict = run_diagnosis_dict(diagnosis)["verdict"]
+        verdict = diagnosis.to_dict()["verdict"]
         named += verdict["missing_effects"] + [t["term"] for t in verdict["remaining_structure"]]
     assert named == []
 
 
 def test_without_sigma_the_verdict_holds_and_the_noise_is_estimated():
     hidden, _, _ = SCENARIOS["bias_drift"]
-    d = run_diagnosis_dict(diagnose_run(_run(seed=5, sigma=False, **hidden)))
+    d = diagnose_run(_run(seed=5, sigma=False, **hidden)).to_dict()
     assert d["verdict"]["missing_effect"] == "bias_drift"
     assert d["sigma_source"] == "estimated"
     assert abs(d["sigma_dph"] - NOISE) < 0.15 * NOISE
@@ -155,6 +155,6 @@ def test_outputs_with_different_noise_get_their_own_level_and_no_false_name():
                                        seed=seed, dwell_s=120.0, **hidden)  # fmt: skip
         run = CalibrationRun(position_inputs(positions, LATITUDE_RAD), sim.outputs_dph, None,
                              sim.time_s)  # fmt: skip
-        d = run_diagnosis_dict(diagnose_run(run))
+        d = diagnose_run(run).to_dict()
         assert any("the two outputs' noise differ" in w for w in d["warnings"])
         assert d["verdict"]["missing_effects"] == ([] if not hidden else ["bias_drift"])

@@ -363,9 +363,9 @@ def test_with_noise_per_angle_every_model_is_judged_at_its_own_noise():
     # it fixed, so an angle whose effect that model lacked was down-weighted and the effect lost.
     # Now each model is refitted at the noise it estimates itself: the verdict and the fits do
     # not depend on the sigmas the second pass starts from.
-    from turntable_pin.measurement.diagnosis import _diagnose
+    from turntable_pin.measurement.diagnosis import OrientationFamily
     from turntable_pin.measurement.simulation import Schedule
-    from turntable_pin.measurement.table import measured_table
+    from turntable_pin.stats.diagnosis_engine import diagnose_screened
 
     sim = simulate_measurements(
         random_errors(np.random.default_rng(5)), {"inner_encoder_harmonics": {"c1": 3.0}},
@@ -376,7 +376,8 @@ def test_with_noise_per_angle_every_model_is_judged_at_its_own_noise():
     for start in ((0.5, 2.0, 1.0), (20.0, 0.1, 1.0)):  # right, and badly wrong on dpsi
         sigma = np.broadcast_to(np.array(start) / ARCSEC_PER_RAD, data.angles_rad.shape).copy()
         start_data = data.replace(sigma_rad=sigma, sigma_relative=True)
-        d = _diagnose(start_data, False, None, measured_table(None), False, noise_per_angle=True)
+        family = OrientationFamily(start_data, noise_per_angle=True)
+        d = diagnose_screened(family, outliers=False)
         outcomes.append(d)
     right, wrong = outcomes
     assert right.missing_effect == wrong.missing_effect == "inner_encoder_harmonics"

@@ -422,14 +422,14 @@ def test_mmt_verdict_with_noise_per_angle_does_not_depend_on_where_it_starts(mmt
     # Before each model was fitted at its own per-angle noise, a second pass started from the
     # first row's sigmas (those of a model without TF) named encoder_harmonics@azimuth.
     from turntable_pin.core.units import ARCSEC_PER_RAD
-    from turntable_pin.measurement.diagnosis import _diagnose
-    from turntable_pin.measurement.table import measured_table
+    from turntable_pin.measurement.diagnosis import OrientationFamily
+    from turntable_pin.stats.diagnosis_engine import diagnose_screened
 
     table = GenericTable(ALTAZ_URDF)
     data = read_measurements(mmt_run, table.joint_names)
     sigma = np.broadcast_to(np.array(start_arcsec) / ARCSEC_PER_RAD, data.angles_rad.shape)
     start = data.replace(sigma_rad=sigma.copy(), sigma_relative=True)
-    d = _diagnose(start, False, None, measured_table(table), True, noise_per_angle=True)
+    d = diagnose_screened(OrientationFamily(start, None, table, noise_per_angle=True))
     assert [s.added for s in d.steps] == ["TF", "TX"]
     assert d.best_fit.result.rms_user == pytest.approx(0.661, abs=0.005)
 

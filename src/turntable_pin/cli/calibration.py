@@ -301,7 +301,7 @@ def _read_run(args: argparse.Namespace, table):
 
 
 def _diagnose_run(args: argparse.Namespace, table) -> int:
-    from ..instrument.diagnosis import diagnose_run, run_diagnosis_dict
+    from ..instrument.diagnosis import diagnose_run
     from ..instrument.effects import run_catalogue
     from ..report.run_report import run_report_lines, write_run_plots, write_run_report
 
@@ -311,7 +311,7 @@ def _diagnose_run(args: argparse.Namespace, table) -> int:
         run, until_explained=args.until_explained, outliers=not args.keep_outliers,
         catalogue=catalogue,
     )  # fmt: skip
-    out = {**run_diagnosis_dict(diagnosis), **_table_keys(table)}
+    out = {**diagnosis.to_dict(), **_table_keys(table)}
     if args.plots:
         out["plots"] = [str(p) for p in write_run_plots(diagnosis, args.plots)]
     if args.report:

@@ -21,14 +21,12 @@ Probes of the structure search (the shape of what is missing):
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Sequence
 
 import numpy as np
 
 from ..calibration.drift_fit import gravity_words
 from ..core.exceptions import InputError
-from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from ..core.units import DEG_PER_RAD
 from ..measurement.diagnosis import (
     dense_joint_grid,
@@ -38,34 +36,22 @@ from ..measurement.diagnosis import (
 )
 from ..measurement.table import measured_table
 from ..model.angles import ANGLE_NAMES
+from ..stats.diagnosis_engine import SEPARATION_CHI2, DataFamily, diagnose_data
 from ..stats.least_squares import zero_point
-from ..stats.model_selection import Diagnosis, diagnose
+from ..stats.model_selection import Diagnosis
 from ..stats.structure_search import Probe, ProbeFactors
 from .effects import run_catalogue
 from .effects.base import RunEffect
 from .model import CHANNELS, RunFit, RunModel, fit_run, reference_coefficients, run_context
 
 __all__ = [
-    "NOISE_PER_CHANNEL_ALPHA",
     "OUTLIER_RULE",
-    "SEPARATION_CHI2",
     "RunFamily",
-    "channel_variances",
     "diagnose_run",
     "run_design_command",
-    "run_diagnosis_dict",
     "run_diagnosis_residuals",
+    "run_results",
 ]
-
-SEPARATION_CHI2 = 25.0
-"""Noise-free misfit chi2 above which a denser set of positions is said to separate two effects."""
-
-NOISE_PER_CHANNEL_ALPHA = 0.01
-"""Without sigmas, out_x and out_y get their own noise level when an F test of their residual
-variances rejects equal noise at this level."""
-
-NOISE_ITERATIONS = 20
-NOISE_RTOL = 1e-2
 
 OUTLIER_RULE = (
     "studentized residual |t| = |r| / (s sqrt(1 - h)) above the two-sided normal quantile at "
@@ -77,79 +63,132 @@ OUTLIER_RULE = (
 """The outlier rule of :func:`diagnose_run` in words (``turntable_pin.stats.outliers``)."""
 
 
-class RunFamily:
-    """A calibration run, its 14 coefficients and the run catalogue (a ``ModelFamily``).
+class RunFamily(DataFamily):
+    """A calibration run, its 14 coefficients and the run catalogue (a
+    :class:`~turntable_pin.stats.diagnosis_engine.DataFamily`).
 
     Args:
         run: the :class:`~turntable_pin.calibration.run.CalibrationRun`.
         catalogue: the candidate effects (default :func:`~.effects.run_catalogue` of the run's
             table).
         mask: (N, 2) the outputs fitted (False: left out as outliers).
-        noise_per_channel: sigma unknown and the channels' noise differ: every model is fitted
-            with a noise level per output estimated with that model, and scored with each level
-            profiled.
+        channel_sigma: (2,) the relative noise of ``out_x`` and ``out_y`` (deg/h) when sigma is
+            unknown and the channels' noise differ: every model is then fitted with a noise
+            level per output estimated with that model (starting from these), and scored with
+            each level profiled; ``None``: one noise level.
     """
 
+    columns = CHANNELS
+    column_key = "output"
     record_label = "positions"
+    record_words = "run rows"
+    observations = "outputs"
     observation_unit = "dph"
+    unit_words = "deg/h"
+    user_unit_scale = 1.0
+    outlier_rule = OUTLIER_RULE
+    noise_subject = "the two outputs'"
+    noise_column = "output"
+    noise_how = "each output is weighted by its own estimated noise"
 
     def __init__(
         self,
         run,
         catalogue: Sequence[RunEffect] | None = None,
         mask: np.ndarray | None = None,
-        noise_per_channel: bool = False,
+        channel_sigma: np.ndarray | None = None,
     ) -> None:
         self.run = self.data = run
         self.table = measured_table(run.table)
-        self.catalogue = tuple(catalogue if catalogue is not None else run_catalogue(self.table))
-        self.n_records = run.n_positions
         self.mask = np.ones((run.n_positions, 2), bool) if mask is None else mask
-        self.noise_per_channel = noise_per_channel
-        self.sigma_scale = float(np.median(run.sigma_dph)) if run.sigma_dph is not None else 1.0
+        self.channel_sigma = channel_sigma
         self.context = run_context(run, reference_coefficients(run, self.mask))
-        self._cache: dict[tuple[str, ...], RunFit] = {}
-        self._zero = None
+        super().__init__(
+            catalogue if catalogue is not None else run_catalogue(self.table),
+            self.mask,
+            sigma_scale=float(np.median(run.sigma_dph)) if run.sigma_dph is not None else 1.0,
+            noise_per_column=channel_sigma is not None,
+        )
 
-    # ---- fits -------------------------------------------------------------------------------
-    def fit(self, effects: Sequence[RunEffect], noise_variance: float | None = None) -> RunFit:
-        """The fit of the 14 coefficients plus ``effects`` (cached per effect list)."""
-        key = tuple(e.name for e in effects)
-        if key not in self._cache:
-            fit = fit_run(self.run, effects, context=self.context, mask=self.mask,
-                          zero_point=self._zero_point())  # fmt: skip
-            self._cache[key] = self._own_noise(fit) if self.noise_per_channel else fit
-        return self._cache[key]
+    # ---- the hooks of the one diagnosis (stats.diagnosis_engine) ---------------------------
+    def fit_model(self, effects: Sequence[RunEffect], zero_point) -> RunFit:
+        """The fit of the 14 coefficients plus ``effects`` (:func:`~.model.fit_run`)."""
+        return fit_run(self.run, effects, context=self.context, mask=self.mask,
+                       channel_sigma=self.channel_sigma, zero_point=zero_point)  # fmt: skip
 
-    def _zero_point(self):
-        """The reduced Jacobian of the base and every testable effect, shared by the fits."""
-        if self._zero is None:
-            testable = [e for e in self.catalogue if not self.untestable_reason(e)]
-            try:
-                model = RunModel(self.context, testable, self.mask)
-            except InputError:
-                return None
-            w = 1.0 / model.sigma if model.sigma is not None else np.ones(model.observed.size)
-            jac = model.jacobian(None) * w[:, None]
-            res = (model.observed - model.predict(np.zeros(model.n_params))) * w
-            self._zero = zero_point(model.parameter_names, [(jac, res, w)])
-        return self._zero
+    def zero_point_of(self, effects: Sequence[RunEffect]):
+        """The reduced Jacobian at zero of the coefficients and ``effects``."""
+        model = RunModel(self.context, effects, self.mask, self.channel_sigma)
+        w = 1.0 / model.sigma if model.sigma is not None else np.ones(model.observed.size)
+        jac = model.jacobian(None) * w[:, None]
+        res = (model.observed - model.predict(np.zeros(model.n_params))) * w
+        return zero_point(model.parameter_names, [(jac, res, w)])
 
-    def _own_noise(self, fit: RunFit) -> RunFit:
-        """``fit`` refitted with the per-channel noise levels it estimates itself."""
-        sigma = None
-        for _ in range(NOISE_ITERATIONS):
-            variance, _, _ = channel_variances(fit)
-            new = np.sqrt(variance)
-            if sigma is not None and np.all(np.abs(new - sigma) <= NOISE_RTOL * sigma):
-                break
-            sigma = new
-            fit = fit_run(self.run, fit.model.effects, context=self.context, mask=self.mask,
-                          channel_sigma=sigma)  # fmt: skip
-        groups = np.broadcast_to(np.arange(2), self.mask.shape)[self.mask]
-        return dataclasses.replace(fit, result=dataclasses.replace(fit.result, noise_groups=groups))
+    def initial_column_sigma(self) -> np.ndarray | None:
+        """The per-channel levels the outputs are weighted with first."""
+        return self.channel_sigma
 
-    # ---- what the diagnosis asks ------------------------------------------------------------
+    def refit(self, fit: RunFit, column_sigma: np.ndarray) -> RunFit:
+        """``fit``'s model fitted again with the relative noise ``column_sigma`` (2,) deg/h."""
+        return fit_run(self.run, fit.model.effects, context=self.context, mask=self.mask,
+                       channel_sigma=column_sigma)  # fmt: skip
+
+    def residual_table(self, fit: RunFit) -> np.ndarray:
+        """(N, 2) the residuals of ``fit``, deg/h, NaN where left out."""
+        return fit.residuals_dph
+
+    def full_residuals(self, fit: RunFit) -> np.ndarray:
+        """(N, 2) the outputs minus ``fit``'s, deg/h, those left out too."""
+        return self.run.outputs_dph - fit.fitted_dph
+
+    def sigma_table(self) -> np.ndarray | None:
+        """(N, 2) the outputs' sigmas (stated, times the channels' relative noise), or None."""
+        run = self.run
+        if run.sigma_dph is None and self.channel_sigma is None:
+            return None
+        rows = np.ones(run.n_positions) if run.sigma_dph is None else run.sigma_dph
+        channels = np.ones(2) if self.channel_sigma is None else self.channel_sigma
+        return rows[:, None] * channels[None, :]
+
+    @property
+    def sigma_given(self) -> bool:
+        """Whether the run states its noise (``sigma_dph``)."""
+        return self.run.sigma_dph is not None
+
+    @property
+    def rows(self) -> np.ndarray:
+        """The run file's row number of each position."""
+        return self.run.rows
+
+    def without(self, cells: np.ndarray) -> RunFamily:
+        """The family on this run with the outputs ``cells`` (N, 2) left out as outliers."""
+        return RunFamily(self.run, self.catalogue, self.mask & ~cells, self.channel_sigma)
+
+    def with_column_noise(self, column_sigma: np.ndarray) -> RunFamily:
+        """The family on this run with every model fitted at its own per-channel noise,
+        starting from ``column_sigma`` (2,) deg/h."""
+        return RunFamily(self.run, self.catalogue, self.mask, column_sigma)
+
+    def screen_fit(self, cells: np.ndarray, effects: Sequence[RunEffect]):
+        """The fit of base + ``effects`` without the outputs ``cells`` (the outlier screen),
+        at the reference coefficients of the outputs kept."""
+        mask = self.mask & ~cells
+        context = run_context(self.run, reference_coefficients(self.run, mask))
+        return fit_run(self.run, effects, context=context, mask=mask,
+                       channel_sigma=self.channel_sigma).result  # fmt: skip
+
+    @property
+    def doubt_words(self) -> str:
+        """The doubt about the run: the stated sigma, the latitude or the table."""
+        return (
+            "no catalogued effect of the table or the instrument makes this run; is the stated "
+            "sigma_dph too small, the latitude or the table (--urdf) wrong?"
+        )
+
+    def complete(self, diagnosis: Diagnosis) -> None:
+        """The run's own data in the result (:func:`run_results`)."""
+        run_results(diagnosis)
+
     def untestable_reason(self, effect: RunEffect) -> str | None:
         """Why ``effect`` cannot be tested here (its columns are missing, or not numbers), or
         None."""
@@ -158,17 +197,9 @@ class RunFamily:
             return f"needs the column(s) {self.run.missing_columns_words(missing)}"
         return None
 
-    def effect(self, name: str) -> RunEffect:
-        """The catalogued effect called ``name``."""
-        return next(e for e in self.catalogue if e.name == name)
-
-    def describe(self, effect: RunEffect | str) -> dict:
-        """The effect's story, with the side it lives on."""
-        return (self.effect(effect) if isinstance(effect, str) else effect).describe()
-
-    def inputs(self, effect: RunEffect) -> set[str]:
-        """The run columns ``effect`` depends on beyond the joint angles."""
-        return set(effect.required_columns)
+    def base_inputs(self) -> set[str]:
+        """The joint angles (``phi1``...): the probes in them are not suspects."""
+        return {f"phi{k}" for k in range(1, self.run.joint_rad.shape[1] + 1)}
 
     def design_warnings(self, base_fit: RunFit) -> list[str]:
         """What the positions cannot tell, in plain words: the coefficients they leave
@@ -207,17 +238,6 @@ class RunFamily:
         w[self.mask] = fit.result.weights
         return w
 
-    def _probe(self, name, description, factors: ProbeFactors, spec, basis) -> Probe:
-        mask = self.mask.reshape(-1)
-        factors = dataclasses.replace(factors, basis=basis)
-
-        def columns():
-            cols = factors.direction_matrix()[:, :, None] * basis[:, None, :]
-            cols = cols.reshape(-1, cols.shape[-1])
-            return cols if mask.all() else cols[mask]
-
-        return Probe(name, description, columns, 1.0, "deg/h", factors, effect_spec=spec)
-
     def _shape_probes(self, directions, plot, shape, text, spec) -> list[Probe]:
         """One probe per direction ``(site, description, (N, 2) direction)`` for one shape."""
         var, values, functions, scale, unit = plot
@@ -225,7 +245,7 @@ class RunFamily:
         out = []
         for site, what, direction in directions:
             factors = ProbeFactors(var, values, functions, direction, scale, unit, self.mask)
-            out.append(self._probe(f"{site} {shape}", f"{text} {what}", factors,
+            out.append(self.probe(f"{site} {shape}", f"{text} {what}", factors,
                                    f"{site}~{spec}", basis))  # fmt: skip
         return out
 
@@ -275,13 +295,6 @@ class RunFamily:
                 f"{column})",
             )  # fmt: skip
         return probes
-
-    def suspect_probes(self, fit: RunFit) -> list[Probe]:
-        """The probes in inputs other than the joint angles (time, other columns)."""
-        return [
-            p for p in self.probes(fit)
-            if p.factors is not None and not p.factors.variable.startswith("phi")
-        ]  # fmt: skip
 
     # ---- separation ---------------------------------------------------------------------------
     def _dense_run(self):
@@ -387,118 +400,6 @@ class RunFamily:
         return sorted(out, key=lambda e: e["chi2_run"])
 
 
-def channel_variances(fit: RunFit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(variance deg^2/h^2, counts, degrees of freedom)`` of each output's residuals
-    (:func:`~turntable_pin.stats.outliers.column_variances`)."""
-    from ..stats.outliers import column_variances
-
-    return column_variances(fit.residuals_dph, fit.result.dof, fit.result.n_obs)
-
-
-def _noise_per_channel(diagnosis: Diagnosis) -> tuple[np.ndarray, str] | None:
-    """Without sigmas: the residual rms of each output under the best model and a sentence,
-    when the two channels' noise differ (F test), else None."""
-    from ..stats.outliers import variances_differ
-
-    variance, counts, dof = channel_variances(diagnosis.best_fit)
-    if not variances_differ(variance, counts, dof, NOISE_PER_CHANNEL_ALPHA)[0]:
-        return None
-    sigma = np.sqrt(variance)
-    return sigma, (
-        f"sigma not given, and the two outputs' noise differ (estimated out_x {sigma[0]:.3g}, "
-        f"out_y {sigma[1]:.3g} deg/h; F test p < {NOISE_PER_CHANNEL_ALPHA:g}): each output was "
-        "weighted by its own noise, estimated with each model"
-    )
-
-
-def _screen(run, effects, catalogue) -> tuple[np.ndarray, str | None]:
-    """The outlier cells (N, 2) of ``run`` under base + ``effects`` by the iterated rule
-    (:func:`~turntable_pin.stats.outliers.screen_cells`), and its note."""
-    from ..stats.outliers import screen_cells
-
-    def fit_without(flagged):
-        return RunFamily(run, catalogue, ~flagged).fit(effects).result
-
-    return screen_cells(fit_without, np.ones((run.n_positions, 2), bool), "outputs")
-
-
-def _outlier_records(diagnosis: Diagnosis, run, cells: np.ndarray) -> list[dict]:
-    """``{"row", "output", "residual_sigma"}`` of each outlier cell under the final model."""
-    fit = diagnosis.best_fit
-    residual = run.outputs_dph - fit.fitted_dph
-    if run.sigma_dph is not None:
-        sigma = run.sigma_dph[:, None] * np.sqrt(diagnosis.noise_variance) * np.ones((1, 2))
-    else:
-        sigma = np.full(cells.shape, np.sqrt(diagnosis.noise_variance))
-        if diagnosis.group_variance is not None:
-            sigma = np.broadcast_to(np.sqrt(diagnosis.group_variance), cells.shape)
-    out = [
-        {"row": int(run.rows[i]), "output": CHANNELS[c],
-         "residual_sigma": float(residual[i, c] / sigma[i, c])}
-        for i, c in zip(*np.nonzero(cells), strict=True)
-    ]  # fmt: skip
-    return sorted(out, key=lambda o: -abs(o["residual_sigma"]))
-
-
-def diagnose_run(
-    run,
-    *,
-    until_explained: bool = False,
-    catalogue: Sequence[RunEffect] | None = None,
-    outliers: bool = True,
-) -> Diagnosis:
-    """Diagnose a calibration run against the run catalogue (module docstring).
-
-    Raises:
-        InputError: more rows than ``MAX_DIAGNOSED_ROWS``.
-    """
-    check_count(run.n_positions, MAX_DIAGNOSED_ROWS, "run rows", DIAGNOSIS_ROW_BYTES)
-    catalogue = tuple(catalogue if catalogue is not None else run_catalogue(run.table))
-    diagnosis = _diagnose(run, until_explained, catalogue, outliers)
-    if run.sigma_dph is None:
-        per_channel = _noise_per_channel(diagnosis)
-        if per_channel is not None:
-            _, note = per_channel
-            diagnosis = None
-            diagnosis = _diagnose(run, until_explained, catalogue, outliers, True)
-            diagnosis.warnings.append(note)
-    diagnosis.doubt = _instrument_doubt(diagnosis)
-    return diagnosis
-
-
-def _instrument_doubt(diagnosis: Diagnosis) -> str | None:
-    """With sigma given, a best model still far from the noise: the stated sigma or the run."""
-    best = diagnosis.best_fit.result
-    if not best.sigma_known or best.dof <= 0:
-        return None
-    chi2_reduced = best.rss / best.dof
-    if chi2_reduced <= 9.0:
-        return None
-    return (
-        f"with every accepted effect the residuals are still {chi2_reduced**0.5:.1f} times the "
-        f"stated noise (chi2_reduced {chi2_reduced:.3g}): no catalogued effect of the table or "
-        "the instrument makes this run; is the stated sigma_dph too small, the latitude or the "
-        "table (--urdf) wrong?"
-    )
-
-
-def _diagnose(run, until_explained, catalogue, outliers, per_channel=False) -> Diagnosis:
-    def go(cells):
-        family = RunFamily(run, catalogue, ~cells, per_channel)
-        return diagnose(family, until_explained=until_explained)
-
-    if not outliers:
-        return go(np.zeros((run.n_positions, 2), bool))
-    from ..stats.outliers import screened_diagnosis
-
-    return screened_diagnosis(
-        go,
-        lambda effects, first: _screen(run, effects, catalogue),
-        lambda diagnosis, cells: _outlier_records(diagnosis, run, cells),
-        OUTLIER_RULE,
-    )
-
-
 def run_diagnosis_residuals(diagnosis: Diagnosis):
     """The residual sets of a run diagnosis' base and best fits, judged with its noise."""
     from .residuals import run_residuals
@@ -530,45 +431,57 @@ def run_design_command(run, pair: tuple[str, str]) -> str:
     return " ".join(shlex.quote(w) for w in words)
 
 
-def run_diagnosis_dict(diagnosis: Diagnosis) -> dict:
-    """The structured result of a run diagnosis that the text, JSON and HTML views render:
-    the diagnosis dict, the side of every candidate and of the verdict (``table`` or
-    ``instrument``), the calibrated coefficients of the best model and what the run tells
-    about the table (:mod:`.table_errors`)."""
+def diagnose_run(
+    run,
+    *,
+    until_explained: bool = False,
+    catalogue: Sequence[RunEffect] | None = None,
+    outliers: bool = True,
+) -> Diagnosis:
+    """Diagnose a calibration run against the run catalogue (module docstring):
+    :func:`~turntable_pin.stats.diagnosis_engine.diagnose_data` on the :class:`RunFamily` of
+    ``run``; the result carries the run's own data too (:func:`run_results`).
+
+    Raises:
+        InputError: more rows than ``MAX_DIAGNOSED_ROWS``.
+    """
+    family = RunFamily(run, catalogue)
+    return diagnose_data(family, until_explained=until_explained, outliers=outliers)
+
+
+def run_results(diagnosis: Diagnosis) -> None:
+    """Fill a run diagnosis with the run's own data, which the text, JSON and HTML views render:
+    the side of every candidate and of the verdict (``table`` or ``instrument``) and the effects
+    of the other side (``family_verdict``), the ``design`` commands that settle each rival, the
+    calibrated coefficients of the best model and what the run tells about the table
+    (:mod:`.table_errors`; ``family_results``)."""
     from .table_errors import table_from_run
 
     family = diagnosis.family
     run = family.run
-    out = diagnosis.to_dict()
-    verdict = out["verdict"]
     sides = {e.name: e.side for e in family.catalogue}
-    verdict["sides"] = sides
-    named = verdict["missing_effects"]
-    verdict["side"] = (
-        None if not named else sides[named[0]] if len({sides[n] for n in named}) == 1 else "both"
-    )
-    best = diagnosis.best_fit.with_noise_variance(diagnosis.noise_variance)
-    out["coefficients_dph"] = best.to_dict()["coefficients_dph"]
-    out["refit_command"] = "calibrate"
-    out["base_label"] = "the coefficients"
-    out["source"] = run.source
-    out["latitude_deg"] = float(np.degrees(run.inputs.latitude_rad))
+    named = diagnosis.missing_effects
+    side = None if not named else sides[named[0]] if len({sides[n] for n in named}) == 1 else "both"
+    other_side = []
     if diagnosis.steps:
-        first = family.fit(diagnosis.best_fit.model.effects[:1])
-        verdict["other_side"] = family.other_side(first)
-    else:
-        verdict["other_side"] = []
-    commands = {}
+        other_side = family.other_side(family.fit(diagnosis.best_fit.model.effects[:1]))
+    diagnosis.family_verdict = {"sides": sides, "side": side, "other_side": other_side}
     if diagnosis.steps and run.source:
-        first = verdict["missing_effect"]
-        rivals = [*verdict["separations"], *(r["effect"] for r in verdict["other_side"])]
+        rivals = [*diagnosis.separations, *(r["effect"] for r in other_side)]
         known = {e.name for e in family.catalogue}
-        for name in dict.fromkeys(rivals):
-            if name in known:
-                commands[name] = run_design_command(run, (first, name))
-    if commands:
-        verdict["separation_commands"] = commands
-    out["table_from_run"] = table_from_run(
-        run, family.table, mask=family.mask, context=family.context
-    ).to_dict()
-    return out
+        diagnosis.separation_commands = {
+            name: run_design_command(run, (diagnosis.missing_effect, name))
+            for name in dict.fromkeys(rivals)
+            if name in known
+        }
+    best = diagnosis.best_fit.with_noise_variance(diagnosis.noise_variance)
+    diagnosis.family_results = {
+        "coefficients_dph": best.to_dict()["coefficients_dph"],
+        "refit_command": "calibrate",
+        "base_label": "the coefficients",
+        "source": run.source,
+        "latitude_deg": float(np.degrees(run.inputs.latitude_rad)),
+        "table_from_run": table_from_run(
+            run, family.table, mask=family.mask, context=family.context
+        ).to_dict(),
+    }

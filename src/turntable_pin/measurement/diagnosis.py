@@ -13,18 +13,17 @@ Probes of the structure search (what "shape" the missing part has):
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from ..core.exceptions import InputError
-from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from ..core.turn_grid import every_combination, full_turn_grid_deg
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
+from ..stats.diagnosis_engine import SEPARATION_CHI2, DataFamily, diagnose_data
 from ..stats.least_squares import RANK_RTOL, fit_least_squares
-from ..stats.model_selection import Diagnosis, diagnose
+from ..stats.model_selection import Diagnosis
 from ..stats.structure_search import Probe, ProbeFactors
 from .catalogue import catalogue as table_catalogue
 from .catalogue import resolve_effect
@@ -44,9 +43,7 @@ from .table import measured_table
 __all__ = [
     "DATA_PLACEHOLDER",
     "MAX_HARMONIC",
-    "NOISE_PER_ANGLE_ALPHA",
     "OUTLIER_RULE",
-    "SEPARATION_CHI2",
     "OrientationFamily",
     "design_command",
     "diagnose_measurements",
@@ -60,8 +57,6 @@ __all__ = [
 ]
 
 MAX_HARMONIC = 5
-SEPARATION_CHI2 = 25.0
-"""Noise-free misfit chi2 above which a denser design is said to separate two effects."""
 
 
 def harmonic_basis(k: int):
@@ -127,9 +122,20 @@ def max_harmonic_order(angle_rad: np.ndarray) -> int:
     return int(min(MAX_HARMONIC, max(0, (distinct - 1) // 2)))
 
 
-class OrientationFamily:
+OUTLIER_RULE = (
+    "studentized residual |t| = |r| / (s sqrt(1 - h)) above the two-sided normal quantile at "
+    "0.01 / m (m measured angles; h the leverage; s the robust scale 1.4826 median "
+    "|r| / sqrt(1 - h), the larger of that of the same angle, dpsi, dtheta or dgamma, and that "
+    "of all), iterated: the worst (|t| at least half the largest) left out, refitted, tested "
+    "again; first on the base model, then on the model with the accepted effects; at most 5 % "
+    "of the angles"
+)
+"""The outlier rule of :func:`diagnose_measurements` in words (``turntable_pin.stats.outliers``)."""
+
+
+class OrientationFamily(DataFamily):
     """Orientation data, the table's base error model and its effect catalogue (a
-    ``ModelFamily``).
+    :class:`~turntable_pin.stats.diagnosis_engine.DataFamily`).
 
     Args:
         data: the measurements.
@@ -144,8 +150,21 @@ class OrientationFamily:
             noise. ``data``'s relative sigmas are only the first weights.
     """
 
+    columns = ANGLE_NAMES
+    column_key = "angle"
     record_label = "positions"
+    record_words = "measurement rows"
+    observations = "measured angles"
     observation_unit = "arcsec"
+    unit_words = "arcsec"
+    user_unit_scale = ARCSEC_PER_RAD
+    outlier_rule = OUTLIER_RULE
+    noise_subject = "the measured angles'"
+    noise_column = "angle"
+    noise_how = (
+        "each angle is weighted by its own estimated noise (state it with sigma_dpsi_arcsec, "
+        "sigma_dtheta_arcsec, sigma_dgamma_arcsec)"
+    )
 
     def __init__(
         self,
@@ -156,68 +175,114 @@ class OrientationFamily:
         noise_per_angle: bool = False,
     ) -> None:
         self.data = data
-        self.noise_per_angle = noise_per_angle
         self.left_out_rad = left_out_rad
         self.table = measured_table(turntable)
         self.turntable = self.table
-        self.catalogue = tuple(catalogue if catalogue is not None else table_catalogue(self.table))
-        self.n_records = data.n_positions
-        self.sigma_scale = (
-            float(np.nanmedian(np.where(data.measured, data.sigma_rad, np.nan)) * ARCSEC_PER_RAD)
-            if data.sigma_rad is not None
-            else ARCSEC_PER_RAD
+        scale = ARCSEC_PER_RAD
+        if data.sigma_rad is not None:
+            scale *= float(np.nanmedian(np.where(data.measured, data.sigma_rad, np.nan)))
+        super().__init__(
+            catalogue if catalogue is not None else table_catalogue(self.table),
+            data.measured,
+            sigma_scale=scale,
+            noise_per_column=noise_per_angle,
         )
-        self._observed = data.measured
-        self._mask = data.measured.reshape(-1)
-        self._cache: dict[tuple[str, ...], OrientationFit] = {}
 
-    def fit(self, effects: Sequence[Effect], noise_variance: float | None = None) -> OrientationFit:
-        """The fit of the base errors plus ``effects`` (cached per effect list)."""
-        key = tuple(e.name for e in effects)
-        if key not in self._cache:
-            fit = fit_orientation(
-                self.data,
-                effects,
-                turntable=self.table,
-                zero_point=self._zero_point(),
-                base_fit=self.fit([]) if effects else None,
-            )
-            self._cache[key] = self._own_noise(fit) if self.noise_per_angle else fit
-        return self._cache[key]
+    @property
+    def noise_per_angle(self) -> bool:
+        """Whether every model is fitted at its own per-angle noise."""
+        return self.noise_per_column
 
-    def _own_noise(self, fit: OrientationFit) -> OrientationFit:
-        """``fit`` refitted with the per-angle noise levels it estimates itself, until they
-        stop moving (:data:`NOISE_RTOL`, at most :data:`NOISE_ITERATIONS` refits); its result
-        carries the angle of each observation as its noise group."""
+    # ---- the hooks of the one diagnosis (stats.diagnosis_engine) ---------------------------
+    def fit_model(self, effects: Sequence[Effect], zero_point) -> OrientationFit:
+        """The fit of the base errors plus ``effects`` (:func:`~.fit.fit_orientation`)."""
+        return fit_orientation(
+            self.data,
+            effects,
+            turntable=self.table,
+            zero_point=zero_point,
+            base_fit=self.fit([]) if effects else None,
+        )
+
+    def zero_point_of(self, effects: Sequence[Effect]):
+        """:func:`~.fit.orientation_zero_point` of the base and ``effects`` on these data."""
+        return orientation_zero_point(self.data, effects, turntable=self.table)
+
+    def initial_column_sigma(self) -> np.ndarray | None:
+        """The per-angle levels the data are weighted with (the first pass' estimate)."""
         data = self.data
-        # the levels ``fit`` was weighted with (the family's data: the first pass' estimate)
-        sigma = None if data.sigma_rad is None else np.nanmedian(data.sigma_rad, axis=0)
-        for _ in range(NOISE_ITERATIONS):
-            variance, counts, _ = _angle_variances(fit)
-            measured = counts > 0
-            new = np.sqrt(np.where(measured, variance, np.mean(variance[measured])))
-            if sigma is not None and np.all(np.abs(new - sigma) <= NOISE_RTOL * sigma):
-                break
-            sigma = new
-            weighted = data.replace(
-                sigma_rad=np.broadcast_to(sigma, data.angles_rad.shape).copy(),
-                sigma_relative=True,
-            )
-            fit = _refit(fit, weighted)
-        groups = np.broadcast_to(np.arange(3), data.angles_rad.shape)[data.measured]
-        return dataclasses.replace(fit, result=dataclasses.replace(fit.result, noise_groups=groups))
+        return None if data.sigma_rad is None else np.nanmedian(data.sigma_rad, axis=0)
 
-    def _zero_point(self):
-        """The reduced Jacobian at zero of the base and every testable catalogued effect, shared
-        by all fits of the diagnosis (computed on first use)."""
-        if not hasattr(self, "_zero"):
-            variables = self.data.variables()
-            testable = [e for e in self.catalogue if not e.missing_columns(variables)]
-            try:
-                self._zero = orientation_zero_point(self.data, testable, turntable=self.table)
-            except InputError:  # effects that cannot share one model: each fit on its own
-                self._zero = None
-        return self._zero
+    def refit(self, fit: OrientationFit, column_sigma: np.ndarray) -> OrientationFit:
+        """``fit``'s model fitted again with the relative noise ``column_sigma`` (3,) rad per
+        angle: from zero errors, or from ``fit``'s solution when its base errors are large
+        offsets (:data:`~.fit.RELINEARISE_RAD`, as :func:`~.fit.fit_orientation` restarts)."""
+        n_base = len(fit.model.base_names)
+        large = np.max(np.abs(fit.result.params[:n_base]), initial=0.0) > RELINEARISE_RAD
+        problem = OrientationFitProblem(_weighted(self.data, column_sigma), fit.model)
+        result = fit_least_squares(problem, origin=fit.result.params if large else None)
+        return OrientationFit(problem.data, fit.model, result)
+
+    def residual_table(self, fit: OrientationFit) -> np.ndarray:
+        """(N, 3) the residuals of ``fit``, rad, NaN where not measured."""
+        return fit.residuals_rad
+
+    def full_residuals(self, fit: OrientationFit) -> np.ndarray:
+        """(N, 3) the measured minus ``fit``'s angles, rad, the cells left out too."""
+        return self.data.angles_rad - fit.fitted_rad()
+
+    def sigma_table(self) -> np.ndarray | None:
+        """(N, 3) the data's sigmas, rad (stated or relative), or None."""
+        return self.data.sigma_rad
+
+    @property
+    def sigma_given(self) -> bool:
+        """Whether the data state their sigmas."""
+        return self.data.sigma_rad is not None
+
+    @property
+    def rows(self) -> np.ndarray:
+        """The data file's row number of each position."""
+        return self.data.rows
+
+    def without(self, cells: np.ndarray) -> OrientationFamily:
+        """The family on these data with the angles ``cells`` (N, 3) left out as outliers."""
+        return OrientationFamily(
+            _without(self.data, cells), self.catalogue, self.table,
+            np.where(cells, self.data.angles_rad, np.nan), self.noise_per_angle,
+        )  # fmt: skip
+
+    def with_column_noise(self, column_sigma: np.ndarray) -> OrientationFamily:
+        """The family on these data weighted by ``column_sigma`` (3,) rad per angle, every
+        model fitted at its own per-angle noise."""
+        return OrientationFamily(_weighted(self.data, column_sigma), self.catalogue, self.table,
+                                 noise_per_angle=True)  # fmt: skip
+
+    def screen_fit(self, cells: np.ndarray, effects: Sequence[Effect]):
+        """The fit of base + ``effects`` without the angles ``cells`` (the outlier screen)."""
+        return fit_orientation(_without(self.data, cells), effects, turntable=self.table).result
+
+    @property
+    def doubt_words(self) -> str:
+        """The doubt about the table: were the data measured on another one?"""
+        where = self.table.urdf_path
+        urdf = f"the URDF {Path(where).name}" if where is not None else "the default URDF"
+        return (
+            f"no rigid error set of {urdf} and no catalogued effect makes these data; were they "
+            "measured on another table (--urdf)? Or is the stated sigma too small?"
+        )
+
+    def complete(self, diagnosis: Diagnosis) -> None:
+        """The ``design --separate`` command that settles each separation of the verdict."""
+        if not diagnosis.separations:
+            return
+        data = self.data
+        data_name = data.source if data.source and Path(data.source).is_file() else DATA_PLACEHOLDER
+        urdf, mount = urdf_option(self.table), mount_option(self.table)
+        diagnosis.separation_commands = {
+            name: design_command(data_name, (diagnosis.missing_effect, name), urdf, mount)
+            for name in diagnosis.separations
+        }
 
     def untestable_reason(self, effect: Effect) -> str | None:
         """Why ``effect`` cannot be tested here (its data columns are missing, or not numbers),
@@ -231,10 +296,6 @@ class OrientationFamily:
     def effect(self, name: str) -> Effect:
         """The effect called ``name``: in this family's catalogue first, then the table's."""
         return resolve_effect(name, self.table, self.catalogue)
-
-    def describe(self, effect: Effect | str) -> dict:
-        """The effect's story: title, definition, explanation, how to confirm it."""
-        return (self.effect(effect) if isinstance(effect, str) else effect).describe()
 
     def design_warnings(self, base_fit: OrientationFit) -> list[str]:
         """Warn when the positions determine fewer error combinations than a full grid does.
@@ -357,26 +418,6 @@ class OrientationFamily:
             )
         return out
 
-    def _probe(
-        self, name: str, description: str, factors: ProbeFactors, spec: str, basis: np.ndarray
-    ) -> Probe:
-        """A probe whose columns are ``factors``' direction (N, 3) times its functions at the
-        data, ``basis`` (N, g) (computed once for the probes that share them), as rows of the
-        measured observations; ``spec``: its ``effect_spec`` (what ``fit --effects`` takes to
-        add it)."""
-        mask = self._mask
-
-        factors = dataclasses.replace(factors, basis=basis)
-
-        def columns():
-            cols = factors.direction_matrix()[:, :, None] * basis[:, None, :]
-            cols = cols.reshape(-1, cols.shape[-1])
-            return cols if mask.all() else cols[mask]
-
-        return Probe(
-            name, description, columns, ARCSEC_PER_RAD, "arcsec", factors, effect_spec=spec
-        )
-
     def _measured_angle_probes(
         self, shape: str, text: str, plot: tuple, directions, spec: str
     ) -> list[Probe]:
@@ -391,10 +432,10 @@ class OrientationFamily:
             if not self.data.measured[:, a].any():
                 continue
             factors = ProbeFactors(
-                var, values, functions, directions[a], scale, unit, self._observed
+                var, values, functions, directions[a], scale, unit, self.observed
             )
             probes.append(
-                self._probe(
+                self.probe(
                     f"{angle} {shape}",
                     text.format(angle=angle),
                     factors,
@@ -433,7 +474,7 @@ class OrientationFamily:
             group = (alike or {}).get(e, [e])
             lead = names[group[0]]
             factors = ProbeFactors(
-                var, values, functions, directions[e], scale, unit, self._observed
+                var, values, functions, directions[e], scale, unit, self.observed
             )
             description = f"a {text} of {lead} ({self.table.descriptions.get(lead, lead)})"
             if len(group) > 1:
@@ -443,7 +484,7 @@ class OrientationFamily:
                     "which see only their combination"
                 )
             probes.append(
-                self._probe(f"{lead} {shape}", description, factors, f"{lead}~{spec}", basis)
+                self.probe(f"{lead} {shape}", description, factors, f"{lead}~{spec}", basis)
             )
         return probes
 
@@ -542,22 +583,10 @@ class OrientationFamily:
             )
         return probes
 
-    def inputs(self, effect: Effect) -> set[str]:
-        """The data columns ``effect`` depends on beyond the joint angles (``time_s``,
-        ``dirK``, ``temperature_c``): a shape in one of them is its own kind."""
-        return set(effect.required_columns)
-
-    def suspect_probes(self, fit: OrientationFit) -> list[Probe]:
-        """The probes of shapes in inputs other than the joint angles (time, approach direction,
-        other numeric columns): what a catalogued effect may mimic through the measurement
-        order, but cannot be."""
-        angles = {self.table.angle_label(k) for k in range(1, self.data.n_joints + 1)}
-
-        def of_angles(probe) -> bool:
-            variable = probe.factors.variable if probe.factors is not None else ""
-            return bool(variable) and set(variable.replace("-", "+").split("+")) <= angles
-
-        return [p for p in self.probes(fit) if not of_angles(p)]
+    def base_inputs(self) -> set[str]:
+        """The joint angles' labels (``phi1``, or ``azimuth`` on a mount): the probes in them
+        are not suspects."""
+        return {self.table.angle_label(k) for k in range(1, self.data.n_joints + 1)}
 
     def _dense_variables(self) -> PositionVariables:
         """A dense design over every axis (15-degree grid; 30 degrees for three axes; as many
@@ -613,17 +642,6 @@ class OrientationFamily:
         )
 
 
-OUTLIER_RULE = (
-    "studentized residual |t| = |r| / (s sqrt(1 - h)) above the two-sided normal quantile at "
-    "0.01 / m (m measured angles; h the leverage; s the robust scale 1.4826 median "
-    "|r| / sqrt(1 - h), the larger of that of the same angle, dpsi, dtheta or dgamma, and that "
-    "of all), iterated: the worst (|t| at least half the largest) left out, refitted, tested "
-    "again; first on the base model, then on the model with the accepted effects; at most 5 % "
-    "of the angles"
-)
-"""The outlier rule of :func:`diagnose_measurements` in words (``turntable_pin.stats.outliers``)."""
-
-
 def _without(data: OrientationMeasurements, cells: np.ndarray) -> OrientationMeasurements:
     """``data`` with the cells ``cells`` (N, 3) left out (as not measured)."""
     if not cells.any():
@@ -633,89 +651,11 @@ def _without(data: OrientationMeasurements, cells: np.ndarray) -> OrientationMea
     return data.replace(angles_rad=angles)
 
 
-def _screen(data, effects, table, first=None) -> tuple[np.ndarray, str | None]:
-    """The outlier cells (N, 3) of ``data`` under base + ``effects`` by the iterated rule
-    (:func:`~turntable_pin.stats.outliers.screen_cells`), and a note when the rule would flag
-    more than its share; ``first``: the fit of base + ``effects`` on all of ``data`` when it is
-    at hand."""
-    from ..stats.outliers import screen_cells
-
-    def fit_without(flagged):
-        if first is not None and not flagged.any():
-            return first.result
-        return fit_orientation(_without(data, flagged), effects, turntable=table).result
-
-    return screen_cells(fit_without, data.measured, "measured angles")
-
-
-def _outlier_records(diagnosis: Diagnosis, data, cells: np.ndarray) -> list[dict]:
-    """``{"row", "angle", "residual_sigma"}`` of each outlier cell under the final model, worst
-    first (sigma: the noise the verdict uses, given or estimated)."""
-    fit = diagnosis.best_fit
-    fitted = fit.fitted_rad()
-    if data.sigma_rad is not None:
-        sigma = data.sigma_rad * np.sqrt(diagnosis.noise_variance)
-    else:
-        sigma = np.full(data.angles_rad.shape, np.sqrt(diagnosis.noise_variance))
-    out = []
-    for i, a in zip(*np.nonzero(cells), strict=True):
-        value = (data.angles_rad[i, a] - fitted[i, a]) / sigma[i, a]
-        out.append({"row": int(data.rows[i]), "angle": ANGLE_NAMES[a],
-                    "residual_sigma": float(value)})  # fmt: skip
-    return sorted(out, key=lambda o: -abs(o["residual_sigma"]))
-
-
-NOISE_PER_ANGLE_ALPHA = 0.01
-"""Without sigmas, the three angles get their own noise level when an F test of their residual
-variances rejects equal noise at this level (over the pairs, Bonferroni)."""
-
-
-def _refit(fit: OrientationFit, data: OrientationMeasurements) -> OrientationFit:
-    """``fit``'s model fitted again to ``data`` (the same positions, other weights): from zero
-    errors, or from ``fit``'s solution when its base errors are large offsets
-    (:data:`~.fit.RELINEARISE_RAD`, as :func:`~.fit.fit_orientation` restarts)."""
-    n_base = len(fit.model.base_names)
-    large = np.max(np.abs(fit.result.params[:n_base]), initial=0.0) > RELINEARISE_RAD
-    problem = OrientationFitProblem(data, fit.model)
-    result = fit_least_squares(problem, origin=fit.result.params if large else None)
-    return OrientationFit(data, fit.model, result)
-
-
-def _angle_variances(fit: OrientationFit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(variance rad^2, counts, degrees of freedom)`` of each measured angle's residuals
-    under ``fit`` (:func:`~turntable_pin.stats.outliers.column_variances`)."""
-    from ..stats.outliers import column_variances
-
-    return column_variances(fit.residuals_rad, fit.result.dof, fit.result.n_obs)
-
-
-NOISE_ITERATIONS = 20
-"""Most refits of a model with its own per-angle noise (:meth:`OrientationFamily.fit`)."""
-
-NOISE_RTOL = 1e-2
-"""The per-angle noise levels of a model have converged when none moves by more than this
-fraction (the profiled likelihood is stationary there: what is left changes a score by its
-square)."""
-
-
-def _noise_per_angle(diagnosis: Diagnosis) -> tuple[np.ndarray, str] | None:
-    """Without sigmas: the residual rms of each measured angle under the best model (rad) and a
-    sentence, when the angles' noise differ (F test at :data:`NOISE_PER_ANGLE_ALPHA`), else None.
-    """
-    from ..stats.outliers import variances_differ
-
-    variance, counts, dof = _angle_variances(diagnosis.best_fit)
-    differ, present = variances_differ(variance, counts, dof, NOISE_PER_ANGLE_ALPHA)
-    if not differ:
-        return None
-    sigma = np.sqrt(variance)
-    for a in set(range(3)) - set(present):
-        sigma[a] = np.sqrt(np.mean(variance[present]))
-    words = ", ".join(f"{ANGLE_NAMES[a]} {sigma[a] * ARCSEC_PER_RAD:.3g}" for a in present)
-    return sigma, (
-        f"sigma not given, and the measured angles' noise differ (estimated {words} arcsec; F "
-        f"test p < {NOISE_PER_ANGLE_ALPHA:g}): each angle is weighted by its own estimated noise "
-        "(state it with sigma_dpsi_arcsec, sigma_dtheta_arcsec, sigma_dgamma_arcsec)"
+def _weighted(data: OrientationMeasurements, column_sigma: np.ndarray) -> OrientationMeasurements:
+    """``data`` weighted by the relative noise ``column_sigma`` (3,) rad of each angle."""
+    return data.replace(
+        sigma_rad=np.broadcast_to(column_sigma, data.angles_rad.shape).copy(),
+        sigma_relative=True,
     )
 
 
@@ -738,42 +678,21 @@ def diagnose_measurements(
     turntable=None,
     outliers: bool = True,
 ) -> Diagnosis:
-    """Diagnose orientation measurements against the effect catalogue (see :mod:`diagnosis`).
+    """Diagnose orientation measurements against the effect catalogue (see :mod:`diagnosis`):
+    :func:`~turntable_pin.stats.diagnosis_engine.diagnose_data` on the :class:`OrientationFamily`
+    of ``data``.
 
     With ``outliers`` (the default) gross outliers are found by :data:`OUTLIER_RULE`, left out of
     every fit of the verdict and listed in ``Diagnosis.outliers``; ``outliers=False`` keeps every
-    measured angle. Without sigmas, when the residuals show that the three angles' noise differ
-    (:func:`_noise_per_angle`), the diagnosis is made again with each angle weighted by its own
-    estimated noise, and a warning says so.
+    measured angle. Without sigmas, when the residuals show that the three angles' noise differ,
+    the diagnosis is made again with each model fitted at its own per-angle noise, and a warning
+    says so.
 
     Raises:
         InputError: more rows than :data:`~turntable_pin.core.sizes.MAX_DIAGNOSED_ROWS`.
     """
-    check_count(data.n_positions, MAX_DIAGNOSED_ROWS, "measurement rows", DIAGNOSIS_ROW_BYTES)
-    table = measured_table(turntable)
-    diagnosis = _diagnose(data, until_explained, catalogue, table, outliers)
-    if data.sigma_rad is None:
-        per_angle = _noise_per_angle(diagnosis)
-        if per_angle is not None:
-            sigma, note = per_angle
-            weighted = data.replace(
-                sigma_rad=np.broadcast_to(sigma, data.angles_rad.shape).copy(),
-                sigma_relative=True,
-            )
-            diagnosis = None  # free the first one's fits before the second
-            diagnosis = _diagnose(
-                weighted, until_explained, catalogue, table, outliers, noise_per_angle=True
-            )
-            diagnosis.warnings.append(_per_angle_note(diagnosis, note))
-    diagnosis.doubt = _table_doubt(diagnosis, table)
-    if diagnosis.separations:
-        data_name = data.source if data.source and Path(data.source).is_file() else DATA_PLACEHOLDER
-        urdf, mount = urdf_option(turntable), mount_option(turntable)
-        diagnosis.separation_commands = {
-            name: design_command(data_name, (diagnosis.missing_effect, name), urdf, mount)
-            for name in diagnosis.separations
-        }
-    return diagnosis
+    family = OrientationFamily(data, catalogue, turntable)
+    return diagnose_data(family, until_explained=until_explained, outliers=outliers)
 
 
 DATA_PLACEHOLDER = "DATA.csv"
@@ -822,67 +741,3 @@ def mount_option(turntable) -> str | None:
     if table.telescope_mount == table.declared_mount:
         return None
     return table.telescope_mount or NO_MOUNT
-
-
-WRONG_TABLE_CHI2_REDUCED = 9.0
-"""With sigma given, a best model (every accepted effect in) still this far from the noise
-(residuals three times the stated sigma) makes the diagnosis ask whether the URDF is the table
-the data were measured on."""
-
-
-def _table_doubt(diagnosis: Diagnosis, table) -> str | None:
-    """Why the table itself is in doubt (the data may come from another table), or None."""
-    best = diagnosis.best_fit.result
-    if not best.sigma_known or best.dof <= 0:
-        return None
-    chi2_reduced = best.rss / best.dof
-    if chi2_reduced <= WRONG_TABLE_CHI2_REDUCED:
-        return None
-    where = getattr(table, "urdf_path", None)
-    urdf = f"the URDF {Path(where).name}" if where is not None else "the default URDF"
-    return (
-        f"with every accepted effect the residuals are still {chi2_reduced**0.5:.1f} times the "
-        f"stated noise (chi2_reduced {chi2_reduced:.3g}): no rigid error set of {urdf} and no "
-        "catalogued effect makes these data; were they measured on another table (--urdf)? "
-        "Or is the stated sigma too small?"
-    )
-
-
-def _per_angle_note(diagnosis: Diagnosis, found: str) -> str:
-    """The warning of a diagnosis made with each model's own per-angle noise: why (``found``,
-    the first pass' sentence) and the best model's levels."""
-    variance, counts, _ = _angle_variances(diagnosis.best_fit)
-    words = ", ".join(
-        f"{ANGLE_NAMES[a]} {np.sqrt(variance[a]) * ARCSEC_PER_RAD:.3g}"
-        for a in range(3)
-        if counts[a]
-    )
-    return (
-        f"{found}; every model was fitted and compared at its own per-angle noise (the best "
-        f"model's: {words} arcsec)"
-    )
-
-
-def _diagnose(
-    data, until_explained, catalogue, table, outliers, noise_per_angle: bool = False
-) -> Diagnosis:
-    """The diagnosis of ``data`` with the outlier rule (or without it); ``noise_per_angle``:
-    see :class:`OrientationFamily`."""
-
-    def run(cells):
-        left_out = np.where(cells, data.angles_rad, np.nan)
-        family = OrientationFamily(
-            _without(data, cells), catalogue, table, left_out, noise_per_angle
-        )
-        return diagnose(family, until_explained=until_explained)
-
-    if not outliers:
-        return run(np.zeros(data.angles_rad.shape, bool))
-    from ..stats.outliers import screened_diagnosis
-
-    return screened_diagnosis(
-        run,
-        lambda effects, first: _screen(data, effects, table, first),
-        lambda diagnosis, cells: _outlier_records(diagnosis, data, cells),
-        OUTLIER_RULE,
-    )

@@ -1,9 +1,9 @@
 """The diagnosis of a calibration run in words, figures and one HTML page.
 
-Three views of one structured result
-(:func:`~turntable_pin.instrument.diagnosis.run_diagnosis_dict`): the text opens with the
-verdict (which effect is missing, on the table's side or the instrument's); the HTML page tells
-the same story with the residuals against each joint angle, time and temperature before and
+Three views of one structured result (``Diagnosis.to_dict()`` of
+:func:`~turntable_pin.instrument.diagnosis.diagnose_run`): the text opens with the verdict
+(which effect is missing, on the table's side or the instrument's); the HTML page tells the same
+story with the residuals against each joint angle, time and temperature before and
 after; the figures are written once by :func:`write_run_plots`.
 """
 

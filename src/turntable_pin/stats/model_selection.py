@@ -33,6 +33,7 @@ construction). The structure search pays a look-elsewhere penalty of ``2 ln G`` 
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -438,6 +439,12 @@ class Diagnosis:
             this model at all), said before the verdict; ``None`` when it has none.
         group_variance: with a noise level per group estimated with each model, the best
             model's (:func:`_group_variance`): every fit's chi2 is reported at it.
+        family_verdict: the family's own entries of the verdict (JSON-ready; a calibration
+            run's side of each effect and the effects of the other side), after the generic ones
+            in :meth:`to_dict`; ``separation_commands`` then follow them (they settle the
+            family's rivals too).
+        family_results: the family's own entries of the result (JSON-ready; a calibration run's
+            calibrated coefficients), after the generic ones in :meth:`to_dict`.
     """
 
     family: Any = field(repr=False)
@@ -458,6 +465,8 @@ class Diagnosis:
     doubt: str | None = None
     group_variance: np.ndarray | None = field(default=None, repr=False)
     separation_commands: dict[str, str] = field(default_factory=dict)
+    family_verdict: dict[str, Any] = field(default_factory=dict)
+    family_results: dict[str, Any] = field(default_factory=dict)
 
     @property
     def missing_effect(self) -> str | None:
@@ -580,7 +589,7 @@ class Diagnosis:
                 for name, value in self.unneeded_given_structure.items()
             ],
         }
-        if self.separation_commands:
+        if self.separation_commands and not self.family_verdict:
             verdict["separation_commands"] = dict(self.separation_commands)
         named_parameters = self.named_parameters()
         verdict["named_parameters"] = named_parameters
@@ -598,6 +607,9 @@ class Diagnosis:
         ]
         if self.missing_effect:
             verdict["effect_story"] = self.family.describe(self.missing_effect)
+        verdict.update(copy.deepcopy(self.family_verdict))
+        if self.separation_commands and self.family_verdict:
+            verdict["separation_commands"] = dict(self.separation_commands)
         unit = self.family.observation_unit
         return {
             f"n_{self.family.record_label}": self.family.n_records,
@@ -626,6 +638,7 @@ class Diagnosis:
                 "of chi2(larger added_rank)",
                 "fit_test_alpha": FIT_TEST_ALPHA if self.sigma_known else None,
             },
+            **copy.deepcopy(self.family_results),
         }
 
 

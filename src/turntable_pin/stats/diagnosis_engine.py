@@ -1,0 +1,435 @@
+"""One diagnosis over families of data: the fits a family shares, the screen for gross outliers,
+a noise level per observation column, the two passes and the doubt about the family itself.
+
+As statsmodels' GLM is one fitting engine and each family supplies only its link and variance, a
+kind of data (orientation measurements, the outputs of a calibration run, a third later) is a
+:class:`DataFamily` that supplies only what is its own: the names and unit of its observation
+columns, the fit of its base model plus effects (:meth:`DataFamily.fit_model`), the candidate
+effects, the probes of the structure search and its words. Written here once, for every family:
+
+- the fits of one data set, cached per effect list and sharing one zero point
+  (:meth:`DataFamily.fit`), each model refitted at the per-column noise it estimates itself when
+  the columns' noise differ (:meth:`DataFamily.own_column_noise`);
+- which effect is missing (:func:`~.model_selection.diagnose`), with gross outliers left out by
+  the stated rule (:func:`~.outliers.screen_cells`) in two passes
+  (:func:`~.outliers.screened_diagnosis`) and listed (:func:`outlier_records`);
+- without sigmas, the F test of the columns' noise and the diagnosis made again with a noise level
+  per column (:func:`column_noise`);
+- the doubt when even the best model stays far from the stated noise (:data:`DOUBT_CHI2_REDUCED`).
+
+:func:`diagnose_data` is the one entry point. The engine carries no domain names or units: the
+family passes them in.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ..core.exceptions import InputError
+from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
+from .model_selection import Diagnosis, diagnose
+from .structure_search import Probe, ProbeFactors
+
+__all__ = [
+    "DOUBT_CHI2_REDUCED",
+    "NOISE_ITERATIONS",
+    "NOISE_PER_COLUMN_ALPHA",
+    "NOISE_RTOL",
+    "SEPARATION_CHI2",
+    "DataFamily",
+    "column_noise",
+    "diagnose_data",
+    "diagnose_screened",
+    "doubt",
+    "outlier_records",
+]
+
+DOUBT_CHI2_REDUCED = 9.0
+"""With sigma given, a best model (every accepted effect in) still this far from the noise
+(residuals three times the stated sigma) makes the diagnosis doubt the family itself: the data may
+not come from this model at all (another table, a wrong stated sigma), said before the verdict."""
+
+NOISE_PER_COLUMN_ALPHA = 0.01
+"""Without sigmas, the observation columns get their own noise level when an F test of their
+residual variances rejects equal noise at this level (over the pairs, Bonferroni)."""
+
+NOISE_ITERATIONS = 20
+"""Most refits of a model with its own per-column noise (:meth:`DataFamily.own_column_noise`)."""
+
+NOISE_RTOL = 1e-2
+"""The per-column noise levels of a model have converged when none moves by more than this
+fraction (the profiled likelihood is stationary there: what is left changes a score by its
+square)."""
+
+SEPARATION_CHI2 = 25.0
+"""Noise-free misfit chi2 above which a denser set of positions is said to separate two effects
+(five sigma)."""
+
+
+class DataFamily:
+    """A family of data for the one diagnosis: a ``ModelFamily``
+    (:class:`~.model_selection.ModelFamily`) bound to one data set, with some cells left out as
+    outliers and maybe a noise level per column, and what :func:`diagnose_data` asks of it.
+
+    A subclass sets the class attributes below, calls ``DataFamily.__init__`` and implements the
+    hooks :meth:`fit_model`, :meth:`zero_point_of`, :meth:`refit`, :meth:`residual_table`,
+    :meth:`full_residuals`, :meth:`without`, :meth:`with_column_noise`, :meth:`screen_fit`,
+    :meth:`untestable_reason`, :meth:`probes`, :meth:`separation`, :meth:`design_warnings`; it
+    may fill the result with its own data in :meth:`complete`.
+
+    Attributes:
+        columns: the names of the K observation columns of a record.
+        column_key: the key naming the column of an outlier record.
+        record_label: what a record is (the key ``n_<label>`` of the result).
+        record_words: the records in words, for the size limit of a diagnosis.
+        observations: the observations in words, plural (the outlier rule's note).
+        observation_unit: the key suffix of ``rms_``/``sigma_`` in the result.
+        unit_words: the user unit in sentences.
+        user_unit_scale: user units per internal unit of the observations.
+        outlier_rule: the outlier rule in words (the result's ``outlier_rule``).
+        noise_subject, noise_column, noise_how: the words of the note on a noise level per
+            column (:func:`column_noise_note`).
+        catalogue: the candidate effects (objects with a ``name``), in catalogue order.
+        n_records: number of records R.
+        observed: (R, K) the cells that hold an observation fitted here.
+        noise_per_column: whether every model is fitted at its own per-column noise.
+        sigma_scale: the observations' typical sigma in user units (the unit-weight noise).
+    """
+
+    columns: tuple[str, ...] = ()
+    column_key: str = "column"
+    record_label: str = "records"
+    record_words: str = "records"
+    observations: str = "observations"
+    observation_unit: str = ""
+    unit_words: str = ""
+    user_unit_scale: float = 1.0
+    outlier_rule: str = ""
+    noise_subject: str = "the columns'"
+    noise_column: str = "column"
+    noise_how: str = "each column is weighted by its own estimated noise"
+
+    def __init__(
+        self,
+        catalogue: Sequence[Any],
+        observed: np.ndarray,
+        *,
+        sigma_scale: float,
+        noise_per_column: bool = False,
+    ) -> None:
+        self.catalogue = tuple(catalogue)
+        self.observed = np.asarray(observed, bool)
+        self.n_records = int(self.observed.shape[0])
+        self.sigma_scale = sigma_scale
+        self.noise_per_column = noise_per_column
+        self._cache: dict[tuple[str, ...], Any] = {}
+        self._zero: tuple[Any] | None = None
+
+    # ---- hooks of the family --------------------------------------------------------------
+    def fit_model(self, effects: Sequence[Any], zero_point) -> Any:
+        """The fit (an object with a ``result``, a ``FitResult``) of the base model plus
+        ``effects`` to this family's data, starting from ``zero_point`` (or None)."""
+        raise NotImplementedError
+
+    def zero_point_of(self, effects: Sequence[Any]):
+        """The reduced Jacobian at zero (``least_squares.zero_point``) of the base model plus
+        ``effects`` on these data, with the weights of :meth:`fit_model`'s fits."""
+        raise NotImplementedError
+
+    def refit(self, fit, column_sigma: np.ndarray) -> Any:
+        """``fit``'s model fitted again with the relative noise ``column_sigma`` (K,) per column
+        (internal units)."""
+        raise NotImplementedError
+
+    def residual_table(self, fit) -> np.ndarray:
+        """(R, K) the residuals of ``fit`` (internal units), NaN where no observation is fitted."""
+        raise NotImplementedError
+
+    def full_residuals(self, fit) -> np.ndarray:
+        """(R, K) the observed minus ``fit``'s values at every cell, those left out too."""
+        raise NotImplementedError
+
+    def sigma_table(self) -> np.ndarray | None:
+        """(R, K) the sigmas of these data (stated, or relative weights), or None."""
+        return None
+
+    @property
+    def sigma_given(self) -> bool:
+        """Whether the data state their noise (then no per-column noise is estimated)."""
+        raise NotImplementedError
+
+    @property
+    def rows(self) -> np.ndarray:
+        """(R,) the row number of each record, as outlier records name it."""
+        raise NotImplementedError
+
+    def without(self, cells: np.ndarray) -> DataFamily:
+        """The family on these data with the cells ``cells`` (R, K) left out as outliers."""
+        raise NotImplementedError
+
+    def with_column_noise(self, column_sigma: np.ndarray) -> DataFamily:
+        """The family on these data whose every model is fitted at its own per-column noise,
+        starting from ``column_sigma`` (K,)."""
+        raise NotImplementedError
+
+    def screen_fit(self, cells: np.ndarray, effects: Sequence[Any]):
+        """The ``FitResult`` of base + ``effects`` without the cells ``cells`` (the screen)."""
+        raise NotImplementedError
+
+    @property
+    def doubt_words(self) -> str:
+        """What the doubt asks when the best model stays far from the stated noise."""
+        return "no catalogued effect makes these data; is the stated sigma too small?"
+
+    def complete(self, diagnosis: Diagnosis) -> None:
+        """Fill ``diagnosis`` with the family's own data (its ``separation_commands``,
+        ``family_verdict``, ``family_results``); by default nothing."""
+
+    # ---- the fits, written once -------------------------------------------------------------
+    def fit(self, effects: Sequence[Any], noise_variance: float | None = None) -> Any:
+        """The fit of the base model plus ``effects`` (cached per effect list; every fit of the
+        family shares :meth:`zero_point`; with a noise level per column, at its own noise)."""
+        key = tuple(e.name for e in effects)
+        if key not in self._cache:
+            fit = self.fit_model(effects, self.zero_point())
+            self._cache[key] = self.own_column_noise(fit) if self.noise_per_column else fit
+        return self._cache[key]
+
+    def zero_point(self):
+        """The reduced Jacobian at zero of the base and every testable catalogued effect,
+        shared by all fits of the family (computed on first use; None when the effects cannot
+        share one model: each fit is then made on its own)."""
+        if self._zero is None:
+            testable = [e for e in self.catalogue if not self.untestable_reason(e)]
+            try:
+                self._zero = (self.zero_point_of(testable),)
+            except InputError:
+                self._zero = (None,)
+        return self._zero[0]
+
+    def initial_column_sigma(self) -> np.ndarray | None:
+        """The per-column noise (K,) the family's models are weighted with first, or None."""
+        return None
+
+    def own_column_noise(self, fit) -> Any:
+        """``fit`` refitted with the per-column noise levels it estimates itself, until they
+        stop moving (:data:`NOISE_RTOL`, at most :data:`NOISE_ITERATIONS` refits); its result
+        carries the column of each observation as its noise group."""
+        sigma = self.initial_column_sigma()
+        for _ in range(NOISE_ITERATIONS):
+            variance, counts, _ = self.column_variances(fit)
+            seen = counts > 0
+            new = np.sqrt(np.where(seen, variance, np.mean(variance[seen])))
+            if sigma is not None and np.all(np.abs(new - sigma) <= NOISE_RTOL * sigma):
+                break
+            sigma = new
+            fit = self.refit(fit, sigma)
+        groups = np.broadcast_to(np.arange(self.observed.shape[1]), self.observed.shape)
+        result = dataclasses.replace(fit.result, noise_groups=groups[self.observed])
+        return dataclasses.replace(fit, result=result)
+
+    def column_variances(self, fit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(variance, counts, degrees of freedom)`` of each column's residuals under ``fit``
+        (:func:`~.outliers.column_variances`), internal units squared."""
+        from .outliers import column_variances
+
+        return column_variances(self.residual_table(fit), fit.result.dof, fit.result.n_obs)
+
+    # ---- what the diagnosis asks, written once ----------------------------------------------
+    def untestable_reason(self, effect) -> str | None:
+        """Why ``effect`` cannot be tested here (e.g. its data columns are missing), or None."""
+        return None
+
+    def effect(self, name: str):
+        """The catalogued effect called ``name``."""
+        return next(e for e in self.catalogue if e.name == name)
+
+    def describe(self, effect) -> dict:
+        """The effect's story (``effect.describe()``), the effect given or named."""
+        return (self.effect(effect) if isinstance(effect, str) else effect).describe()
+
+    def inputs(self, effect) -> set[str]:
+        """The data columns ``effect`` depends on beyond the base model's inputs (its
+        ``required_columns``): a shape in one of them is its own kind, not one it mimics."""
+        return set(getattr(effect, "required_columns", ()))
+
+    def probes(self, fit) -> list[Probe]:
+        """The structure-search probes in the residuals of ``fit``."""
+        raise NotImplementedError
+
+    def base_inputs(self) -> set[str]:
+        """The names of the base model's own inputs (the probes' variables made of them are not
+        suspects: :meth:`suspect_probes`)."""
+        return set()
+
+    def suspect_probes(self, fit) -> list[Probe]:
+        """The probes of shapes in inputs other than the base model's own (time, other data
+        columns, and combinations ``a+b``/``a-b`` of base inputs count as base inputs): what a
+        catalogued effect may mimic through the measurement order, but cannot be."""
+        own = self.base_inputs()
+
+        def of_base(probe) -> bool:
+            variable = probe.factors.variable if probe.factors is not None else ""
+            return bool(variable) and set(variable.replace("-", "+").split("+")) <= own
+
+        return [p for p in self.probes(fit) if not of_base(p)]
+
+    def probe(
+        self, name: str, description: str, factors: ProbeFactors, spec: str, basis: np.ndarray
+    ) -> Probe:
+        """A probe whose columns are ``factors``' direction (R, K) times its functions at the
+        data, ``basis`` (R, g) (computed once for the probes that share them), as rows of the
+        observations fitted; ``spec``: its ``effect_spec`` (what a fit takes to add it)."""
+        mask = self.observed.reshape(-1)
+        factors = dataclasses.replace(factors, basis=basis)
+
+        def columns():
+            cols = factors.direction_matrix()[:, :, None] * basis[:, None, :]
+            cols = cols.reshape(-1, cols.shape[-1])
+            return cols if mask.all() else cols[mask]
+
+        return Probe(name, description, columns, self.user_unit_scale, self.unit_words, factors,
+                     effect_spec=spec)  # fmt: skip
+
+
+def diagnose_data(
+    family: DataFamily, *, until_explained: bool = False, outliers: bool = True
+) -> Diagnosis:
+    """Diagnose a family's data (module docstring): which catalogued effect is missing.
+
+    ``family`` holds all the data (no cell left out, no per-column noise). With ``outliers``
+    (the default) gross outliers are found by the family's rule, left out of every fit of the
+    verdict and listed in ``Diagnosis.outliers`` (:func:`diagnose_screened`); ``outliers=False``
+    keeps every observation. Without sigmas, when the residuals show that the columns' noise
+    differ (:func:`column_noise`), the diagnosis is made again with every model fitted at its own
+    per-column noise, and a warning says so. The doubt about the family (:func:`doubt`) and the
+    family's own data (:meth:`DataFamily.complete`) complete the result.
+
+    Raises:
+        InputError: more records than :data:`MAX_DIAGNOSED_ROWS` (of ``core.sizes``).
+    """
+    check_count(family.n_records, MAX_DIAGNOSED_ROWS, family.record_words, DIAGNOSIS_ROW_BYTES)
+    diagnosis = diagnose_screened(family, until_explained=until_explained, outliers=outliers)
+    if not family.sigma_given:
+        noise = column_noise(diagnosis)
+        if noise is not None:
+            sigma, found = noise
+            family = family.with_column_noise(sigma)
+            diagnosis = None  # free the first one's fits before the second
+            diagnosis = diagnose_screened(family, until_explained=until_explained,
+                                          outliers=outliers)  # fmt: skip
+            diagnosis.warnings.append(column_noise_note(diagnosis, found))
+    diagnosis.doubt = doubt(diagnosis)
+    diagnosis.family.complete(diagnosis)
+    return diagnosis
+
+
+def diagnose_screened(
+    family: DataFamily, *, until_explained: bool = False, outliers: bool = True
+) -> Diagnosis:
+    """One pass of :func:`diagnose_data`: the diagnosis of ``family``'s data with the outlier rule
+    (screened under the base model, then under the accepted effects:
+    :func:`~.outliers.screened_diagnosis`) or, without ``outliers``, of every observation."""
+    from .outliers import screen_cells, screened_diagnosis
+
+    def diagnose_without(cells):
+        return diagnose(family.without(cells), until_explained=until_explained)
+
+    if not outliers:
+        return diagnose_without(np.zeros(family.observed.shape, bool))
+
+    def screen(effects, first):
+        def fit_without(flagged):
+            if first is not None and not flagged.any():
+                return first.result
+            return family.screen_fit(flagged, effects)
+
+        return screen_cells(fit_without, family.observed, family.observations)
+
+    return screened_diagnosis(
+        diagnose_without,
+        screen,
+        lambda diagnosis, cells: outlier_records(diagnosis, family, cells),
+        family.outlier_rule,
+    )
+
+
+def outlier_records(diagnosis: Diagnosis, family: DataFamily, cells: np.ndarray) -> list[dict]:
+    """``{"row", <family.column_key>, "residual_sigma"}`` of each outlier cell of ``family``'s
+    data under the diagnosis' final model, worst first. Sigma is the noise the verdict uses: the
+    best model's own per column when it has one, else the data's sigmas (stated or relative)
+    times the unit-weight noise, else the unit-weight noise."""
+    residual = family.full_residuals(diagnosis.best_fit)
+    table = family.sigma_table()
+    if diagnosis.group_variance is not None:  # per noise group: the columns with observations
+        per_column = np.full(cells.shape[1], np.nan)
+        per_column[np.unique(diagnosis.best_fit.result.noise_groups)] = diagnosis.group_variance
+        sigma = np.broadcast_to(np.sqrt(per_column), cells.shape)
+    elif table is not None:
+        sigma = table * np.sqrt(diagnosis.noise_variance)
+    else:
+        sigma = np.full(cells.shape, np.sqrt(diagnosis.noise_variance))
+    out = [
+        {"row": int(family.rows[i]), family.column_key: family.columns[c],
+         "residual_sigma": float(residual[i, c] / sigma[i, c])}
+        for i, c in zip(*np.nonzero(cells), strict=True)
+    ]  # fmt: skip
+    return sorted(out, key=lambda o: -abs(o["residual_sigma"]))
+
+
+def _levels(family: DataFamily, sigma: np.ndarray, columns) -> str:
+    """``name level, ...`` of the columns ``columns`` in the family's user unit."""
+    scale = family.user_unit_scale
+    return ", ".join(f"{family.columns[c]} {sigma[c] * scale:.3g}" for c in columns)
+
+
+def column_noise(diagnosis: Diagnosis) -> tuple[np.ndarray, str] | None:
+    """Without sigmas: the residual rms of each column under the best model (internal units; a
+    column with too few observations to test gets the mean level) and a sentence, when the
+    columns' noise differ (F test at :data:`NOISE_PER_COLUMN_ALPHA`), else None."""
+    from .outliers import variances_differ
+
+    family = diagnosis.family
+    variance, counts, dof = family.column_variances(diagnosis.best_fit)
+    differ, present = variances_differ(variance, counts, dof, NOISE_PER_COLUMN_ALPHA)
+    if not differ:
+        return None
+    sigma = np.sqrt(variance)
+    for c in set(range(len(counts))) - set(present):
+        sigma[c] = np.sqrt(np.mean(variance[present]))
+    return sigma, (
+        f"sigma not given, and {family.noise_subject} noise differ (estimated "
+        f"{_levels(family, sigma, present)} {family.unit_words}; F test p < "
+        f"{NOISE_PER_COLUMN_ALPHA:g}): {family.noise_how}"
+    )
+
+
+def column_noise_note(diagnosis: Diagnosis, found: str) -> str:
+    """The warning of a diagnosis made with each model's own per-column noise: why (``found``,
+    the first pass' sentence of :func:`column_noise`) and the best model's levels."""
+    family = diagnosis.family
+    variance, counts, _ = family.column_variances(diagnosis.best_fit)
+    levels = _levels(family, np.sqrt(variance), [c for c in range(len(counts)) if counts[c]])
+    return (
+        f"{found}; every model was fitted and compared at its own per-{family.noise_column} "
+        f"noise (the best model's: {levels} {family.unit_words})"
+    )
+
+
+def doubt(diagnosis: Diagnosis) -> str | None:
+    """Why the family itself is in doubt (with sigma given, the best model's residuals stay
+    above :data:`DOUBT_CHI2_REDUCED` times the noise), in the family's words, or None."""
+    best = diagnosis.best_fit.result
+    if not best.sigma_known or best.dof <= 0:
+        return None
+    chi2_reduced = best.rss / best.dof
+    if chi2_reduced <= DOUBT_CHI2_REDUCED:
+        return None
+    return (
+        f"with every accepted effect the residuals are still {chi2_reduced**0.5:.1f} times the "
+        f"stated noise (chi2_reduced {chi2_reduced:.3g}): {diagnosis.family.doubt_words}"
+    )
