@@ -323,14 +323,14 @@ def test_allocate_limits(scratch, option, value):
 
 @fuzz(10)
 @given(
-    option=st.sampled_from(["-n", "--seed", "--phi2-step-deg", "--scale-bounds"]),
+    option=st.sampled_from(["-n", "--seed", "--grid-step-deg", "--scale-bounds"]),
     value=number_text,
 )
 def test_montecarlo_options(scratch, option, value):
     number = _number(value)
     if option == "-n":  # small runs only (sizes are checked elsewhere)
         assume(_not_a_large_count(value, 50))
-    if option == "--phi2-step-deg":
+    if option == "--grid-step-deg":
         assume(number is None or not 0 < number < 5)
     folder = example_folder(scratch)
     base = ["montecarlo", "--limits-arcmin", "1", "--quiet", "-n", "20"]
