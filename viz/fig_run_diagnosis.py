@@ -17,16 +17,16 @@ import numpy as np
 from turntable_pin.calibration.run import read_run
 from turntable_pin.core.resources import examples_dir
 from turntable_pin.instrument.diagnosis import diagnose_run
-from turntable_pin.report.run_report import write_run_plots, write_run_report
+from turntable_pin.report.html_report import write_report
+from turntable_pin.report.measurement_figures import write_diagnosis_plots
 
 
 def main(out_dir: Path, fast: bool = False) -> list[Path]:
     out_dir = Path(out_dir) / "run_diagnosis"  # its residuals.png is not the orientation one's
     run = read_run(examples_dir() / "runs" / "run_mount.csv", np.radians(45.75))
     diagnosis = diagnose_run(run)
-    paths = [Path(p) for p in write_run_plots(diagnosis, out_dir)]
-    write_run_report(diagnosis, diagnosis.to_dict(), out_dir / "run_report.html",
-                     title="bundled calibration run")  # fmt: skip
+    paths = [Path(p) for p in write_diagnosis_plots(diagnosis, out_dir)]
+    write_report(diagnosis, out_dir / "run_report.html", title="bundled calibration run")
     return paths
 
 

@@ -93,9 +93,9 @@ def test_a_tilted_mount_is_said_to_be_the_tables_payload_rotation_too():
     assert "table:errors" in rivals
     assert rivals["table:errors"]["chi2_dense"] < 1e-6
     assert "no set of positions separates them" in rivals["table:errors"]["words"]
-    from turntable_pin.report.run_report import run_report_lines
+    from turntable_pin.report.diagnosis_text import diagnosis_lines
 
-    text = "\n".join(run_report_lines(d))
+    text = "\n".join(diagnosis_lines(d))
     assert "confounded: the run alone cannot say which side it is" in text
 
 

@@ -303,7 +303,9 @@ def _read_run(args: argparse.Namespace, table):
 def _diagnose_run(args: argparse.Namespace, table) -> int:
     from ..instrument.diagnosis import diagnose_run
     from ..instrument.effects import run_catalogue
-    from ..report.run_report import run_report_lines, write_run_plots, write_run_report
+    from ..report.diagnosis_text import diagnosis_lines
+    from ..report.html_report import write_report
+    from ..report.measurement_figures import write_diagnosis_plots
 
     run = _read_run(args, table)
     catalogue = (*run_catalogue(table), *_user_run_effects(args, run))
@@ -313,15 +315,15 @@ def _diagnose_run(args: argparse.Namespace, table) -> int:
     )  # fmt: skip
     out = {**diagnosis.to_dict(), **_table_keys(table)}
     if args.plots:
-        out["plots"] = [str(p) for p in write_run_plots(diagnosis, args.plots)]
+        out["plots"] = [str(p) for p in write_diagnosis_plots(diagnosis, args.plots)]
     if args.report:
         title = f"Calibration run {Path(args.data).name}: the table or the GyroWheel?"
-        out["report"] = str(write_run_report(diagnosis, out, args.report, title=title))
+        out["report"] = str(write_report(diagnosis, args.report, title=title))
     if args.json:
         print_json(out)
         return 0
     _print_table(args, table)
-    print("\n".join(run_report_lines(out)))
+    print("\n".join(diagnosis_lines(out)))
     for path in [*out.get("plots", []), *([out["report"]] if "report" in out else [])]:
         print(f"wrote {path}")
     return 0

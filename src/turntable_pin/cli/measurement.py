@@ -652,17 +652,13 @@ def _diagnosis(args: argparse.Namespace):
 
 
 def run_diagnose(args: argparse.Namespace) -> int:
-    from ..measurement.diagnosis import diagnosis_residuals
     from ..report.diagnosis_text import diagnosis_lines
-    from ..report.measurement_figures import write_residual_plots, write_structure_plots
+    from ..report.measurement_figures import write_diagnosis_plots
 
     diagnosis = _diagnosis(args)
     out = diagnosis.to_dict()
     if args.plots:
-        base, best = diagnosis_residuals(diagnosis)
-        sets = [base, best] if diagnosis.steps else [base]
-        out["plots"] = [str(p) for p in write_residual_plots(sets, args.plots)]
-        out["plots"] += [str(p) for p in write_structure_plots(diagnosis.structure, args.plots)]
+        out["plots"] = [str(p) for p in write_diagnosis_plots(diagnosis, args.plots)]
     if args.json:
         print_json(out)
         return 0

@@ -36,7 +36,7 @@ from ..measurement.diagnosis import (
 )
 from ..measurement.table import measured_table
 from ..model.angles import ANGLE_NAMES
-from ..stats.diagnosis_engine import SEPARATION_CHI2, DataFamily, diagnose_data
+from ..stats.diagnosis_engine import SEPARATION_CHI2, DataFamily, PageWords, diagnose_data
 from ..stats.least_squares import zero_point
 from ..stats.model_selection import Diagnosis
 from ..stats.structure_search import Probe, ProbeFactors
@@ -49,7 +49,6 @@ __all__ = [
     "RunFamily",
     "diagnose_run",
     "run_design_command",
-    "run_diagnosis_residuals",
     "run_results",
 ]
 
@@ -90,6 +89,30 @@ class RunFamily(DataFamily):
     noise_subject = "the two outputs'"
     noise_column = "output"
     noise_how = "each output is weighted by its own estimated noise"
+    page = PageWords(
+        title="GyroWheel calibration run diagnosis",
+        page_title="turntable-pin run report",
+        sections=(
+            ("run_intro", ""),
+            ("warnings", ""),
+            ("outliers", ""),
+            ("base", "1. The base model: eq. 1's 2 x 7 coefficients"),
+            ("diagnosis", "2. Which effect is missing: the table or the instrument?"),
+            ("added", "3. Add it and watch the error fall"),
+            ("run_results", "4. Coefficients and the table"),
+        ),
+        fit_columns=("rms", "chi2_reduced", "rank", "n_params"),
+        candidate_columns=(
+            "side",
+            "delta_bic",
+            "rms",
+            "chi2_reduced",
+            "added_rank",
+            "alternatives",
+        ),
+        structure_shapes="harmonic shapes of each output and of the table's orientation errors "
+        "through the outputs, drifts in time and terms in other columns",
+    )
 
     def __init__(
         self,
@@ -140,6 +163,17 @@ class RunFamily(DataFamily):
     def full_residuals(self, fit: RunFit) -> np.ndarray:
         """(N, 2) the outputs minus ``fit``'s, deg/h, those left out too."""
         return self.run.outputs_dph - fit.fitted_dph
+
+    def residual_set(self, fit: RunFit):
+        """The residuals of ``fit`` for the figures (:func:`~.residuals.run_residuals`)."""
+        from .residuals import run_residuals
+
+        return run_residuals(fit)
+
+    @property
+    def source(self) -> str | None:
+        """The file the run was read from."""
+        return self.run.source
 
     def sigma_table(self) -> np.ndarray | None:
         """(N, 2) the outputs' sigmas (stated, times the channels' relative noise), or None."""
@@ -398,16 +432,6 @@ class RunFamily(DataFamily):
             out.append({"effect": b.name, "side": b.side, "chi2_run": chi2_run,
                         "chi2_dense": chi2_dense, "words": self.separation(fit_a, b)})  # fmt: skip
         return sorted(out, key=lambda e: e["chi2_run"])
-
-
-def run_diagnosis_residuals(diagnosis: Diagnosis):
-    """The residual sets of a run diagnosis' base and best fits, judged with its noise."""
-    from .residuals import run_residuals
-
-    return tuple(
-        run_residuals(fit.with_noise_variance(diagnosis.noise_variance))
-        for fit in (diagnosis.base_fit, diagnosis.best_fit)
-    )
 
 
 def run_design_command(run, pair: tuple[str, str]) -> str:

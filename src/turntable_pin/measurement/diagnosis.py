@@ -21,7 +21,13 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.turn_grid import every_combination, full_turn_grid_deg
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
-from ..stats.diagnosis_engine import SEPARATION_CHI2, DataFamily, diagnose_data
+from ..stats.diagnosis_engine import (
+    DATA_PLACEHOLDER,
+    SEPARATION_CHI2,
+    DataFamily,
+    PageWords,
+    diagnose_data,
+)
 from ..stats.least_squares import RANK_RTOL, fit_least_squares
 from ..stats.model_selection import Diagnosis
 from ..stats.structure_search import Probe, ProbeFactors
@@ -47,7 +53,6 @@ __all__ = [
     "OrientationFamily",
     "design_command",
     "diagnose_measurements",
-    "diagnosis_residuals",
     "dense_joint_grid",
     "harmonic_basis",
     "max_harmonic_order",
@@ -165,6 +170,34 @@ class OrientationFamily(DataFamily):
         "each angle is weighted by its own estimated noise (state it with sigma_dpsi_arcsec, "
         "sigma_dtheta_arcsec, sigma_dgamma_arcsec)"
     )
+    page = PageWords(
+        title="Turntable measurement diagnosis",
+        page_title="turntable-pin report",
+        sections=(
+            ("measurement_intro", ""),
+            ("warnings", ""),
+            ("outliers", ""),
+            ("data", "1. The data"),
+            ("base", "2. The base model"),
+            ("fails", "3. Where the base model fails"),
+            ("diagnosis", "4. Diagnosis: which physical effect is missing?"),
+            ("added", "5. Add it and watch the error fall"),
+            ("parameters", "6. Parameters of the final model"),
+            ("decision_rule", ""),
+        ),
+        fit_columns=("rms", "chi2_reduced", "rank", "n_params", "p_value"),
+        candidate_columns=(
+            "delta_bic",
+            "after_first",
+            "rms",
+            "chi2_reduced",
+            "added_rank",
+            "alternatives",
+        ),
+        parts=frozenset({"anchor", "base_errors", "untestable", "story", "maps"}),
+        structure_shapes="harmonic shapes of each turntable error and of each measured angle, "
+        "drifts, steps with the approach direction",
+    )
 
     def __init__(
         self,
@@ -230,6 +263,15 @@ class OrientationFamily(DataFamily):
     def full_residuals(self, fit: OrientationFit) -> np.ndarray:
         """(N, 3) the measured minus ``fit``'s angles, rad, the cells left out too."""
         return self.data.angles_rad - fit.fitted_rad()
+
+    def residual_set(self, fit: OrientationFit) -> ResidualSet:
+        """The residuals of ``fit`` for the figures, the angles left out as outliers apart."""
+        return orientation_residuals(fit, left_out_rad=self.left_out_rad)
+
+    @property
+    def source(self) -> str | None:
+        """The file the measurements were read from."""
+        return self.data.source
 
     def sigma_table(self) -> np.ndarray | None:
         """(N, 3) the data's sigmas, rad (stated or relative), or None."""
@@ -659,17 +701,6 @@ def _weighted(data: OrientationMeasurements, column_sigma: np.ndarray) -> Orient
     )
 
 
-def diagnosis_residuals(diagnosis: Diagnosis) -> tuple[ResidualSet, ResidualSet]:
-    """The residuals of an orientation diagnosis' base and best fits, both judged with its noise
-    variance, with the angles left out as outliers kept apart for the plots."""
-    left_out = diagnosis.family.left_out_rad
-    return tuple(
-        orientation_residuals(fit.with_noise_variance(diagnosis.noise_variance),
-                              left_out_rad=left_out)
-        for fit in (diagnosis.base_fit, diagnosis.best_fit)
-    )  # fmt: skip
-
-
 def diagnose_measurements(
     data: OrientationMeasurements,
     *,
@@ -693,10 +724,6 @@ def diagnose_measurements(
     """
     family = OrientationFamily(data, catalogue, turntable)
     return diagnose_data(family, until_explained=until_explained, outliers=outliers)
-
-
-DATA_PLACEHOLDER = "DATA.csv"
-"""The data file a command names when the data were not read from one (simulated in memory)."""
 
 
 def design_command(

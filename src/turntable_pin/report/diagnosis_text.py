@@ -1,9 +1,11 @@
-"""The diagnosis in words: the text rendering of the diagnosis JSON (``Diagnosis.to_dict()``).
+"""The diagnosis in words: the text rendering of the diagnosis JSON (``Diagnosis.to_dict()``), of
+every family of data (orientation measurements, calibration runs).
 
 The text report, the JSON and the HTML page are three views of one structured result: this module
 reads only the dictionary, never another renderer's output. :func:`verdict_lines` is the verdict
 part, which the HTML report shows in its verdict box; :func:`headline` the one-line verdict both
-reports open with.
+reports open with; :func:`family_lines` the parts a family's own data add (a calibration run's
+other side, coefficients and what it tells about the table), each said when the result has it.
 
 A headline effect is a *partial explanation*, not "the missing effect", when the model with
 every accepted effect is still unexplained (it fails the chi2 test, e.g. chi2_reduced 2.7 with
@@ -12,7 +14,20 @@ sigma given, or the structure search still finds a term).
 
 from __future__ import annotations
 
-__all__ = ["diagnosis_lines", "fit_command", "header_lines", "headline", "verdict_lines"]
+from ..stats.diagnosis_engine import DATA_PLACEHOLDER
+
+__all__ = [
+    "DATA_PLACEHOLDER",
+    "coefficient_lines",
+    "diagnosis_lines",
+    "family_lines",
+    "fit_command",
+    "header_lines",
+    "headline",
+    "other_side_lines",
+    "table_from_run_lines",
+    "verdict_lines",
+]
 
 
 def _number(value, fmt: str = "#.3g") -> str:
@@ -177,7 +192,7 @@ def header_lines(d: dict) -> list[str]:
     return lines
 
 
-def verdict_lines(d: dict, data: str = "DATA.csv") -> list[str]:
+def verdict_lines(d: dict, data: str = DATA_PLACEHOLDER) -> list[str]:
     """The steps of the forward selection, the missing effect and whether anything remains;
     for each remaining term, the ``fit`` command (on the file ``data``) that adds it."""
     verdict = d["verdict"]
@@ -316,7 +331,82 @@ def fit_command(data: str, specs: list[str], command: str = "fit") -> str:
     return f"turntable-pin {command} {shlex.quote(data)} --effects {shlex.quote(','.join(specs))}"
 
 
-def diagnosis_lines(d: dict, data: str = "DATA.csv") -> list[str]:
+def other_side_lines(d: dict) -> list[str]:
+    """The effects of the other side (table vs instrument) that move the outputs like the one
+    named, on the run's positions: the confounded explanations, and what would separate them
+    (none when the result has no other side)."""
+    verdict = d["verdict"]
+    if "other_side" not in verdict or not verdict["missing_effect"]:
+        return []
+    rivals = verdict["other_side"]
+    other = "instrument" if verdict["side"] == "table" else "table"
+    if not rivals:
+        return [
+            f"the other side: no effect of the {other} moves the outputs like "
+            f"{verdict['missing_effect']} on these positions"
+        ]
+    lines = [
+        f"the other side: on these positions, {len(rivals)} effect(s) of the "
+        f"{other} move the outputs like "
+        f"{verdict['missing_effect']} (confounded: the run alone cannot say which side it is):"
+    ]
+    commands = verdict.get("separation_commands", {})
+    for r in rivals:
+        lines.append(f"  {r['effect']} (noise-free misfit chi2 {r['chi2_run']:.2g} here): "
+                     f"{r['words']}")  # fmt: skip
+        if r["effect"] in commands:
+            lines.append(f"    to settle it, design the next positions: {commands[r['effect']]}")
+    return lines
+
+
+def coefficient_lines(d: dict) -> list[str]:
+    """The calibrated coefficients of the best model, both axes (deg/h-based units); none when
+    the result has none."""
+    if "coefficients_dph" not in d:
+        return []
+    lines = ["coefficients of the final model (value +- std):"]
+    for axis, terms in d["coefficients_dph"].items():
+        for name, entry in terms.items():
+            std = "-" if entry["std"] is None else f"{entry['std']:.3g}"
+            lines.append(f"  D{axis}{name:3s} = {entry['value']:12.6f} +- {std} {entry['unit']}")
+    return lines
+
+
+def table_from_run_lines(d: dict) -> list[str]:
+    """What a calibration run tells about the table's errors; none when the result has no
+    ``table_from_run``."""
+    if "table_from_run" not in d:
+        return []
+    t = d["table_from_run"]
+    lines = [
+        f"the table from the run: its {len(t['errors'])} errors add {t['rank_added']} "
+        f"combination(s) the outputs determine (noise {t['sigma_dph']:.3g} deg/h):"
+    ]
+    lines += [f"  {c['name']} = {c['value']:.3g} +- {c['std']:.2g} {c['unit']}"
+              for c in t["determined"]]  # fmt: skip
+    absorbed = [f"{a['error']} ({a['correlation']:.2f})" for a in t["absorbed"]]
+    if t["with_coefficients"]:
+        lines.append("  determined only together with the instrument's coefficients: "
+                     + "; ".join(c["name"] for c in t["with_coefficients"][:6]))  # fmt: skip
+    if absorbed:
+        lines.append(f"  mostly absorbed by the coefficients (correlation > "
+                     f"{t['absorbed_above']:g}: the calibration takes them for instrument terms): "
+                     + ", ".join(absorbed))  # fmt: skip
+    if t["undetermined"]:
+        lines.append("  not seen at all (only the sums above are): "
+                     + "; ".join(t["undetermined"][:6]))  # fmt: skip
+    return lines
+
+
+def family_lines(d: dict) -> list[str]:
+    """The lines of a family's own data, after the verdict: the other side, the coefficients
+    and the table from the run (a calibration run's)."""
+    return [*other_side_lines(d), *coefficient_lines(d), *table_from_run_lines(d)]
+
+
+def diagnosis_lines(d: dict, data: str | None = None) -> list[str]:
     """The whole diagnosis in words: the headline, the header lines, the verdict lines (with the
-    fit command for ``data``)."""
-    return [headline(d), *header_lines(d), *verdict_lines(d, data)]
+    fit command for ``data``: default the result's ``source``, else :data:`DATA_PLACEHOLDER`) and
+    the family's own lines."""
+    data = data or d.get("source") or DATA_PLACEHOLDER
+    return [headline(d), *header_lines(d), *verdict_lines(d, data), *family_lines(d)]

@@ -1,9 +1,13 @@
-"""One self-contained HTML page telling the whole story of a measurement file.
+"""One self-contained HTML page telling the whole story of a diagnosis, of any family of data.
 
-The one-line verdict first, then data, base fit, where it fails (a residual map over both
-angles), the diagnosis (with a plot of each term the structure search finds against its
-variable), the fit with the missing effect(s) and the parameters, with every plot embedded once
-as a base64 PNG (the page needs no other file).
+:func:`diagnosis_html` is the one builder: the one-line verdict first, then the sections the
+family lists in its :class:`~turntable_pin.stats.diagnosis_engine.PageWords` (for a measurement
+file: data, base fit, where it fails with a residual map over both angles, the diagnosis with a
+plot of each term the structure search finds against its variable, the fit with the missing
+effect(s) and the parameters; for a calibration run: base fit, the diagnosis with each effect's
+side, the fit with the effect, the coefficients and the table), each rendered here from the one
+result (``Diagnosis.to_dict()`` and its fits), with every plot embedded once as a base64 PNG (the
+page needs no other file).
 """
 
 from __future__ import annotations
@@ -17,10 +21,16 @@ import numpy as np
 from ..core.files import write_text_atomic
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..measurement.data import ANGLE_NAMES
-from ..measurement.diagnosis import diagnosis_residuals
 from ..measurement.residuals import analyse_residuals
+from ..stats.diagnosis_engine import DATA_PLACEHOLDER, residual_sets
 from ..stats.model_selection import Diagnosis
-from .diagnosis_text import headline, verdict_lines
+from .diagnosis_text import (
+    coefficient_lines,
+    headline,
+    other_side_lines,
+    table_from_run_lines,
+    verdict_lines,
+)
 from .figures import pyplot, save_png
 from .measurement_figures import (
     COLOURS,
@@ -95,61 +105,51 @@ def data_figure(data) -> bytes:
     return save_png(fig)
 
 
-def _fit_rows(diagnosis: Diagnosis, fits) -> list[list]:
-    rows = []
-    for label, fit in fits:
-        s = diagnosis.summary(fit)
-        rows.append(
-            [label, s["rms_arcsec"], s["chi2_reduced"], s["rank"], s["n_params"],
-             "-" if s["p_value"] is None else f"{s['p_value']:.3g}"]
-        )  # fmt: skip
-    return rows
+class _Page:
+    """What the sections of one page share: the result, its residual sets and figures' inputs
+    (each computed once)."""
 
+    def __init__(self, diagnosis: Diagnosis) -> None:
+        self.diagnosis = diagnosis
+        self.family = diagnosis.family
+        self.words = diagnosis.family.page
+        self.d = diagnosis.to_dict()
+        self.verdict = self.d["verdict"]
+        self.effect = self.verdict["missing_effect"]
+        self.base_rs, self.best_rs = residual_sets(diagnosis)
+        self.base_an = analyse_residuals(self.base_rs)
+        self.limit = map_limit([self.base_rs, self.best_rs])
+        self.names = {name for name, _ in self.words.sections}
 
-def _structure_section(diagnosis: Diagnosis, best_fit) -> list[str]:
-    """HTML of the terms the structure search finds: words and one plot per term."""
-    terms = diagnosis.structure
-    if not terms:
-        return []
-    label = " + ".join(("base", *best_fit.effect_names))
-    parts = [
-        f"<h3>Structure left in the residuals of {html.escape(label)}</h3><p>The structure "
-        "search (harmonic shapes of each turntable error and of each measured angle, drifts, "
-        "steps with the approach direction) finds the term(s) below. Each plot shows the "
-        "residual, with this term's fitted part added back, projected at each position onto "
-        "the direction the term enters the measured angles along, against the variable of "
-        "the term, with the fitted term over it and the noise of one point as a grey "
-        "band.</p>"
-    ]
-    for term in terms:
-        words = (
-            f"<p><b>{html.escape(term.name)}</b>: {html.escape(term.description)}, amplitude "
-            f"{term.amplitude:.3g} {html.escape(term.unit)}, delta BIC {term.delta_bic:.0f}.</p>"
+    def fit_table(self, rows: list[tuple[str, dict]]) -> str:
+        """The table of fits ``(label, summary)`` in the family's columns."""
+        unit = self.family.unit_words
+        key = f"rms_{self.family.observation_unit}"
+        header = {"rms": f"rms ({unit})", "chi2_reduced": "chi2_reduced", "rank": "rank",
+                  "n_params": "params", "p_value": "p-value"}  # fmt: skip
+
+        def cell(column, s):
+            if column == "p_value":
+                return "-" if s["p_value"] is None else f"{s['p_value']:.3g}"
+            return s[key if column == "rms" else column]
+
+        columns = self.words.fit_columns
+        return html_table(
+            ["model", *(header[c] for c in columns)],
+            [[label, *(cell(c, s) for c in columns)] for label, s in rows],
         )
-        if term.factors is not None and term.residual_weighted is not None:
-            words += img_tag(structure_term_figure(term), f"structure: {term.name}")
-        parts.append(words)
-    return parts
 
 
-def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
-    """The HTML page of a diagnosis (self-contained)."""
-    data = diagnosis.family.data
-    d = diagnosis.to_dict()
-    verdict = d["verdict"]
-    base_fit = diagnosis.base_fit.with_noise_variance(diagnosis.noise_variance)
-    best_fit = diagnosis.best_fit.with_noise_variance(diagnosis.noise_variance)
-    base_rs, best_rs = diagnosis_residuals(diagnosis)
-    base_an = analyse_residuals(base_rs)
-    explained = not verdict["unexplained"]
-    parts = [f"<h1>{html.escape(title or 'Turntable measurement diagnosis')}</h1>"]
-    parts.append(
-        f'<p class="verdict headline{"" if explained else " warn"}" id="verdict">'
-        f"{html.escape(headline(d))}</p>"
-    )
+def _heading(text: str) -> str:
+    return f"<h2>{text}</h2>" if text else ""
+
+
+def _measurement_intro(page: _Page, heading: str) -> list[str]:
+    """The measurement file, its positions and measured angles, and where its noise comes from."""
+    data, d = page.family.data, page.d
     counts = data.measured.sum(axis=0)
     unmeasured = not_measured_note(ANGLE_NAMES, counts, data.n_positions, separator="; ")
-    parts.append(
+    return [
         f"<p>Source: <code>{html.escape(data.source)}</code> &mdash; {data.n_positions} "
         f"positions, {int(data.measured.sum())} measured angles"
         + (
@@ -161,62 +161,105 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
         + (
             f"from the file's <code>sigma_arcsec</code> column (median {d['sigma_arcsec']:.3g} "
             "arcsec)."
-            if diagnosis.sigma_known
+            if page.diagnosis.sigma_known
             else f"not given: estimated from the best fit, {d['sigma_arcsec']:.3g} arcsec."
         )
         + "</p>"
+    ]
+
+
+def _run_intro(page: _Page, heading: str) -> list[str]:
+    """The run file, its positions and outputs, its latitude and where its noise comes from."""
+    d = page.d
+    sigma = (
+        "from the file's <code>sigma_dph</code> column"
+        if d["sigma_source"] == "column"
+        else f"not given: estimated, {d['sigma_dph']:.3g} deg/h"
     )
-    parts += [f'<p class="verdict warn">warning: {html.escape(w)}</p>' for w in d["warnings"]]
-    if d.get("outliers"):
-        parts.append(
-            f"<p>{len(d['outliers'])} gross outlier(s) were left out of every fit (shown here, "
-            f"not silently dropped; rule: {html.escape(d['outlier_rule'])}):</p>"
-            + html_table(
-                ["row", "angle", "residual (sigma, final model)"],
-                [[o["row"], o["angle"], o["residual_sigma"]] for o in d["outliers"][:50]],
+    return [
+        f"<p>Run <code>{html.escape(str(d.get('source') or ''))}</code>: {d['n_positions']} "
+        f"positions, {d['n_observations']} outputs, latitude {d['latitude_deg']:g} deg; noise "
+        f"{sigma}.</p>"
+    ]
+
+
+def _warnings(page: _Page, heading: str) -> list[str]:
+    return [f'<p class="verdict warn">warning: {html.escape(w)}</p>' for w in page.d["warnings"]]
+
+
+def _outliers(page: _Page, heading: str) -> list[str]:
+    """The observations left out as gross outliers, shown (never silently dropped)."""
+    d = page.d
+    if not d.get("outliers"):
+        return []
+    key = page.family.column_key
+    return [
+        f"<p>{len(d['outliers'])} gross outlier(s) were left out of every fit (shown here, "
+        f"not silently dropped; rule: {html.escape(d['outlier_rule'])}):</p>"
+        + html_table(
+            ["row", key, "residual (sigma, final model)"],
+            [[o["row"], o[key], o["residual_sigma"]] for o in d["outliers"][:50]],
+        )
+    ]
+
+
+def _data(page: _Page, heading: str) -> list[str]:
+    return [_heading(heading) + img_tag(data_figure(page.family.data), "measured angles")]
+
+
+def _combinations(result) -> str:
+    return html_table(
+        ["combination", "value", "std", "unit"],
+        [[c["name"], c["value"], c["std"], c["unit"]] for c in result.combinations()],
+    )
+
+
+def _base(page: _Page, heading: str) -> list[str]:
+    """The base model, the combinations of its errors the data determine (``base_errors``) and
+    its fit; without a missing effect and without a section on where it fails, its residuals."""
+    table = page.fit_table([("base", page.d["base"])])
+    if "base_errors" not in page.words.parts:
+        parts = [_heading(heading) + table]
+    else:
+        measured = page.family.table
+        result = page.diagnosis.base_fit.result
+        parts = [
+            _heading(heading)
+            + "<p>"
+            + (
+                "The nine turntable errors of the paper (the intersection error never changes "
+                "the orientation, so eight angles are fitted)."
+                if measured.paper
+                else f"The {len(measured.base_names)} rotation errors of the table "
+                f"{html.escape(measured.label)} (its offsets never change the orientation)."
             )
-        )
-    parts.append("<h2>1. The data</h2>" + img_tag(data_figure(data), "measured angles"))
-    b = d["base"]
-    parts.append(
-        "<h2>2. The base model</h2><p>"
-        + (
-            "The nine turntable errors of the paper (the intersection error never changes the "
-            "orientation, so eight angles are fitted)."
-            if diagnosis.family.table.paper
-            else f"The {len(diagnosis.family.table.base_names)} rotation errors of the table "
-            f"{html.escape(diagnosis.family.table.label)} (its offsets never change the "
-            "orientation)."
-        )
-        + f" The data determine {b['rank']} combinations of them:</p>"
-    )
-    combos = base_fit.result.combinations()
-    parts.append(
-        html_table(
-            ["combination", "value", "std", "unit"],
-            [[c["name"], c["value"], c["std"], c["unit"]] for c in combos],
-        )
-    )
-    und = base_fit.result.undetermined_combinations()
-    if und:
-        parts.append(
-            "<p>Not determined by orientation data (flat directions): "
-            + ", ".join(f"<code>{html.escape(u)}</code>" for u in und)
-            + ".</p>"
-        )
-    parts.append(
-        html_table(
-            ["model", "rms (arcsec)", "chi2_reduced", "rank", "params", "p-value"],
-            _fit_rows(diagnosis, [("base", base_fit)]),
-        )
-    )
-    failing = base_an.failing
-    parts.append(
-        f"<h2>3. Where the base model fails</h2><p>{len(failing)} of {data.n_positions} "
-        f"positions have a residual beyond {base_an.k_sigma:g} sigma.</p>"
-    )
+            + f" The data determine {page.d['base']['rank']} combinations of them:</p>",
+            _combinations(result),
+        ]
+        und = result.undetermined_combinations()
+        if und:
+            parts.append(
+                "<p>Not determined by orientation data (flat directions): "
+                + ", ".join(f"<code>{html.escape(u)}</code>" for u in und)
+                + ".</p>"
+            )
+        parts.append(table)
+    if not page.effect and "fails" not in page.names:
+        parts.append(img_tag(residual_figure([page.base_rs]), "base residuals"))
+    return parts
+
+
+def _fails(page: _Page, heading: str) -> list[str]:
+    """Where the base model fails: the positions beyond k sigma, the residual map and, without
+    a missing effect, the base residuals and their harmonics."""
+    failing = page.base_an.failing
+    n_positions = page.d["n_positions"]
+    parts = [
+        f"{_heading(heading)}<p>{len(failing)} of {n_positions} positions have a residual "
+        f"beyond {page.base_an.k_sigma:g} sigma.</p>"
+    ]
     if failing:
-        joints = range(1, data.n_joints + 1)
+        joints = range(1, page.family.data.n_joints + 1)
         parts.append(
             html_table(
                 ["row", *(f"phi{k} (deg)" for k in joints), "angle", "residual (arcsec)", "sigmas"],
@@ -232,54 +275,69 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
                 ],
             )  # fmt: skip
         )
-    limit = map_limit([base_rs, best_rs])
-    base_map = residual_map_figure([base_rs], limit)
+    base_map = residual_map_figure([page.base_rs], page.limit)
     if base_map is not None:
         parts.append(
             "<p>The residuals over both angles (one square per position, repeats averaged): "
             "structure in phi1 and phi2 at once shows here, while the plots against one angle "
             "average over the other.</p>" + img_tag(base_map, "base residual map")
         )
-    if not verdict["missing_effect"]:  # else shown before/after in section 5
-        parts.append(img_tag(residual_figure([base_rs]), "base residuals"))
-        parts.append(img_tag(harmonics_figure([base_an]), "base harmonics"))
-    cls = "verdict" if not verdict["unexplained"] else "verdict warn"
-    parts.append("<h2>4. Diagnosis: which physical effect is missing?</h2>")
-    first = verdict["missing_effect"]
-    parts.append(
-        html_table(
-            [
-                "effect",
-                "delta BIC",
-                f"on top of {first}" if first else "-",
-                "rms (arcsec)",
-                "chi2_reduced",
-                "new rank",
-                "same as",
-            ],
-            [
-                [
-                    c["effect"],
-                    "-" if c["delta_bic"] is None else f"{c['delta_bic']:.1f}",
-                    "-"
-                    if c.get("delta_bic_after_first") is None
-                    else f"{c['delta_bic_after_first']:.1f}",
-                    "-" if c["rms_arcsec"] is None else c["rms_arcsec"],
-                    "-" if c["chi2_reduced"] is None else c["chi2_reduced"],
-                    c["added_rank"] if c["testable"] else "-",
-                    ", ".join(c["alternatives"]),
-                ]
-                for c in d["candidates"]
-            ],
-        )  # fmt: skip
+    if not page.effect:  # else shown before/after in the section of the effect added
+        parts.append(img_tag(residual_figure([page.base_rs]), "base residuals"))
+        parts.append(img_tag(harmonics_figure([page.base_an]), "base harmonics"))
+    return parts
+
+
+_CANDIDATE_HEADERS = {
+    "side": "side", "delta_bic": "delta BIC", "rms": "rms", "chi2_reduced": "chi2_reduced",
+    "added_rank": "new rank", "alternatives": "same as",
+}  # fmt: skip
+
+
+def _candidates(page: _Page) -> str:
+    """The table of candidates in the family's columns."""
+    verdict, first = page.verdict, page.effect
+    key = f"rms_{page.family.observation_unit}"
+    headers = dict(_CANDIDATE_HEADERS, rms=f"rms ({page.family.unit_words})",
+                   after_first=f"on top of {first}" if first else "-")  # fmt: skip
+
+    def cell(column: str, c: dict):
+        if column == "side":
+            return verdict["sides"].get(c["effect"], "")
+        if column == "delta_bic":
+            return "-" if c["delta_bic"] is None else f"{c['delta_bic']:.1f}"
+        if column == "after_first":
+            later = c.get("delta_bic_after_first")
+            return "-" if later is None else f"{later:.1f}"
+        if column == "rms":
+            return "-" if c[key] is None else c[key]
+        if column == "chi2_reduced":
+            return "-" if c["chi2_reduced"] is None else c["chi2_reduced"]
+        if column == "added_rank":
+            return c["added_rank"] if c["testable"] else "-"
+        return ", ".join(c["alternatives"])
+
+    columns = page.words.candidate_columns
+    return html_table(
+        ["effect", *(headers[c] for c in columns)],
+        [[c["effect"], *(cell(col, c) for col in columns)] for c in page.d["candidates"]],
     )
-    notes = [f"<li><b>{html.escape(c['effect'])}</b>: {html.escape(c['reason'])}</li>"
-             for c in d["candidates"] if c.get("reason")]  # fmt: skip
-    if notes:
-        parts.append("<p>Not testable here:</p><ul>" + "".join(notes) + "</ul>")
-    words = "<br>".join(html.escape(line) for line in verdict_lines(d, data.source or "DATA.csv"))
-    parts.append(f'<div class="{cls}">{words}</div>')
-    if verdict["missing_effect"]:
+
+
+def _diagnosis(page: _Page, heading: str) -> list[str]:
+    """Which effect is missing: the candidates, why some are not testable (``untestable``), the
+    verdict in words, the effect's story (``story``) and the structure left."""
+    d, verdict = page.d, page.verdict
+    parts = [_heading(heading), _candidates(page)]
+    if "untestable" in page.words.parts:
+        notes = [f"<li><b>{html.escape(c['effect'])}</b>: {html.escape(c['reason'])}</li>"
+                 for c in d["candidates"] if c.get("reason")]  # fmt: skip
+        if notes:
+            parts.append("<p>Not testable here:</p><ul>" + "".join(notes) + "</ul>")
+    lines = [*verdict_lines(d, page.family.source or DATA_PLACEHOLDER), *other_side_lines(d)]
+    words = "<br>".join(html.escape(line) for line in lines)
+    parts.append(f'<div class="verdict{" warn" if verdict["unexplained"] else ""}">{words}</div>')
+    if page.effect and "story" in page.words.parts:
         story = verdict["effect_story"]
         parts.append(
             f"<p><b>{html.escape(story['effect'])}</b> &mdash; {html.escape(story['title'])}. "
@@ -287,46 +345,70 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
             f"<p>{html.escape(story['explanation'])}</p>"
             f"<p><i>How to confirm it on the machine:</i> {html.escape(story['confirm'])}</p>"
         )
-    parts += _structure_section(diagnosis, best_fit)
-    if verdict["missing_effect"]:
-        best_an = analyse_residuals(best_rs)
+    return parts + _structure(page)
+
+
+def _structure(page: _Page) -> list[str]:
+    """The terms the structure search finds: words and one plot per term."""
+    terms = page.diagnosis.structure
+    if not terms:
+        return []
+    label = " + ".join(("base", *page.diagnosis.best_fit.effect_names))
+    parts = [
+        f"<h3>Structure left in the residuals of {html.escape(label)}</h3><p>The structure "
+        f"search ({html.escape(page.words.structure_shapes)}) finds the term(s) below. Each "
+        "plot shows the residual, with this term's fitted part added back, projected at each "
+        "position onto the direction the term enters the "
+        f"{html.escape(page.family.observations)} along, against the variable of the term, "
+        "with the fitted term over it and the noise of one point as a grey band.</p>"
+    ]
+    for term in terms:
+        words = (
+            f"<p><b>{html.escape(term.name)}</b>: {html.escape(term.description)}, amplitude "
+            f"{term.amplitude:.3g} {html.escape(term.unit)}, delta BIC {term.delta_bic:.0f}.</p>"
+        )
+        if term.factors is not None and term.residual_weighted is not None:
+            words += img_tag(structure_term_figure(term), f"structure: {term.name}")
+        parts.append(words)
+    return parts
+
+
+def _added(page: _Page, heading: str) -> list[str]:
+    """With a missing effect: the fits as each is added, the residuals and their harmonics
+    before and after, and (``maps``) the residual map after."""
+    if not page.effect:
+        return []
+    d = page.d
+    rows = [("base", d["base"]), *((f"+ {s['added']}", s) for s in d["steps"])]
+    parts = [
+        _heading(heading)
+        + page.fit_table(rows)
+        + img_tag(residual_figure([page.base_rs, page.best_rs]), "residuals before and after")
+        + img_tag(
+            harmonics_figure([page.base_an, analyse_residuals(page.best_rs)]),
+            "harmonics before and after",
+        )
+    ]
+    best_map = None
+    if "maps" in page.words.parts:
+        best_map = residual_map_figure([page.best_rs], page.limit)
+    if best_map is not None:
         parts.append(
-            "<h2>5. Add it and watch the error fall</h2>"
-            + html_table(
-                ["model", "rms (arcsec)", "chi2_reduced", "rank", "params", "p-value"],
-                _fit_rows(diagnosis, [("base", base_fit)])
-                + [
-                    [
-                        f"+ {s['added']}",
-                        s["rms_arcsec"],
-                        s["chi2_reduced"],
-                        s["rank"],
-                        s["n_params"],
-                        "-" if s["p_value"] is None else f"{s['p_value']:.3g}",
-                    ]
-                    for s in d["steps"]
-                ],
-            )  # fmt: skip
-            + img_tag(residual_figure([base_rs, best_rs]), "residuals before and after")
-            + img_tag(harmonics_figure([base_an, best_an]), "harmonics before and after")
+            "<p>The residual map after, on the colour scale of the map in section 3:</p>"
+            + img_tag(best_map, "residual map after")
         )
-        best_map = residual_map_figure([best_rs], limit)
-        if best_map is not None:
-            parts.append(
-                "<p>The residual map after, on the colour scale of the map in section 3:</p>"
-                + img_tag(best_map, "residual map after")
-            )
-    res = best_fit.result
-    parts.append(
-        "<h2>6. Parameters of the final model</h2><p>Determined combinations (value &plusmn; "
-        f"standard error; rank {res.rank} of {res.n_params} parameters):</p>"
-    )
-    parts.append(
-        html_table(
-            ["combination", "value", "std", "unit"],
-            [[c["name"], c["value"], c["std"], c["unit"]] for c in res.combinations()],
-        )
-    )
+    return parts
+
+
+def _parameters(page: _Page, heading: str) -> list[str]:
+    """The combinations of the final model's parameters the data determine, and its flat
+    directions."""
+    res = page.diagnosis.best_fit.result
+    parts = [
+        f"{_heading(heading)}<p>Determined combinations (value &plusmn; standard error; rank "
+        f"{res.rank} of {res.n_params} parameters):</p>",
+        _combinations(res),
+    ]
     und = res.undetermined_combinations()
     if und:
         parts.append(
@@ -334,16 +416,62 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
             + ", ".join(f"<code>{html.escape(u)}</code>" for u in und)
             + ".</p>"
         )
-    parts.append(
+    return parts
+
+
+def _decision_rule(page: _Page, heading: str) -> list[str]:
+    return [
         "<p style='color:#777;font-size:.85em'>Decision rule: an effect is accepted when it "
         "lowers BIC by 6 or more; effects whose fit is as good are listed as alternatives; the "
         "final model is 'unexplained' when it fails the chi2 test (sigma given) or a harmonic "
         "structure search still finds a term.</p>"
-    )
+    ]
+
+
+def _run_results(page: _Page, heading: str) -> list[str]:
+    """A calibration run's coefficients and what it tells about the table."""
+    d = page.d
+    return [_heading(heading) + "<p>"
+            + "<br>".join(html.escape(x) for x in coefficient_lines(d)) + "</p><p>"
+            + "<br>".join(html.escape(x) for x in table_from_run_lines(d)) + "</p>"]  # fmt: skip
+
+
+SECTIONS = {
+    "measurement_intro": _measurement_intro,
+    "run_intro": _run_intro,
+    "warnings": _warnings,
+    "outliers": _outliers,
+    "data": _data,
+    "base": _base,
+    "fails": _fails,
+    "diagnosis": _diagnosis,
+    "added": _added,
+    "parameters": _parameters,
+    "decision_rule": _decision_rule,
+    "run_results": _run_results,
+}
+"""The sections a page may have (``PageWords.sections`` names them): ``(page, heading) -> HTML
+parts``."""
+
+
+def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
+    """The HTML page of a diagnosis of any family (self-contained): its title, the one-line
+    verdict and the sections its family's :class:`~turntable_pin.stats.diagnosis_engine.PageWords`
+    list (:data:`SECTIONS`)."""
+    page = _Page(diagnosis)
+    words = page.words
+    anchor = ' id="verdict"' if "anchor" in words.parts else ""
+    parts = [
+        f"<h1>{html.escape(title or words.title)}</h1>",
+        f'<p class="verdict headline{" warn" if page.verdict["unexplained"] else ""}"{anchor}>'
+        f"{html.escape(headline(page.d))}</p>",
+    ]
+    for name, heading in words.sections:
+        parts += SECTIONS[name](page, heading)
     body = "\n".join(parts)
     return (
         "<!DOCTYPE html><html><head><meta charset='utf-8'>"
-        f"<title>{html.escape(title or 'turntable-pin report')}</title><style>{PAGE_STYLE}</style>"
+        f"<title>{html.escape(title or words.page_title)}</title><style>{PAGE_STYLE}</style>"
         f"</head><body>{body}</body></html>\n"
     )
 
@@ -353,4 +481,12 @@ def write_report(diagnosis: Diagnosis, path: str | Path, *, title: str = "") -> 
     return write_text_atomic(path, diagnosis_html(diagnosis, title=title))
 
 
-__all__ = ["PAGE_STYLE", "data_figure", "diagnosis_html", "html_table", "img_tag", "write_report"]
+__all__ = [
+    "PAGE_STYLE",
+    "SECTIONS",
+    "data_figure",
+    "diagnosis_html",
+    "html_table",
+    "img_tag",
+    "write_report",
+]

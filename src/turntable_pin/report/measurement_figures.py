@@ -25,6 +25,7 @@ __all__ = [
     "residual_figure",
     "residual_map_figure",
     "structure_term_figure",
+    "write_diagnosis_plots",
     "write_residual_plots",
     "write_structure_plots",
 ]
@@ -341,3 +342,15 @@ def write_structure_plots(terms: Sequence[FoundTerm], directory: str | Path) -> 
         for i, term in enumerate(terms, 1)
         if term.factors is not None and term.residual_weighted is not None
     ]
+
+
+def write_diagnosis_plots(diagnosis, directory: str | Path) -> list[Path]:
+    """The figures of a diagnosis of any family into ``directory``: the residuals before and
+    (with a missing effect) after, their harmonics and maps (:func:`write_residual_plots`) and
+    each structure term (:func:`write_structure_plots`); returns the paths."""
+    from ..stats.diagnosis_engine import residual_sets
+
+    base, best = residual_sets(diagnosis)
+    sets = [base, best] if diagnosis.steps else [base]
+    return [*write_residual_plots(sets, directory),
+            *write_structure_plots(diagnosis.structure, directory)]  # fmt: skip

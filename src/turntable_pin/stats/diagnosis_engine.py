@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -35,17 +36,21 @@ from .model_selection import Diagnosis, diagnose
 from .structure_search import Probe, ProbeFactors
 
 __all__ = [
+    "DATA_PLACEHOLDER",
     "DOUBT_CHI2_REDUCED",
     "NOISE_ITERATIONS",
     "NOISE_PER_COLUMN_ALPHA",
     "NOISE_RTOL",
     "SEPARATION_CHI2",
     "DataFamily",
+    "PageWords",
     "column_noise",
+    "column_noise_note",
     "diagnose_data",
     "diagnose_screened",
     "doubt",
     "outlier_records",
+    "residual_sets",
 ]
 
 DOUBT_CHI2_REDUCED = 9.0
@@ -65,9 +70,43 @@ NOISE_RTOL = 1e-2
 fraction (the profiled likelihood is stationary there: what is left changes a score by its
 square)."""
 
+DATA_PLACEHOLDER = "DATA.csv"
+"""The data file a command names when the data were not read from one (made in memory)."""
+
 SEPARATION_CHI2 = 25.0
 """Noise-free misfit chi2 above which a denser set of positions is said to separate two effects
 (five sigma)."""
+
+
+@dataclass(frozen=True)
+class PageWords:
+    """A family's words for the one HTML page of its diagnosis (``report.html_report`` lays it
+    out; the engine only carries them).
+
+    Attributes:
+        title: the page's heading when the caller gives none.
+        page_title: the browser's title when the caller gives none.
+        sections: ``(section, heading)`` of each section of the page, in order, among those the
+            report knows; an empty heading: the section has none.
+        fit_columns: the columns of each table of fits after the model's label, among ``rms``,
+            ``chi2_reduced``, ``rank``, ``n_params``, ``p_value``.
+        candidate_columns: the columns of the table of candidates after the effect, among
+            ``side``, ``delta_bic``, ``after_first``, ``rms``, ``chi2_reduced``, ``added_rank``,
+            ``alternatives``.
+        parts: the optional parts the page shows (e.g. an anchor on its verdict, the effect's
+            story, residual maps), by the names the report gives them.
+        structure_shapes: the shapes the structure search tries, in words.
+    """
+
+    title: str
+    page_title: str
+    sections: tuple[tuple[str, str], ...]
+    fit_columns: tuple[str, ...] = ("rms", "chi2_reduced", "rank", "n_params", "p_value")
+    candidate_columns: tuple[str, ...] = (
+        "delta_bic", "rms", "chi2_reduced", "added_rank", "alternatives",
+    )  # fmt: skip
+    parts: frozenset[str] = frozenset()
+    structure_shapes: str = "the probes of the family"
 
 
 class DataFamily:
@@ -77,9 +116,9 @@ class DataFamily:
 
     A subclass sets the class attributes below, calls ``DataFamily.__init__`` and implements the
     hooks :meth:`fit_model`, :meth:`zero_point_of`, :meth:`refit`, :meth:`residual_table`,
-    :meth:`full_residuals`, :meth:`without`, :meth:`with_column_noise`, :meth:`screen_fit`,
-    :meth:`untestable_reason`, :meth:`probes`, :meth:`separation`, :meth:`design_warnings`; it
-    may fill the result with its own data in :meth:`complete`.
+    :meth:`full_residuals`, :meth:`residual_set`, :meth:`without`, :meth:`with_column_noise`,
+    :meth:`screen_fit`, :meth:`untestable_reason`, :meth:`probes`, :meth:`separation`,
+    :meth:`design_warnings`; it may fill the result with its own data in :meth:`complete`.
 
     Attributes:
         columns: the names of the K observation columns of a record.
@@ -93,6 +132,7 @@ class DataFamily:
         outlier_rule: the outlier rule in words (the result's ``outlier_rule``).
         noise_subject, noise_column, noise_how: the words of the note on a noise level per
             column (:func:`column_noise_note`).
+        page: the words of the HTML page of its diagnosis (:class:`PageWords`).
         catalogue: the candidate effects (objects with a ``name``), in catalogue order.
         n_records: number of records R.
         observed: (R, K) the cells that hold an observation fitted here.
@@ -112,6 +152,7 @@ class DataFamily:
     noise_subject: str = "the columns'"
     noise_column: str = "column"
     noise_how: str = "each column is weighted by its own estimated noise"
+    page: PageWords = PageWords("Diagnosis", "diagnosis", ())
 
     def __init__(
         self,
@@ -152,6 +193,16 @@ class DataFamily:
     def full_residuals(self, fit) -> np.ndarray:
         """(R, K) the observed minus ``fit``'s values at every cell, those left out too."""
         raise NotImplementedError
+
+    def residual_set(self, fit):
+        """The residuals of ``fit`` for the figures (a ``ResidualSet`` of the family's layer),
+        the observations left out as outliers kept apart."""
+        raise NotImplementedError
+
+    @property
+    def source(self) -> str | None:
+        """The file the data were read from, or None (made in memory)."""
+        return None
 
     def sigma_table(self) -> np.ndarray | None:
         """(R, K) the sigmas of these data (stated, or relative weights), or None."""
@@ -294,6 +345,16 @@ class DataFamily:
 
         return Probe(name, description, columns, self.user_unit_scale, self.unit_words, factors,
                      effect_spec=spec)  # fmt: skip
+
+
+def residual_sets(diagnosis: Diagnosis) -> tuple[Any, Any]:
+    """The residual sets of a diagnosis' base and best fits (:meth:`DataFamily.residual_set`),
+    both judged with its noise variance."""
+    family = diagnosis.family
+    return tuple(
+        family.residual_set(fit.with_noise_variance(diagnosis.noise_variance))
+        for fit in (diagnosis.base_fit, diagnosis.best_fit)
+    )
 
 
 def diagnose_data(
