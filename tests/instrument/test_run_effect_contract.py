@@ -151,3 +151,32 @@ def test_the_probe_is_a_few_of_the_runs_rows(run):
     probe = probe_context(run, context.coefficients)
     assert probe.run.n_positions == 7 and probe.sensitivity.shape == (7, 2, 3)
     assert np.array_equal(probe.run.joint_rad, run.joint_rad[[0, 3, 6, 9, 12, 15, 18]])
+
+
+def test_run_and_orientation_effects_share_one_base_and_each_family_loads_its_own(tmp_path):
+    """One base class (stats.candidate_effect.CandidateEffect) under both families: a module
+    with an orientation effect and a run effect gives each family its own, the run effect's
+    story tells its side after its name, and a side the run family does not know is refused."""
+    from effect_modules import orientation_module
+    from turntable_pin.instrument.effects import RunEffect
+    from turntable_pin.measurement.effects.base import Effect
+    from turntable_pin.measurement.effects.contract import check_story
+    from turntable_pin.measurement.user_effects import load_effects_module
+    from turntable_pin.stats.candidate_effect import CandidateEffect
+
+    run_class = "class CableDrag" + run_module().split("class CableDrag", 1)[1]
+    imports = "\n\nfrom turntable_pin.instrument.effects import RunEffect\n\n\n"
+    text = orientation_module() + imports + run_class
+    path = write_file(tmp_path, text, "both.py")
+    (lobes,) = load_effects_module(path, Effect)
+    (drag,) = load_effects_module(path, RunEffect)
+    assert type(lobes).__name__ == "Lobes" and type(drag).__name__ == "CableDrag"
+    assert isinstance(lobes, CandidateEffect) and isinstance(drag, CandidateEffect)
+    assert not isinstance(drag, Effect) and not isinstance(lobes, RunEffect)
+    assert list(drag.describe())[:2] == ["effect", "side"] and drag.describe()["side"] == "table"
+    assert "side" not in lobes.describe()
+    check_story(drag, RunEffect)
+    drag.side = "payload"
+    with pytest.raises(UserCodeError, match="its side is 'payload'; expected 'table' or "
+                       "'instrument'"):  # fmt: skip
+        check_story(drag, RunEffect)

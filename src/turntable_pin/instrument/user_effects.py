@@ -17,8 +17,9 @@ from pathlib import Path
 import numpy as np
 
 from ..core.user_code import is_user_code
+from ..measurement.effects.contract import check_story
 from .effects.base import RunContext, RunEffect
-from .effects.contract import check_run_effect, check_run_story
+from .effects.contract import check_run_effect
 
 __all__ = ["PROBE_POSITIONS", "check_user_run_effects", "load_run_effects_modules", "probe_context"]
 
@@ -88,7 +89,7 @@ def check_user_run_effects(effects: Sequence[RunEffect], run) -> tuple[RunEffect
 
     for effect in effects:
         if is_user_code(effect):
-            check_run_story(effect)
+            check_story(effect, RunEffect)
     check_user_effect_names(effects, taken=_catalogue_names(run.table))
     # the package's own are not checked; an effect a column of which the run lacks cannot be
     # tested on it (the diagnosis says so)

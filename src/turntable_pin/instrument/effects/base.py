@@ -12,10 +12,12 @@ its physical story and how to confirm it.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 import numpy as np
 
 from ...measurement.effects.base import ParameterSpec, PositionVariables
+from ...stats.candidate_effect import CandidateEffect
 
 __all__ = ["INSTRUMENT", "TABLE", "ParameterSpec", "RunContext", "RunEffect"]
 
@@ -46,30 +48,23 @@ class RunContext:
     memo: dict = field(default_factory=dict)
 
 
-class RunEffect:
-    """Base class of a candidate effect of a calibration run (a plug-in).
+class RunEffect(CandidateEffect):
+    """Base class of a candidate effect of a calibration run (a plug-in): the one base of every
+    family's effects (:class:`~turntable_pin.stats.candidate_effect.CandidateEffect`: name,
+    story, required columns, parameters) with the side it lives on and how it moves the outputs.
 
     Subclasses set the class attributes and implement :meth:`parameters` and :meth:`columns`.
 
     Attributes:
         name: the catalogue name.
-        side: ``"table"`` or ``"instrument"``.
+        side: ``"table"`` or ``"instrument"`` (the run family's story field: ``story_fields``).
         title, definition, explanation, confirm: its story for the reports (what it is, how it
             changes the outputs, one paragraph of physics, how to confirm it on the bench).
         required_columns: run columns it needs (``time_s``, ``temperature_c``).
     """
 
-    name: str = ""
     side: str = INSTRUMENT
-    title: str = ""
-    definition: str = ""
-    explanation: str = ""
-    confirm: str = ""
-    required_columns: tuple[str, ...] = ()
-
-    def missing_columns(self, run) -> tuple[str, ...]:
-        """The required columns ``run`` lacks (empty when the effect can be tested)."""
-        return tuple(c for c in self.required_columns if run.column(c) is None)
+    story_fields = MappingProxyType({"side": (TABLE, INSTRUMENT)})
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
         """The parameters this effect has on ``run``."""
@@ -78,15 +73,3 @@ class RunEffect:
     def columns(self, context: RunContext) -> np.ndarray:
         """``d(out_x, out_y)/d(parameter)``, (N, 2, p), deg/h per internal unit."""
         raise NotImplementedError
-
-    def describe(self) -> dict:
-        """The effect's story, as the reports show it."""
-        return {
-            "effect": self.name,
-            "side": self.side,
-            "title": self.title,
-            "definition": self.definition,
-            "explanation": self.explanation,
-            "confirm": self.confirm,
-            "required_columns": list(self.required_columns),
-        }

@@ -32,23 +32,9 @@ from ...measurement.effects.contract import (
     effect_label,
     numbers_returned,
 )
-from .base import INSTRUMENT, TABLE, ParameterSpec, RunContext, RunEffect
+from .base import ParameterSpec, RunContext, RunEffect
 
-__all__ = ["SIDES", "check_run_effect", "check_run_story"]
-
-SIDES = (TABLE, INSTRUMENT)
-"""The sides a run effect may live on."""
-
-
-def check_run_story(effect) -> None:
-    """Refuse a run effect whose story is not text, whose ``side`` is not one of :data:`SIDES`
-    or whose ``required_columns`` is not a tuple of column names."""
-    check_story(effect, RunEffect)
-    side = getattr(effect, "side", None)
-    if side not in SIDES:
-        raise contract_error(
-            effect, f"its side is {described(side)}; expected '{TABLE}' or '{INSTRUMENT}'"
-        )
+__all__ = ["check_run_effect"]
 
 
 def check_run_effect(
@@ -65,7 +51,7 @@ def check_run_effect(
     run = context.run
     n = run.n_positions
     on = on or f"the run ({n} positions)"
-    check_run_story(effect)
+    check_story(effect, RunEffect)
     path, label = effect_file(effect), effect_label(effect)
     specs = call_user(f"{label}: parameters(run) on {on}", effect.parameters, run, path=path)
     specs = check_parameters(effect, specs, "parameters(run)", on)

@@ -28,6 +28,7 @@ import numpy as np
 from ...core.csv_table import missing_columns_words
 from ...core.units import ARCSEC_PER_RAD
 from ...model.named_effects import EffectText, Labels
+from ...stats.candidate_effect import CandidateEffect
 
 __all__ = [
     "ARCSEC",
@@ -242,9 +243,11 @@ def harmonic_parameters(prefix: str, what: str, angle: str) -> tuple[ParameterSp
     )
 
 
-class Effect:
-    """Base class of a candidate physical effect (a plug-in of
-    :mod:`turntable_pin.measurement.effects`).
+class Effect(CandidateEffect):
+    """Base class of a candidate physical effect of orientation data (a plug-in of
+    :mod:`turntable_pin.measurement.effects`): the one base of every family's effects
+    (:class:`~turntable_pin.stats.candidate_effect.CandidateEffect`: name, story, required
+    columns, parameters) with how it changes the kinematic chain.
 
     Subclasses set the class attributes and implement :meth:`parameters` and :meth:`chain_terms`.
 
@@ -264,15 +267,8 @@ class Effect:
         required_columns: data columns it needs; with ``any_column=True`` one of them suffices.
     """
 
-    name: str = ""
     kind: str = ""
     joints: tuple[str, ...] = ()
-    title: str = ""
-    definition: str = ""
-    explanation: str = ""
-    confirm: str = ""
-    required_columns: tuple[str, ...] = ()
-    any_column: bool = False
 
     def __init__(self, name=None, text: EffectText | None = None, default=None) -> None:
         self.name = name or self.name
@@ -280,13 +276,6 @@ class Effect:
             for key, value in asdict(story or EffectText()).items():
                 if value is not None:
                     setattr(self, key, value)
-
-    def missing_columns(self, variables: PositionVariables) -> tuple[str, ...]:
-        """The required data columns ``variables`` lacks (empty when the effect can be tested)."""
-        missing = tuple(c for c in self.required_columns if not variables.has(c))
-        if self.any_column and len(missing) < len(self.required_columns):
-            return ()
-        return missing
 
     def parameters(self, variables: PositionVariables) -> tuple[ParameterSpec, ...]:
         """The parameters this effect has on a data set with these variables."""
@@ -299,14 +288,3 @@ class Effect:
         an effect's terms (:meth:`PositionVariables.memo`), so the same effect object must give
         the same terms for the same variables."""
         raise NotImplementedError
-
-    def describe(self) -> dict:
-        """The effect's story, as the reports show it."""
-        return {
-            "effect": self.name,
-            "title": self.title,
-            "definition": self.definition,
-            "explanation": self.explanation,
-            "confirm": self.confirm,
-            "required_columns": list(self.required_columns),
-        }

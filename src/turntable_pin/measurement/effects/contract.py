@@ -29,6 +29,7 @@ import numpy as np
 from ...core.exceptions import UserCodeError
 from ...core.user_code import call_user, class_file
 from ...model.angles import ANGLE_NAMES
+from ...stats.candidate_effect import STORY_TEXTS
 from .base import MEASURED, POST, PRE, ChainTerm, ParameterSpec, PositionVariables
 
 __all__ = [
@@ -50,7 +51,7 @@ __all__ = [
 PROBE_POSITIONS = 7
 """Positions of the probe an effect is first called on (a count no data set is likely to share,
 so that an effect which built its arrays for one data set's size shows it)."""
-STORY_ATTRIBUTES = ("name", "title", "definition", "explanation", "confirm")
+STORY_ATTRIBUTES = ("name", *STORY_TEXTS)
 """The attributes of an effect's story, each a text."""
 _ROTATION_AXES = ("x", "y", "z")
 _JOINT_COLUMN = re.compile(r"^(dir|phi)\d+$")
@@ -100,8 +101,10 @@ def numbers_returned(value) -> np.ndarray | None:
 
 
 def check_story(effect, base: type) -> None:
-    """Refuse an effect whose story attributes are not text or whose ``required_columns`` is not
-    a tuple of column names; ``base`` is the class it must derive from."""
+    """Refuse an effect whose story attributes are not text, whose ``required_columns`` is not
+    a tuple of column names or whose family story field (``base.story_fields``: a run effect's
+    ``side``) is not one of the values it may take; ``base`` is the family's effect class it must
+    derive from (:class:`~turntable_pin.stats.candidate_effect.CandidateEffect`'s subclass)."""
     if not isinstance(effect, base):
         raise contract_error(
             effect, f"is {described(effect)}; expected an instance of {base.__qualname__}"
@@ -128,6 +131,11 @@ def check_story(effect, base: type) -> None:
             f"its required_columns is {described(columns)}; expected a tuple of "
             "column names such as ('time_s',)",
         )
+    for key, values in base.story_fields.items():
+        value = getattr(effect, key, None)
+        if value not in values:
+            expected = " or ".join(f"'{v}'" for v in values)
+            raise contract_error(effect, f"its {key} is {described(value)}; expected {expected}")
 
 
 def check_parameters(effect, specs, call: str, on: str) -> tuple[ParameterSpec, ...]:
