@@ -1,7 +1,7 @@
 """The one diagnosis engine on a third family of data, a toy one: two columns of readings against
 one variable, a constant per column as the base model, a slope and a wave as the candidates. The
 family writes only its columns, model, candidates and words; the verdict, the outlier screen, the
-noise per column, the two passes and the doubt come from the engine."""
+noise per column, the two passes, the doubt and the separation rule come from the engine."""
 
 from __future__ import annotations
 
@@ -10,9 +10,12 @@ import dataclasses
 import numpy as np
 import pytest
 
+from turntable_pin.core.exceptions import InputError
+from turntable_pin.stats.candidate_effect import CandidateEffect
 from turntable_pin.stats.diagnosis_engine import (
     DOUBT_CHI2_REDUCED,
     DataFamily,
+    SeparationWords,
     diagnose_data,
 )
 from turntable_pin.stats.least_squares import FitResult, fit_least_squares, zero_point
@@ -20,17 +23,11 @@ from turntable_pin.stats.least_squares import FitResult, fit_least_squares, zero
 N = 160
 
 
-@dataclasses.dataclass(frozen=True)
-class Shape:
-    """A candidate effect: one coefficient per column times ``shape(x)``."""
+class Shape(CandidateEffect):
+    """A candidate effect of the one base class: one coefficient per column times ``shape(x)``."""
 
-    name: str
-    shape: object
-    required_columns: tuple[str, ...] = ()
-
-    def describe(self) -> dict:
-        return {"effect": self.name, "title": f"a {self.name}", "definition": "-",
-                "explanation": "-", "confirm": "-", "required_columns": []}  # fmt: skip
+    def __init__(self, name: str, shape) -> None:
+        self.name, self.shape, self.title = name, shape, f"a {name}"
 
 
 CATALOGUE = (Shape("slope", lambda x: x / (2 * np.pi)), Shape("wave", np.sin))
@@ -130,6 +127,13 @@ class ToyFamily(DataFamily):
     def rows(self):
         return np.arange(self.x.size) + 2
 
+    @property
+    def data_columns(self):
+        return self  # no column besides x: every effect is testable
+
+    def column(self, name):
+        return None
+
     def without(self, cells):
         return ToyFamily(self.x, self.y, self.sigma, self.mask & ~cells, self.column_sigma)
 
@@ -146,8 +150,16 @@ class ToyFamily(DataFamily):
     def probes(self, fit):
         return []
 
-    def separation(self, fit_a, effect_b):
-        return "they differ"
+    misfit: float | Exception = 100.0
+    """What :meth:`dense_misfit` gives (or raises), set by a test."""
+
+    def dense_misfit(self, fit_a, effect_b):
+        if isinstance(self.misfit, Exception):
+            raise self.misfit
+        return self.misfit
+
+    def separation_words(self):
+        return SeparationWords("grid", "dense grid", "grid (9 positions)", "x", "look", "more x")
 
     def design_warnings(self, base_fit):
         return []
@@ -196,3 +208,21 @@ def test_a_stated_sigma_far_too_small_puts_the_family_in_doubt():
         f"with every accepted effect the residuals are still {chi2_reduced**0.5:.1f} times the "
         f"stated noise (chi2_reduced {chi2_reduced:.3g}): is this the right toy?"
     )
+
+
+@pytest.mark.parametrize(
+    "misfit, words",
+    [
+        (100.0, "slope mimics wave on these positions only: on a grid (9 positions) it would "
+                "leave chi2 = 100 of misfit at the same noise, so more x separates them"),
+        (1e-3, "slope reproduces the fitted wave at every x (noise-free misfit chi2 = 0.001 on a "
+               "grid), so no set of positions separates them; an independent look does. For "
+               "wave:  For slope: "),
+        (InputError("infinite at x = 0"), "slope cannot be compared with wave on a dense grid "
+         "(infinite at x = 0); an independent look tells them apart. For wave:  For slope: "),
+    ],
+)  # fmt: skip
+def test_one_separation_rule_in_the_familys_words(misfit, words):
+    family = ToyFamily(*_readings(4))
+    family.misfit = misfit
+    assert family.separation(family.fit([CATALOGUE[1]]), CATALOGUE[0]) == words

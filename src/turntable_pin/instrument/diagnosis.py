@@ -31,14 +31,21 @@ from ..core.units import DEG_PER_RAD
 from ..measurement.diagnosis import (
     dense_joint_grid,
     harmonic_basis,
-    max_harmonic_order,
+    joint_harmonics,
     polynomial_basis,
 )
 from ..measurement.table import measured_table
 from ..model.angles import ANGLE_NAMES
-from ..stats.diagnosis_engine import SEPARATION_CHI2, DataFamily, PageWords, diagnose_data
+from ..stats.diagnosis_engine import (
+    SEPARATION_CHI2,
+    DataFamily,
+    PageWords,
+    SeparationWords,
+    diagnose_data,
+)
 from ..stats.least_squares import zero_point
 from ..stats.model_selection import Diagnosis
+from ..stats.outliers import outlier_rule_words
 from ..stats.structure_search import Probe, ProbeFactors
 from .effects import run_catalogue
 from .effects.base import RunEffect
@@ -52,13 +59,7 @@ __all__ = [
     "run_results",
 ]
 
-OUTLIER_RULE = (
-    "studentized residual |t| = |r| / (s sqrt(1 - h)) above the two-sided normal quantile at "
-    "0.01 / m (m outputs; h the leverage; s the robust scale 1.4826 median |r| / sqrt(1 - h), "
-    "the larger of that of the same output channel and that of both), iterated: the worst "
-    "(|t| at least half the largest) left out, refitted, tested again; first on the base "
-    "model, then on the model with the accepted effects; at most 5 % of the outputs"
-)
+OUTLIER_RULE = outlier_rule_words("outputs", "the same output channel", "both", "outputs")
 """The outlier rule of :func:`diagnose_run` in words (``turntable_pin.stats.outliers``)."""
 
 
@@ -223,13 +224,10 @@ class RunFamily(DataFamily):
         """The run's own data in the result (:func:`run_results`)."""
         run_results(diagnosis)
 
-    def untestable_reason(self, effect: RunEffect) -> str | None:
-        """Why ``effect`` cannot be tested here (its columns are missing, or not numbers), or
-        None."""
-        missing = effect.missing_columns(self.run)
-        if missing:
-            return f"needs the column(s) {self.run.missing_columns_words(missing)}"
-        return None
+    @property
+    def data_columns(self):
+        """The run's columns (the :class:`~turntable_pin.calibration.run.CalibrationRun`)."""
+        return self.run
 
     def base_inputs(self) -> set[str]:
         """The joint angles (``phi1``...): the probes in them are not suspects."""
@@ -299,24 +297,14 @@ class RunFamily(DataFamily):
         ]
         probes = []
         labels = [f"phi{k}" for k in range(1, run.joint_rad.shape[1] + 1)]
-        for var, phi in zip(labels, run.joint_rad.T, strict=True):
-            for k in range(1, max_harmonic_order(phi) + 1):
-                plot = (var, phi, harmonic_basis(k), DEG_PER_RAD, "deg")
-                probes += self._shape_probes(
-                    channels + angles, plot, f"{k}/rev in {var}", f"a {k}/rev term in {var}",
-                    f"h{k}({var})",
-                )  # fmt: skip
-        for i in range(len(labels)):
-            for j in range(i + 1, len(labels)):
-                a, b = run.joint_rad[:, i], run.joint_rad[:, j]
-                for sign, combined in (("+", a + b), ("-", a - b)):
-                    label = f"{labels[i]}{sign}{labels[j]}"
-                    for k in range(1, min(2, max_harmonic_order(combined)) + 1):
-                        plot = (label, combined, harmonic_basis(k), DEG_PER_RAD, "deg")
-                        probes += self._shape_probes(
-                            channels, plot, f"{k}/rev in {label}", f"a {k}/rev term in {label}",
-                            f"h{k}({label})",
-                        )  # fmt: skip
+        # each harmonic on each output and through each of the table's angles; those coupling
+        # two joint angles on each output only
+        for var, values, k, coupled in joint_harmonics(labels, run.joint_rad):
+            plot = (var, values, harmonic_basis(k), DEG_PER_RAD, "deg")
+            probes += self._shape_probes(
+                channels if coupled else channels + angles, plot, f"{k}/rev in {var}",
+                f"a {k}/rev term in {var}", f"h{k}({var})",
+            )  # fmt: skip
         columns = {"time_s": run.time_s, **run.extra}
         for column, values in columns.items():
             if values is None or not np.ptp(values) > 0:
@@ -334,7 +322,7 @@ class RunFamily(DataFamily):
     def _dense_run(self):
         """The run's positions replaced by a dense grid over every joint within its limits
         (:func:`~turntable_pin.measurement.diagnosis.dense_joint_grid`), time and extra columns
-        spread over their ranges in random order; and the grid's name."""
+        spread over their ranges in random order."""
         from ..calibration.positions import PositionSet, position_inputs
         from ..calibration.run import CalibrationRun
 
@@ -349,9 +337,7 @@ class RunFamily(DataFamily):
             return None if v is None else rng.permutation(np.linspace(v.min(), v.max(), n))
 
         extra = {k: spread(v) for k, v in run.extra.items()}
-        dense = CalibrationRun(inputs, np.zeros((n, 2)), None, spread(run.time_s), extra)
-        step = "30" if joints.shape[1] > 2 else "15"
-        return dense, f"{step}-degree grid within the joints' limits ({n} positions)"
+        return CalibrationRun(inputs, np.zeros((n, 2)), None, spread(run.time_s), extra)
 
     def misfit(self, fit_a: RunFit, effect_b: RunEffect, dense: bool) -> float:
         """The noise-free chi2 left when the model with ``effect_b`` instead of ``fit_a``'s last
@@ -359,8 +345,7 @@ class RunFamily(DataFamily):
         dense grid over every joint (:meth:`_dense_run`). Raises :class:`InputError` when
         ``effect_b`` cannot be evaluated there (a column the grid has not)."""
         if dense:
-            run, _ = self._dense_run()
-            context = run_context(run, fit_a.model.context.coefficients)
+            context = run_context(self._dense_run(), fit_a.model.context.coefficients)
             mask = None
         else:
             context, mask = fit_a.model.context, self.mask
@@ -375,29 +360,22 @@ class RunFamily(DataFamily):
             sigma *= self.sigma_scale
         return float(np.sum(((target - jac @ coef) * w) ** 2)) / sigma**2
 
-    def separation(self, fit_a: RunFit, effect_b: RunEffect) -> str:
-        """Whether more positions would separate effect A (fitted) from B, or only another test."""
-        a = fit_a.model.effects[-1]
-        _, grid = self._dense_run()
-        try:
-            chi2 = self.misfit(fit_a, effect_b, dense=True)
-        except InputError as exc:
-            return (
-                f"{effect_b.name} cannot be compared with {a.name} on a {grid} "
-                f"({exc.detail}); an independent test tells them apart. For {a.name}: "
-                f"{a.confirm} For {effect_b.name}: {effect_b.confirm}"
-            )
-        if chi2 > SEPARATION_CHI2:
-            return (
-                f"{effect_b.name} mimics {a.name} on these positions only: on a {grid} it would "
-                f"leave chi2 = {chi2:.0f} of misfit at the same noise, so calibrating at more "
-                "varied positions separates them"
-            )
-        return (
-            f"{effect_b.name} reproduces the fitted {a.name} at every position of the table "
-            f"(noise-free misfit chi2 = {chi2:.2g} on a {grid}), so no set of positions "
-            f"separates them; an independent test does. For {a.name}: {a.confirm} "
-            f"For {effect_b.name}: {effect_b.confirm}"
+    def dense_misfit(self, fit_a: RunFit, effect_b: RunEffect) -> float:
+        """:meth:`misfit` on the dense grid."""
+        return self.misfit(fit_a, effect_b, dense=True)
+
+    def separation_words(self) -> SeparationWords:
+        """The dense grid in words (its step and size), and the checks."""
+        joints = dense_joint_grid(self.table)
+        step = "30" if joints.shape[1] > 2 else "15"
+        grid = f"{step}-degree grid within the joints' limits ({joints.shape[0]} positions)"
+        return SeparationWords(
+            grid=grid,
+            grid_cannot=grid,
+            grid_mimics=grid,
+            position="position of the table",
+            check="test",
+            more_data="calibrating at more varied positions",
         )
 
     def other_side(self, fit_a: RunFit) -> list[dict]:
@@ -437,22 +415,16 @@ class RunFamily(DataFamily):
 def run_design_command(run, pair: tuple[str, str]) -> str:
     """The ``turntable-pin design --separate A,B --run RUN`` command (with ``--urdf``, ``--mount``
     and ``--latitude-deg`` when they are not the defaults) that chooses the calibration positions
-    telling the two effects apart, or says that none do (:mod:`.separate`)."""
-    import shlex
-
+    telling the two effects apart, or says that none do (:mod:`.separate`; the one
+    :func:`~turntable_pin.measurement.diagnosis.design_command`)."""
     from ..calibration.site import DEFAULT_LATITUDE_DEG
-    from ..measurement.diagnosis import mount_option, urdf_option
+    from ..measurement.diagnosis import design_command, mount_option, urdf_option
 
-    words = ["turntable-pin", "design", "--separate", ",".join(pair), "--run", run.source]
-    urdf, mount = urdf_option(run.table), mount_option(run.table)
-    if urdf:
-        words += ["--urdf", urdf]
-    if mount:
-        words += ["--mount", mount]
     latitude = float(np.degrees(run.inputs.latitude_rad))
-    if abs(latitude - DEFAULT_LATITUDE_DEG) > 1e-9:
-        words += ["--latitude-deg", f"{latitude:g}"]
-    return " ".join(shlex.quote(w) for w in words)
+    default = abs(latitude - DEFAULT_LATITUDE_DEG) <= 1e-9
+    extra = [] if default else ["--latitude-deg", f"{latitude:g}"]
+    return design_command(run.source, pair, urdf_option(run.table), mount_option(run.table),
+                          data_option="--run", extra=extra)  # fmt: skip
 
 
 def diagnose_run(

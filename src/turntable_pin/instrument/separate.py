@@ -12,11 +12,11 @@ leaves the noise-free misfit
 over the outputs of the run and the new positions, and ``lambda_BA`` the other way round. The
 design maximises the smaller of the two (T-optimal, :func:`~turntable_pin.stats.discrimination.
 t_optimal_exchange`) over seeded candidate positions within the joints' limits, added to the run.
-A misfit of :data:`~.diagnosis.SEPARATION_CHI2` (25: five sigma) tells them apart clearly.
-When B reproduces A at every candidate, no position separates them, and the result says so with
-the independent tests of the two effects' stories. Effects that need ``time_s`` or another
-column are refused: positions alone do not decide them (repeat positions late, or change the
-temperature).
+A misfit of :data:`~turntable_pin.stats.diagnosis_engine.SEPARATION_CHI2` (25: five sigma) tells
+them apart clearly. When B reproduces A at every candidate, no position separates them, and the
+result says so with the independent tests of the two effects' stories. Effects that need
+``time_s`` or another column are refused: positions alone do not decide them (repeat positions
+late, or change the temperature).
 """
 
 from __future__ import annotations
@@ -26,8 +26,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.exceptions import InputError
+from ..stats.diagnosis_engine import SEPARATION_CHI2
 from ..stats.discrimination import Direction, t_optimal_exchange
-from .diagnosis import SEPARATION_CHI2, RunFamily
+from .diagnosis import RunFamily
 from .model import RunModel, run_context
 
 __all__ = ["SAME_RTOL", "RunSeparation", "design_run_separation"]

@@ -18,18 +18,18 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.exceptions import InputError
 from ..core.turn_grid import every_combination, full_turn_grid_deg
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..stats.diagnosis_engine import (
     DATA_PLACEHOLDER,
-    SEPARATION_CHI2,
     DataFamily,
     PageWords,
+    SeparationWords,
     diagnose_data,
 )
 from ..stats.least_squares import RANK_RTOL, fit_least_squares
 from ..stats.model_selection import Diagnosis
+from ..stats.outliers import outlier_rule_words
 from ..stats.structure_search import Probe, ProbeFactors
 from .catalogue import catalogue as table_catalogue
 from .catalogue import resolve_effect
@@ -55,6 +55,7 @@ __all__ = [
     "diagnose_measurements",
     "dense_joint_grid",
     "harmonic_basis",
+    "joint_harmonics",
     "max_harmonic_order",
     "mount_option",
     "polynomial_basis",
@@ -127,13 +128,25 @@ def max_harmonic_order(angle_rad: np.ndarray) -> int:
     return int(min(MAX_HARMONIC, max(0, (distinct - 1) // 2)))
 
 
-OUTLIER_RULE = (
-    "studentized residual |t| = |r| / (s sqrt(1 - h)) above the two-sided normal quantile at "
-    "0.01 / m (m measured angles; h the leverage; s the robust scale 1.4826 median "
-    "|r| / sqrt(1 - h), the larger of that of the same angle, dpsi, dtheta or dgamma, and that "
-    "of all), iterated: the worst (|t| at least half the largest) left out, refitted, tested "
-    "again; first on the base model, then on the model with the accepted effects; at most 5 % "
-    "of the angles"
+def joint_harmonics(labels: Sequence[str], joint_rad: np.ndarray):
+    """The harmonic shapes a structure search tries in the joint angles, in order: each k/rev
+    term in each joint angle (k up to :func:`max_harmonic_order`), then each k/rev term
+    (k = 1, 2) in the sum and in the difference of two joint angles (``phiA+phiB``,
+    ``phiA-phiB``: shapes that couple them, which terms in one angle each miss). Yields
+    ``(variable, values rad (N,), k, coupled)``."""
+    for var, phi in zip(labels, joint_rad.T, strict=True):
+        for k in range(1, max_harmonic_order(phi) + 1):
+            yield var, phi, k, False
+    for i in range(len(labels)):
+        for j in range(i + 1, len(labels)):
+            a, b = joint_rad[:, i], joint_rad[:, j]
+            for sign, combined in (("+", a + b), ("-", a - b)):
+                for k in range(1, min(2, max_harmonic_order(combined)) + 1):
+                    yield f"{labels[i]}{sign}{labels[j]}", combined, k, True
+
+
+OUTLIER_RULE = outlier_rule_words(
+    "measured angles", "the same angle, dpsi, dtheta or dgamma,", "all", "angles"
 )
 """The outlier rule of :func:`diagnose_measurements` in words (``turntable_pin.stats.outliers``)."""
 
@@ -326,14 +339,10 @@ class OrientationFamily(DataFamily):
             for name in diagnosis.separations
         }
 
-    def untestable_reason(self, effect: Effect) -> str | None:
-        """Why ``effect`` cannot be tested here (its data columns are missing, or not numbers),
-        or None."""
-        variables = self.data.variables()
-        missing = effect.missing_columns(variables)
-        if missing:
-            return f"needs the column(s) {variables.missing_columns_words(missing)}"
-        return None
+    @property
+    def data_columns(self) -> PositionVariables:
+        """The measurements' columns (their :class:`~.effects.base.PositionVariables`)."""
+        return self.data.variables()
 
     def effect(self, name: str) -> Effect:
         """The effect called ``name``: in this family's catalogue first, then the table's."""
@@ -565,33 +574,19 @@ class OrientationFamily(DataFamily):
         on_angle = [_one_angle(w, a) for a in range(len(ANGLE_NAMES))]  # a term on one angle
         probes = []
         labels = [self.table.angle_label(k) for k in range(1, data.n_joints + 1)]
-        for var, phi in zip(labels, data.joint_rad.T, strict=True):
-            for k in range(1, max_harmonic_order(phi) + 1):
-                plot = (var, phi, harmonic_basis(k), DEG_PER_RAD, "deg")
-                shape = f"{k}/rev in {var}"
-                spec = f"h{k}({var})"
+        # Each harmonic on each base error and on each angle itself; those coupling two angles
+        # (k/rev in phiA + phiB or phiA - phiB) on each angle only.
+        for var, values, k, coupled in joint_harmonics(labels, data.joint_rad):
+            plot = (var, values, harmonic_basis(k), DEG_PER_RAD, "deg")
+            shape = f"{k}/rev in {var}"
+            spec = f"h{k}({var})"
+            if not coupled:
                 probes += self._error_probes(
                     along, shape, f"{k}/rev term in {var}", plot, spec, unseen, alike
                 )
-                probes += self._measured_angle_probes(
-                    shape, f"a {k}/rev term in {var} of {{angle}} itself", plot, on_angle, spec
-                )
-        # Terms coupling two angles (k/rev in phiA + phiB or phiA - phiB) on each angle: the
-        # shapes above are separable in the angles and would miss them.
-        for i in range(data.n_joints):
-            for j in range(i + 1, data.n_joints):
-                a, b = data.joint_rad[:, i], data.joint_rad[:, j]
-                for sign, combined in (("+", a + b), ("-", a - b)):
-                    label = f"{labels[i]}{sign}{labels[j]}"
-                    for k in range(1, min(2, max_harmonic_order(combined)) + 1):
-                        plot = (label, combined, harmonic_basis(k), DEG_PER_RAD, "deg")
-                        probes += self._measured_angle_probes(
-                            f"{k}/rev in {label}",
-                            f"a {k}/rev term in {label} of {{angle}} itself",
-                            plot,
-                            on_angle,
-                            f"h{k}({label})",
-                        )
+            probes += self._measured_angle_probes(
+                shape, f"a {k}/rev term in {var} of {{angle}} itself", plot, on_angle, spec
+            )
         if data.time_s is not None and np.ptp(data.time_s) > 0:
             plot = ("time_s", data.time_s, polynomial_basis(data.time_s), 1.0, "s")
             probes += self._measured_angle_probes(
@@ -646,10 +641,11 @@ class OrientationFamily(DataFamily):
                  for k, v in data.extra.items()}  # fmt: skip
         return PositionVariables(joints, time, dirs, extra)
 
-    def separation(self, fit_a: OrientationFit, effect_b: Effect) -> str:
-        """Whether more positions would separate effect A (fitted) from B, or only another test."""
+    def dense_misfit(self, fit_a: OrientationFit, effect_b: Effect) -> float:
+        """The noise-free chi2 of the model with ``effect_b`` in place of ``fit_a``'s last effect
+        fitted to ``fit_a``'s prediction on the dense design (:meth:`_dense_variables`), at
+        ``fit_a``'s noise."""
         a_effects = fit_a.model.effects
-        a = a_effects[-1]
         variables = self._dense_variables()
         truth = OrientationModel(variables, a_effects, self.table).predict(fit_a.result.params)
         sigma = float(np.median(fit_a.sigma_rad))
@@ -657,30 +653,22 @@ class OrientationFamily(DataFamily):
             variables.joint_rad, truth, np.full(variables.n, sigma), variables.time_s,
             variables.dirs, dict(variables.extra), source="dense design",
         )  # fmt: skip
-        base_effects = [e for e in a_effects if e is not a]
+        base_effects = [e for e in a_effects if e is not a_effects[-1]]
+        return fit_orientation(dense, [*base_effects, effect_b], turntable=self.table).result.rss
+
+    def separation_words(self) -> SeparationWords:
+        """The dense design in words (its step, its limits, its size), and the checks."""
         grid = ("30-degree" if self.data.n_joints > 2 else "15-degree") + " grid"
         if any(limits is not None for limits in self.table.joint_limits_rad):
             grid += " within the joints' limits"
-        try:
-            misfit = fit_orientation(dense, [*base_effects, effect_b], turntable=self.table)
-        except InputError as exc:  # B cannot be evaluated everywhere (cot E at the horizon)
-            return (
-                f"{effect_b.name} cannot be compared with {a.name} on a dense {grid} "
-                f"({exc.detail}); an independent measurement tells them apart. For {a.name}: "
-                f"{a.confirm} For {effect_b.name}: {effect_b.confirm}"
-            )
-        chi2 = misfit.result.rss
-        if chi2 > SEPARATION_CHI2:
-            return (
-                f"{effect_b.name} mimics {a.name} on these positions only: on a {grid} "
-                f"({variables.n} positions, random time order) it would leave chi2 = {chi2:.0f} "
-                f"of misfit at the same noise, so measuring more angles separates them"
-            )
-        return (
-            f"{effect_b.name} reproduces the fitted {a.name} at every turntable position "
-            f"(noise-free misfit chi2 = {chi2:.2g} on a {grid}), so no set of positions "
-            f"separates them; an independent measurement does. For {a.name}: {a.confirm} "
-            f"For {effect_b.name}: {effect_b.confirm}"
+        n = dense_joint_grid(self.table).shape[0]
+        return SeparationWords(
+            grid=grid,
+            grid_cannot=f"dense {grid}",
+            grid_mimics=f"{grid} ({n} positions, random time order)",
+            position="turntable position",
+            check="measurement",
+            more_data="measuring more angles",
         )
 
 
@@ -727,20 +715,26 @@ def diagnose_measurements(
 
 
 def design_command(
-    data: str, pair: tuple[str, str], urdf: str | None = None, mount: str | None = None
+    data: str,
+    pair: tuple[str, str],
+    urdf: str | None = None,
+    mount: str | None = None,
+    *,
+    data_option: str = "--from",
+    extra: Sequence[str] = (),
 ) -> str:
-    """The ``turntable-pin design --separate A,B --from DATA`` command (with ``--urdf`` when the
-    table is not the paper's, ``--mount`` when the table is not what its URDF declares) that
-    chooses the positions telling the two effects apart, or says that none do
-    (``turntable_pin.design.separate``)."""
+    """The ``turntable-pin design --separate A,B --from DATA`` command (``data_option``: ``--run``
+    for a calibration run; with ``--urdf`` when the table is not the paper's, ``--mount`` when
+    the table is not what its URDF declares, then the words ``extra``) that chooses the positions
+    telling the two effects apart, or says that none do (``turntable_pin.design.separate``)."""
     import shlex
 
-    words = ["turntable-pin", "design", "--separate", ",".join(pair), "--from", data]
+    words = ["turntable-pin", "design", "--separate", ",".join(pair), data_option, data]
     if urdf:
         words += ["--urdf", urdf]
     if mount:
         words += ["--mount", mount]
-    return " ".join(shlex.quote(w) for w in words)
+    return " ".join(shlex.quote(w) for w in [*words, *extra])
 
 
 def urdf_option(turntable) -> str | None:

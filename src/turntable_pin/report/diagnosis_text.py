@@ -193,48 +193,59 @@ def header_lines(d: dict) -> list[str]:
 
 
 def verdict_lines(d: dict, data: str = DATA_PLACEHOLDER) -> list[str]:
-    """The steps of the forward selection, the missing effect and whether anything remains;
-    for each remaining term, the ``fit`` command (on the file ``data``) that adds it."""
+    """The steps of the forward selection, the missing effect and its rivals, whether anything
+    remains (for each remaining term, the ``fit`` command on the file ``data`` that adds it) and
+    the outliers left out."""
+    return [*_effect_lines(d), *_rival_lines(d), *_unexplained_lines(d, data), *_outlier_lines(d)]
+
+
+def _effect_lines(d: dict) -> list[str]:
+    """Each step, the effect named (its side, why, how to confirm it, its parameters and
+    whether the data determine them), or none."""
+    verdict = d["verdict"]
+    if not d["steps"]:
+        return ["missing effect: none (no catalogued effect improves the base fit)"]
+    lines = []
+    for i, s in enumerate(d["steps"], 1):
+        unit = _unit(d)
+        lines.append(
+            f"step {i}: add {s['added']} (delta_bic {s['delta_bic']:.1f}) -> rms "
+            f"{s[f'rms_{unit}']:{_FORMAT[unit]}} {unit}, chi2_reduced "
+            f"{s['chi2_reduced']:.3f}"
+        )
+    story = verdict["effect_story"]
+    if verdict["unexplained"]:
+        lines.append(
+            f"partial explanation: {verdict['missing_effect']} ({story['title']}); "
+            f"still unexplained: {_still_unexplained(d)}"
+        )
+    else:
+        lines.append(f"missing effect: {verdict['missing_effect']} ({story['title']})")
+    side = verdict.get("side")
+    if side:
+        lines.append(f"  side: {_SIDE_WORDS.get(side, side)}")
+    lines.append(f"  why: {story['explanation']}")
+    lines.append(f"  confirm on the machine: {story['confirm']}")
+    base = d.get("base_label", "the base errors")
+    for name, entries in verdict.get("named_parameters", {}).items():
+        if entries:
+            words = "; ".join(_parameter_words(e, base) for e in entries)
+            lines.append(f"  {name} parameters: {words}")
+    for name, loose in verdict.get("named_undetermined", {}).items():
+        lines.append(
+            f"  caution: {_short(loose)} of {name} are not determined (traded off against "
+            "the model's other parameters, correlation > 0.95, or none reaches 3 sigma): the "
+            "data support only the part of it they do determine; "
+            "read it as the shape it adds, not as these values"
+        )
+    return lines
+
+
+def _rival_lines(d: dict) -> list[str]:
+    """The effects besides the one named: also significant, as good (with what separates them),
+    significant but not determined, not needed beside the structure, absorbed by the base."""
     verdict = d["verdict"]
     lines = []
-    if d["steps"]:
-        for i, s in enumerate(d["steps"], 1):
-            unit = _unit(d)
-            lines.append(
-                f"step {i}: add {s['added']} (delta_bic {s['delta_bic']:.1f}) -> rms "
-                f"{s[f'rms_{unit}']:{_FORMAT[unit]}} {unit}, chi2_reduced "
-                f"{s['chi2_reduced']:.3f}"
-            )
-        story = verdict["effect_story"]
-        if verdict["unexplained"]:
-            lines.append(
-                f"partial explanation: {verdict['missing_effect']} ({story['title']}); "
-                f"still unexplained: {_still_unexplained(d)}"
-            )
-        else:
-            lines.append(f"missing effect: {verdict['missing_effect']} ({story['title']})")
-        side = verdict.get("side")
-        if side:
-            lines.append(f"  side: {_SIDE_WORDS.get(side, side)}")
-        lines.append(f"  why: {story['explanation']}")
-        lines.append(f"  confirm on the machine: {story['confirm']}")
-        for name, entries in verdict.get("named_parameters", {}).items():
-            if entries:
-                lines.append(
-                    f"  {name} parameters: "
-                    + "; ".join(
-                        _parameter_words(e, d.get("base_label", "the base errors")) for e in entries
-                    )  # fmt: skip
-                )
-        for name, loose in verdict.get("named_undetermined", {}).items():
-            lines.append(
-                f"  caution: {_short(loose)} of {name} are not determined (traded off against "
-                "the model's other parameters, correlation > 0.95, or none reaches 3 sigma): the "
-                "data support only the part of it they do determine; "
-                "read it as the shape it adds, not as these values"
-            )
-    else:
-        lines.append("missing effect: none (no catalogued effect improves the base fit)")
     if verdict["also_significant"]:
         lines.append(
             "also significant on top of it: "
@@ -272,6 +283,13 @@ def verdict_lines(d: dict, data: str = DATA_PLACEHOLDER) -> list[str]:
             f"note: {name} cannot be told apart from the base errors on these data (if "
             "present, it is absorbed into them; see its candidate entry)"
         )
+    return lines
+
+
+def _unexplained_lines(d: dict, data: str) -> list[str]:
+    """Whether the best model leaves anything unexplained, and the command that fits it."""
+    verdict = d["verdict"]
+    lines = []
     if verdict["unexplained"]:
         why = []
         structure = verdict["remaining_structure"]
@@ -301,18 +319,29 @@ def verdict_lines(d: dict, data: str = DATA_PLACEHOLDER) -> list[str]:
             )
     else:
         lines.append("unexplained: no (the residuals are consistent with the noise)")
-    outliers = d.get("outliers", [])
-    if outliers:
-        shown = ", ".join(
-            f"row {o['row']} {o.get('angle', o.get('output'))} ({o['residual_sigma']:+.1f} sigma)"
-            for o in outliers[:10]
-        )
-        more = f" and {len(outliers) - 10} more" if len(outliers) > 10 else ""
-        lines.append(
-            f"outliers left out of every fit ({len(outliers)}): {shown}{more}; the rule: "
-            f"{d.get('outlier_rule')}; --keep-outliers keeps them"
-        )
     return lines
+
+
+def _outlier_lines(d: dict) -> list[str]:
+    """The observations left out as gross outliers (row, column, residual), and the rule."""
+    outliers = d.get("outliers", [])
+    if not outliers:
+        return []
+    shown = ", ".join(
+        f"row {o['row']} {_record_column(o)} ({o['residual_sigma']:+.1f} sigma)"
+        for o in outliers[:10]
+    )
+    more = f" and {len(outliers) - 10} more" if len(outliers) > 10 else ""
+    return [
+        f"outliers left out of every fit ({len(outliers)}): {shown}{more}; the rule: "
+        f"{d.get('outlier_rule')}; --keep-outliers keeps them"
+    ]
+
+
+def _record_column(record: dict) -> str:
+    """The observation column an outlier record names (under its family's key: ``angle``,
+    ``output``)."""
+    return next(v for k, v in record.items() if k not in ("row", "residual_sigma"))
 
 
 def _settle(commands: dict, name: str) -> list[str]:

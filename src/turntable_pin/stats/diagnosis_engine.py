@@ -44,6 +44,7 @@ __all__ = [
     "SEPARATION_CHI2",
     "DataFamily",
     "PageWords",
+    "SeparationWords",
     "column_noise",
     "column_noise_note",
     "diagnose_data",
@@ -109,6 +110,27 @@ class PageWords:
     structure_shapes: str = "the probes of the family"
 
 
+@dataclass(frozen=True)
+class SeparationWords:
+    """A family's words for :meth:`DataFamily.separation` (``on a {grid}``...).
+
+    Attributes:
+        grid: the dense set of positions, as the sentence that no position separates says it.
+        grid_cannot: the same, where the effect cannot be evaluated on it.
+        grid_mimics: the same, where it separates the effects (with its size).
+        position: what one position is (``at every {position}``).
+        check: the independent check that tells the effects apart (``an independent {check}``).
+        more_data: what separates two effects that only these positions confuse.
+    """
+
+    grid: str
+    grid_cannot: str
+    grid_mimics: str
+    position: str
+    check: str
+    more_data: str
+
+
 class DataFamily:
     """A family of data for the one diagnosis: a ``ModelFamily``
     (:class:`~.model_selection.ModelFamily`) bound to one data set, with some cells left out as
@@ -117,8 +139,9 @@ class DataFamily:
     A subclass sets the class attributes below, calls ``DataFamily.__init__`` and implements the
     hooks :meth:`fit_model`, :meth:`zero_point_of`, :meth:`refit`, :meth:`residual_table`,
     :meth:`full_residuals`, :meth:`residual_set`, :meth:`without`, :meth:`with_column_noise`,
-    :meth:`screen_fit`, :meth:`untestable_reason`, :meth:`probes`, :meth:`separation`,
-    :meth:`design_warnings`; it may fill the result with its own data in :meth:`complete`.
+    :meth:`screen_fit`, :attr:`data_columns`, :meth:`probes`, :meth:`dense_misfit`,
+    :meth:`separation_words`, :meth:`design_warnings`; it may fill the result with its own data
+    in :meth:`complete`.
 
     Attributes:
         columns: the names of the K observation columns of a record.
@@ -227,6 +250,22 @@ class DataFamily:
         starting from ``column_sigma`` (K,)."""
         raise NotImplementedError
 
+    @property
+    def data_columns(self):
+        """The data's columns, for the effects' required columns (an object with
+        ``column(name)`` and ``missing_columns_words(names)``)."""
+        raise NotImplementedError
+
+    def dense_misfit(self, fit_a, effect_b) -> float:
+        """The noise-free chi2 left when the model with ``effect_b`` in place of ``fit_a``'s last
+        effect is fitted to ``fit_a``'s fitted signal on a dense set of positions; raises
+        ``InputError`` when ``effect_b`` cannot be evaluated there."""
+        raise NotImplementedError
+
+    def separation_words(self) -> SeparationWords:
+        """The family's words of :meth:`separation`."""
+        raise NotImplementedError
+
     def screen_fit(self, cells: np.ndarray, effects: Sequence[Any]):
         """The ``FitResult`` of base + ``effects`` without the cells ``cells`` (the screen)."""
         raise NotImplementedError
@@ -292,8 +331,40 @@ class DataFamily:
 
     # ---- what the diagnosis asks, written once ----------------------------------------------
     def untestable_reason(self, effect) -> str | None:
-        """Why ``effect`` cannot be tested here (e.g. its data columns are missing), or None."""
+        """Why ``effect`` cannot be tested here (its data columns are missing, or not numbers),
+        or None."""
+        columns = self.data_columns
+        missing = effect.missing_columns(columns)
+        if missing:
+            return f"needs the column(s) {columns.missing_columns_words(missing)}"
         return None
+
+    def separation(self, fit_a, effect_b) -> str:
+        """Whether more positions would separate effect A (``fit_a``'s last) from ``effect_b``,
+        or only an independent check: B's noise-free misfit to A's fitted signal on a dense set
+        of positions (:meth:`dense_misfit`) against :data:`SEPARATION_CHI2`, in the family's
+        words (:meth:`separation_words`)."""
+        a, b = fit_a.model.effects[-1], effect_b
+        words = self.separation_words()
+        both = f"For {a.name}: {a.confirm} For {b.name}: {b.confirm}"
+        try:
+            chi2 = self.dense_misfit(fit_a, b)
+        except InputError as exc:  # B cannot be evaluated everywhere (infinite somewhere)
+            return (
+                f"{b.name} cannot be compared with {a.name} on a {words.grid_cannot} "
+                f"({exc.detail}); an independent {words.check} tells them apart. {both}"
+            )
+        if chi2 > SEPARATION_CHI2:
+            return (
+                f"{b.name} mimics {a.name} on these positions only: on a {words.grid_mimics} it "
+                f"would leave chi2 = {chi2:.0f} of misfit at the same noise, so "
+                f"{words.more_data} separates them"
+            )
+        return (
+            f"{b.name} reproduces the fitted {a.name} at every {words.position} (noise-free "
+            f"misfit chi2 = {chi2:.2g} on a {words.grid}), so no set of positions separates "
+            f"them; an independent {words.check} does. {both}"
+        )
 
     def effect(self, name: str):
         """The catalogued effect called ``name``."""

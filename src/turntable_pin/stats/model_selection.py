@@ -546,32 +546,33 @@ class Diagnosis:
         """rms, chi2_reduced, rank and p-value of ``fit`` judged with this noise variance."""
         return _summary(fit.result, self.noise_variance, self.group_variance)
 
-    def to_dict(self) -> dict:
-        """The spec's diagnosis JSON (plus steps, structure and per-effect explanations)."""
+    def _candidate_dict(self, c: Candidate) -> dict:
+        """One candidate of :meth:`to_dict`."""
         nv, gv = self.noise_variance, self.group_variance
+        entry = {
+            "effect": c.effect,
+            "testable": c.testable,
+            "delta_bic": c.delta_bic,
+            self.base_fit.result.rms_key: c.fit.result.rms_user if c.fit is not None else None,
+            "chi2_reduced": (_summary(c.fit.result, nv, gv)["chi2_reduced"] if c.fit else None),
+            "added_rank": c.added_rank,
+            "significant": c.significant,
+            "alternatives": list(c.alternatives),
+            "in_best_model": c.effect in {s.added for s in self.steps},
+        }
+        if c.parameters:
+            entry["determined"] = c.determined
+            entry["parameters"] = [dict(p) for p in c.parameters]
+        if self.steps and c.effect != self.steps[0].added:
+            entry["delta_bic_after_first"] = self.after_first.get(c.effect)
+        if c.reason:
+            entry["reason"] = c.reason
+        return entry
+
+    def _verdict_dict(self) -> dict:
+        """The ``verdict`` of :meth:`to_dict`: the generic entries, then the family's own
+        (``family_verdict``); the ``separation_commands`` after the rivals they settle."""
         named = {s.added for s in self.steps}
-        candidates = []
-        for c in self.candidates:
-            entry = {
-                "effect": c.effect,
-                "testable": c.testable,
-                "delta_bic": c.delta_bic,
-                self.base_fit.result.rms_key: c.fit.result.rms_user if c.fit is not None else None,
-                "chi2_reduced": (_summary(c.fit.result, nv, gv)["chi2_reduced"] if c.fit else None),
-                "added_rank": c.added_rank,
-                "significant": c.significant,
-                "alternatives": list(c.alternatives),
-            }
-            entry["in_best_model"] = c.effect in named
-            if c.parameters:
-                entry["determined"] = c.determined
-                entry["parameters"] = [dict(p) for p in c.parameters]
-            if self.steps and c.effect != self.steps[0].added:
-                entry["delta_bic_after_first"] = self.after_first.get(c.effect)
-            if c.reason:
-                entry["reason"] = c.reason
-            candidates.append(entry)
-        best = self.best_fit
         verdict = {
             "doubt": self.doubt,
             "missing_effect": self.missing_effect,
@@ -610,6 +611,13 @@ class Diagnosis:
         verdict.update(copy.deepcopy(self.family_verdict))
         if self.separation_commands and self.family_verdict:
             verdict["separation_commands"] = dict(self.separation_commands)
+        return verdict
+
+    def to_dict(self) -> dict:
+        """The spec's diagnosis JSON (plus steps, structure and per-effect explanations), with
+        the family's own results last (``family_results``): the one structured result the text
+        and HTML reports render."""
+        nv, gv = self.noise_variance, self.group_variance
         unit = self.family.observation_unit
         return {
             f"n_{self.family.record_label}": self.family.n_records,
@@ -617,17 +625,16 @@ class Diagnosis:
             "sigma_source": "column" if self.sigma_known else "estimated",
             f"sigma_{unit}" if unit else "sigma": self._sigma_user(),
             "base": _summary(self.base_fit.result, nv, gv),
-            "candidates": candidates,
+            "candidates": [self._candidate_dict(c) for c in self.candidates],
             "steps": [
-                {
-                    "added": s.added,
-                    "delta_bic": s.delta_bic,
-                    **_summary(s.fit.result, nv, gv),
-                }
+                {"added": s.added, "delta_bic": s.delta_bic, **_summary(s.fit.result, nv, gv)}
                 for s in self.steps
             ],
-            "best": {"effects": [s.added for s in self.steps], **_summary(best.result, nv, gv)},
-            "verdict": verdict,
+            "best": {
+                "effects": [s.added for s in self.steps],
+                **_summary(self.best_fit.result, nv, gv),
+            },
+            "verdict": self._verdict_dict(),
             "warnings": list(self.warnings),
             "outliers": [dict(o) for o in self.outliers],
             "outlier_rule": self.outlier_rule,

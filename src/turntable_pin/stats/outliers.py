@@ -25,6 +25,7 @@ __all__ = [
     "OUTLIER_ALPHA",
     "OutlierTest",
     "leverages",
+    "outlier_rule_words",
     "outlier_threshold",
     "column_variances",
     "screen_cells",
@@ -106,6 +107,21 @@ def screen_outliers(
     flagged = np.flatnonzero(t > z)
     scale = float(np.median(scales)) if r.size else 0.0
     return OutlierTest(t, scale, z, flagged[np.argsort(-t[flagged])])
+
+
+def outlier_rule_words(observations: str, group: str, pool: str, share: str) -> str:
+    """The iterated rule (:func:`screen_cells`, :func:`screened_diagnosis`) in words, from its
+    constants, for a family that names its ``observations`` (``m <observations>``), a noise
+    ``group`` and the ``pool`` of all groups (the robust scale of a group is the larger of
+    theirs) and the observations a ``share`` of which may be left out."""
+    return (
+        "studentized residual |t| = |r| / (s sqrt(1 - h)) above the two-sided normal quantile at "
+        f"{OUTLIER_ALPHA:g} / m (m {observations}; h the leverage; s the robust scale "
+        f"{_MAD_TO_SIGMA:g} median |r| / sqrt(1 - h), the larger of that of {group} and that of "
+        f"{pool}), iterated: the worst (|t| at least half the largest) left out, refitted, tested "
+        "again; first on the base model, then on the model with the accepted effects; at most "
+        f"{MAX_OUTLIER_FRACTION * 100:g} % of the {share}"
+    )
 
 
 MAX_SCREEN_ROUNDS = 20
