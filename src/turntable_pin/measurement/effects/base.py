@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from ...core.csv_table import missing_columns_words
+from ...core.exceptions import InputError
 from ...core.units import ARCSEC_PER_RAD
 from ...model.named_effects import EffectText, Labels
 from ...stats.candidate_effect import CandidateEffect
@@ -179,7 +180,11 @@ class PositionVariables:
         return int(self.joint_rad.shape[1])
 
     def angle(self, k: int) -> np.ndarray:
-        """The commanded angle of joint ``k`` (1 = the base-most joint), rad (N,)."""
+        """The commanded angle of joint ``k`` (1 = the base-most joint), rad (N,); refused
+        (:class:`InputError`) when the positions have no joint ``k`` (``phi2_rad`` of a one-joint
+        table)."""
+        if not 1 <= k <= self.n_joints:
+            raise InputError(f"these positions have {self.n_joints} joint(s), no joint {k}")
         return self.joint_rad[:, k - 1]
 
     @property
