@@ -46,7 +46,7 @@ from ..stats.diagnosis_engine import (
 from ..stats.least_squares import zero_point
 from ..stats.model_selection import Diagnosis
 from ..stats.outliers import outlier_rule_words
-from ..stats.structure_search import Probe, ProbeFactors
+from ..stats.structure_search import Probe
 from .effects import run_catalogue
 from .effects.base import RunEffect
 from .model import CHANNELS, RunFit, RunModel, fit_run, reference_coefficients, run_context
@@ -271,15 +271,10 @@ class RunFamily(DataFamily):
         return w
 
     def _shape_probes(self, directions, plot, shape, text, spec) -> list[Probe]:
-        """One probe per direction ``(site, description, (N, 2) direction)`` for one shape."""
-        var, values, functions, scale, unit = plot
-        basis = functions(values)
-        out = []
-        for site, what, direction in directions:
-            factors = ProbeFactors(var, values, functions, direction, scale, unit, self.mask)
-            out.append(self.probe(f"{site} {shape}", f"{text} {what}", factors,
-                                   f"{site}~{spec}", basis))  # fmt: skip
-        return out
+        """One probe per direction ``(site, description, (N, 2) direction)`` for one shape
+        (:meth:`shape_probes`, described as ``text`` and the direction's description)."""
+        sites = [(site, direction, f"{text} {what}") for site, what, direction in directions]
+        return self.shape_probes(plot, shape, spec, sites)
 
     def probes(self, fit: RunFit) -> list[Probe]:
         """The structure-search probes, weighted like the residuals of ``fit`` (module)."""

@@ -30,7 +30,7 @@ from ..stats.diagnosis_engine import (
 from ..stats.least_squares import RANK_RTOL, fit_least_squares
 from ..stats.model_selection import Diagnosis
 from ..stats.outliers import outlier_rule_words
-from ..stats.structure_search import Probe, ProbeFactors
+from ..stats.structure_search import Probe
 from .catalogue import catalogue as table_catalogue
 from .catalogue import resolve_effect
 from .data import ANGLE_NAMES, OrientationMeasurements
@@ -476,25 +476,12 @@ class OrientationFamily(DataFamily):
         scale, unit) added to that angle itself (``directions[a]``, shared by the probes of every
         shape); ``text`` describes it (``{angle}``: the angle), ``spec`` is the shape part of its
         ``effect_spec`` (``h3(phi1)``)."""
-        probes = []
-        var, values, functions, scale, unit = plot
-        basis = functions(values)
-        for a, angle in enumerate(ANGLE_NAMES):
-            if not self.data.measured[:, a].any():
-                continue
-            factors = ProbeFactors(
-                var, values, functions, directions[a], scale, unit, self.observed
-            )
-            probes.append(
-                self.probe(
-                    f"{angle} {shape}",
-                    text.format(angle=angle),
-                    factors,
-                    f"{angle}~{spec}",
-                    basis,
-                )
-            )
-        return probes
+        sites = [
+            (angle, directions[a], text.format(angle=angle))
+            for a, angle in enumerate(ANGLE_NAMES)
+            if self.data.measured[:, a].any()
+        ]
+        return self.shape_probes(plot, shape, spec, sites)
 
     def _error_probes(
         self,
@@ -515,18 +502,13 @@ class OrientationFamily(DataFamily):
         ``alike`` (:meth:`_alike_errors`): errors that enter the measured angles alike give the
         same probe, so a shape found along them is named after the most physical of them and
         says which others it cannot be told from."""
-        probes = []
-        var, values, functions, scale, unit = plot
-        basis = functions(values)
         names = self.table.base_names
+        sites = []
         for e, name in enumerate(names):
             if name in unseen:
                 continue
             group = (alike or {}).get(e, [e])
             lead = names[group[0]]
-            factors = ProbeFactors(
-                var, values, functions, directions[e], scale, unit, self.observed
-            )
             description = f"a {text} of {lead} ({self.table.descriptions.get(lead, lead)})"
             if len(group) > 1:
                 others = " or ".join(names[k] for k in group[1:])
@@ -534,10 +516,8 @@ class OrientationFamily(DataFamily):
                     f", or of {others}: they enter the measured angles alike on these data, "
                     "which see only their combination"
                 )
-            probes.append(
-                self.probe(f"{lead} {shape}", description, factors, f"{lead}~{spec}", basis)
-            )
-        return probes
+            sites.append((lead, directions[e], description))
+        return self.shape_probes(plot, shape, spec, sites)
 
     def _alike_errors(self, jac: np.ndarray, w: np.ndarray, unseen) -> dict[int, list[int]]:
         """``{error index: the errors entering the measured angles alike, most physical first}``

@@ -417,6 +417,22 @@ class DataFamily:
         return Probe(name, description, columns, self.user_unit_scale, self.unit_words, factors,
                      effect_spec=spec)  # fmt: skip
 
+    def shape_probes(self, plot: tuple, shape: str, spec: str, directions) -> list[Probe]:
+        """One probe per ``(site, direction, description)`` of ``directions`` for one shape:
+        ``plot`` is ``(variable, values, functions, value scale, unit)`` (the functions' basis
+        computed once for all the sites), the direction (R, K) (or a function giving it) where
+        the shape enters the observations at ``site``; each probe is named ``<site> <shape>``,
+        its ``effect_spec`` ``<site>~<spec>``."""
+        var, values, functions, scale, unit = plot
+        basis = functions(values)
+        probes = []
+        for site, direction, description in directions:
+            factors = ProbeFactors(var, values, functions, direction, scale, unit, self.observed)
+            probes.append(
+                self.probe(f"{site} {shape}", description, factors, f"{site}~{spec}", basis)
+            )
+        return probes
+
 
 def residual_sets(diagnosis: Diagnosis) -> tuple[Any, Any]:
     """The residual sets of a diagnosis' base and best fits (:meth:`DataFamily.residual_set`),
