@@ -38,9 +38,7 @@ DEFAULT_POSITIONS = 24
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``design`` to ``subparsers``."""
-    from ..calibration.site import DEFAULT_LATITUDE_DEG
-    from ..design.calibrate import DEFAULT_MIN_EFFICIENCY, MAX_MIN_EFFICIENCY
-    from ..design.space import DEFAULT_CANDIDATES, GRID_STEP_DEG
+    from ..design.space import GRID_STEP_DEG
 
     p = subparsers.add_parser(
         "design",
@@ -57,6 +55,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     one_line_errors(p)
     add_table_options(p)
     add_mount_option(p)
+    _add_mode_options(p)
+    _add_design_options(p)
+    _add_output_options(p)
+    p.set_defaults(func=run_design)
+
+
+def _add_mode_options(p: argparse.ArgumentParser) -> None:
+    """``--separate``, ``--calibrate`` and their own options."""
+    from ..design.calibrate import DEFAULT_MIN_EFFICIENCY, MAX_MIN_EFFICIENCY
+
     mode = p.add_mutually_exclusive_group()
     mode.add_argument(
         "--separate",
@@ -89,6 +97,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         f"against the grid of the same N (default {DEFAULT_MIN_EFFICIENCY:g}: at least as "
         "precise as the grid)",
     )  # fmt: skip
+
+
+def _add_design_options(p: argparse.ArgumentParser) -> None:
+    """How many positions, from which candidates, after which data, with which effects."""
+    from ..design.space import DEFAULT_CANDIDATES, GRID_STEP_DEG
+
     p.add_argument(
         "-n",
         "--positions-count",
@@ -157,6 +171,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=60.0,
         help="time per measurement, for the time_s column (default 60)",
     )
+
+
+def _add_output_options(p: argparse.ArgumentParser) -> None:
+    """``-o``, ``--run`` (with its latitude), ``--json`` and ``--plots``."""
+    from ..calibration.site import DEFAULT_LATITUDE_DEG
+
     p.add_argument(
         "-o",
         "--output",
@@ -179,7 +199,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )  # fmt: skip
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plots", type=Path, metavar="DIR", help="write the design's figures here")
-    p.set_defaults(func=run_design)
 
 
 def _noise_arcsec(text: str) -> float:

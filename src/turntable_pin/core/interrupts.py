@@ -24,6 +24,7 @@ them), die on SIGTERM and die with their parent. A forked child that still has o
 signal arrives takes the default action instead of raising the parent's exception.
 """
 
+# ctypes is imported inside worker_initializer: only pool workers need it
 from __future__ import annotations
 
 import contextlib

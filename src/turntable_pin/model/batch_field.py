@@ -268,22 +268,6 @@ class OrientationErrorField:
         shape = (c.shape[0], 3, 3) + (N_BASIS,) * expansion.n_joints
         return cls(c.reshape(shape), n_joints=expansion.n_joints)
 
-    @classmethod
-    def from_model(cls, model) -> OrientationErrorField:
-        """The field of one :class:`~.turntable.TurntableModel` (its chain and error set)."""
-        return cls.from_chain(model.chain, model.errors.as_array()[None])
-
-    @classmethod
-    def from_error_values(cls, error_values: np.ndarray, model=None) -> OrientationErrorField:
-        """The fields of K error sets of the paper's table, ``error_values`` (K, 9) in
-        ``ERROR_NAMES`` order (or (K, 8): ``deta`` 0) on ``model``'s URDF (default bundled)."""
-        from .errors import ERROR_NAMES
-        from .turntable import TurntableModel
-
-        values = np.atleast_2d(np.asarray(error_values, dtype=float))
-        values = np.pad(values, ((0, 0), (0, len(ERROR_NAMES) - values.shape[1])))
-        return cls.from_chain((model or TurntableModel()).chain, values)
-
     # ---- evaluation --------------------------------------------------------------------------
     def _evaluate(self, coefficients: np.ndarray, angles_rad) -> np.ndarray:
         """Contract (K, E, 5, ..., 5) coefficients with the basis at N angle tuples: (K, E, N)."""
@@ -314,16 +298,3 @@ class OrientationErrorField:
         One (3K, 5^J) x (5^J, P) product per block of P tuples; see the module docstring.
         """
         return self._evaluate(self._angle_coefficients, angles_rad).transpose(0, 2, 1)
-
-    def angles_on_phi2_grid(self, phi1_rad: float, phi2_grid_rad) -> np.ndarray:
-        """``(dpsi, dtheta, dgamma)`` of every error set of a two-joint table on a grid of the
-        second joint at one angle of the first: (K, 3, M)."""
-        return self.angles(float(phi1_rad), np.asarray(phi2_grid_rad, dtype=float)).transpose(
-            0, 2, 1
-        )
-
-    def max_abs_angles(self, *grids_rad) -> np.ndarray:
-        """Largest ``|dpsi|, |dtheta|, |dgamma|`` of each set over the full grid (one array of
-        angles per joint, every combination), radians: (K, 3)."""
-        k = self.n_sets
-        return max_abs_on_grid(self._angle_coefficients.reshape(k, 3, -1), grids_rad)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
@@ -283,10 +283,6 @@ class TurntableErrors:
         out = {f"{n}_arcsec": getattr(self, n) * ARCSEC_PER_RAD for n in ANGULAR_ERROR_NAMES}
         out["deta_mm"] = self.deta / M_PER_MM
         return out
-
-    def as_dict(self) -> dict[str, float]:
-        """``{name: value}`` in internal units (rad, m)."""
-        return asdict(self)
 
     def scaled(self, factor: float) -> TurntableErrors:
         """Every component multiplied by ``factor``."""

@@ -19,8 +19,10 @@ from __future__ import annotations
 from functools import lru_cache
 from pathlib import Path
 
+from ..core.exceptions import InputError
+from ..core.resources import default_urdf_path
 from .errors import ERROR_DESCRIPTIONS, ERROR_NAMES
-from .generic_table import ClosedForm, ErrorLayout
+from .generic_table import ClosedForm, ErrorLayout, GenericTable
 from .named_effects import EffectText, NamedEffect
 from .small_angle import small_angle_orientation_error
 
@@ -235,8 +237,6 @@ frame) is read under it (:func:`table_of`)."""
 @lru_cache(maxsize=8)
 def _table_under(urdf: str, layout: ErrorLayout, telescope_mount: str | None = None):
     """The table of a URDF under a bundled layout, read once per file, layout, mount and process."""
-    from .generic_table import GenericTable
-
     return GenericTable(urdf, layout=layout, telescope_mount=telescope_mount)
 
 
@@ -244,9 +244,6 @@ def paper_table(urdf_path: str | Path | None = None, telescope_mount: str | None
     """The paper's table: the :class:`~turntable_pin.model.generic_table.GenericTable` of
     ``urdf_path`` (default the bundled ``models/turntable.urdf``) under :data:`PAPER_LAYOUT`
     (read once per file, ``telescope_mount`` and process)."""
-    from ..core.exceptions import InputError
-    from ..core.resources import default_urdf_path
-
     path = Path(urdf_path) if urdf_path is not None else default_urdf_path()
     if not path.is_file():
         raise InputError("no such URDF file", path=path)
@@ -255,9 +252,8 @@ def paper_table(urdf_path: str | Path | None = None, telescope_mount: str | None
 
 def resolve_table(table=None):
     """The table ``table`` stands for, the one place a default table is chosen: ``None``, the
-    bundled table (:func:`paper_table`); an object holding a table as ``.table`` (a
-    :class:`~turntable_pin.model.turntable.TurntableModel`, a position set), that table; else
-    ``table`` itself."""
+    bundled table (:func:`paper_table`); an object holding a table as ``.table`` (a position
+    set), that table; else ``table`` itself."""
     if table is None:
         return paper_table()
     return getattr(table, "table", table)
@@ -273,8 +269,6 @@ def table_of(
     payload frame), else under the generic rule; ``telescope_mount`` says what it is, overriding
     its URDF (``None``: as the URDF declares;
     :class:`~turntable_pin.model.generic_table.GenericTable`)."""
-    from .generic_table import GenericTable
-
     table = GenericTable(urdf_path or paper_table().urdf_path, payload_frame,
                          telescope_mount=telescope_mount)  # fmt: skip
     layout = next((x for x in LAYOUTS if x.fits(table.joint_names, table.payload_frame)), None)

@@ -4,6 +4,7 @@ yourdfpy is also a second, independent forward-kinematics library: :class:`Yourd
 evaluates the same orientation error from a URDF without Pinocchio, for cross-checks.
 """
 
+# yourdfpy is imported inside functions: import turntable_pin stays light
 from __future__ import annotations
 
 import warnings
@@ -13,6 +14,7 @@ import numpy as np
 
 from ..core.exceptions import InputError, ModelError
 from ..core.files import check_input_file, write_atomic
+from ..core.resources import default_urdf_path
 from ..core.sizes import MAX_URDF_FILE_BYTES
 from .chain import ErrorChain
 
@@ -77,8 +79,6 @@ class YourdfpyTurntable:
         joints: tuple[str, ...] = ("outer_axis", "inner_axis"),
         payload_frame: str = "gyrowheel",
     ) -> None:
-        from ..core.resources import default_urdf_path
-
         self.joints, self.payload_frame = tuple(joints), payload_frame
         self.actual = _load_yourdfpy(urdf_path)
         self.nominal = _load_yourdfpy(nominal_urdf_path or default_urdf_path())

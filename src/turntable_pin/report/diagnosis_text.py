@@ -14,6 +14,7 @@ sigma given, or the structure search still finds a term).
 
 from __future__ import annotations
 
+from ..core.words import Command, argument, command
 from ..stats.diagnosis_engine import DATA_PLACEHOLDER
 
 __all__ = [
@@ -250,7 +251,7 @@ def _rival_lines(d: dict) -> list[str]:
         lines.append(
             "also significant on top of it: "
             + ", ".join(verdict["also_significant"])
-            + " (--until-explained names every step)"
+            + f" ({argument('until_explained')} names every step)"
         )
     commands = verdict.get("separation_commands", {})
     for name in verdict.get("alternatives", []):
@@ -315,7 +316,7 @@ def _unexplained_lines(d: dict, data: str) -> list[str]:
             effects = [*d.get("best", {}).get("effects", []), *specs]
             lines.append(
                 "  fit with what remains: "
-                + fit_command(data, effects, d.get("refit_command", "fit"))
+                + str(fit_command(data, effects, d.get("refit_command", "fit")))
             )
     else:
         lines.append("unexplained: no (the residuals are consistent with the noise)")
@@ -334,7 +335,7 @@ def _outlier_lines(d: dict) -> list[str]:
     more = f" and {len(outliers) - 10} more" if len(outliers) > 10 else ""
     return [
         f"outliers left out of every fit ({len(outliers)}): {shown}{more}; the rule: "
-        f"{d.get('outlier_rule')}; --keep-outliers keeps them"
+        f"{d.get('outlier_rule')}; {argument('outliers=False')} keeps them"
     ]
 
 
@@ -352,12 +353,9 @@ def _settle(commands: dict, name: str) -> list[str]:
     return [f"    to settle it, design the next positions: {commands[name]}"]
 
 
-def fit_command(data: str, specs: list[str], command: str = "fit") -> str:
-    """The ``turntable-pin fit`` command (``calibrate`` for a run) that adds the inline terms
-    ``specs`` to the model."""
-    import shlex
-
-    return f"turntable-pin {command} {shlex.quote(data)} --effects {shlex.quote(','.join(specs))}"
+def fit_command(data: str, specs: list[str], name: str = "fit") -> Command:
+    """The ``fit`` command (``calibrate`` for a run) that adds the inline terms ``specs``."""
+    return command(name, data, effects=",".join(specs))
 
 
 def other_side_lines(d: dict) -> list[str]:

@@ -10,6 +10,7 @@ result (``Diagnosis.to_dict()`` and its fits), with every plot embedded once as 
 page needs no other file).
 """
 
+# matplotlib is imported inside functions: import turntable_pin stays light
 from __future__ import annotations
 
 import base64
@@ -226,13 +227,9 @@ def _base(page: _Page, heading: str) -> list[str]:
         parts = [
             _heading(heading)
             + "<p>"
-            + (
-                "The nine turntable errors of the paper (the intersection error never changes "
-                "the orientation, so eight angles are fitted)."
-                if measured.paper
-                else f"The {len(measured.base_names)} rotation errors of the table "
-                f"{html.escape(measured.label)} (its offsets never change the orientation)."
-            )
+            + f"The {len(measured.base_names)} rotation errors of {html.escape(measured.title)} "
+            f"(its {len(measured.chain.error_names) - len(measured.base_names)} offset error(s) "
+            "never change the orientation)."
             + f" The data determine {page.d['base']['rank']} combinations of them:</p>",
             _combinations(result),
         ]

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..core.files import write_bytes_atomic
 from ..measurement.residuals import ResidualAnalysis, ResidualSet, analyse_residuals
+from ..stats.diagnosis_engine import residual_sets
 from ..stats.structure_search import FoundTerm
 from .figures import pyplot, save_png
 
@@ -104,34 +105,7 @@ def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
         sigma = np.nanmedian(np.abs(rs.residuals / np.where(rs.normalised == 0, 1, rs.normalised)))
         for row, (name, _) in enumerate(variables):
             ax = axes[row, col]
-            x = np.arange(rs.residuals.shape[0]) if name == "position" else (
-                rs.angles_deg.get(name, rs.others.get(name))
-            )  # fmt: skip
-            direction = direction_of(rs, name)
-            for i, comp in enumerate(rs.components):
-                if not measured[i]:
-                    continue
-                jitter = 0.0 if name == "position" else (i - 1) * 0.01 * (np.ptp(x) or 1.0)
-                if direction is None:
-                    ax.plot(x + jitter, rs.residuals[:, i], ".", ms=3, color=COLOURS[i],
-                            label=comp)  # fmt: skip
-                    continue
-                for sign, (marker, _) in DIRECTION_MARKERS.items():
-                    pick = direction == sign
-                    ax.plot(x[pick] + jitter, rs.residuals[pick, i], marker, ms=3.5,
-                            color=COLOURS[i], mfc=COLOURS[i] if sign > 0 else "none", mew=0.7,
-                            label=comp if sign > 0 else None)  # fmt: skip
-            if rs.outliers is not None:
-                # Left out of every fit: drawn at their value, or at the edge when beyond it.
-                shown = np.clip(rs.outliers, -0.97 * limit, 0.97 * limit)
-                for i in range(len(rs.components)):
-                    pick = np.isfinite(rs.outliers[:, i])
-                    ax.plot(x[pick], shown[pick, i], "x", ms=6, mew=1.4, color="black",
-                            label="outlier (left out)" if i == 0 else None)  # fmt: skip
-            if direction is not None:
-                ax.text(0.01, 0.02, "filled up-triangles: approached forward (dir +1)\n"
-                        "open down-triangles: backward (dir -1)", transform=ax.transAxes,
-                        fontsize=6.5, color="#555")  # fmt: skip
+            _residual_points(ax, rs, name, measured, limit)
             if np.isfinite(sigma) and sigma > 0:
                 for s in (-k_sigma * sigma, k_sigma * sigma):
                     ax.axhline(s, color="grey", lw=0.7, ls="--")
@@ -147,6 +121,39 @@ def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
                 ax.legend(fontsize=7, loc="upper right", ncol=3)
     fig.tight_layout()
     return save_png(fig)
+
+
+def _residual_points(ax, rs: ResidualSet, name: str, measured, limit: float) -> None:
+    """The residuals of ``rs`` against the variable ``name`` (by approach direction when it has
+    one) and its outliers, on ``ax``."""
+    x = np.arange(rs.residuals.shape[0]) if name == "position" else (
+        rs.angles_deg.get(name, rs.others.get(name))
+    )  # fmt: skip
+    direction = direction_of(rs, name)
+    for i, comp in enumerate(rs.components):
+        if not measured[i]:
+            continue
+        jitter = 0.0 if name == "position" else (i - 1) * 0.01 * (np.ptp(x) or 1.0)
+        if direction is None:
+            ax.plot(x + jitter, rs.residuals[:, i], ".", ms=3, color=COLOURS[i],
+                    label=comp)  # fmt: skip
+            continue
+        for sign, (marker, _) in DIRECTION_MARKERS.items():
+            pick = direction == sign
+            ax.plot(x[pick] + jitter, rs.residuals[pick, i], marker, ms=3.5,
+                    color=COLOURS[i], mfc=COLOURS[i] if sign > 0 else "none", mew=0.7,
+                    label=comp if sign > 0 else None)  # fmt: skip
+    if rs.outliers is not None:
+        # Left out of every fit: drawn at their value, or at the edge when beyond it.
+        shown = np.clip(rs.outliers, -0.97 * limit, 0.97 * limit)
+        for i in range(len(rs.components)):
+            pick = np.isfinite(rs.outliers[:, i])
+            ax.plot(x[pick], shown[pick, i], "x", ms=6, mew=1.4, color="black",
+                    label="outlier (left out)" if i == 0 else None)  # fmt: skip
+    if direction is not None:
+        ax.text(0.01, 0.02, "filled up-triangles: approached forward (dir +1)\n"
+                "open down-triangles: backward (dir -1)", transform=ax.transAxes,
+                fontsize=6.5, color="#555")  # fmt: skip
 
 
 def harmonics_figure(analyses: Sequence[ResidualAnalysis]) -> bytes:
@@ -348,8 +355,6 @@ def write_diagnosis_plots(diagnosis, directory: str | Path) -> list[Path]:
     """The figures of a diagnosis of any family into ``directory``: the residuals before and
     (with a missing effect) after, their harmonics and maps (:func:`write_residual_plots`) and
     each structure term (:func:`write_structure_plots`); returns the paths."""
-    from ..stats.diagnosis_engine import residual_sets
-
     base, best = residual_sets(diagnosis)
     sets = [base, best] if diagnosis.steps else [base]
     return [*write_residual_plots(sets, directory),

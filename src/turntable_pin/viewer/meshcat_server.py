@@ -9,6 +9,7 @@ whose start was cut short is found in the process table (a child of ours running
 ``meshcat.servers.zmqserver``) and killed.
 """
 
+# meshcat and zmq are imported inside functions: import turntable_pin stays light
 from __future__ import annotations
 
 import contextlib
