@@ -79,7 +79,7 @@ def test_magnification_of_small_deta_and_of_a_perfect_table():
     tiny = TurntableErrors.from_arcsec(deps_x=4.0, deta_mm=0.001)
     k = Exaggeration.for_errors(tiny)
     assert k.length_factor == pytest.approx(k.angle_factor)  # 2.7 mm: shown with the same factor
-    assert Exaggeration.for_errors(TurntableErrors.zero()) == Exaggeration(1.0, 1.0)
+    assert Exaggeration.for_errors(TurntableErrors()) == Exaggeration(1.0, 1.0)
     only_deta = Exaggeration.for_errors(TurntableErrors.from_arcsec(deta_mm=0.2))
     assert only_deta.angle_factor == 1.0
     assert only_deta.length_factor == pytest.approx(DEFAULT_DISPLAY_OFFSET_M / 2e-4)

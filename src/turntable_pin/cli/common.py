@@ -23,6 +23,7 @@ __all__ = [
     "add_table_options",
     "check_outputs",
     "effect_list",
+    "effect_options",
     "effect_spec",
     "FOLDER_OUTPUTS",
     "NamesFiles",
@@ -338,6 +339,24 @@ def effect_spec(text: str) -> NamesFiles:
     from ..measurement.user_effects import effect_files_named
 
     return NamesFiles.of(text, effect_files_named(text.partition(":")[0]))
+
+
+def effect_options(texts, option: str, table, user=()) -> dict[str, dict[str, float]]:
+    """``NAME:P=V,...`` options (``option``) as ``{effect: {parameter: value}}``, each effect at
+    most once; names of ``table``'s catalogue, of the effects ``user`` or inline terms."""
+    from ..measurement.effects import parse_effect_spec
+    from ..measurement.user_effects import resolve_effects
+
+    effects: dict[str, dict[str, float]] = {}
+    for text in texts:
+        try:
+            name, params = parse_effect_spec(text, lambda n: resolve_effects([n], table, user)[0])
+        except InputError as exc:
+            raise InputError(f"{option} '{text}': {exc}") from None
+        if name in effects:
+            raise InputError(f"{option} '{text}': effect '{name}' is given twice")
+        effects[name] = params
+    return effects
 
 
 def position_scheme(text: str) -> NamesFiles:

@@ -19,6 +19,7 @@ from .common import (
     add_table_options,
     bounded_float,
     effect_list,
+    effect_options,
     effect_spec,
     input_path,
     latitude_deg,
@@ -314,7 +315,6 @@ def _run_separate(args: argparse.Namespace) -> int:
     amplitude (``--amplitude``, else fitted on ``--from``), with the chance of the right name;
     one line (exit 0) when no positions within the limits separate them."""
     from ..design.separate import design_separate
-    from ..measurement.effects import parse_effect_spec
     from ..measurement.user_effects import load_effects_modules, resolve_effects
     from ..report.separation_figures import write_separate_plots
 
@@ -324,21 +324,8 @@ def _run_separate(args: argparse.Namespace) -> int:
         )
     table = table_from_args(args)
     modules = load_effects_modules(args.effects_module, table)
-    names = [n.strip() for n in args.separate.split(",") if n.strip()]
-    if len(names) != 2:
-        raise InputError(f"--separate takes two effects, A,B; got '{args.separate}'")
-    pair = resolve_effects(names, table, modules)
-    amplitudes: dict[str, dict[str, float]] = {}
-    for text in args.amplitude:
-        try:
-            name, values = parse_effect_spec(
-                text, lambda n: resolve_effects([n], table, modules)[0]
-            )
-        except InputError as exc:
-            raise InputError(f"--amplitude '{text}': {exc}") from None
-        if name in amplitudes:
-            raise InputError(f"--amplitude '{text}': effect '{name}' is given twice")
-        amplitudes[name] = values
+    pair = resolve_effects(_pair(args), table, modules)
+    amplitudes = effect_options(args.amplitude, "--amplitude", table, modules)
     space = _space(args, pair)
     result = design_separate(
         space,
@@ -355,6 +342,14 @@ def _run_separate(args: argparse.Namespace) -> int:
             print(result.report())
         return 0
     return _finish(result, args, write_separate_plots)
+
+
+def _pair(args: argparse.Namespace) -> list[str]:
+    """The two effects of ``--separate A,B``."""
+    names = [n.strip() for n in args.separate.split(",") if n.strip()]
+    if len(names) != 2:
+        raise InputError(f"--separate takes two effects, A,B; got '{args.separate}'")
+    return names
 
 
 def _run_calibrate(args: argparse.Namespace) -> int:
@@ -406,9 +401,7 @@ def _run_separate_run(args: argparse.Namespace) -> int:
                 f"design --separate --run: {option} is for orientation measurements; the run "
                 "gives the amplitudes and the noise"
             )
-    names = [n.strip() for n in args.separate.split(",") if n.strip()]
-    if len(names) != 2:
-        raise InputError(f"--separate takes two effects, A,B; got '{args.separate}'")
+    names = _pair(args)
     space = _space(args, effects=())
     count = _positions_count(args, space)
     run = read_run(args.run, deg_to_rad(args.latitude_deg), space.table)

@@ -18,6 +18,7 @@ from .common import (
     add_table_options,
     bounded_float,
     effect_list,
+    effect_options,
     effect_spec,
     error_values_from_args,
     input_path,
@@ -360,23 +361,6 @@ def _read(args: argparse.Namespace, table=None):
     return data.without_sigma() if args.ignore_sigma else data
 
 
-def _parse_effect_options(texts: list[str], table=None, user=()) -> dict[str, dict[str, float]]:
-    """The ``--effect`` options as ``{effect: {parameter: value}}``; each effect at most once.
-    Names may be the table's catalogue's, of the effects ``user`` or inline terms."""
-    from ..measurement.user_effects import resolve_effects
-
-    effects: dict[str, dict[str, float]] = {}
-    for text in texts:
-        try:
-            name, params = parse_effect_spec(text, lambda n: resolve_effects([n], table, user)[0])
-        except InputError as exc:
-            raise InputError(f"--effect '{text}': {exc}") from None
-        if name in effects:
-            raise InputError(f"--effect '{text}': effect '{name}' is given twice")
-        effects[name] = params
-    return effects
-
-
 def _option(dest: str) -> str:
     return "--" + dest.replace("_", "-")
 
@@ -494,7 +478,7 @@ def _run_simulate_orientation(args: argparse.Namespace) -> int:
     table = table_from_args(args)
     joints = _generic_joints(table)
     user = load_catalogue(args.catalogue, table)
-    effects = _parse_effect_options(args.effect, table, user)
+    effects = effect_options(args.effect, "--effect", table, user)
     user = (*user, *(inline_effect(name, table) for name in effects if "~" in name))
     design = _position_design(args, table, joints)
     if args.noise_spread != 1:

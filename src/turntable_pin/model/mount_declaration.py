@@ -1,16 +1,14 @@
 """What a table says it is: a telescope mount of a named kind, or (saying nothing) a turntable.
 
-A table is a telescope mount only when it says so; its axes are never read to guess it (a
-turntable whose outer axis is vertical and inner axis horizontal has the axes of an alt-az mount,
-and is not one). Its URDF says it with one element, a child of ``<robot>``, that Pinocchio and
-yourdfpy ignore as they ignore ``<gazebo>``::
+A table is a telescope mount only when it says so, never guessed from its axes (a turntable
+may have an alt-az mount's axes). Its URDF says it with a child of ``<robot>`` that Pinocchio and
+yourdfpy ignore::
 
     <turntable_pin mount="altaz"/>          (or mount="equatorial")
 
-The caller may say it instead, and then overrides the URDF (``GenericTable(...,
-telescope_mount=...)``): a kind, or :data:`NO_MOUNT` for a turntable whatever the URDF declares.
-Whether the chain is that mount in the documented frames is checked where the mount's terms are
-used (:func:`turntable_pin.measurement.pointing_terms.mount_kind`).
+The caller may override it (``GenericTable(..., telescope_mount=...)``: a kind, or
+:data:`NO_MOUNT`). The chain is checked where the mount's terms are used
+(:func:`turntable_pin.measurement.pointing_terms.mount_kind`).
 """
 
 from __future__ import annotations

@@ -56,8 +56,11 @@ def _unit(d: dict) -> str:
     return _rms_key(d["base"])[len("rms_") :]
 
 
-def _term_words(term: dict) -> str:
-    return f"{term['term']} ({term['amplitude']:.3g} {term['unit']})"
+def _structure_words(structure: list[dict]) -> str:
+    """The first remaining term (and how many more)."""
+    first = structure[0]
+    more = f" and {len(structure) - 1} more" if len(structure) > 1 else ""
+    return f"{first['term']} ({first['amplitude']:.3g} {first['unit']}){more}"
 
 
 def _still_unexplained(d: dict) -> str:
@@ -65,8 +68,7 @@ def _still_unexplained(d: dict) -> str:
     verdict = d["verdict"]
     structure = verdict["remaining_structure"]
     if structure:
-        more = f" and {len(structure) - 1} more" if len(structure) > 1 else ""
-        return f"structure remains: {_term_words(structure[0])}{more}"
+        return f"structure remains: {_structure_words(structure)}"
     if verdict["fails_fit_test"]:
         return (
             f"the best model still fails the chi2 test (chi2_reduced "
@@ -134,9 +136,8 @@ def _verdict_headline(d: dict) -> str:
     level = f"rms {_number(base[key])} {unit}, chi2_reduced {_number(base['chi2_reduced'])}"
     structure = verdict["remaining_structure"]
     if structure:
-        more = f" and {len(structure) - 1} more" if len(structure) > 1 else ""
         return (
-            f"Unexplained structure: {_term_words(structure[0])}{more} (no catalogued effect) "
+            f"Unexplained structure: {_structure_words(structure)} (no catalogued effect) "
             f"-- {level}"
         )
     if verdict["fails_fit_test"]:
@@ -381,8 +382,7 @@ def other_side_lines(d: dict) -> list[str]:
     for r in rivals:
         lines.append(f"  {r['effect']} (noise-free misfit chi2 {r['chi2_run']:.2g} here): "
                      f"{r['words']}")  # fmt: skip
-        if r["effect"] in commands:
-            lines.append(f"    to settle it, design the next positions: {commands[r['effect']]}")
+        lines += _settle(commands, r["effect"])
     return lines
 
 

@@ -30,16 +30,8 @@ def pyplot() -> Any:
 
 
 def save_png(fig: Any, path: str | Path | None = None, *, dpi: int = FIGURE_DPI) -> Any:
-    """Render ``fig`` to PNG and close it.
-
-    Args:
-        fig: a matplotlib figure.
-        path: where to write (atomically); ``None`` returns the PNG bytes instead.
-        dpi: resolution, dots per inch.
-
-    Returns:
-        The path written, or the PNG bytes when ``path`` is ``None``.
-    """
+    """Render the matplotlib ``fig`` to PNG at ``dpi`` and close it: written atomically to
+    ``path`` (returned), or the PNG bytes when ``path`` is ``None``."""
     try:
         if path is None:
             buffer = io.BytesIO()

@@ -39,10 +39,8 @@ DIRECTION_MARKERS = {1.0: ("^", "forward"), -1.0: ("v", "backward")}
 
 
 def direction_of(rs: ResidualSet, variable: str) -> np.ndarray | None:
-    """The approach direction (+1/-1 per position) that goes with an angle variable, or None.
-
-    The angle ``phi<k>_deg`` goes with the column ``dir<k>``; any other variable with none.
-    """
+    """The approach direction (``dir<k>``, +1/-1 per position) of the angle ``phi<k>_deg``, or
+    None."""
     if not variable.startswith("phi") or not variable.endswith("_deg"):
         return None
     value = rs.others.get("dir" + variable[3:-4])
@@ -64,9 +62,8 @@ def measured_counts(sets: Sequence[ResidualSet]) -> np.ndarray:
 def not_measured_note(
     components: Sequence[str], counts, n_positions: int, separator: str = "\n"
 ) -> str:
-    """Words naming the components not measured at every position, one per ``separator`` (a
-    line of a figure's title by default), e.g. ``"dgamma: not measured"`` or ``"dpsi: measured
-    at 40 of 80 positions"``; ``""`` when every component was measured everywhere."""
+    """The components not measured everywhere, one per ``separator``: ``"dgamma: not measured"``,
+    ``"dpsi: measured at 40 of 80 positions"``; ``""`` when none."""
     words = []
     for name, count in zip(components, counts, strict=True):
         if count == 0:
@@ -220,16 +217,10 @@ def map_limit(sets: Sequence[ResidualSet]) -> float:
 
 
 def residual_map_figure(sets: Sequence[ResidualSet], limit: float | None = None) -> bytes | None:
-    """PNG: the residual of each component over the first two angles (maps), or None.
-
-    One row per residual set, one panel per measured component (dpsi, dtheta, dgamma; those no
-    set measured are named above the maps, not drawn), the first angle across, the second up,
-    one square per measured position coloured by its residual (repeats averaged; a hollow grey
-    square where the component was not measured), on one symmetric colour scale (``limit`` in
-    the sets' unit; default: the largest residual, :func:`map_limit`), so structure in both
-    angles at once shows. None when the sets have fewer than two angles (only the first two are
-    mapped: the others are averaged over).
-    """
+    """PNG: the residual of each measured component over the first two angles, one row per set
+    (repeats averaged; hollow grey: not measured there), on one symmetric colour scale
+    (``limit``, default :func:`map_limit`), so structure in both angles shows; None with fewer
+    than two angles."""
     names = list(sets[0].angles_deg)
     if len(names) < 2:
         return None
@@ -276,12 +267,8 @@ def residual_map_figure(sets: Sequence[ResidualSet], limit: float | None = None)
 
 
 def structure_term_figure(term: FoundTerm) -> bytes:
-    """PNG: one found term against its variable: the data that show it, the fit, the noise.
-
-    Points: the partial residual projected at each record onto the direction the term enters the
-    observations along (:meth:`FoundTerm.projection`); line: the fitted term; grey band: +-1 sigma
-    of one point (the noise floor).
-    """
+    """PNG: one found term against its variable: the partial residual projected on the term's
+    direction (:meth:`FoundTerm.projection`), the fitted term, and +-1 sigma of one point."""
     plt = pyplot()
 
     pr = term.projection()
