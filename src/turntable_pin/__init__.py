@@ -1,16 +1,9 @@
 """turntable-pin: error analysis, error allocation and measurement diagnosis of two-axis turntables.
 
-The turntable is a URDF whose joint placements carry its errors; Pinocchio computes the payload
-orientation and the orientation error ``dR = Rd^T Rt``. Angles are radians and lengths metres inside
-the package; names carry the unit where it is not radians.
-
-The public API below is what a user scripts with, layer by layer (the CLI uses the same calls):
-the error model (``TurntableErrors``, ``OrientationErrorField``), the GyroWheel
-calibration layer (``GyroWheelModel``, ``PositionSet``, ``calibrate_run``, ``rate_error``,
-``orientation_requirement``), the allocation layer (``allocate_tolerances``,
-``average_sensitivities``, ``run_monte_carlo``), the measurement layer (``read_measurements``,
-``simulate_measurements``, ``fit_orientation``, ``diagnose_measurements``, ``write_report``) and the
-viewer (``SetupScene``, ``render_snapshot``). Everything else lives in its module.
+The turntable is a URDF whose joint placements carry its errors; Pinocchio computes the orientation
+error ``dR = Rd^T Rt``. Inside, angles are radians and lengths metres; names carry other units.
+Below is the public API a user scripts with, layer by layer (the CLI makes the same calls);
+everything else lives in its module.
 """
 
 from importlib import metadata

@@ -1,10 +1,8 @@
 """``design``: which positions to measure next, to identify, to separate two effects, to calibrate.
 
-The common options say the table (``--urdf``), the joints' limits, the effects, the positions
-already measured (``--from``), how many positions to choose and from how many seeded candidates;
-each mode is one function (``_run_identify``, ``_run_separate``, ``_run_calibrate``) that calls
-the library (:mod:`turntable_pin.design`) and renders its one result as text, JSON, a CSV of the
-positions (``-o``: what ``simulate --positions`` and the test crew read) and figures (``--plots``).
+Each mode is one function (``_run_identify``, ``_run_separate``, ``_run_calibrate``,
+``_run_separate_run``) that calls :mod:`turntable_pin.design` and renders its one result as text,
+JSON, a CSV of the positions (``-o``, what ``simulate --positions`` reads) and figures.
 """
 
 from __future__ import annotations

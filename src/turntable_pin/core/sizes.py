@@ -140,13 +140,9 @@ def check_count(count: float, limit: int, what: str, bytes_each: float = 0.0) ->
 def check_positions_count(
     n_positions, available: int, name: str = "n_positions", more: str = "more candidates"
 ) -> int:
-    """``n_positions`` as an int when it is a whole number from 1 to ``available``, the candidate
-    positions a design chooses among (each at most once); checked before any work, since a design
-    costs time with every position it chooses.
-
-    Raises:
-        InputError: naming the argument ``name`` and how to choose more (``more``).
-    """
+    """``n_positions`` as an int when a whole number from 1 to ``available`` (the candidates a
+    design chooses among, each once), checked before any work; else :class:`InputError` naming
+    the argument ``name`` and how to choose ``more``."""
     if isinstance(n_positions, bool) or not isinstance(n_positions, numbers.Integral):
         raise InputError(f"{name} must be a whole number of positions, got {n_positions!r}")
     count = int(n_positions)

@@ -1,10 +1,6 @@
 """Positions over whole turns of any number of joints, in degrees: the one full-turn grid and the
-one uniform random draw every layer builds its positions from.
-
-A joint angle here is a number of degrees; a grid axis is ``start, start + step, ... <
-start + 360`` (:func:`~turntable_pin.core.sizes.turn_grid_count` angles), and several axes
-combine into every combination, the first joint varying slowest (``numpy.meshgrid`` with
-``indexing="ij"``).
+one uniform random draw every layer builds its positions from (every combination of the axes,
+the first joint varying slowest).
 """
 
 from __future__ import annotations

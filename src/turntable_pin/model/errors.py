@@ -230,16 +230,8 @@ class TurntableErrors:
     def from_yaml(
         cls, path: str | Path, *, max_angle_deg: float = MAX_ANGULAR_ERROR_DEG
     ) -> TurntableErrors:
-        """Read a YAML file: a mapping ``name[_unit]: value``, optionally under a key ``errors``
-        (angles up to ``max_angle_deg``, degrees).
-
-        Example::
-
-            errors:
-              dphi_y1_arcsec: 3.0
-              deps_x_arcsec: -2.0
-              deta_mm: 0.2
-        """
+        """Read a YAML file of ``name[_unit]: value`` (``dphi_y1_arcsec: 3.0``, ``deta_mm: 0.2``),
+        optionally under a key ``errors`` (angles up to ``max_angle_deg``, degrees)."""
         path = Path(path)
         data = read_error_mapping(path)
         try:

@@ -3,15 +3,14 @@ joints with free names, axes and nominal origins.
 
 The rule that places the errors (stated once, here):
 
-- every joint ``J`` carries, after its nominal ``<origin>``, rotations about its own axis ``a``
-  (``J.position``, the position error) and about two directions perpendicular to it, ``u`` then
-  ``v`` (``J.tilt_a``, ``J.tilt_b``: the axis' wobble or orthogonality error), then translations
-  along ``u`` and ``v`` (``J.offset_a``, ``J.offset_b``, metres: the axes missing each other);
-- ``u`` is the coordinate axis of the joint frame least aligned with ``a`` (the first of x, y, z
-  on a tie), made perpendicular to ``a``; ``v = a x u``;
-- the payload mount (the first fixed joint after the last revolute one, or the payload frame
-  itself when there is none) carries rotations about its x, y and z axes (``M.rot_x``,
-  ``M.rot_y``, ``M.rot_z``): how the payload sits on the table.
+- every joint ``J`` carries, after its nominal ``<origin>``, rotations about its axis ``a``
+  (``J.position``) and about ``u`` then ``v`` perpendicular to it (``J.tilt_a``, ``J.tilt_b``:
+  wobble or orthogonality), then translations along ``u`` and ``v`` (``J.offset_a``,
+  ``J.offset_b``, metres: the axes missing each other);
+- ``u`` is the joint frame's coordinate axis least aligned with ``a`` (x, y, z first on a tie),
+  made perpendicular to ``a``; ``v = a x u``;
+- the payload mount (the first fixed joint after the last revolute one, else the payload frame)
+  carries rotations about its x, y and z axes (``M.rot_x``, ``M.rot_y``, ``M.rot_z``).
 
 Angles are radians, offsets metres. Which combinations orientation data determine is found
 numerically (:meth:`GenericTable.identifiable`); no combination is hard-coded. A table may bring
@@ -215,13 +214,9 @@ def generic_layout(chain: ErrorChain, mount: str) -> ErrorLayout:
 
 @dataclass(frozen=True)
 class OrientationError:
-    """The orientation error of the payload at one position.
-
-    Attributes:
-        dR: ``Rd^T Rt`` (eq. 23), 3x3.
-        dpsi_rad, dtheta_rad, dgamma_rad: ``dR[0,2]``, ``dR[1,0]``, ``dR[2,1]`` (eq. 24), radians.
-        payload_origin_m: payload origin in the base frame, metres (zero for a perfect table).
-    """
+    """The orientation error of the payload at one position: ``dR = Rd^T Rt`` (eq. 23), its
+    angles ``dR[0,2]``, ``dR[1,0]``, ``dR[2,1]`` (eq. 24, radians) and the payload origin in the
+    base frame, metres (zero for a perfect table)."""
 
     dR: np.ndarray
     dpsi_rad: float

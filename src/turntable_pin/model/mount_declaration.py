@@ -50,13 +50,9 @@ def declaration_text(kind: str) -> str:
 
 
 def read_mount_declaration(root, path: str | Path) -> str | None:
-    """The mount kind the URDF at ``path`` (its parsed ``<robot>`` element ``root``) declares, or
-    ``None`` when it declares none.
-
-    Raises:
-        InputError: naming ``path``, for a declaration that is not one child of ``<robot>``
-            with exactly the attribute ``mount`` set to one of :data:`MOUNT_KINDS`.
-    """
+    """The mount kind the URDF at ``path`` (its ``<robot>`` element ``root``) declares, or
+    ``None``; :class:`InputError` for a declaration that is not one child of ``<robot>`` with
+    exactly ``mount`` set to one of :data:`MOUNT_KINDS`."""
     found = list(root.iter(DECLARATION_ELEMENT))
     if not found:
         return None
@@ -73,12 +69,8 @@ def read_mount_declaration(root, path: str | Path) -> str | None:
 
 
 def resolve_mount(declared: str | None, given: str | None) -> str | None:
-    """What a table is: ``given`` (a kind, or :data:`NO_MOUNT` for a turntable) when it is not
-    ``None``, else ``declared`` (its URDF's declaration); ``None`` is a turntable.
-
-    Raises:
-        InputError: ``given`` is none of :data:`MOUNT_KINDS`, :data:`NO_MOUNT` or ``None``.
-    """
+    """What a table is (``None``: a turntable): ``given`` (a kind, or :data:`NO_MOUNT`) unless
+    ``None``, else ``declared`` (its URDF's); :class:`InputError` for any other ``given``."""
     if given is None:
         return declared
     if given not in (*MOUNT_KINDS, NO_MOUNT):

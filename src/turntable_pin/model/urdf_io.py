@@ -41,14 +41,8 @@ def _load_yourdfpy(path: str | Path):
 def write_error_urdf(
     urdf_path: str | Path, chain: ErrorChain, error_values: np.ndarray, path: str | Path
 ) -> Path:
-    """Write the nominal URDF ``urdf_path`` with ``chain``'s error transforms in its joint origins.
-
-    Args:
-        urdf_path: the nominal URDF (never overwritten).
-        chain: the error chain read off that URDF.
-        error_values: the errors in ``chain.error_names`` order (rad, m).
-        path: the output file, written atomically.
-    """
+    """Write the nominal URDF ``urdf_path`` (never overwritten) to ``path`` (atomically) with the
+    error transforms of ``chain`` (read off it) for ``error_values`` in its joint origins."""
     path, urdf_path = Path(path), Path(urdf_path)
     if path.exists() and path.resolve() == urdf_path.resolve():
         raise InputError("refusing to overwrite the input URDF", path=path)
@@ -62,15 +56,9 @@ def write_error_urdf(
 
 
 class YourdfpyTurntable:
-    """Orientation error of a URDF turntable computed with yourdfpy (independent of Pinocchio).
-
-    Args:
-        urdf_path: the URDF with errors in its placements.
-        nominal_urdf_path: the URDF giving the ideal orientation (default: the bundled nominal
-            file, ``models/turntable.urdf``).
-        joints: the revolute joints from the base (default the paper's ``outer_axis``,
-            ``inner_axis``); payload_frame: the payload frame (default ``gyrowheel``).
-    """
+    """Orientation error of ``urdf_path`` (errors in its placements) against
+    ``nominal_urdf_path`` (default the bundled table) with yourdfpy, independent of Pinocchio;
+    ``joints`` from the base and ``payload_frame`` default to the paper's."""
 
     def __init__(
         self,

@@ -1,15 +1,11 @@
 """The diagnosis in words: the text rendering of the diagnosis JSON (``Diagnosis.to_dict()``), of
 every family of data (orientation measurements, calibration runs).
 
-The text report, the JSON and the HTML page are three views of one structured result: this module
-reads only the dictionary, never another renderer's output. :func:`verdict_lines` is the verdict
-part, which the HTML report shows in its verdict box; :func:`headline` the one-line verdict both
-reports open with; :func:`family_lines` the parts a family's own data add (a calibration run's
-other side, coefficients and what it tells about the table), each said when the result has it.
-
-A headline effect is a *partial explanation*, not "the missing effect", when the model with
-every accepted effect is still unexplained (it fails the chi2 test, e.g. chi2_reduced 2.7 with
-sigma given, or the structure search still finds a term).
+Text, JSON and HTML are three views of one result: this module reads only the dictionary.
+:func:`headline` is the one-line verdict both reports open with, :func:`verdict_lines` the part
+the HTML shows in its verdict box, :func:`family_lines` what a family's own data add (a run's
+other side, coefficients and table). A headline effect is a *partial explanation* when the model
+with every accepted effect is still unexplained (chi2 test failed, or structure remains).
 """
 
 from __future__ import annotations

@@ -76,15 +76,8 @@ def import_meshcat():
 
 
 class MeshcatServer:
-    """Context manager: a running meshcat server and a ``meshcat.Visualizer`` connected to it.
-
-    Example::
-
-        with MeshcatServer() as server:
-            server.visualizer["box"].set_object(...)
-            print(server.url)
-        # the server process is gone here
-    """
+    """Context manager: a running meshcat server and a ``meshcat.Visualizer`` connected to it
+    (``server.visualizer``, ``server.url``); the server process is gone after the block."""
 
     def __init__(self) -> None:
         self.visualizer = None

@@ -456,12 +456,9 @@ class SetupScene:
 
     def set_camera(self, target_m=None, offset_m=None) -> None:
         """Aim the camera at ``target_m`` from ``target_m + offset_m`` (base frame, metres;
-        default: the scene's ``camera_target_m``, ``camera_offset_m``).
-
-        pinocchio's ``setCameraPosition`` fails with meshcat 0.3.2; the camera is a node whose
-        transform is the orbit target and whose child's ``position`` is the eye offset, in the
-        viewer's y-up frame: ``[dx, dz, -dy]``.
-        """
+        default the scene's). pinocchio's ``setCameraPosition`` fails with meshcat 0.3.2: the
+        camera node's transform is the target, its child's ``position`` the eye offset in the
+        viewer's y-up frame, ``[dx, dz, -dy]``."""
         target_m = self.camera_target_m if target_m is None else target_m
         dx, dy, dz = self.camera_offset_m if offset_m is None else offset_m
         self._vis["/Cameras/default"].set_transform(_translation(target_m))

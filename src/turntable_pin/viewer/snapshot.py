@@ -1,11 +1,9 @@
 """A PNG of the setup scene of any table, rendered headless: meshcat's static page in Chromium.
 
-The scene is drawn into a short-lived meshcat server, which hands back a self-contained HTML page
-(``static_html``, about 0.9 MB, works offline); the server is then stopped. The page gets the
-controls panel hidden and a legend, and headless Chromium renders it to PNG
-(:func:`turntable_pin.viewer.browser.screenshot_html`). Neither the server nor the browser nor a
-temporary folder outlives the call, also on error or interruption. The same scene and angles give
-a byte-identical PNG (virtual time).
+A short-lived meshcat server hands back a self-contained HTML page (``static_html``, about
+0.9 MB); with the controls hidden and a legend, headless Chromium renders it to PNG
+(:func:`~turntable_pin.viewer.browser.screenshot_html`). Nothing outlives the call, also on error
+or interruption; the same scene and angles give a byte-identical PNG (virtual time).
 """
 
 from __future__ import annotations
