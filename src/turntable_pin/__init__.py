@@ -6,7 +6,6 @@ Below is the public API a user scripts with, layer by layer (the CLI makes the s
 everything else lives in its module.
 """
 
-from importlib import metadata
 from typing import TYPE_CHECKING
 
 from .core.lazy import lazy_exports
@@ -70,19 +69,25 @@ _EXPORTS = {
 }
 
 __all__ = sorted(_EXPORTS)
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+_export, __dir__ = lazy_exports(__name__, _EXPORTS)
+
+
+def __getattr__(name: str):
+    """A public name, imported on first use; ``__version__`` read from the metadata then."""
+    if name == "__version__":
+        return _version()
+    return _export(name)
 
 
 def _version() -> str:
     """The installed distribution's version (one version: ``pyproject.toml``'s, read from the
-    metadata at run time)."""
+    metadata on use: importlib.metadata costs a few hundredths of a second at start-up)."""
+    from importlib import metadata
+
     try:
         return metadata.version("turntable-pin")
     except metadata.PackageNotFoundError:  # a source tree on the path, not installed
         return "0+unknown"
-
-
-__version__ = _version()
 
 if TYPE_CHECKING:  # names for static checkers; nothing is imported at run time
     from .allocation.capability import ManufacturingCapability  # noqa: F401
