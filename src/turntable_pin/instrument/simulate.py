@@ -33,17 +33,27 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import yaml
 
 from ..calibration.gyrowheel import AXES, MAX_COEFFICIENT_DPH, GyroWheelModel, regressor_matrix
-from ..calibration.positions import PositionSet, base_frame_inputs, position_inputs
+from ..calibration.positions import (
+    POSITION_BYTES,
+    PositionSet,
+    base_frame_inputs,
+    position_inputs,
+)
 from ..calibration.rate_error import orientation_error_rotation
 from ..calibration.run import MAX_RUN_OUTPUT_DPH, MIN_RUN_SIGMA_DPH
 from ..core.csv_table import write_csv_table
 from ..core.exceptions import InputError, check_seed
 from ..core.files import write_text_atomic
-from ..core.sizes import MAX_TIME_S
+from ..core.sizes import MAX_POSITIONS, MAX_TIME_S, check_count
 from ..core.turn_grid import random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, deg_to_rad, rad_to_deg
+from ..measurement.catalogue import resolve_effect
+from ..measurement.effect_model import OrientationModel
+from ..measurement.effects.base import PositionVariables
+from ..measurement.table import measured_table
 from ..model.angles import ANGLE_ENTRIES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
 
@@ -236,9 +246,6 @@ def random_positions(n: int, table, seed: int) -> PositionSet:
     Raises:
         InputError: ``n`` below 1 or above ``MAX_POSITIONS`` (checked before anything is drawn).
     """
-    from ..calibration.positions import POSITION_BYTES
-    from ..core.sizes import MAX_POSITIONS, check_count
-
     seed = check_seed(seed)
     if n < 1:
         raise InputError(f"random positions: expected N >= 1, got {n}")
@@ -332,8 +339,6 @@ class SimulatedRun:
     def write_truth(self, path: str | Path, *, data: str = "", command: str = "") -> Path:
         """Write the truth as YAML, atomically (``data``: the run file it belongs to;
         ``command``: the command that made it)."""
-        import yaml
-
         head = {"data": data or None, "command": command or None}
         body = {k: v for k, v in head.items() if v is not None} | self.truth
         title = f"# The truth behind {data}.\n" if data else "# The truth behind a simulated run.\n"
@@ -365,16 +370,8 @@ def _column(values, n: int, name: str, low: float, high: float) -> np.ndarray:
     return array
 
 
-def _table_rotation_errors(
-    positions: PositionSet,
-    table_errors_rad: Mapping[str, float],
-    table_effects: Mapping[str, Mapping[str, float]],
-    time_s: np.ndarray,
-    catalogue: Sequence,
-) -> tuple[np.ndarray, dict[str, float], dict[str, dict[str, float]]]:
-    """``dR`` (N, 3, 3) of the exact chain, the errors in user units (non-zero ones) and the
-    effects by their catalogue names."""
-    table = positions.table
+def _checked_errors(table, table_errors_rad: Mapping[str, float]):
+    """The table's error vector (rad, m) and its non-zero errors in user units, each checked."""
     limit_rad = deg_to_rad(MAX_ANGULAR_ERROR_DEG)
     vector = table.values(dict(table_errors_rad or {}))
     for name, value in zip(table.parameter_names, vector, strict=True):
@@ -385,18 +382,11 @@ def _table_rotation_errors(
                 f"table error '{name}' = {value:g} rad is no small error: it must be within "
                 f"+-{MAX_ANGULAR_ERROR_DEG:g} deg"
             )
-    errors = {k: v for k, v in table.to_user_units(vector).items() if v != 0.0}
-    angles = positions.angles_rad
-    if not table_effects:
-        return table.rotation_error(vector, list(angles.T)), errors, {}
+    return vector, {k: v for k, v in table.to_user_units(vector).items() if v != 0.0}
 
-    from ..measurement.catalogue import resolve_effect
-    from ..measurement.effect_model import OrientationModel
-    from ..measurement.effects.base import PositionVariables
-    from ..measurement.table import measured_table
 
-    measured = measured_table(table)
-    variables = PositionVariables(np.array(angles), time_s=np.array(time_s))
+def _resolved_effects(table_effects, measured, variables, catalogue):
+    """The catalogued table effects named in ``table_effects`` and their parameters by name."""
     objects, effects = [], {}
     for name, params in dict(table_effects).items():
         effect = resolve_effect(str(name), measured, tuple(catalogue))
@@ -413,11 +403,12 @@ def _table_rotation_errors(
             )
         objects.append(effect)
         effects[effect.name] = {str(k): float(v) for k, v in params.items()}
-    model = OrientationModel(variables, objects, measured)
-    values = {
-        n: float(v) for n, v in zip(table.parameter_names, vector, strict=True)
-        if n in measured.base_names
-    }  # fmt: skip
+    return objects, effects
+
+
+def _effect_values(objects, effects, variables) -> dict[str, float]:
+    """``{effect.parameter: internal value}`` of the effects' given parameters, each checked."""
+    values = {}
     for effect in objects:
         specs = {s.name: s for s in effect.parameters(variables)}
         for pname, value in effects[effect.name].items():
@@ -432,6 +423,32 @@ def _table_rotation_errors(
                     f"within +-{_MOUNT_LIMIT_ARCSEC:g} (in its user unit)"
                 )
             values[f"{effect.name}.{pname}"] = value * specs[pname].per_user_unit
+    return values
+
+
+def _table_rotation_errors(
+    positions: PositionSet,
+    table_errors_rad: Mapping[str, float],
+    table_effects: Mapping[str, Mapping[str, float]],
+    time_s: np.ndarray,
+    catalogue: Sequence,
+) -> tuple[np.ndarray, dict[str, float], dict[str, dict[str, float]]]:
+    """``dR`` (N, 3, 3) of the exact chain, the errors in user units (non-zero ones) and the
+    effects by their catalogue names."""
+    table = positions.table
+    vector, errors = _checked_errors(table, table_errors_rad)
+    angles = positions.angles_rad
+    if not table_effects:
+        return table.rotation_error(vector, list(angles.T)), errors, {}
+    measured = measured_table(table)
+    variables = PositionVariables(np.array(angles), time_s=np.array(time_s))
+    objects, effects = _resolved_effects(table_effects, measured, variables, catalogue)
+    model = OrientationModel(variables, objects, measured)
+    values = {
+        n: float(v) for n, v in zip(table.parameter_names, vector, strict=True)
+        if n in measured.base_names
+    }  # fmt: skip
+    values.update(_effect_values(objects, effects, variables))
     params = model.parameter_vector(values)
     rotation = model.rotation_error(params)
     # Terms a (user) effect adds to a measured angle itself, outside the chain, turn the payload
@@ -471,9 +488,7 @@ def simulate_calibration_run(
         table_effects: catalogued table effects ``{effect: {parameter: value in its user unit}}``
             (arcsec, arcsec/g, arcsec/h), e.g. ``{"inner_wobble_harmonics": {"x_c1": 15}}``.
         instrument: instrument effects ``{effect: {parameter: value}}`` of
-            :data:`SIMULATED_INSTRUMENT_EFFECTS` (mount in arcsec, bias drift in deg/h per h,
-            temperature coefficient in deg/h/degC, earth-rate scale in ppm, g^2 terms in
-            deg/h/g^2).
+            :data:`SIMULATED_INSTRUMENT_EFFECTS` in their units.
         noise_dph: 1-sigma Gaussian noise of ``out_x, out_y`` (one number for both), deg/h.
         time_s: (N,) time of each row, s; default ``index * dwell_s`` in measurement order.
         dwell_s: time per position when ``time_s`` is not given, s.
@@ -494,11 +509,7 @@ def simulate_calibration_run(
     instrument = check_instrument_effects(instrument or {})
     n = len(positions)
     time_given = time_s is not None
-    if time_s is None:
-        if not (math.isfinite(dwell_s) and dwell_s > 0):
-            raise InputError(f"dwell_s must be a number > 0, got {dwell_s!r}")
-        time_s = np.arange(n) * float(dwell_s)
-    time_s = _column(time_s, n, "time_s", 0.0, MAX_RUN_TIME_S)
+    time_s = _run_times(time_s, dwell_s, n)
     profile = None
     if isinstance(temperature_c, TemperatureProfile):
         profile, temperature_c = temperature_c, temperature_c.at(time_s)
@@ -509,74 +520,25 @@ def simulate_calibration_run(
             "instrument effect 'temperature_coefficient' needs a temperature: give temperature_c "
             "(--temperature START,RAMP_PER_H,SWING,PERIOD_H)"
         )
-    outliers = int(outliers)
-    if not 0 <= outliers <= n // 2:
-        raise InputError(f"outliers: expected 0 .. {n // 2} rows of a run of {n}, got {outliers}")
-    if outlier_dph is not None and not (math.isfinite(outlier_dph) and outlier_dph > 0):
-        raise InputError(f"outlier_dph must be a number > 0, got {outlier_dph!r}")
-    if outliers and outlier_dph is None and min(sigma) == 0.0:
-        raise InputError("outliers of a noise-free run need their size: give outlier_dph")
-
-    inputs = position_inputs(positions, latitude_rad)
+    outliers = _checked_outliers(outliers, outlier_dph, n, sigma)
     table_dR, errors, effects = _table_rotation_errors(
         positions, table_errors_rad or {}, table_effects or {}, time_s, catalogue
     )
-    mount = {"mx": 0.0, "my": 0.0, "mz": 0.0}
-    for name in ("instrument_tilt", "instrument_heading"):
-        mount.update(instrument.get(name, {}))
-    m_rad = {k: v / ARCSEC_PER_RAD for k, v in mount.items()}
-    mount_rotation = orientation_error_rotation(m_rad["my"], m_rad["mz"], m_rad["mx"], exact=True)
-    chain = inputs.payload_rotation @ table_dR @ mount_rotation
-    force0, rate0 = base_frame_inputs(latitude_rad)
-    force = np.einsum("i,nij->nj", force0, chain)
-    rate = np.einsum("i,nij->nj", rate0, chain)
-
-    scale = instrument.get("earth_rate_scale", {"x": 0.0, "y": 0.0})
-    drift = instrument.get("bias_drift", {"x": 0.0, "y": 0.0})
-    thermal = instrument.get("temperature_coefficient", {"x": 0.0, "y": 0.0})
-    g2 = instrument.get("g_squared_terms", dict.fromkeys(("x_xz", "x_yz", "y_xz", "y_yz"), 0.0))
-    exact = np.empty((n, 2))
-    for c, axis in enumerate(AXES):
-        out = (1.0 + scale[axis] * 1e-6) * rate[:, c]
-        out = out + regressor_matrix(axis, force) @ gyrowheel.axis(axis).as_array()
-        out = out + g2[f"{axis}_xz"] * force[:, 0] * force[:, 2]
-        out = out + g2[f"{axis}_yz"] * force[:, 1] * force[:, 2]
-        out = out + drift[axis] * time_s / 3600.0
-        if temperature_c is not None:
-            out = out + thermal[axis] * (temperature_c - temperature_c.mean())
-        exact[:, c] = out
-
+    force, rate = _sensed(positions, latitude_rad, table_dR, instrument)
+    exact = _exact_outputs(force, rate, gyrowheel, instrument, time_s, temperature_c)
     rng = np.random.default_rng(seed)
     measured = exact + rng.standard_normal((n, 2)) * np.array(sigma)
-    outlier_rows = []
-    if outliers:
-        rows = np.sort(rng.choice(n, size=outliers, replace=False))
-        channels = rng.integers(0, 2, outliers)
-        signs = rng.choice(np.array([-1.0, 1.0]), outliers)
-        for row, channel, sign in zip(rows, channels, signs, strict=True):
-            size = DEFAULT_OUTLIER_SIGMAS * sigma[channel] if outlier_dph is None else outlier_dph
-            measured[row, channel] += sign * size
-            outlier_rows.append(
-                {
-                    # the position (0 = the first data row): the file row depends on how many
-                    # comment lines the CSV is written with
-                    "index": int(row),
-                    "column": f"out_{AXES[channel]}_dph",
-                    "offset_dph": float(sign * size),
-                }
-            )
+    outlier_rows = _add_outliers(measured, rng, outliers, outlier_dph, sigma)
     largest = float(np.max(np.abs(measured)))
     if not largest <= MAX_RUN_OUTPUT_DPH:
         raise InputError(
             f"the simulated outputs reach {largest:g} deg/h, beyond the +-{MAX_RUN_OUTPUT_DPH:g} "
             "deg/h a run may hold; give smaller coefficients, effects or noise"
         )
-
-    table = positions.table
     truth = {
         "simulator": "turntable_pin.instrument.simulate_calibration_run",
         "seed": seed,
-        "table": table.label,
+        "table": positions.table.label,
         "positions": positions.name,
         "n_positions": n,
         "latitude_deg": float(rad_to_deg(latitude_rad)),
@@ -605,3 +567,75 @@ def simulate_calibration_run(
         truth=truth,
         seed=seed,
     )
+
+
+def _run_times(time_s, dwell_s: float, n: int) -> np.ndarray:
+    """The rows' times, s: ``time_s`` checked, or ``index * dwell_s``."""
+    if time_s is None:
+        if not (math.isfinite(dwell_s) and dwell_s > 0):
+            raise InputError(f"dwell_s must be a number > 0, got {dwell_s!r}")
+        time_s = np.arange(n) * float(dwell_s)
+    return _column(time_s, n, "time_s", 0.0, MAX_RUN_TIME_S)
+
+
+def _checked_outliers(outliers, outlier_dph, n: int, sigma) -> int:
+    """The number of outlier rows, checked with their size."""
+    outliers = int(outliers)
+    if not 0 <= outliers <= n // 2:
+        raise InputError(f"outliers: expected 0 .. {n // 2} rows of a run of {n}, got {outliers}")
+    if outlier_dph is not None and not (math.isfinite(outlier_dph) and outlier_dph > 0):
+        raise InputError(f"outlier_dph must be a number > 0, got {outlier_dph!r}")
+    if outliers and outlier_dph is None and min(sigma) == 0.0:
+        raise InputError("outliers of a noise-free run need their size: give outlier_dph")
+    return outliers
+
+
+def _sensed(positions, latitude_rad, table_dR, instrument):
+    """The specific force (g) and earth rate (deg/h) the GyroWheel senses (N, 3) through the
+    exact chain: the payload's rotation, the table's errors, the instrument's mount."""
+    inputs = position_inputs(positions, latitude_rad)
+    mount = {"mx": 0.0, "my": 0.0, "mz": 0.0}
+    for name in ("instrument_tilt", "instrument_heading"):
+        mount.update(instrument.get(name, {}))
+    m_rad = {k: v / ARCSEC_PER_RAD for k, v in mount.items()}
+    mount_rotation = orientation_error_rotation(m_rad["my"], m_rad["mz"], m_rad["mx"], exact=True)
+    chain = inputs.payload_rotation @ table_dR @ mount_rotation
+    force0, rate0 = base_frame_inputs(latitude_rad)
+    return np.einsum("i,nij->nj", force0, chain), np.einsum("i,nij->nj", rate0, chain)
+
+
+def _exact_outputs(force, rate, gyrowheel, instrument, time_s, temperature_c) -> np.ndarray:
+    """(N, 2) the noise-free outputs: eq. 1 plus the instrument effects."""
+    scale = instrument.get("earth_rate_scale", {"x": 0.0, "y": 0.0})
+    drift = instrument.get("bias_drift", {"x": 0.0, "y": 0.0})
+    thermal = instrument.get("temperature_coefficient", {"x": 0.0, "y": 0.0})
+    g2 = instrument.get("g_squared_terms", dict.fromkeys(("x_xz", "x_yz", "y_xz", "y_yz"), 0.0))
+    exact = np.empty((len(time_s), 2))
+    for c, axis in enumerate(AXES):
+        out = (1.0 + scale[axis] * 1e-6) * rate[:, c]
+        out = out + regressor_matrix(axis, force) @ gyrowheel.axis(axis).as_array()
+        out = out + g2[f"{axis}_xz"] * force[:, 0] * force[:, 2]
+        out = out + g2[f"{axis}_yz"] * force[:, 1] * force[:, 2]
+        out = out + drift[axis] * time_s / 3600.0
+        if temperature_c is not None:
+            out = out + thermal[axis] * (temperature_c - temperature_c.mean())
+        exact[:, c] = out
+    return exact
+
+
+def _add_outliers(measured, rng, outliers: int, outlier_dph, sigma) -> list[dict]:
+    """Gross errors added in place to ``outliers`` seeded rows, one channel each; their records
+    (``index``: the position, 0 = the first data row, whatever comment lines the CSV has)."""
+    if not outliers:
+        return []
+    n = measured.shape[0]
+    rows = np.sort(rng.choice(n, size=outliers, replace=False))
+    channels = rng.integers(0, 2, outliers)
+    signs = rng.choice(np.array([-1.0, 1.0]), outliers)
+    out = []
+    for row, channel, sign in zip(rows, channels, signs, strict=True):
+        size = DEFAULT_OUTLIER_SIGMAS * sigma[channel] if outlier_dph is None else outlier_dph
+        measured[row, channel] += sign * size
+        record = {"index": int(row), "column": f"out_{AXES[channel]}_dph"}
+        out.append({**record, "offset_dph": float(sign * size)})
+    return out
