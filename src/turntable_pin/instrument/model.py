@@ -20,9 +20,8 @@ import numpy as np
 
 from ..calibration.gyrowheel import AXES, N_COEFFICIENTS, TERM_NAMES
 from ..core.user_code import is_user_code
-from ..measurement.effects.base import PositionVariables
 from ..stats.least_squares import FitResult, fit_least_squares
-from .effects.base import RunContext, RunEffect
+from .effects.base import RunContext, RunEffect, run_variables
 from .effects.contract import check_run_effect
 from .sensitivity import drift_regressor, rate_sensitivity_dph
 
@@ -35,7 +34,6 @@ __all__ = [
     "fit_run",
     "reference_coefficients",
     "run_context",
-    "run_variables",
 ]
 
 CHANNELS = ("out_x", "out_y")
@@ -49,18 +47,6 @@ BASE_UNITS: tuple[str, ...] = tuple(
     _UNIT_OF_TERM.get(name, "deg/h/g^2") for axis in AXES for name in TERM_NAMES[axis]
 )
 """The unit of each of :data:`BASE_NAMES`."""
-
-
-def run_variables(run) -> PositionVariables:
-    """The run's joint angles, time and extra columns as :class:`PositionVariables` (cached on
-    the run: the effects of one run share it)."""
-    cached = run.__dict__.get("_variables")
-    if cached is None:
-        cached = PositionVariables(
-            run.joint_rad, run.time_s, (), dict(run.extra), ignored_columns=run.ignored_columns
-        )
-        object.__setattr__(run, "_variables", cached)
-    return cached
 
 
 def reference_coefficients(run, mask: np.ndarray | None = None) -> np.ndarray:

@@ -18,11 +18,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ...core.exceptions import InputError
+from ...measurement.catalogue import catalogue
+from ...measurement.table import measured_table
 from .base import INSTRUMENT, TABLE, RunContext, RunEffect
 from .bias_drift import BiasDrift
 from .earth_rate_scale import EarthRateScale
 from .g_squared import GSquaredTerms
 from .mount import InstrumentHeading, InstrumentTilt
+from .output_terms import run_term
 from .table_side import PREFIX, TableEffect, TableError
 from .temperature import TemperatureCoefficient
 
@@ -53,9 +56,6 @@ _LEFT_OUT_KINDS = ("payload_mount",)
 def run_catalogue(table=None) -> tuple[RunEffect, ...]:
     """The candidate effects of a run on ``table`` (module docstring): the table side first,
     then the instrument's."""
-    from ...measurement.catalogue import catalogue
-    from ...measurement.table import measured_table
-
     measured = measured_table(table)
     out: list[RunEffect] = [TableError(measured, name) for name in measured.base_names]
     out += [
@@ -71,9 +71,6 @@ def resolve_run_effects(names: Sequence[str], table=None, extra=()) -> list[RunE
     """The effects called ``names`` in the run catalogue of ``table`` (plus ``extra``, the
     user's); a table effect may be named without its ``table:`` prefix; an inline term
     (``out_x~h2(phi1)``, ``dpsi~h1(phi2)``) is :func:`~.output_terms.run_term`'s."""
-    from ...measurement.table import measured_table
-    from .output_terms import run_term
-
     known = {e.name: e for e in (*run_catalogue(table), *extra)}
     out = []
     for name in names:

@@ -19,7 +19,7 @@ import numpy as np
 from ...measurement.effects.base import ParameterSpec, PositionVariables
 from ...stats.candidate_effect import CandidateEffect
 
-__all__ = ["INSTRUMENT", "TABLE", "ParameterSpec", "RunContext", "RunEffect"]
+__all__ = ["INSTRUMENT", "TABLE", "ParameterSpec", "RunContext", "RunEffect", "run_variables"]
 
 TABLE = "table"
 """``side`` of an effect of the turntable (its errors reach the outputs through dR)."""
@@ -46,6 +46,17 @@ class RunContext:
     coefficients: np.ndarray
     variables: PositionVariables
     memo: dict = field(default_factory=dict)
+
+
+def run_variables(run) -> PositionVariables:
+    """The run's joint angles, time and extra columns (cached on the run: its effects share it)."""
+    cached = run.__dict__.get("_variables")
+    if cached is None:
+        cached = PositionVariables(
+            run.joint_rad, run.time_s, (), dict(run.extra), ignored_columns=run.ignored_columns
+        )
+        object.__setattr__(run, "_variables", cached)
+    return cached
 
 
 class RunEffect(CandidateEffect):

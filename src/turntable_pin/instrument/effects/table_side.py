@@ -16,7 +16,7 @@ import numpy as np
 
 from ...measurement.effect_model import OrientationModel
 from ...measurement.effects.base import ARCSEC, Effect
-from .base import TABLE, ParameterSpec, RunContext, RunEffect
+from .base import TABLE, ParameterSpec, RunContext, RunEffect, run_variables
 
 __all__ = ["PREFIX", "TableEffect", "TableError", "TableErrors"]
 
@@ -111,14 +111,10 @@ class TableEffect(RunEffect):
 
     def missing_columns(self, run) -> tuple[str, ...]:
         """The run columns the orientation effect needs and ``run`` lacks."""
-        from ..model import run_variables
-
         return self.effect.missing_columns(run_variables(run))
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
         """This effect's parameters on ``run`` (their user units and scales)."""
-        from ..model import run_variables
-
         return tuple(self.effect.parameters(run_variables(run)))
 
     def columns(self, context: RunContext) -> np.ndarray:
