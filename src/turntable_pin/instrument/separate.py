@@ -1,5 +1,5 @@
-"""Positions that tell two explanations of a calibration run apart (``design --separate A,B
---run RUN.csv``).
+"""Positions that tell two explanations of a calibration run apart (the design of a separation
+on a run).
 
 When the run diagnosis says that effect B moves the outputs like effect A on the run's
 positions (a table error and the instrument's tilt, a g-squared term and a wobble), the question
@@ -29,6 +29,7 @@ from ..calibration.positions import PositionSet, position_inputs
 from ..calibration.run import CalibrationRun
 from ..core.exceptions import InputError
 from ..core.sizes import check_positions_count
+from ..core.words import argument
 from ..stats.diagnosis_engine import SEPARATION_CHI2
 from ..stats.discrimination import Direction, t_optimal_exchange
 from .diagnosis import RunFamily
@@ -69,8 +70,7 @@ class RunSeparation:
     noise_dph: float
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The positions as run columns ``phiK_deg`` (what ``simulate --run --positions``
-        reads)."""
+        """The positions as run columns ``phiK_deg`` (what a simulated run's positions read)."""
         return {f"phi{k + 1}_deg": self.positions_deg[:, k] for k in range(len(self.joint_names))}
 
     def to_dict(self) -> dict:
@@ -191,7 +191,9 @@ def _pair(family: RunFamily, names: tuple[str, str]):
             raise InputError(f"unknown run effect '{name}'; known: {', '.join(known)}")
     a, b = (known.get(name) or known[f"table:{name}"] for name in names)
     if a is b:
-        raise InputError(f"--separate needs two different effects, got '{a.name}' twice")
+        raise InputError(
+            f"{argument('separate')} needs two different effects, got '{a.name}' twice"
+        )
     for effect in (a, b):
         _refuse_columns(effect)
     base_rank = family.fit([]).result.rank
@@ -239,5 +241,5 @@ def _words(a, b, before, after, same, n: int) -> str:
         )
     return (
         f"these {n} positions raise the smaller misfit to {min(after):.3g}, still below "
-        f"{SEPARATION_CHI2:g}: choose more positions (-n) or repeat them"
+        f"{SEPARATION_CHI2:g}: choose more positions ({argument('n')}) or repeat them"
     )
