@@ -53,13 +53,7 @@ from .model import CHANNELS, RunFit, RunModel, fit_run, reference_coefficients, 
 from .residuals import run_residuals
 from .table_errors import table_from_run
 
-__all__ = [
-    "OUTLIER_RULE",
-    "RunFamily",
-    "diagnose_run",
-    "run_design_command",
-    "run_results",
-]
+__all__ = ["OUTLIER_RULE", "RunFamily", "diagnose_run", "run_design_command", "run_results"]
 
 OUTLIER_RULE = outlier_rule_words("outputs", "the same output channel", "both", "outputs")
 """The outlier rule of :func:`diagnose_run` in words (``turntable_pin.stats.outliers``)."""
@@ -418,11 +412,7 @@ def diagnose_run(
     outliers: bool = True,
 ) -> Diagnosis:
     """Diagnose a calibration run against the run catalogue: ``diagnose_data`` on its
-    :class:`RunFamily`, the result carrying the run's own data too (:func:`run_results`).
-
-    Raises:
-        InputError: more rows than ``MAX_DIAGNOSED_ROWS``.
-    """
+    :class:`RunFamily` (InputError beyond ``MAX_DIAGNOSED_ROWS`` rows)."""
     family = RunFamily(run, catalogue)
     return diagnose_data(family, until_explained=until_explained, outliers=outliers)
 

@@ -1,22 +1,13 @@
-"""Positions that tell two explanations of a calibration run apart (the design of a separation
-on a run).
+"""Positions that tell two explanations of a calibration run apart.
 
-When the run diagnosis says that effect B moves the outputs like effect A on the run's
-positions (a table error and the instrument's tilt, a g-squared term and a wobble), the question
-is at which positions to calibrate next. Each effect is taken at the amplitude the run fits it
-with (with the 14 coefficients); if A is true, fitting the coefficients and B to what A predicts
-leaves the noise-free misfit
-
-    lambda_AB = || (I - P_B) J_A a ||^2 / sigma^2   (P_B: the projector on the coefficients and B)
-
-over the outputs of the run and the new positions, and ``lambda_BA`` the other way round. The
-design maximises the smaller of the two (T-optimal, :func:`~turntable_pin.stats.discrimination.
-t_optimal_exchange`) over seeded candidate positions within the joints' limits, added to the run.
-A misfit of :data:`~turntable_pin.stats.diagnosis_engine.SEPARATION_CHI2` (25: five sigma) tells
-them apart clearly. When B reproduces A at every candidate, no position separates them, and the
-result says so with the independent tests of the two effects' stories. Effects that need
-``time_s`` or another column are refused: positions alone do not decide them (repeat positions
-late, or change the temperature).
+When effect B moves the outputs like effect A on the run's positions (a table error and the
+instrument's tilt), where to calibrate next? Each effect at the amplitude the run fits it with:
+if A is true, fitting the coefficients and B to A's prediction leaves ``lambda_AB = || (I - P_B)
+J_A a ||^2 / sigma^2`` over the run and the new positions (``lambda_BA`` the other way). The
+design maximises the smaller (T-optimal, ``stats.discrimination.t_optimal_exchange``) over seeded
+candidates within the joints' limits; ``SEPARATION_CHI2`` (25: five sigma) tells them apart
+clearly. When B reproduces A at every candidate, the result says so with the effects' independent
+tests. Effects needing ``time_s`` or another column are refused: positions do not decide them.
 """
 
 from __future__ import annotations
@@ -44,16 +35,14 @@ A's signal beyond the coefficients."""
 
 @dataclass(frozen=True)
 class RunSeparation:
-    """The positions that tell two run effects apart, or why none do.
+    """The positions that tell two run effects ``(A, B)`` apart, or why none do.
 
     Attributes:
-        effects: the two effects ``(A, B)``.
-        joint_names: the table's joints.
-        positions_deg: (n, J) the chosen positions, degrees (empty when none separate them).
-        misfit_run: ``(lambda_AB, lambda_BA)`` on the run's positions alone (chi2 units).
-        misfit_design: the same with the chosen positions added.
-        separable: whether some positions within the limits tell them apart.
-        words: the conclusion in a sentence.
+        positions_deg: (n, J) the chosen positions of the ``joint_names``, degrees (empty when
+            none separate them).
+        misfit_run: ``(lambda_AB, lambda_BA)`` on the run alone (chi2); misfit_design: with the
+            chosen positions added.
+        separable: whether some positions tell them apart; words: the conclusion.
         n_candidates, seed: the candidates chosen from and their seed.
         noise_dph: the output noise the misfits are in units of.
     """

@@ -1,27 +1,19 @@
 """Simulated GyroWheel calibration runs: table errors, instrument effects, noise, outliers, a seed.
 
-The outputs are made along the *exact* path, independent of any linearised model, so that they
-check the run diagnosis' first-order columns:
+The outputs follow the *exact* path, independent of any linearised model, so that they check
+the run diagnosis' first-order columns:
 
-- the table turns the payload by ``dR = Rd^T Rt`` at each position: the exact chain of the
-  table's errors (``GenericTable.rotation_error``), and with catalogued table effects the exact
-  chain of :class:`~turntable_pin.measurement.effect_model.OrientationModel` (base errors plus
-  the effects' parameters);
-- the GyroWheel sits on the payload turned by its mount ``M = exp([m]x)``, ``m = (mx, my, mz)``
-  about payload x, y, z; as row vectors it senses ``a = a0 Rd dR M`` and ``w = w0 Rd dR M``
-  (``a0 = (0, 0, 1) g`` and ``w0`` the earth rate in the base frame F0, x north, y west, z up);
-- each channel c (x, y) reads ``(1 + s_c 1e-6) w_c + A_c(a) beta_c`` (eq. 1, Table 1 by
-  default) plus the instrument effects of :data:`SIMULATED_INSTRUMENT_EFFECTS` and Gaussian
-  noise; a few seeded rows get a gross outlier on one channel.
+- the table turns the payload by ``dR = Rd^T Rt``: the exact chain of its errors, with table
+  effects that of ``measurement.effect_model.OrientationModel``;
+- the GyroWheel sits turned by its mount ``M = exp([m]x)``, ``m = (mx, my, mz)`` about payload
+  x, y, z, and senses (row vectors) ``a = a0 Rd dR M``, ``w = w0 Rd dR M`` (``a0 = (0, 0, 1) g``,
+  ``w0`` the earth rate in F0: x north, y west, z up);
+- channel c reads ``(1 + s_c 1e-6) w_c + A_c(a) beta_c`` (eq. 1, Table 1 by default) plus the
+  instrument effects (the run catalogue's names and units) and Gaussian noise; a few seeded rows
+  get a gross outlier on one channel.
 
-The instrument effects carry the names and units of the run diagnosis' catalogue
-(:mod:`turntable_pin.instrument.effects`: ``instrument_tilt`` (``mx, my``),
-``instrument_heading`` (``mz``), ``bias_drift``, ``temperature_coefficient``,
-``earth_rate_scale``, ``g_squared_terms``); the tilt and the heading make one exact rotation
-``exp([m]x)`` here, whose first order is the diagnosis' linear columns.
-
-The run CSV is the one :func:`~turntable_pin.calibration.run.read_run` reads, with the seed,
-the noise and the positions in ``#`` comment lines and, unless hidden, the truth.
+The run CSV is what ``calibration.run.read_run`` reads, with the seed, the noise and the
+positions in ``#`` comment lines and, unless hidden, the truth.
 """
 
 from __future__ import annotations
@@ -36,12 +28,7 @@ import numpy as np
 import yaml
 
 from ..calibration.gyrowheel import AXES, MAX_COEFFICIENT_DPH, GyroWheelModel, regressor_matrix
-from ..calibration.positions import (
-    POSITION_BYTES,
-    PositionSet,
-    base_frame_inputs,
-    position_inputs,
-)
+from ..calibration.positions import POSITION_BYTES, PositionSet, base_frame_inputs, position_inputs
 from ..calibration.rate_error import orientation_error_rotation
 from ..calibration.run import MAX_RUN_OUTPUT_DPH, MIN_RUN_SIGMA_DPH
 from ..core.csv_table import write_csv_table
@@ -50,6 +37,7 @@ from ..core.files import write_text_atomic
 from ..core.sizes import MAX_POSITIONS, MAX_TIME_S, check_count
 from ..core.turn_grid import random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, deg_to_rad, rad_to_deg
+from ..core.words import argument, command
 from ..measurement.catalogue import resolve_effect
 from ..measurement.effect_model import OrientationModel
 from ..measurement.effects.base import PositionVariables
@@ -68,7 +56,6 @@ __all__ = [
     "check_instrument_effects",
     "random_positions",
     "simulate_calibration_run",
-    "temperature_profile",
 ]
 
 DEFAULT_DWELL_S = 60.0
@@ -83,15 +70,9 @@ _MOUNT_LIMIT_ARCSEC = MAX_ANGULAR_ERROR_DEG * 3600.0
 
 @dataclass(frozen=True)
 class InstrumentEffect:
-    """One effect of the instrument itself (not of the table) on a calibration run.
-
-    Attributes:
-        name: the effect's name (``--effect NAME:P=V``).
-        parameter_names: its parameters; a parameter not given is zero.
-        unit: the user unit of every parameter.
-        limit: largest ``|value|`` of a parameter, in ``unit`` (beyond it, no such instrument).
-        description: what it is, physically, and how it enters the outputs.
-    """
+    """One effect of the instrument itself on a simulated run: its ``name``, its
+    ``parameter_names`` (zero when not given), the ``unit`` of all, the ``limit`` of a
+    ``|value|`` in it, and a ``description`` (what it is, how it enters the outputs)."""
 
     name: str
     parameter_names: tuple[str, ...]
@@ -100,8 +81,7 @@ class InstrumentEffect:
     description: str
 
     def parameters(self, variables=None) -> tuple:
-        """The parameters as the effect specs of the measurement layer read them (for
-        ``parse_effect_spec``): objects with ``name`` and ``unit``."""
+        """The parameters (``name``, ``unit``) as ``parse_effect_spec`` reads them."""
         return tuple(_Parameter(n, self.unit) for n in self.parameter_names)
 
 
@@ -151,12 +131,8 @@ def check_instrument_effects(
     instrument: Mapping[str, Mapping[str, float]],
 ) -> dict[str, dict[str, float]]:
     """``{effect: {parameter: value}}`` checked against :data:`SIMULATED_INSTRUMENT_EFFECTS`
-    (names known, at least one parameter, finite values within the effect's limit), every
-    parameter filled (zero when not given).
-
-    Raises:
-        InputError: an unknown effect or parameter (listing the known ones), or a bad value.
-    """
+    (known names, at least one parameter, finite values within the limit), every parameter
+    filled (zero when not given); InputError otherwise, listing the known names."""
     out: dict[str, dict[str, float]] = {}
     for name, params in dict(instrument or {}).items():
         effect = SIMULATED_INSTRUMENT_EFFECTS.get(str(name))
@@ -193,11 +169,8 @@ def check_instrument_effects(
 
 @dataclass(frozen=True)
 class TemperatureProfile:
-    """A temperature history: a start, a linear ramp and a sinusoidal swing.
-
-    ``T(t) = start_c + ramp_c_per_h * t / 3600 + swing_c * sin(2 pi t / (period_h * 3600))``,
-    degC, ``t`` in seconds since the start of the run.
-    """
+    """A temperature history, degC, ``t`` in s since the start: ``T(t) = start_c + ramp_c_per_h
+    t / 3600 + swing_c sin(2 pi t / (period_h 3600))``."""
 
     start_c: float
     ramp_c_per_h: float = 0.0
@@ -232,20 +205,9 @@ class TemperatureProfile:
         }
 
 
-def temperature_profile(
-    time_s, start_c: float, ramp_c_per_h: float = 0.0, swing_c: float = 0.0, period_h: float = 1.0
-) -> np.ndarray:
-    """:meth:`TemperatureProfile.at` of the profile with these numbers (degC at ``time_s``)."""
-    return TemperatureProfile(start_c, ramp_c_per_h, swing_c, period_h).at(time_s)
-
-
 def random_positions(n: int, table, seed: int) -> PositionSet:
-    """``n`` positions uniform over every joint's turn [0, 360) deg (rounded to 1e-6 deg), drawn
-    from their own stream of ``seed`` (not the noise's).
-
-    Raises:
-        InputError: ``n`` below 1 or above ``MAX_POSITIONS`` (checked before anything is drawn).
-    """
+    """``n`` positions uniform over every joint's turn [0, 360) deg (rounded to 1e-6 deg), from
+    their own stream of ``seed``; InputError for ``n`` below 1 or above ``MAX_POSITIONS``."""
     seed = check_seed(seed)
     if n < 1:
         raise InputError(f"random positions: expected N >= 1, got {n}")
@@ -260,13 +222,10 @@ class SimulatedRun:
     """A simulated calibration run and the truth behind it.
 
     Attributes:
-        positions: the commanded positions (and the table).
-        latitude_rad: latitude of the test site, rad.
-        outputs_dph: (N, 2) ``out_x, out_y`` as measured (with noise and outliers), deg/h.
-        exact_outputs_dph: (N, 2) the same without noise and outliers, deg/h.
-        noise_dph: ``(sigma_x, sigma_y)`` of the Gaussian noise, deg/h.
-        time_s: (N,) time since the start of the run, s.
-        temperature_c: (N,) temperature, degC, or ``None`` (no such column).
+        positions: the commanded positions (and the table); latitude_rad: the site's, rad.
+        outputs_dph: (N, 2) ``out_x, out_y`` as measured; exact_outputs_dph: without noise and
+            outliers, deg/h; noise_dph: ``(sigma_x, sigma_y)``, deg/h.
+        time_s: (N,) s since the start; temperature_c: (N,) degC, or ``None``.
         truth: what made the run, JSON-ready (errors in arcsec, effects in their user units).
         seed: the random seed.
     """
@@ -287,9 +246,8 @@ class SimulatedRun:
         return len(self.positions)
 
     def columns(self, *, with_sigma: bool = True) -> dict[str, np.ndarray]:
-        """The run CSV's columns: ``phiK_deg`` (chain order), ``out_x_dph, out_y_dph``,
-        ``sigma_dph`` (with ``with_sigma``, when both channels have the same noise > 0),
-        ``time_s`` and ``temperature_c`` (when there is one)."""
+        """The run CSV's columns: ``phiK_deg``, ``out_x_dph, out_y_dph``, ``sigma_dph`` (with
+        ``with_sigma``, both channels' noise equal and > 0), ``time_s``, ``temperature_c``."""
         angles = rad_to_deg(self.positions.angles_rad).T
         out: dict[str, np.ndarray] = {f"phi{k}_deg": a for k, a in enumerate(angles, start=1)}
         out["out_x_dph"] = self.outputs_dph[:, 0]
@@ -303,11 +261,10 @@ class SimulatedRun:
         return out
 
     def comment(self, *, hide_truth: bool = False) -> str:
-        """The ``#`` lines above the CSV header: seed, noise, positions, and (unless
-        ``hide_truth``) the truth as one JSON line."""
+        """The ``#`` lines above the CSV header: seed, noise, positions, the truth (a JSON line)."""
         truth = self.truth
         lines = [
-            "simulated GyroWheel calibration run (turntable-pin simulate --run)",
+            f"simulated GyroWheel calibration run ({command('simulate', run=True)})",
             f"seed={self.seed}",
             "noise_dph={:g},{:g} (x,y)".format(*self.noise_dph),
             f"positions: {truth['positions']} ({truth['n_positions']}), table {truth['table']}, "
@@ -321,7 +278,8 @@ class SimulatedRun:
             )
         if hide_truth:
             lines.append(
-                "coefficients, table errors, effects and outliers: not recorded (--hide-truth)"
+                "coefficients, table errors, effects and outliers: not recorded "
+                f"({argument('hide_truth')})"
             )
         else:
             lines.append("truth: " + json.dumps(truth, sort_keys=False))
@@ -330,15 +288,14 @@ class SimulatedRun:
     def write_csv(
         self, path: str | Path, *, hide_truth: bool = False, with_sigma: bool = True
     ) -> Path:
-        """Write the run CSV atomically (``read_run`` reads it), the seed and, unless
-        ``hide_truth``, the truth in ``#`` comment lines."""
+        """Write the run CSV atomically with its :meth:`comment` lines."""
         return write_csv_table(
             path, self.columns(with_sigma=with_sigma), comment=self.comment(hide_truth=hide_truth)
         )
 
     def write_truth(self, path: str | Path, *, data: str = "", command: str = "") -> Path:
-        """Write the truth as YAML, atomically (``data``: the run file it belongs to;
-        ``command``: the command that made it)."""
+        """Write the truth as YAML, atomically (with the run file ``data`` and the ``command``
+        that made it)."""
         head = {"data": data or None, "command": command or None}
         body = {k: v for k, v in head.items() if v is not None} | self.truth
         title = f"# The truth behind {data}.\n" if data else "# The truth behind a simulated run.\n"
@@ -483,25 +440,24 @@ def simulate_calibration_run(
         positions: the commanded positions; ``positions.table`` is the table.
         latitude_rad: latitude of the test site, rad.
         gyrowheel: the true drift coefficients (default paper Table 1).
-        table_errors_rad: ``{error: value}`` in the table's ``parameter_names`` (rad; offsets
-            in m, which turn nothing); missing errors are zero.
-        table_effects: catalogued table effects ``{effect: {parameter: value in its user unit}}``
-            (arcsec, arcsec/g, arcsec/h), e.g. ``{"inner_wobble_harmonics": {"x_c1": 15}}``.
+        table_errors_rad: ``{error: value}`` of the table's ``parameter_names`` (rad; m for
+            offsets, which turn nothing); missing errors are zero.
+        table_effects: ``{effect: {parameter: value in its user unit}}``, e.g.
+            ``{"inner_wobble_harmonics": {"x_c1": 15}}`` (arcsec).
         instrument: instrument effects ``{effect: {parameter: value}}`` of
             :data:`SIMULATED_INSTRUMENT_EFFECTS` in their units.
         noise_dph: 1-sigma Gaussian noise of ``out_x, out_y`` (one number for both), deg/h.
         time_s: (N,) time of each row, s; default ``index * dwell_s`` in measurement order.
         dwell_s: time per position when ``time_s`` is not given, s.
-        temperature_c: (N,) temperature, degC, or a :class:`TemperatureProfile` (evaluated at
-            ``time_s``), or ``None``; written as the ``temperature_c`` column when given.
+        temperature_c: (N,) degC, or a :class:`TemperatureProfile` (at ``time_s``), or None.
         outliers: number of rows (a seeded pick) given a gross error on one channel.
         outlier_dph: size of that error, deg/h, sign seeded (default 30 sigma of the channel).
         seed: seed of the noise and the outliers (noise drawn first), 0 <= seed < 2**63.
         catalogue: user effects besides the table's catalogue that ``table_effects`` may name.
 
     Raises:
-        InputError: an unknown error, effect or parameter (naming the known ones), a value out
-            of range, a temperature coefficient without a temperature, too many outliers.
+        InputError: an unknown name (naming the known ones), a value out of range, a
+            temperature coefficient without a temperature, too many outliers.
     """
     seed = check_seed(seed)
     gyrowheel = GyroWheelModel.nominal() if gyrowheel is None else gyrowheel
@@ -510,47 +466,19 @@ def simulate_calibration_run(
     n = len(positions)
     time_given = time_s is not None
     time_s = _run_times(time_s, dwell_s, n)
-    profile = None
-    if isinstance(temperature_c, TemperatureProfile):
-        profile, temperature_c = temperature_c, temperature_c.at(time_s)
-    if temperature_c is not None:
-        temperature_c = _column(temperature_c, n, "temperature_c", -273.15, 1000.0)
-    if "temperature_coefficient" in instrument and temperature_c is None:
-        raise InputError(
-            "instrument effect 'temperature_coefficient' needs a temperature: give temperature_c "
-            "(--temperature START,RAMP_PER_H,SWING,PERIOD_H)"
-        )
+    profile, temperature_c = _temperatures(temperature_c, time_s, instrument)
     outliers = _checked_outliers(outliers, outlier_dph, n, sigma)
     table_dR, errors, effects = _table_rotation_errors(
         positions, table_errors_rad or {}, table_effects or {}, time_s, catalogue
     )
     force, rate = _sensed(positions, latitude_rad, table_dR, instrument)
     exact = _exact_outputs(force, rate, gyrowheel, instrument, time_s, temperature_c)
-    rng = np.random.default_rng(seed)
-    measured = exact + rng.standard_normal((n, 2)) * np.array(sigma)
-    outlier_rows = _add_outliers(measured, rng, outliers, outlier_dph, sigma)
-    largest = float(np.max(np.abs(measured)))
-    if not largest <= MAX_RUN_OUTPUT_DPH:
-        raise InputError(
-            f"the simulated outputs reach {largest:g} deg/h, beyond the +-{MAX_RUN_OUTPUT_DPH:g} "
-            "deg/h a run may hold; give smaller coefficients, effects or noise"
-        )
+    measured, outlier_rows = _measured(exact, sigma, seed, outliers, outlier_dph)
     truth = {
-        "simulator": "turntable_pin.instrument.simulate_calibration_run",
-        "seed": seed,
-        "table": positions.table.label,
-        "positions": positions.name,
-        "n_positions": n,
-        "latitude_deg": float(rad_to_deg(latitude_rad)),
-        "noise_dph": {"x": sigma[0], "y": sigma[1]},
-        "time": "given" if time_given else {"dwell_s": float(dwell_s)},
-        "gyrowheel": {axis: gyrowheel.axis(axis).to_dict() for axis in AXES},
+        **_run_truth(positions, latitude_rad, seed, sigma, time_given, dwell_s, gyrowheel),
         "table_errors": errors,
         "table_effects": effects,
-        "instrument_effects": {
-            k: {p: v for p, v in ps.items() if v} for k, ps in instrument.items()
-        },
-        "instrument_units": {k: SIMULATED_INSTRUMENT_EFFECTS[k].unit for k in instrument},
+        **_instrument_truth(instrument),
         "temperature_profile": None if profile is None else profile.to_dict(),
         "outliers": outlier_rows,
     }
@@ -567,6 +495,48 @@ def simulate_calibration_run(
         truth=truth,
         seed=seed,
     )
+
+
+def _run_truth(positions, latitude_rad, seed, sigma, time_given, dwell_s, gyrowheel) -> dict:
+    """The truth's head: the simulator, the seed, the table, positions, site, noise, time and the
+    drift coefficients."""
+    return {
+        "simulator": "turntable_pin.instrument.simulate_calibration_run",
+        "seed": seed,
+        "table": positions.table.label,
+        "positions": positions.name,
+        "n_positions": len(positions),
+        "latitude_deg": float(rad_to_deg(latitude_rad)),
+        "noise_dph": {"x": sigma[0], "y": sigma[1]},
+        "time": "given" if time_given else {"dwell_s": float(dwell_s)},
+        "gyrowheel": {axis: gyrowheel.axis(axis).to_dict() for axis in AXES},
+    }
+
+
+def _instrument_truth(instrument) -> dict:
+    """The instrument effects of the truth: their non-zero parameters and their units."""
+    return {
+        "instrument_effects": {
+            k: {p: v for p, v in ps.items() if v} for k, ps in instrument.items()
+        },
+        "instrument_units": {k: SIMULATED_INSTRUMENT_EFFECTS[k].unit for k in instrument},
+    }
+
+
+def _temperatures(temperature_c, time_s, instrument):
+    """``(profile or None, temperature (N,) degC or None)``, checked; a temperature coefficient
+    needs one."""
+    profile = None
+    if isinstance(temperature_c, TemperatureProfile):
+        profile, temperature_c = temperature_c, temperature_c.at(time_s)
+    if temperature_c is not None:
+        temperature_c = _column(temperature_c, len(time_s), "temperature_c", -273.15, 1000.0)
+    if "temperature_coefficient" in instrument and temperature_c is None:
+        raise InputError(
+            "instrument effect 'temperature_coefficient' needs a temperature: give temperature_c "
+            "(--temperature START,RAMP_PER_H,SWING,PERIOD_H)"
+        )
+    return profile, temperature_c
 
 
 def _run_times(time_s, dwell_s: float, n: int) -> np.ndarray:
@@ -621,6 +591,21 @@ def _exact_outputs(force, rate, gyrowheel, instrument, time_s, temperature_c) ->
             out = out + thermal[axis] * (temperature_c - temperature_c.mean())
         exact[:, c] = out
     return exact
+
+
+def _measured(exact, sigma, seed: int, outliers: int, outlier_dph):
+    """The outputs as measured (seeded noise, then outliers: :func:`_add_outliers`), checked
+    against the range a run may hold, and the outliers' records."""
+    rng = np.random.default_rng(seed)
+    measured = exact + rng.standard_normal(exact.shape) * np.array(sigma)
+    outlier_rows = _add_outliers(measured, rng, outliers, outlier_dph, sigma)
+    largest = float(np.max(np.abs(measured)))
+    if not largest <= MAX_RUN_OUTPUT_DPH:
+        raise InputError(
+            f"the simulated outputs reach {largest:g} deg/h, beyond the +-{MAX_RUN_OUTPUT_DPH:g} "
+            "deg/h a run may hold; give smaller coefficients, effects or noise"
+        )
+    return measured, outlier_rows
 
 
 def _add_outliers(measured, rng, outliers: int, outlier_dph, sigma) -> list[dict]:

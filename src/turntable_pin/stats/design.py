@@ -19,13 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = [
-    "ExchangeResult",
-    "d_optimal_design",
-    "fedorov_exchange",
-    "greedy_design",
-    "log_det",
-]
+__all__ = ["ExchangeResult", "d_optimal_design", "fedorov_exchange", "greedy_design", "log_det"]
 
 RIDGE_RTOL = 1e-9
 """Ridge of the greedy start (of n candidates' mean information): ``M`` is singular until p rows

@@ -119,8 +119,8 @@ class SeparationWords:
 
 
 class DataFamily:
-    """A ``ModelFamily`` bound to one data set (some cells maybe left out as outliers, maybe a
-    noise level per column): what :func:`diagnose_data` asks of a family. A subclass sets the
+    """A family of data bound to one data set (some cells maybe left out as outliers, maybe a
+    noise level per column): what the diagnosis asks of a family. A subclass sets the
     class attributes, calls ``DataFamily.__init__`` and implements the hooks that raise
     ``NotImplementedError`` here; :meth:`complete` may add its own data to the result.
 

@@ -111,21 +111,14 @@ def _rref(matrix: np.ndarray, tol: float = 1e-9) -> np.ndarray:
 
 def combination_name(coefficients: np.ndarray, names: tuple[str, ...]) -> str:
     """``"a + b"``, ``"a - 0.5 c.d"``, from coefficients per name."""
-    parts = []
+    out = ""
     for c, name in zip(coefficients, names, strict=True):
         if c == 0:
             continue
+        text = name if abs(abs(c) - 1.0) < 1e-6 else f"{abs(c):.4g} {name}"
         sign = "-" if c < 0 else "+"
-        mag = abs(c)
-        text = name if abs(mag - 1.0) < 1e-6 else f"{mag:.4g} {name}"
-        parts.append((sign, text))
-    if not parts:
-        return "0"
-    first_sign, first = parts[0]
-    out = ("-" if first_sign == "-" else "") + first
-    for sign, text in parts[1:]:
-        out += f" {sign} {text}"
-    return out
+        out = f"{out} {sign} {text}" if out else ("-" if c < 0 else "") + text
+    return out or "0"
 
 
 @dataclass(frozen=True)
@@ -482,10 +475,7 @@ def _evaluator(problem: FitProblem):
     both = getattr(problem, "predict_and_jacobian", None)
     if both is not None:
         return both  # its Jacobian is a new array: the fit scales it in place
-    return lambda params: (
-        problem.predict(params),
-        np.array(problem.jacobian(params), dtype=float),
-    )
+    return lambda params: (problem.predict(params), np.array(problem.jacobian(params), dtype=float))
 
 
 def tall_times(tall: np.ndarray, small: np.ndarray) -> np.ndarray:
@@ -576,13 +566,7 @@ def fit_least_squares(
     weights, j0, gradient0, cost0 = _at_zero(problem, evaluate, weights, zero_point)
     ident = analyse_identifiability(j0, names)
     m = problem.observed.size
-    if ident.rank == 0:
-        raise IdentifiabilityError("the data determine no parameter of the model")
-    if m - ident.rank <= 0:
-        raise IdentifiabilityError(
-            f"{m} observations cannot fit {ident.rank} independent parameter combinations with a "
-            "degree of freedom left; measure more positions"
-        )
+    _check_rank(ident.rank, m)
     # Whitened coordinates: the weighted Jacobian at zero times ``basis`` is orthonormal, so the
     # normal equations of every step are as well conditioned as the problem is nonlinear.
     basis = ident.basis / ident.singular_values[: ident.rank]
@@ -623,6 +607,17 @@ def fit_least_squares(
         _jacobian=_weighted_jacobian(problem, params, weights),
         n_function_evaluations=int(nfev),
     )
+
+
+def _check_rank(rank: int, m: int) -> None:
+    """Refuse a fit that determines no parameter or leaves no degree of freedom."""
+    if rank == 0:
+        raise IdentifiabilityError("the data determine no parameter of the model")
+    if m - rank <= 0:
+        raise IdentifiabilityError(
+            f"{m} observations cannot fit {rank} independent parameter combinations with a "
+            "degree of freedom left; measure more positions"
+        )
 
 
 def _at_zero(problem, evaluate, weights, zero_point):

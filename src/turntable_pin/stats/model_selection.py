@@ -1,7 +1,7 @@
 """Which catalogued effect is missing from a model: compare, rank, decide, and say so.
 
-Generic over a :class:`ModelFamily` (a base model, a catalogue of effects that extend it, probes
-for the structure search).
+Generic over a family of data (:class:`~.diagnosis_engine.DataFamily`: a base model, a catalogue
+of effects that extend it, probes for the structure search, its words).
 
 Decision rule. Each testable effect is fitted with the current model and scored by BIC,
 ``delta_bic = delta_chi2 + added_rank ln m`` (sigma given) or ``w ln(rss_new / rss_old) +
@@ -31,7 +31,7 @@ import copy
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
@@ -59,7 +59,6 @@ __all__ = [
     "FIT_TEST_ALPHA",
     "Candidate",
     "Diagnosis",
-    "ModelFamily",
     "Step",
     "compare_effects",
     "diagnose",
@@ -83,50 +82,6 @@ MAX_CORRELATION = 0.95
 
 MAX_CORRELATION_ALL = 0.995
 """... and against all the model's other parameters (its own effect's too) above this one."""
-
-
-class ModelFamily(Protocol):
-    """What :func:`diagnose` needs: fits of base + effects, reasons, probes, separation advice.
-
-    Attributes:
-        catalogue: the candidate effects (objects with a ``name``), in catalogue order.
-        n_records: number of data records (e.g. rows of a data file).
-        record_label: what a record is, for the key ``n_<label>`` of :meth:`Diagnosis.to_dict`.
-        observation_unit: name of the observations' user unit (key suffix of ``rms_``/``sigma_``).
-        sigma_scale: the observations' typical sigma in user units (the unit-weight noise).
-    """
-
-    catalogue: tuple[Any, ...]
-    n_records: int
-    record_label: str
-    observation_unit: str
-    sigma_scale: float
-
-    def fit(self, effects: Sequence[Any], noise_variance: float | None = None) -> Any:
-        """A fit object with a ``result`` (:class:`FitResult`)."""
-
-    def untestable_reason(self, effect: Any) -> str | None:
-        """Why ``effect`` cannot be tested on these data, or None."""
-
-    def probes(self, fit: Any) -> list[Probe]:
-        """Candidate shapes for the structure search in the residuals of ``fit``."""
-
-    def separation(self, fit_a: Any, effect_b: Any) -> str:
-        """Whether more data could separate the fitted effect of ``fit_a`` from ``effect_b``."""
-
-    def describe(self, effect: Any) -> dict:
-        """The effect's story (``title``, ``explanation``, ``confirm``...) for the reports."""
-
-    def design_warnings(self, base_fit: Any) -> list[str]:
-        """What the data's design cannot tell (e.g. too few distinct inputs), in words."""
-
-    def suspect_probes(self, fit: Any) -> list[Probe]:
-        """Optional: probes of shapes no catalogued effect has (terms in other inputs), tried
-        when judging whether an accepted effect only mimics one of them."""
-
-    def inputs(self, effect: Any) -> set[str]:
-        """Optional: the inputs ``effect`` depends on beyond the base model's (a drift's time):
-        a suspect shape in one of them is the effect's own kind (``factors.variable``)."""
 
 
 @dataclass
@@ -289,7 +244,7 @@ def _scored(family, current, base: FitResult, effect) -> Candidate:
     return Candidate(effect.name, True, None, fit, added, float(dbic))
 
 
-def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, candidates):
+def compare_effects(family, current: Sequence[Any], current_fit, candidates):
     """Fit each candidate effect on top of ``current`` and score it (delta_bic vs current),
     best first."""
     base = current_fit.result
@@ -377,32 +332,22 @@ class Diagnosis:
     """The outcome of :func:`diagnose`.
 
     Attributes:
-        base_fit: the base model's fit.
         candidates: every catalogued effect tested against the base, best first.
-        steps: accepted effects in order (forward selection, always run: whether structure
-            remains can only be judged on the model with every significant effect).
-        best_fit: the fit of base + all accepted effects.
+        steps: accepted effects in order (forward selection, always run: remaining structure
+            is judged on the model with every significant effect); best_fit: with them all.
         noise_variance: unit-weight variance chi2 is reported with (1 when sigma is given).
         structure: terms the structure search finds in the best model's residuals.
-        fails_fit_test: the best model's chi2 p-value is below ``FIT_TEST_ALPHA``.
-        separations: advice per alternative of the accepted first effect.
-        separation_commands: the command (the caller's) that would settle each entry of
-            ``separations``; in the JSON only when there are some.
-        until_explained: whether the verdict names every accepted effect (``missing_effects``)
-            or the first one, with the others as ``also_significant``.
-        after_first: delta_bic of each other effect on top of the first accepted one (one that
-            only soaked up part of the real effect's signal is no longer significant there).
-        warnings: what the data's design cannot tell (the family's ``design_warnings``).
-        outliers: the records left out as gross outliers (dicts the caller defines).
-        outlier_rule: the rule in words, or ``None`` when no rule was applied.
-        unneeded_given_structure: accepted effects the best description of the data does not
-            need (:func:`_least_needed`), with the BIC cost of removing each: not named.
+        separations: advice per alternative of the first effect; separation_commands: the
+            caller's command settling each (in the JSON only when there are some).
+        until_explained: whether the verdict names every accepted effect or the first one.
+        after_first: delta_bic of each other effect on top of the first accepted one.
+        outliers: the records left out (the caller's dicts); outlier_rule: the rule in words.
+        unneeded_given_structure: accepted effects the best description does not need, with
+            the BIC cost of removing each (:func:`_least_needed`): not named.
         doubt: the caller's doubt about the model family itself, said before the verdict.
-        group_variance: with a noise level per group, the best model's (every fit's chi2 is
-            reported at it).
-        family_verdict: the family's own entries of the verdict (JSON-ready), after the generic
-            ones; ``separation_commands`` then follow them.
-        family_results: the family's own entries of the result, after the generic ones.
+        group_variance: with a noise level per group, the best model's (every chi2 is at it).
+        family_verdict, family_results: the family's own entries of the verdict and result,
+            after the generic ones.
     """
 
     family: Any = field(repr=False)
@@ -605,7 +550,7 @@ class Diagnosis:
         }
 
 
-def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis:
+def diagnose(family, *, until_explained: bool = False) -> Diagnosis:
     """Test every catalogued effect against the base model and decide (module docstring).
 
     Runs with one BLAS thread (``core.blas_threads``): its products of tall, thin matrices were
@@ -697,7 +642,7 @@ def _separations(family, candidates, steps) -> dict[str, str]:
     }
 
 
-def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
+def _diagnose(family, *, until_explained: bool) -> Diagnosis:
     base_fit = family.fit([])
     candidates = compare_effects(family, [], base_fit, family.catalogue)
     steps, current, current_fit, after_first = _forward(family, candidates, base_fit)
@@ -733,9 +678,8 @@ def _search(
     family, fit, known, max_terms: int = 5, suspects_only: bool = False, skip_inputs=frozenset()
 ) -> tuple[list[FoundTerm], list[Probe]]:
     """The structure search in the residuals of ``fit``, with the probes it used (with
-    ``suspects_only``, the family's ``suspect_probes`` when it has them, except those in the
-    inputs ``skip_inputs``)."""
-    if suspects_only and hasattr(family, "suspect_probes"):
+    ``suspects_only``, the family's ``suspect_probes`` except those in ``skip_inputs``)."""
+    if suspects_only:
         probes = [
             p
             for p in family.suspect_probes(fit)
@@ -831,17 +775,11 @@ class _Description:
 
 def _least_needed(family, current, current_fit, structure, probes, known, threshold):
     """The accepted effect least needed in the best description of the data (the accepted
-    effects plus the structure found on them), with the BIC cost of removing it, or ``None``
-    when each costs at least ``-threshold`` (the acceptance rule), judged two ways:
-
-    - with the same structure: an effect that only soaked up part of a structure it does not
-      explain (a backlash taking a little of a 3/rev term) costs little to remove;
-    - with the structure found among the family's suspect shapes (inputs no catalogued effect
-      depends on) in the residuals of the model without E, when it is not E's own shape (it lies
-      outside the span of the model with E) and fits at least as well as E: E then mimics a
-      shape it does not have (an 8-parameter wobble following a slow temperature change through
-      the measurement order). When the shape is E's own or fits worse, E, the physical
-      hypothesis, is kept.
+    effects plus the structure found), with the BIC cost of removing it, or ``None`` when each
+    costs at least ``-threshold``, judged with the same structure (an effect that soaked up part
+    of a structure it does not explain costs little) and with the suspect shapes found without
+    it, when not its own and fitting as well (it mimics them: a wobble following a slow
+    temperature change through the measurement order); else it, the physical hypothesis, stays.
     """
     description = _Description(current_fit, structure, probes, known)
     worst = None
@@ -869,9 +807,8 @@ def _removal_costs(family, effect, without, current_fit, description, known) -> 
         costs.append(description.score(without, structure, probes)[0] - description.full)
     # What E stood for, in at most two shapes, in inputs E does not depend on itself (a drift in
     # time is a thermal drift's own kind) and in no more parameters than E adds.
-    inputs = family.inputs(effect) if hasattr(family, "inputs") else set()
     own, own_probes = _search(
-        family, without, known, max_terms=2, suspects_only=True, skip_inputs=inputs
+        family, without, known, max_terms=2, suspects_only=True, skip_inputs=family.inputs(effect)
     )
     if (
         own

@@ -159,11 +159,8 @@ class FoundTerm:
     effect_spec: str | None = None
 
     def curve(self, values: np.ndarray) -> np.ndarray:
-        """The fitted term at ``values`` of its variable (internal units), in user units.
-
-        Raises:
-            ValueError: the probe did not say how its columns factor (no ``factors``).
-        """
+        """The fitted term at ``values`` of its variable (internal units), in user units
+        (ValueError without ``factors``)."""
         if self.factors is None:
             raise ValueError(f"term '{self.name}' has no factors: it cannot be drawn as a curve")
         values = np.atleast_1d(np.asarray(values, dtype=float))
@@ -233,12 +230,7 @@ def profiled_weight(m: int, rank_new: int, added: int) -> float:
 
 
 def delta_bic(
-    rss_new: float,
-    rss_old: float,
-    added: int,
-    m: int,
-    noise_variance: float | None,
-    rank_new: int,
+    rss_new: float, rss_old: float, added: int, m: int, noise_variance: float | None, rank_new: int
 ):
     """BIC change of a model adding ``added`` parameters: ``(rss_new - rss_old) / var + added
     ln m`` with a known noise variance, else ``w ln(rss_new / rss_old) + added ln m`` (the

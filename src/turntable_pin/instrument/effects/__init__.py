@@ -1,16 +1,13 @@
 """Candidate effects of a calibration run, on the table's side and on the instrument's.
 
-- table side (:mod:`.table_side`): each base error of the table (``table:<error>``) and each
-  effect of its orientation catalogue (``table:<effect>``), through eqs. 8-13;
-- instrument side: :mod:`.mount` (``instrument_tilt``, ``instrument_heading``),
-  :mod:`.bias_drift` (``bias_drift``), :mod:`.temperature` (``temperature_coefficient``),
-  :mod:`.earth_rate_scale` (``earth_rate_scale``), :mod:`.g_squared` (``g_squared_terms``);
-- :mod:`.output_terms`: inline terms on an output (``out_x~h2(phi1)``), what the structure
-  search names.
+- table side (:mod:`.table_side`): each base error (``table:<error>``) and orientation effect
+  (``table:<effect>``) of the table, through eqs. 8-13 (not ``payload_mount``: the instrument's
+  tilt and heading are the same rotation);
+- instrument side: :mod:`.mount`, :mod:`.bias_drift`, :mod:`.temperature`,
+  :mod:`.earth_rate_scale`, :mod:`.g_squared`;
+- :mod:`.output_terms`: inline terms on an output (``out_x~h2(phi1)``).
 
-The table's own ``payload_mount`` is the instrument's tilt and heading seen from the table (the
-same rotation in the payload frame), so it is left out of the table side. A user's effect
-is a :class:`~.base.RunEffect` subclass passed in the catalogue.
+A user's effect is a :class:`~.base.RunEffect` subclass passed in the catalogue.
 """
 
 from __future__ import annotations

@@ -52,8 +52,7 @@ def check_run_effect(
     array = numbers_returned(columns)
     if array is None or array.shape != (n, 2, len(specs)):
         raise contract_error(
-            effect,
-            f"columns(context) returned {described(columns)} on {on}; expected {expected}",
+            effect, f"columns(context) returned {described(columns)} on {on}; expected {expected}"
         )
     array = array.astype(float)
     bad = ~np.isfinite(array)

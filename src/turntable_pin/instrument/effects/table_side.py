@@ -1,13 +1,10 @@
 """The table's errors and effects, as a calibration run sees them (eqs. 7-14).
 
-Any orientation error the table's URDF can carry (a base error of
-:class:`~turntable_pin.measurement.table.MeasuredTable`: an orthogonality, a wobble, a
-position error) and any effect of the table's orientation catalogue (encoder and wobble
-harmonics, gravity sag, base tilt...) moves the payload by ``(dpsi, dtheta, dgamma)`` at each
-position; the outputs change by the rate sensitivity times that (:mod:`..sensitivity`). The
-orientation derivatives come from the measurement layer's exact chain
-(:class:`~turntable_pin.measurement.effect_model.OrientationModel`), so every table the
-orientation diagnosis knows is known here, under the same names, prefixed ``table:``.
+A base error of the table (orthogonality, wobble, position) or an effect of its orientation
+catalogue moves the payload by ``(dpsi, dtheta, dgamma)``; the outputs change by the rate
+sensitivity times that. The orientation derivatives come from the measurement layer's exact chain
+(``OrientationModel``): every table the orientation diagnosis knows, under its names prefixed
+``table:``.
 """
 
 from __future__ import annotations
