@@ -26,7 +26,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .least_squares import RANK_RTOL
-from .model_selection import MAX_CORRELATION, MAX_CORRELATION_ALL
+from .model_selection import (
+    MAX_CORRELATION,
+    MAX_CORRELATION_ALL,
+    column_span,
+    multiple_correlations,
+)
 
 __all__ = [
     "RIDGE",
@@ -120,24 +125,14 @@ def traded_off(shared: np.ndarray, own: np.ndarray) -> bool:
     rank = int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
     flat = vt[rank:]  # directions the columns do not see
     n_shared = shared.shape[1]
-    rank_shared = orthonormal_span(shared).shape[1]
-
-    def span(index: list[int], cut: int) -> np.ndarray:
-        u, _, _ = np.linalg.svd(scaled[:, index], full_matrices=False)
-        return u[:, : max(cut, 0)]
-
-    base = span(list(range(n_shared)), rank_shared)
+    base = column_span(scaled, range(n_shared), orthonormal_span(shared).shape[1])
     seen = 0
     for i in range(n_shared, columns.shape[1]):
         if norms[i] <= 0 or np.linalg.norm(flat[:, i]) > 1e-8:
             continue  # not seen on its own: counts neither way
         seen += 1
-        column = scaled[:, i]
-        others = span([k for k in range(columns.shape[1]) if k != i], rank - 1)
-        if (
-            np.linalg.norm(base.T @ column) > MAX_CORRELATION
-            or np.linalg.norm(others.T @ column) > MAX_CORRELATION_ALL
-        ):
+        correlation, correlation_all = multiple_correlations(scaled, i, base, rank)
+        if correlation > MAX_CORRELATION or correlation_all > MAX_CORRELATION_ALL:
             return True
     return seen == 0
 

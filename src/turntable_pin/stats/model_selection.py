@@ -52,6 +52,8 @@ __all__ = [
     "DETERMINED_SIGMAS",
     "MAX_CORRELATION",
     "MAX_CORRELATION_ALL",
+    "column_span",
+    "multiple_correlations",
     "UNDETERMINED_GAIN_RATIO",
     "parameter_determination",
     "undetermined_parameters",
@@ -153,24 +155,15 @@ def parameter_determination(
     index = {n: i for i, n in enumerate(result.parameter_names)}
     # Angles between columns are those of R (J = Q R): every projection is done on the small R.
     jac = tall_r_factor(result.jacobian_weighted)
-
-    def span(columns: list[int], rank: int) -> np.ndarray:
-        u, _, _ = np.linalg.svd(jac[:, columns], full_matrices=False)
-        return u[:, : max(int(rank), 0)]
-
-    base = span([index[n] for n in base_names], base_rank)
+    base = column_span(jac, [index[n] for n in base_names], base_rank)
     out = []
     for name in names:
         i = index[name]
         entry = table[name]
         std = entry["std"]
         correlation = correlation_all = 1.0
-        column = jac[:, i]
-        norm = float(np.linalg.norm(column))
-        if std is not None and std > 0 and norm > 0:
-            correlation = min(float(np.linalg.norm(base.T @ column)) / norm, 1.0)
-            others = span([k for k in range(jac.shape[1]) if k != i], result.rank - 1)
-            correlation_all = min(float(np.linalg.norm(others.T @ column)) / norm, 1.0)
+        if std is not None and std > 0 and np.linalg.norm(jac[:, i]) > 0:
+            correlation, correlation_all = multiple_correlations(jac, i, base, result.rank)
         out.append(
             {
                 "name": name,
@@ -188,6 +181,24 @@ def parameter_determination(
             }
         )
     return out
+
+
+def column_span(matrix: np.ndarray, columns: Sequence[int], rank: int) -> np.ndarray:
+    """An orthonormal basis of the span of ``matrix[:, columns]`` cut to ``rank`` directions."""
+    u, _, _ = np.linalg.svd(matrix[:, list(columns)], full_matrices=False)
+    return u[:, : max(int(rank), 0)]
+
+
+def multiple_correlations(matrix, i: int, base: np.ndarray, rank: int) -> tuple[float, float]:
+    """The multiple correlations (at most 1) of column ``i`` of ``matrix`` with the orthonormal
+    ``base`` and with the span of its other columns cut to ``rank - 1`` directions."""
+    column = matrix[:, i]
+    norm = float(np.linalg.norm(column))
+    others = column_span(matrix, [k for k in range(matrix.shape[1]) if k != i], rank - 1)
+    return (
+        min(float(np.linalg.norm(base.T @ column)) / norm, 1.0),
+        min(float(np.linalg.norm(others.T @ column)) / norm, 1.0),
+    )
 
 
 def acceptance_threshold(n_testable: int) -> float:
@@ -239,9 +250,15 @@ def _scored(family, current, base: FitResult, effect) -> Candidate:
         reason = "indistinguishable from the model already fitted on these data: its parameters "
         reason += "only move along " + "; ".join(names[:4])
         return Candidate(effect.name, False, reason, fit=fit)
-    known = 1.0 if base.sigma_known else None
-    dbic = delta_bic(_rss(fit.result), _rss(base), added, base.n_obs, known, fit.result.rank)
-    return Candidate(effect.name, True, None, fit, added, float(dbic))
+    return Candidate(effect.name, True, None, fit, added, _delta_bic(fit.result, base))
+
+
+def _delta_bic(result: FitResult, previous: FitResult) -> float:
+    """delta_bic of ``result`` against the smaller model ``previous`` (its added rank)."""
+    known = 1.0 if previous.sigma_known else None
+    added = result.rank - previous.rank
+    dbic = delta_bic(_rss(result), _rss(previous), added, result.n_obs, known, result.rank)
+    return float(dbic)
 
 
 def compare_effects(family, current: Sequence[Any], current_fit, candidates):
@@ -861,14 +878,8 @@ def _steps_of(family, effects, base_fit) -> list[Step]:
     against the previous model."""
     steps = []
     previous = base_fit
-    known = 1.0 if base_fit.result.sigma_known else None
     for k in range(len(effects)):
         fit = family.fit(effects[: k + 1])
-        added = fit.result.rank - previous.result.rank
-        result = fit.result
-        dbic = delta_bic(
-            _rss(result), _rss(previous.result), added, result.n_obs, known, result.rank
-        )
-        steps.append(Step(effects[k].name, float(dbic), fit, []))
+        steps.append(Step(effects[k].name, _delta_bic(fit.result, previous.result), fit, []))
         previous = fit
     return steps
