@@ -4,9 +4,12 @@ no false name on clean runs, the confounded cases said as such."""
 
 from __future__ import annotations
 
+import shlex
+
 import numpy as np
 import pytest
 
+from conftest import EXAMPLES_DIR
 from turntable_pin.calibration.positions import PositionSet, position_inputs
 from turntable_pin.calibration.run import CalibrationRun
 from turntable_pin.core.units import arcsec_to_rad
@@ -158,3 +161,21 @@ def test_outputs_with_different_noise_get_their_own_level_and_no_false_name():
         d = diagnose_run(run).to_dict()
         assert any("the two outputs' noise differ" in w for w in d["warnings"])
         assert d["verdict"]["missing_effects"] == ([] if not hidden else ["bias_drift"])
+
+
+def test_the_design_command_is_a_python_call_or_under_the_cli_the_shell_command():
+    from turntable_pin.calibration.run import read_run
+    from turntable_pin.cli.words import CLI_WORDS
+    from turntable_pin.core.words import speaking
+    from turntable_pin.instrument.diagnosis import run_design_command
+
+    path = EXAMPLES_DIR / "runs" / "run_bias_drift.csv"
+    command = run_design_command(read_run(path, np.radians(30.0)), ("bias_drift", "table:deps_x"))
+    assert str(command) == (
+        f"design(separate='bias_drift,table:deps_x', run={str(path)!r}, latitude_deg='30')"
+    )
+    with speaking(CLI_WORDS):
+        assert str(command) == (
+            "turntable-pin design --separate bias_drift,table:deps_x --run "
+            f"{shlex.quote(str(path))} --latitude-deg 30"
+        )

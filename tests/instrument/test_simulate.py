@@ -21,7 +21,6 @@ from turntable_pin.core.units import arcsec_to_rad, deg_to_rad
 from turntable_pin.instrument.simulate import (
     TemperatureProfile,
     simulate_calibration_run,
-    temperature_profile,
 )
 from turntable_pin.model.paper_table import paper_table
 
@@ -141,7 +140,7 @@ def test_the_instrument_effects_add_their_closed_forms(grid30, clean):
     np.testing.assert_allclose(g2[:, 1] - base[:, 1], -0.02 * a[:, 1] * a[:, 2], atol=1e-12)
 
     profile = TemperatureProfile(20.0, 1.0, 2.5, 3.0)
-    temperature = temperature_profile(time_s, 20.0, 1.0, 2.5, 3.0)
+    temperature = TemperatureProfile(20.0, 1.0, 2.5, 3.0).at(time_s)
     np.testing.assert_allclose(profile.at(time_s), temperature)
     thermal = simulate_calibration_run(
         grid30, LATITUDE_RAD, dwell_s=120.0, temperature_c=profile,

@@ -11,6 +11,7 @@ CLI_WORDS = CommandLineWords(
     "turntable-pin",
     {
         "from_data": "--from",
+        "n": "-n",
         "outliers=False": "--keep-outliers",
     },
 )

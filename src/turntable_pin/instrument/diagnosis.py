@@ -1,22 +1,15 @@
 """Diagnose a calibration run: is the missing effect the table's or the instrument's?
 
-:class:`RunFamily` is the run's model family for the generic diagnosis
-(:func:`turntable_pin.stats.model_selection.diagnose`): the base is the 2 x 7 drift
-coefficients (eq. 1), the candidates are the run catalogue (:mod:`.effects`: the table's errors
-and effects through eqs. 8-13, and the instrument's own), with the same rules as the orientation
-diagnosis: BIC with the look-elsewhere penalty, determined parameters, alternatives, gross
-outliers left out (per output, groups ``out_x``/``out_y``), a noise level per output channel
-when sigma is not given and the two channels' noise differ, and the structure search.
+:class:`RunFamily` is the run's family for the one diagnosis (``stats.diagnosis_engine``): the
+base is the 2 x 7 drift coefficients (eq. 1), the candidates the run catalogue (:mod:`.effects`:
+the table's errors and effects through eqs. 8-13, and the instrument's own), outliers grouped per
+output (``out_x``/``out_y``), a noise level per output when sigma is not given and they differ.
 
-Probes of the structure search (the shape of what is missing):
-
-- ``out_x k/rev in phiK`` / ``out_y ...``: a harmonic of order k of a joint angle on one output
-  (k = 1 .. 5, fewer with fewer distinct angles), and ``k/rev in phiA+phiB``, ``phiA-phiB``
-  (k = 1, 2);
-- ``dpsi k/rev in phiK`` (and ``dtheta``, ``dgamma``): a harmonic orientation error of the table,
-  through the rate sensitivity;
-- ``out_x drift in time``, ``out_x in <column>``: a quadratic in ``time_s`` or in another numeric
-  column (``temperature_c``...).
+Probes of the structure search: ``out_x k/rev in phiK`` (k = 1 .. 5, fewer with fewer distinct
+angles; ``phiA+phiB``, ``phiA-phiB`` for k = 1, 2) on each output; ``dpsi k/rev in phiK`` (and
+``dtheta``, ``dgamma``), a harmonic orientation error of the table through the rate
+sensitivity; ``out_x drift in time``, ``out_x in <column>``: a quadratic in ``time_s`` or another
+numeric column (``temperature_c``...).
 """
 
 from __future__ import annotations
@@ -26,13 +19,19 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..calibration.drift_fit import gravity_words
+from ..calibration.positions import PositionSet, position_inputs
+from ..calibration.run import CalibrationRun
+from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.exceptions import InputError
 from ..core.units import DEG_PER_RAD
+from ..core.words import Command, argument, command
 from ..measurement.diagnosis import (
     dense_joint_grid,
     harmonic_basis,
     joint_harmonics,
+    mount_option,
     polynomial_basis,
+    urdf_option,
 )
 from ..measurement.table import measured_table
 from ..model.angles import ANGLE_NAMES
@@ -47,35 +46,29 @@ from ..stats.least_squares import zero_point
 from ..stats.model_selection import Diagnosis
 from ..stats.outliers import outlier_rule_words
 from ..stats.structure_search import Probe
-from .effects import run_catalogue
+from .effects import TABLE, run_catalogue
 from .effects.base import RunEffect
+from .effects.table_side import TableErrors
 from .model import CHANNELS, RunFit, RunModel, fit_run, reference_coefficients, run_context
+from .residuals import run_residuals
+from .table_errors import table_from_run
 
-__all__ = [
-    "OUTLIER_RULE",
-    "RunFamily",
-    "diagnose_run",
-    "run_design_command",
-    "run_results",
-]
+__all__ = ["OUTLIER_RULE", "RunFamily", "diagnose_run", "run_design_command", "run_results"]
 
 OUTLIER_RULE = outlier_rule_words("outputs", "the same output channel", "both", "outputs")
 """The outlier rule of :func:`diagnose_run` in words (``turntable_pin.stats.outliers``)."""
 
 
 class RunFamily(DataFamily):
-    """A calibration run, its 14 coefficients and the run catalogue (a
-    :class:`~turntable_pin.stats.diagnosis_engine.DataFamily`).
+    """A calibration run, its 14 coefficients and the run catalogue (a ``DataFamily``).
 
     Args:
         run: the :class:`~turntable_pin.calibration.run.CalibrationRun`.
-        catalogue: the candidate effects (default :func:`~.effects.run_catalogue` of the run's
-            table).
+        catalogue: the candidate effects (default the run catalogue of the run's table).
         mask: (N, 2) the outputs fitted (False: left out as outliers).
-        channel_sigma: (2,) the relative noise of ``out_x`` and ``out_y`` (deg/h) when sigma is
-            unknown and the channels' noise differ: every model is then fitted with a noise
-            level per output estimated with that model (starting from these), and scored with
-            each level profiled; ``None``: one noise level.
+        channel_sigma: (2,) relative noise of ``out_x``, ``out_y`` (deg/h) when sigma is unknown
+            and they differ: every model is fitted at its own per-output noise, starting from
+            these; ``None``: one noise level.
     """
 
     columns = CHANNELS
@@ -134,7 +127,6 @@ class RunFamily(DataFamily):
             noise_per_column=channel_sigma is not None,
         )
 
-    # ---- the hooks of the one diagnosis (stats.diagnosis_engine) ---------------------------
     def fit_model(self, effects: Sequence[RunEffect], zero_point) -> RunFit:
         """The fit of the 14 coefficients plus ``effects`` (:func:`~.model.fit_run`)."""
         return fit_run(self.run, effects, context=self.context, mask=self.mask,
@@ -167,8 +159,6 @@ class RunFamily(DataFamily):
 
     def residual_set(self, fit: RunFit):
         """The residuals of ``fit`` for the figures (:func:`~.residuals.run_residuals`)."""
-        from .residuals import run_residuals
-
         return run_residuals(fit)
 
     @property
@@ -205,8 +195,8 @@ class RunFamily(DataFamily):
         return RunFamily(self.run, self.catalogue, self.mask, column_sigma)
 
     def screen_fit(self, cells: np.ndarray, effects: Sequence[RunEffect]):
-        """The fit of base + ``effects`` without the outputs ``cells`` (the outlier screen),
-        at the reference coefficients of the outputs kept."""
+        """The fit of base + ``effects`` without the outputs ``cells``, at the reference
+        coefficients of the outputs kept."""
         mask = self.mask & ~cells
         context = run_context(self.run, reference_coefficients(self.run, mask))
         return fit_run(self.run, effects, context=context, mask=mask,
@@ -217,7 +207,7 @@ class RunFamily(DataFamily):
         """The doubt about the run: the stated sigma, the latitude or the table."""
         return (
             "no catalogued effect of the table or the instrument makes this run; is the stated "
-            "sigma_dph too small, the latitude or the table (--urdf) wrong?"
+            f"sigma_dph too small, the latitude or the table ({argument('urdf')}) wrong?"
         )
 
     def complete(self, diagnosis: Diagnosis) -> None:
@@ -234,8 +224,8 @@ class RunFamily(DataFamily):
         return {f"phi{k}" for k in range(1, self.run.joint_rad.shape[1] + 1)}
 
     def design_warnings(self, base_fit: RunFit) -> list[str]:
-        """What the positions cannot tell, in plain words: the coefficients they leave
-        undetermined (and the physical reason), too few angles for the harmonic shapes."""
+        """What the positions cannot tell: the coefficients they leave undetermined (and why),
+        too few angles for the harmonic shapes."""
         out = []
         undetermined = base_fit.result.undetermined_combinations()
         if undetermined:
@@ -263,7 +253,6 @@ class RunFamily(DataFamily):
                 )
         return out
 
-    # ---- the structure search ---------------------------------------------------------------
     def _weights(self, fit: RunFit) -> np.ndarray:
         """(N, 2) the weights of ``fit``'s residuals, 0 where an output was left out."""
         w = np.zeros(self.mask.shape)
@@ -271,8 +260,8 @@ class RunFamily(DataFamily):
         return w
 
     def _shape_probes(self, directions, plot, shape, text, spec) -> list[Probe]:
-        """One probe per direction ``(site, description, (N, 2) direction)`` for one shape
-        (:meth:`shape_probes`, described as ``text`` and the direction's description)."""
+        """:meth:`shape_probes` of ``directions`` ``(site, description, (N, 2) direction)``,
+        each described as ``text`` and its description."""
         sites = [(site, direction, f"{text} {what}") for site, what, direction in directions]
         return self.shape_probes(plot, shape, spec, sites)
 
@@ -313,14 +302,9 @@ class RunFamily(DataFamily):
             )  # fmt: skip
         return probes
 
-    # ---- separation ---------------------------------------------------------------------------
     def _dense_run(self):
-        """The run's positions replaced by a dense grid over every joint within its limits
-        (:func:`~turntable_pin.measurement.diagnosis.dense_joint_grid`), time and extra columns
-        spread over their ranges in random order."""
-        from ..calibration.positions import PositionSet, position_inputs
-        from ..calibration.run import CalibrationRun
-
+        """The run on a dense grid over every joint within its limits (``dense_joint_grid``),
+        time and extra columns spread over their ranges in random order."""
         run = self.run
         joints = dense_joint_grid(self.table)
         positions = PositionSet(joints, table=run.table, name="dense grid")
@@ -336,9 +320,9 @@ class RunFamily(DataFamily):
 
     def misfit(self, fit_a: RunFit, effect_b: RunEffect, dense: bool) -> float:
         """The noise-free chi2 left when the model with ``effect_b`` instead of ``fit_a``'s last
-        effect is fitted to ``fit_a``'s prediction: on the run's positions, or (``dense``) on a
-        dense grid over every joint (:meth:`_dense_run`). Raises :class:`InputError` when
-        ``effect_b`` cannot be evaluated there (a column the grid has not)."""
+        effect is fitted to ``fit_a``'s prediction, on the run's positions or (``dense``) on
+        :meth:`_dense_run`. Raises :class:`InputError` when ``effect_b`` cannot be evaluated
+        there (a column the grid has not)."""
         if dense:
             context = run_context(self._dense_run(), fit_a.model.context.coefficients)
             mask = None
@@ -375,13 +359,10 @@ class RunFamily(DataFamily):
 
     def other_side(self, fit_a: RunFit) -> list[dict]:
         """The effects of the other side that move the outputs like ``fit_a``'s last effect on
-        this run's positions (noise-free misfit chi2 below :data:`SEPARATION_CHI2`): for an
-        instrument effect, the table's errors together (``table:errors``) and each table
-        effect; for a table effect, each instrument effect. Each entry: ``effect``,
-        ``chi2_run``, ``chi2_dense`` (None when it cannot be evaluated on the grid) and the
-        ``words`` of :meth:`separation`."""
-        from .effects import TABLE
-        from .effects.table_side import TableErrors
+        this run's positions (misfit chi2 below :data:`SEPARATION_CHI2`): for an instrument
+        effect, the table's errors together (``table:errors``) and each table effect; for a
+        table effect, each instrument effect. Each entry: ``effect``, ``side``, ``chi2_run``,
+        ``chi2_dense`` (None when not evaluable on the grid) and :meth:`separation`'s ``words``."""
 
         a = fit_a.model.effects[-1]
         if a.side == TABLE:
@@ -407,19 +388,20 @@ class RunFamily(DataFamily):
         return sorted(out, key=lambda e: e["chi2_run"])
 
 
-def run_design_command(run, pair: tuple[str, str]) -> str:
-    """The ``turntable-pin design --separate A,B --run RUN`` command (with ``--urdf``, ``--mount``
-    and ``--latitude-deg`` when they are not the defaults) that chooses the calibration positions
-    telling the two effects apart, or says that none do (:mod:`.separate`; the one
-    :func:`~turntable_pin.measurement.diagnosis.design_command`)."""
-    from ..calibration.site import DEFAULT_LATITUDE_DEG
-    from ..measurement.diagnosis import design_command, mount_option, urdf_option
-
+def run_design_command(run, pair: tuple[str, str]) -> Command:
+    """The ``design`` command that chooses the calibration positions telling the two effects
+    apart, or says that none do (:mod:`.separate`), with ``urdf``, ``mount`` and
+    ``latitude_deg`` when they are not the defaults."""
     latitude = float(np.degrees(run.inputs.latitude_rad))
     default = abs(latitude - DEFAULT_LATITUDE_DEG) <= 1e-9
-    extra = [] if default else ["--latitude-deg", f"{latitude:g}"]
-    return design_command(run.source, pair, urdf_option(run.table), mount_option(run.table),
-                          data_option="--run", extra=extra)  # fmt: skip
+    return command(
+        "design",
+        separate=",".join(pair),
+        run=run.source,
+        urdf=urdf_option(run.table),
+        mount=mount_option(run.table),
+        latitude_deg=None if default else f"{latitude:g}",
+    )
 
 
 def diagnose_run(
@@ -429,24 +411,17 @@ def diagnose_run(
     catalogue: Sequence[RunEffect] | None = None,
     outliers: bool = True,
 ) -> Diagnosis:
-    """Diagnose a calibration run against the run catalogue (module docstring):
-    :func:`~turntable_pin.stats.diagnosis_engine.diagnose_data` on the :class:`RunFamily` of
-    ``run``; the result carries the run's own data too (:func:`run_results`).
-
-    Raises:
-        InputError: more rows than ``MAX_DIAGNOSED_ROWS``.
-    """
+    """Diagnose a calibration run against the run catalogue: ``diagnose_data`` on its
+    :class:`RunFamily` (InputError beyond ``MAX_DIAGNOSED_ROWS`` rows)."""
     family = RunFamily(run, catalogue)
     return diagnose_data(family, until_explained=until_explained, outliers=outliers)
 
 
 def run_results(diagnosis: Diagnosis) -> None:
-    """Fill a run diagnosis with the run's own data, which the text, JSON and HTML views render:
-    the side of every candidate and of the verdict (``table`` or ``instrument``) and the effects
-    of the other side (``family_verdict``), the ``design`` commands that settle each rival, the
-    calibrated coefficients of the best model and what the run tells about the table
-    (:mod:`.table_errors`; ``family_results``)."""
-    from .table_errors import table_from_run
+    """Fill a run diagnosis with the run's own data: the side of every candidate and of the
+    verdict and the effects of the other side (``family_verdict``), the ``design`` commands that
+    settle each rival, the best model's coefficients and what the run tells about the table
+    (``family_results``)."""
 
     family = diagnosis.family
     run = family.run

@@ -1,14 +1,10 @@
 """The model of a calibration run: the 2 x 7 drift coefficients plus effects, and its fit.
 
-``out_c = w_c + A_c(a) beta_c + sum_e J_e p_e`` at each position (c = x, y; eq. 1 at the ideal
-orientation plus each effect's columns, :mod:`.effects`). The model is linear in every
-parameter: the table's effects enter through the rate sensitivity at the *reference*
-coefficients (the plain calibration of the run, eq. 6), so the product of an effect with the
-change of the coefficients it causes is left out -- a term of the size of the effect (arc
-seconds, 1e-5 rad) times that change (a small fraction of the coefficients), far below the noise.
-The fit is :func:`~turntable_pin.stats.least_squares.fit_least_squares` (weighted, with the
-determined combinations, their standard errors and the flat directions); observations are the
-two outputs of each position, record by record (``out_x``, ``out_y`` of row 1, then row 2...).
+``out_c = w_c + A_c(a) beta_c + sum_e J_e p_e`` at each position (c = x, y; eq. 1 plus each
+effect's columns). Linear in every parameter: the table's effects enter through the rate
+sensitivity at the *reference* coefficients (the run's plain calibration, eq. 6); the product of
+an effect (1e-5 rad) with the change of coefficients it causes is far below the noise. The
+observations are the two outputs of each position, record by record.
 """
 
 from __future__ import annotations
@@ -20,9 +16,8 @@ import numpy as np
 
 from ..calibration.gyrowheel import AXES, N_COEFFICIENTS, TERM_NAMES
 from ..core.user_code import is_user_code
-from ..measurement.effects.base import PositionVariables
 from ..stats.least_squares import FitResult, fit_least_squares
-from .effects.base import RunContext, RunEffect
+from .effects.base import RunContext, RunEffect, run_variables
 from .effects.contract import check_run_effect
 from .sensitivity import drift_regressor, rate_sensitivity_dph
 
@@ -35,7 +30,6 @@ __all__ = [
     "fit_run",
     "reference_coefficients",
     "run_context",
-    "run_variables",
 ]
 
 CHANNELS = ("out_x", "out_y")
@@ -51,23 +45,9 @@ BASE_UNITS: tuple[str, ...] = tuple(
 """The unit of each of :data:`BASE_NAMES`."""
 
 
-def run_variables(run) -> PositionVariables:
-    """The run's joint angles, time and extra columns as :class:`PositionVariables` (cached on
-    the run: the effects of one run share it)."""
-    cached = run.__dict__.get("_variables")
-    if cached is None:
-        cached = PositionVariables(
-            run.joint_rad, run.time_s, (), dict(run.extra), ignored_columns=run.ignored_columns
-        )
-        object.__setattr__(run, "_variables", cached)
-    return cached
-
-
 def reference_coefficients(run, mask: np.ndarray | None = None) -> np.ndarray:
-    """The plain calibration of ``run`` (eq. 6, weighted by ``sigma_dph`` when given; the
-    minimum-norm solution where the positions leave a combination undetermined), (2, 7).
-
-    ``mask`` (N, 2): the observations to use (default all)."""
+    """The plain calibration of ``run``, (2, 7) (eq. 6, weighted by ``sigma_dph`` when given;
+    minimum-norm where undetermined), from the observations ``mask`` (N, 2) (default all)."""
     design = drift_regressor(run.inputs.specific_force_g)
     rhs = run.outputs_dph - run.inputs.earth_rate_dph[:, :2]
     weights = np.ones(run.n_positions) if run.sigma_dph is None else 1.0 / run.sigma_dph
@@ -81,8 +61,7 @@ def reference_coefficients(run, mask: np.ndarray | None = None) -> np.ndarray:
 
 
 def run_context(run, coefficients: np.ndarray | None = None) -> RunContext:
-    """The :class:`RunContext` of ``run`` at ``coefficients`` (default: its plain
-    calibration)."""
+    """The :class:`RunContext` of ``run`` at ``coefficients`` (default its plain calibration)."""
     beta = reference_coefficients(run) if coefficients is None else np.asarray(coefficients)
     return RunContext(
         run=run,
@@ -93,16 +72,10 @@ def run_context(run, coefficients: np.ndarray | None = None) -> RunContext:
 
 
 class RunModel:
-    """The outputs of a run from the 14 coefficients and ``effects`` (a ``FitProblem``).
-
-    Args:
-        context: the run and the reference coefficients (:func:`run_context`).
-        effects: the run effects added to the base.
-        mask: (N, 2) which outputs are fitted (False: left out as an outlier), default all.
-        channel_sigma: (2,) the relative noise of ``out_x`` and ``out_y`` (estimated per
-            channel by the diagnosis), or ``None``; the fit then estimates the unit-weight
-            variance (``sigma_relative``).
-    """
+    """The outputs of a run from the 14 coefficients and ``effects`` (a ``FitProblem``) in
+    ``context`` (:func:`run_context`), the outputs ``mask`` (N, 2) fitted (default all), with the
+    relative noise ``channel_sigma`` (2,) of ``out_x``, ``out_y`` or ``None`` (then the
+    unit-weight variance is estimated: ``sigma_relative``)."""
 
     observation_unit = "dph"
     user_unit_scale = 1.0
@@ -166,9 +139,8 @@ class RunModel:
 
 
 def _specs_and_columns(effect: RunEffect, context: RunContext):
-    """``effect``'s parameters and columns in ``context`` (the columns computed once per
-    context); a user's effect checked against its contract first
-    (:func:`~.effects.contract.check_run_effect`)."""
+    """``effect``'s parameters and columns in ``context`` (computed once per context; a user's
+    effect checked against its contract first)."""
     if is_user_code(effect):
         return _memo(context, ("contract", id(effect)), lambda: check_run_effect(effect, context))
     columns = _memo(context, ("effect", effect.name, id(effect)), lambda: effect.columns(context))

@@ -7,10 +7,9 @@ order the output of axis c then changes by
 
     d out_c = (g_c x a + e_c x w) . r,    g_c = d(A_c(a) beta_c)/da
 
-with ``A_c`` the drift regressor of eq. 2 and ``beta_c`` the axis' seven coefficients: the drift
-seen at a tilted gravity vector, and the earth rate seen along a tilted axis. The second-order
-remainder is of the size of the orientation error squared times the coefficients (below 1e-6
-deg/h for errors of an arc minute and Table 1's coefficients).
+with ``A_c`` the drift regressor of eq. 2 and ``beta_c`` the axis' seven coefficients. The
+second-order remainder is below 1e-6 deg/h for errors of an arc minute and Table 1's
+coefficients.
 """
 
 from __future__ import annotations

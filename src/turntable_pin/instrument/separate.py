@@ -1,22 +1,13 @@
-"""Positions that tell two explanations of a calibration run apart (``design --separate A,B
---run RUN.csv``).
+"""Positions that tell two explanations of a calibration run apart.
 
-When the run diagnosis says that effect B moves the outputs like effect A on the run's
-positions (a table error and the instrument's tilt, a g-squared term and a wobble), the question
-is at which positions to calibrate next. Each effect is taken at the amplitude the run fits it
-with (with the 14 coefficients); if A is true, fitting the coefficients and B to what A predicts
-leaves the noise-free misfit
-
-    lambda_AB = || (I - P_B) J_A a ||^2 / sigma^2   (P_B: the projector on the coefficients and B)
-
-over the outputs of the run and the new positions, and ``lambda_BA`` the other way round. The
-design maximises the smaller of the two (T-optimal, :func:`~turntable_pin.stats.discrimination.
-t_optimal_exchange`) over seeded candidate positions within the joints' limits, added to the run.
-A misfit of :data:`~turntable_pin.stats.diagnosis_engine.SEPARATION_CHI2` (25: five sigma) tells
-them apart clearly. When B reproduces A at every candidate, no position separates them, and the
-result says so with the independent tests of the two effects' stories. Effects that need
-``time_s`` or another column are refused: positions alone do not decide them (repeat positions
-late, or change the temperature).
+When effect B moves the outputs like effect A on the run's positions (a table error and the
+instrument's tilt), where to calibrate next? Each effect at the amplitude the run fits it with:
+if A is true, fitting the coefficients and B to A's prediction leaves ``lambda_AB = || (I - P_B)
+J_A a ||^2 / sigma^2`` over the run and the new positions (``lambda_BA`` the other way). The
+design maximises the smaller (T-optimal, ``stats.discrimination.t_optimal_exchange``) over seeded
+candidates within the joints' limits; ``SEPARATION_CHI2`` (25: five sigma) tells them apart
+clearly. When B reproduces A at every candidate, the result says so with the effects' independent
+tests. Effects needing ``time_s`` or another column are refused: positions do not decide them.
 """
 
 from __future__ import annotations
@@ -25,7 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..calibration.positions import PositionSet, position_inputs
+from ..calibration.run import CalibrationRun
 from ..core.exceptions import InputError
+from ..core.sizes import check_positions_count
+from ..core.words import argument
 from ..stats.diagnosis_engine import SEPARATION_CHI2
 from ..stats.discrimination import Direction, t_optimal_exchange
 from .diagnosis import RunFamily
@@ -40,16 +35,14 @@ A's signal beyond the coefficients."""
 
 @dataclass(frozen=True)
 class RunSeparation:
-    """The positions that tell two run effects apart, or why none do.
+    """The positions that tell two run effects ``(A, B)`` apart, or why none do.
 
     Attributes:
-        effects: the two effects ``(A, B)``.
-        joint_names: the table's joints.
-        positions_deg: (n, J) the chosen positions, degrees (empty when none separate them).
-        misfit_run: ``(lambda_AB, lambda_BA)`` on the run's positions alone (chi2 units).
-        misfit_design: the same with the chosen positions added.
-        separable: whether some positions within the limits tell them apart.
-        words: the conclusion in a sentence.
+        positions_deg: (n, J) the chosen positions of the ``joint_names``, degrees (empty when
+            none separate them).
+        misfit_run: ``(lambda_AB, lambda_BA)`` on the run alone (chi2); misfit_design: with the
+            chosen positions added.
+        separable: whether some positions tell them apart; words: the conclusion.
         n_candidates, seed: the candidates chosen from and their seed.
         noise_dph: the output noise the misfits are in units of.
     """
@@ -66,8 +59,7 @@ class RunSeparation:
     noise_dph: float
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The positions as run columns ``phiK_deg`` (what ``simulate --run --positions``
-        reads)."""
+        """The positions as run columns ``phiK_deg`` (what a simulated run's positions read)."""
         return {f"phi{k + 1}_deg": self.positions_deg[:, k] for k in range(len(self.joint_names))}
 
     def to_dict(self) -> dict:
@@ -135,31 +127,9 @@ def design_run_separation(
         InputError: ``n`` not from 1 to C (checked first: each candidate is chosen at most once);
             an unknown effect, the same one twice, one the run does not see.
     """
-    from ..calibration.positions import PositionSet, position_inputs
-    from ..calibration.run import CalibrationRun
-    from ..core.sizes import check_positions_count
-
     n = check_positions_count(n, len(candidates_rad), "n")
-
     family = RunFamily(run, catalogue)
-    known = {e.name: e for e in family.catalogue}
-    for name in names:
-        if name not in known and f"table:{name}" not in known:
-            raise InputError(f"unknown run effect '{name}'; known: {', '.join(known)}")
-    a, b = (known.get(name) or known[f"table:{name}"] for name in names)
-    if a is b:
-        raise InputError(f"--separate needs two different effects, got '{a.name}' twice")
-    for effect in (a, b):
-        _refuse_columns(effect)
-    base_rank = family.fit([]).result.rank
-    fit_a, fit_b = family.fit([a]), family.fit([b])
-    for effect, fit in ((a, fit_a), (b, fit_b)):
-        if fit.result.rank <= base_rank:
-            raise InputError(
-                f"the run does not see {effect.name}: on its positions it moves the outputs only "
-                "like the 14 coefficients, so its amplitude cannot be fitted there; calibrate at "
-                "more varied positions first (a grid), or design with the orientation effects"
-            )
+    a, b = _pair(family, names)
     # the noise of one output: the stated one, else the run's estimate under the base model
     if run.sigma_dph is not None:
         sigma = float(np.median(run.sigma_dph))
@@ -170,8 +140,8 @@ def design_run_separation(
                                 np.zeros((len(positions), 2)))  # fmt: skip
     context = run_context(candidates, family.context.coefficients)
 
-    def direction(true_fit, true_effect, rival):
-        p = true_fit.result.params[-len(true_effect.parameters(run)) :]
+    def direction(true_effect, rival):
+        p = family.fit([true_effect]).result.params[-len(true_effect.parameters(run)) :]
         _, signal = _whitened(context, [true_effect], p, sigma)
         fitted, _ = _whitened(context, [rival], None, sigma)
         fixed_fitted, fixed_signal = _whitened(family.context, [rival], None, sigma)
@@ -179,58 +149,86 @@ def design_run_separation(
         return Direction(fitted, signal, fixed_fitted.reshape(-1, fitted.shape[-1]),
                          run_signal.reshape(-1))  # fmt: skip
 
-    directions = [direction(fit_a, a, b), direction(fit_b, b, a)]
+    directions = [direction(a, b), direction(b, a)]
     before = tuple(float(d.misfit(np.zeros(0, int))) for d in directions)
     exchange = t_optimal_exchange(directions, n, seed=seed)
     after = tuple(float(v) for v in exchange.noncentralities)
     scales = [float(np.sum(d.signal[exchange.chosen] ** 2)) for d in directions]
     same = [v <= SAME_RTOL * max(w, 1e-300) for v, w in zip(after, scales, strict=True)]
-    separable = not any(same)
     chosen = np.degrees(candidates_rad[exchange.chosen])
-    if all(same):
-        words = (
-            f"no positions within the limits separate them: {b.name} reproduces {a.name} at "
-            "every candidate position (and the other way round); an independent test does. "
-            f"For {a.name}: {a.confirm} For {b.name}: {b.confirm}"
-        )
+    if any(same):
         chosen = np.zeros((0, candidates_rad.shape[1]))
-    elif any(same):
-        small, large = (b, a) if same[1] else (a, b)
-        words = (
-            f"{small.name} is a special case of {large.name} at every position: when "
-            f"{small.name} is true, {large.name} reproduces it and the diagnosis keeps the "
-            f"simpler {small.name} (its rule makes the extra parameters pay); when {large.name} "
-            f"is true, {small.name} leaves a misfit of {max(after):.3g} with these positions "
-            f"({max(before):.3g} on the run alone). No positions make them more different; an "
-            f"independent test does. For {a.name}: {a.confirm} For {b.name}: {b.confirm}"
-        )
-        chosen = np.zeros((0, candidates_rad.shape[1]))
-    elif min(after) >= SEPARATION_CHI2:
-        already = (
-            "the run alone already tells them apart (misfit at least "
-            f"{min(before):.3g} both ways); "
-            if min(before) >= SEPARATION_CHI2
-            else ""
-        )
-        words = (
-            f"{already}these {n} positions, calibrated besides the run, leave a misfit of at "
-            f"least {min(after):.3g} whichever is true: the diagnosis of the two runs together "
-            "tells them apart"
-        )
-    else:
-        words = (
-            f"these {n} positions raise the smaller misfit to {min(after):.3g}, still below "
-            f"{SEPARATION_CHI2:g}: choose more positions (-n) or repeat them"
-        )
     return RunSeparation(
         effects=(a.name, b.name),
         joint_names=tuple(run.table.joint_names),
         positions_deg=np.round(chosen, 6),
         misfit_run=before,
         misfit_design=after,
-        separable=bool(separable),
-        words=words,
+        separable=not any(same),
+        words=_words(a, b, before, after, same, n),
         n_candidates=len(positions),
         seed=int(seed),
         noise_dph=sigma,
+    )
+
+
+def _pair(family: RunFamily, names: tuple[str, str]):
+    """The two effects named (``table:`` may be left out), each one the run sees."""
+    known = {e.name: e for e in family.catalogue}
+    for name in names:
+        if name not in known and f"table:{name}" not in known:
+            raise InputError(f"unknown run effect '{name}'; known: {', '.join(known)}")
+    a, b = (known.get(name) or known[f"table:{name}"] for name in names)
+    if a is b:
+        raise InputError(
+            f"{argument('separate')} needs two different effects, got '{a.name}' twice"
+        )
+    for effect in (a, b):
+        _refuse_columns(effect)
+    base_rank = family.fit([]).result.rank
+    fits = [family.fit([a]), family.fit([b])]
+    for effect, fit in zip((a, b), fits, strict=True):
+        if fit.result.rank <= base_rank:
+            raise InputError(
+                f"the run does not see {effect.name}: on its positions it moves the outputs only "
+                "like the 14 coefficients, so its amplitude cannot be fitted there; calibrate at "
+                "more varied positions first (a grid), or design with the orientation effects"
+            )
+    return a, b
+
+
+def _words(a, b, before, after, same, n: int) -> str:
+    """The conclusion in a sentence: no positions separate them, one is a special case of the
+    other, these positions do, or not yet."""
+    both = f"For {a.name}: {a.confirm} For {b.name}: {b.confirm}"
+    if all(same):
+        return (
+            f"no positions within the limits separate them: {b.name} reproduces {a.name} at "
+            f"every candidate position (and the other way round); an independent test does. {both}"
+        )
+    if any(same):
+        small, large = (b, a) if same[1] else (a, b)
+        return (
+            f"{small.name} is a special case of {large.name} at every position: when "
+            f"{small.name} is true, {large.name} reproduces it and the diagnosis keeps the "
+            f"simpler {small.name} (its rule makes the extra parameters pay); when {large.name} "
+            f"is true, {small.name} leaves a misfit of {max(after):.3g} with these positions "
+            f"({max(before):.3g} on the run alone). No positions make them more different; an "
+            f"independent test does. {both}"
+        )
+    if min(after) >= SEPARATION_CHI2:
+        already = (
+            "the run alone already tells them apart (misfit at least "
+            f"{min(before):.3g} both ways); "
+            if min(before) >= SEPARATION_CHI2
+            else ""
+        )
+        return (
+            f"{already}these {n} positions, calibrated besides the run, leave a misfit of at "
+            f"least {min(after):.3g} whichever is true: the diagnosis of the two runs together "
+            "tells them apart"
+        )
+    return (
+        f"these {n} positions raise the smaller misfit to {min(after):.3g}, still below "
+        f"{SEPARATION_CHI2:g}: choose more positions ({argument('n')}) or repeat them"
     )

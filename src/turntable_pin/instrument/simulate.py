@@ -1,27 +1,19 @@
 """Simulated GyroWheel calibration runs: table errors, instrument effects, noise, outliers, a seed.
 
-The outputs are made along the *exact* path, independent of any linearised model, so that they
-check the run diagnosis' first-order columns:
+The outputs follow the *exact* path, independent of any linearised model, so that they check
+the run diagnosis' first-order columns:
 
-- the table turns the payload by ``dR = Rd^T Rt`` at each position: the exact chain of the
-  table's errors (``GenericTable.rotation_error``), and with catalogued table effects the exact
-  chain of :class:`~turntable_pin.measurement.effect_model.OrientationModel` (base errors plus
-  the effects' parameters);
-- the GyroWheel sits on the payload turned by its mount ``M = exp([m]x)``, ``m = (mx, my, mz)``
-  about payload x, y, z; as row vectors it senses ``a = a0 Rd dR M`` and ``w = w0 Rd dR M``
-  (``a0 = (0, 0, 1) g`` and ``w0`` the earth rate in the base frame F0, x north, y west, z up);
-- each channel c (x, y) reads ``(1 + s_c 1e-6) w_c + A_c(a) beta_c`` (eq. 1, Table 1 by
-  default) plus the instrument effects of :data:`SIMULATED_INSTRUMENT_EFFECTS` and Gaussian
-  noise; a few seeded rows get a gross outlier on one channel.
+- the table turns the payload by ``dR = Rd^T Rt``: the exact chain of its errors, with table
+  effects that of ``measurement.effect_model.OrientationModel``;
+- the GyroWheel sits turned by its mount ``M = exp([m]x)``, ``m = (mx, my, mz)`` about payload
+  x, y, z, and senses (row vectors) ``a = a0 Rd dR M``, ``w = w0 Rd dR M`` (``a0 = (0, 0, 1) g``,
+  ``w0`` the earth rate in F0: x north, y west, z up);
+- channel c reads ``(1 + s_c 1e-6) w_c + A_c(a) beta_c`` (eq. 1, Table 1 by default) plus the
+  instrument effects (the run catalogue's names and units) and Gaussian noise; a few seeded rows
+  get a gross outlier on one channel.
 
-The instrument effects carry the names and units of the run diagnosis' catalogue
-(:mod:`turntable_pin.instrument.effects`: ``instrument_tilt`` (``mx, my``),
-``instrument_heading`` (``mz``), ``bias_drift``, ``temperature_coefficient``,
-``earth_rate_scale``, ``g_squared_terms``); the tilt and the heading make one exact rotation
-``exp([m]x)`` here, whose first order is the diagnosis' linear columns.
-
-The run CSV is the one :func:`~turntable_pin.calibration.run.read_run` reads, with the seed,
-the noise and the positions in ``#`` comment lines and, unless hidden, the truth.
+The run CSV is what ``calibration.run.read_run`` reads, with the seed, the noise and the
+positions in ``#`` comment lines and, unless hidden, the truth.
 """
 
 from __future__ import annotations
@@ -33,17 +25,23 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import yaml
 
 from ..calibration.gyrowheel import AXES, MAX_COEFFICIENT_DPH, GyroWheelModel, regressor_matrix
-from ..calibration.positions import PositionSet, base_frame_inputs, position_inputs
+from ..calibration.positions import POSITION_BYTES, PositionSet, base_frame_inputs, position_inputs
 from ..calibration.rate_error import orientation_error_rotation
 from ..calibration.run import MAX_RUN_OUTPUT_DPH, MIN_RUN_SIGMA_DPH
 from ..core.csv_table import write_csv_table
 from ..core.exceptions import InputError, check_seed
 from ..core.files import write_text_atomic
-from ..core.sizes import MAX_TIME_S
+from ..core.sizes import MAX_POSITIONS, MAX_TIME_S, check_count
 from ..core.turn_grid import random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, deg_to_rad, rad_to_deg
+from ..core.words import argument, command
+from ..measurement.catalogue import resolve_effect
+from ..measurement.effect_model import OrientationModel
+from ..measurement.effects.base import PositionVariables
+from ..measurement.table import measured_table
 from ..model.angles import ANGLE_ENTRIES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
 
@@ -58,7 +56,6 @@ __all__ = [
     "check_instrument_effects",
     "random_positions",
     "simulate_calibration_run",
-    "temperature_profile",
 ]
 
 DEFAULT_DWELL_S = 60.0
@@ -73,15 +70,9 @@ _MOUNT_LIMIT_ARCSEC = MAX_ANGULAR_ERROR_DEG * 3600.0
 
 @dataclass(frozen=True)
 class InstrumentEffect:
-    """One effect of the instrument itself (not of the table) on a calibration run.
-
-    Attributes:
-        name: the effect's name (``--effect NAME:P=V``).
-        parameter_names: its parameters; a parameter not given is zero.
-        unit: the user unit of every parameter.
-        limit: largest ``|value|`` of a parameter, in ``unit`` (beyond it, no such instrument).
-        description: what it is, physically, and how it enters the outputs.
-    """
+    """One effect of the instrument itself on a simulated run: its ``name``, its
+    ``parameter_names`` (zero when not given), the ``unit`` of all, the ``limit`` of a
+    ``|value|`` in it, and a ``description`` (what it is, how it enters the outputs)."""
 
     name: str
     parameter_names: tuple[str, ...]
@@ -90,8 +81,7 @@ class InstrumentEffect:
     description: str
 
     def parameters(self, variables=None) -> tuple:
-        """The parameters as the effect specs of the measurement layer read them (for
-        ``parse_effect_spec``): objects with ``name`` and ``unit``."""
+        """The parameters (``name``, ``unit``) as ``parse_effect_spec`` reads them."""
         return tuple(_Parameter(n, self.unit) for n in self.parameter_names)
 
 
@@ -141,12 +131,8 @@ def check_instrument_effects(
     instrument: Mapping[str, Mapping[str, float]],
 ) -> dict[str, dict[str, float]]:
     """``{effect: {parameter: value}}`` checked against :data:`SIMULATED_INSTRUMENT_EFFECTS`
-    (names known, at least one parameter, finite values within the effect's limit), every
-    parameter filled (zero when not given).
-
-    Raises:
-        InputError: an unknown effect or parameter (listing the known ones), or a bad value.
-    """
+    (known names, at least one parameter, finite values within the limit), every parameter
+    filled (zero when not given); InputError otherwise, listing the known names."""
     out: dict[str, dict[str, float]] = {}
     for name, params in dict(instrument or {}).items():
         effect = SIMULATED_INSTRUMENT_EFFECTS.get(str(name))
@@ -183,11 +169,8 @@ def check_instrument_effects(
 
 @dataclass(frozen=True)
 class TemperatureProfile:
-    """A temperature history: a start, a linear ramp and a sinusoidal swing.
-
-    ``T(t) = start_c + ramp_c_per_h * t / 3600 + swing_c * sin(2 pi t / (period_h * 3600))``,
-    degC, ``t`` in seconds since the start of the run.
-    """
+    """A temperature history, degC, ``t`` in s since the start: ``T(t) = start_c + ramp_c_per_h
+    t / 3600 + swing_c sin(2 pi t / (period_h 3600))``."""
 
     start_c: float
     ramp_c_per_h: float = 0.0
@@ -222,23 +205,9 @@ class TemperatureProfile:
         }
 
 
-def temperature_profile(
-    time_s, start_c: float, ramp_c_per_h: float = 0.0, swing_c: float = 0.0, period_h: float = 1.0
-) -> np.ndarray:
-    """:meth:`TemperatureProfile.at` of the profile with these numbers (degC at ``time_s``)."""
-    return TemperatureProfile(start_c, ramp_c_per_h, swing_c, period_h).at(time_s)
-
-
 def random_positions(n: int, table, seed: int) -> PositionSet:
-    """``n`` positions uniform over every joint's turn [0, 360) deg (rounded to 1e-6 deg), drawn
-    from their own stream of ``seed`` (not the noise's).
-
-    Raises:
-        InputError: ``n`` below 1 or above ``MAX_POSITIONS`` (checked before anything is drawn).
-    """
-    from ..calibration.positions import POSITION_BYTES
-    from ..core.sizes import MAX_POSITIONS, check_count
-
+    """``n`` positions uniform over every joint's turn [0, 360) deg (rounded to 1e-6 deg), from
+    their own stream of ``seed``; InputError for ``n`` below 1 or above ``MAX_POSITIONS``."""
     seed = check_seed(seed)
     if n < 1:
         raise InputError(f"random positions: expected N >= 1, got {n}")
@@ -253,13 +222,10 @@ class SimulatedRun:
     """A simulated calibration run and the truth behind it.
 
     Attributes:
-        positions: the commanded positions (and the table).
-        latitude_rad: latitude of the test site, rad.
-        outputs_dph: (N, 2) ``out_x, out_y`` as measured (with noise and outliers), deg/h.
-        exact_outputs_dph: (N, 2) the same without noise and outliers, deg/h.
-        noise_dph: ``(sigma_x, sigma_y)`` of the Gaussian noise, deg/h.
-        time_s: (N,) time since the start of the run, s.
-        temperature_c: (N,) temperature, degC, or ``None`` (no such column).
+        positions: the commanded positions (and the table); latitude_rad: the site's, rad.
+        outputs_dph: (N, 2) ``out_x, out_y`` as measured; exact_outputs_dph: without noise and
+            outliers, deg/h; noise_dph: ``(sigma_x, sigma_y)``, deg/h.
+        time_s: (N,) s since the start; temperature_c: (N,) degC, or ``None``.
         truth: what made the run, JSON-ready (errors in arcsec, effects in their user units).
         seed: the random seed.
     """
@@ -280,9 +246,8 @@ class SimulatedRun:
         return len(self.positions)
 
     def columns(self, *, with_sigma: bool = True) -> dict[str, np.ndarray]:
-        """The run CSV's columns: ``phiK_deg`` (chain order), ``out_x_dph, out_y_dph``,
-        ``sigma_dph`` (with ``with_sigma``, when both channels have the same noise > 0),
-        ``time_s`` and ``temperature_c`` (when there is one)."""
+        """The run CSV's columns: ``phiK_deg``, ``out_x_dph, out_y_dph``, ``sigma_dph`` (with
+        ``with_sigma``, both channels' noise equal and > 0), ``time_s``, ``temperature_c``."""
         angles = rad_to_deg(self.positions.angles_rad).T
         out: dict[str, np.ndarray] = {f"phi{k}_deg": a for k, a in enumerate(angles, start=1)}
         out["out_x_dph"] = self.outputs_dph[:, 0]
@@ -296,11 +261,10 @@ class SimulatedRun:
         return out
 
     def comment(self, *, hide_truth: bool = False) -> str:
-        """The ``#`` lines above the CSV header: seed, noise, positions, and (unless
-        ``hide_truth``) the truth as one JSON line."""
+        """The ``#`` lines above the CSV header: seed, noise, positions, the truth (a JSON line)."""
         truth = self.truth
         lines = [
-            "simulated GyroWheel calibration run (turntable-pin simulate --run)",
+            f"simulated GyroWheel calibration run ({command('simulate', run=True)})",
             f"seed={self.seed}",
             "noise_dph={:g},{:g} (x,y)".format(*self.noise_dph),
             f"positions: {truth['positions']} ({truth['n_positions']}), table {truth['table']}, "
@@ -314,7 +278,8 @@ class SimulatedRun:
             )
         if hide_truth:
             lines.append(
-                "coefficients, table errors, effects and outliers: not recorded (--hide-truth)"
+                "coefficients, table errors, effects and outliers: not recorded "
+                f"({argument('hide_truth')})"
             )
         else:
             lines.append("truth: " + json.dumps(truth, sort_keys=False))
@@ -323,17 +288,14 @@ class SimulatedRun:
     def write_csv(
         self, path: str | Path, *, hide_truth: bool = False, with_sigma: bool = True
     ) -> Path:
-        """Write the run CSV atomically (``read_run`` reads it), the seed and, unless
-        ``hide_truth``, the truth in ``#`` comment lines."""
+        """Write the run CSV atomically with its :meth:`comment` lines."""
         return write_csv_table(
             path, self.columns(with_sigma=with_sigma), comment=self.comment(hide_truth=hide_truth)
         )
 
     def write_truth(self, path: str | Path, *, data: str = "", command: str = "") -> Path:
-        """Write the truth as YAML, atomically (``data``: the run file it belongs to;
-        ``command``: the command that made it)."""
-        import yaml
-
+        """Write the truth as YAML, atomically (with the run file ``data`` and the ``command``
+        that made it)."""
         head = {"data": data or None, "command": command or None}
         body = {k: v for k, v in head.items() if v is not None} | self.truth
         title = f"# The truth behind {data}.\n" if data else "# The truth behind a simulated run.\n"
@@ -365,16 +327,8 @@ def _column(values, n: int, name: str, low: float, high: float) -> np.ndarray:
     return array
 
 
-def _table_rotation_errors(
-    positions: PositionSet,
-    table_errors_rad: Mapping[str, float],
-    table_effects: Mapping[str, Mapping[str, float]],
-    time_s: np.ndarray,
-    catalogue: Sequence,
-) -> tuple[np.ndarray, dict[str, float], dict[str, dict[str, float]]]:
-    """``dR`` (N, 3, 3) of the exact chain, the errors in user units (non-zero ones) and the
-    effects by their catalogue names."""
-    table = positions.table
+def _checked_errors(table, table_errors_rad: Mapping[str, float]):
+    """The table's error vector (rad, m) and its non-zero errors in user units, each checked."""
     limit_rad = deg_to_rad(MAX_ANGULAR_ERROR_DEG)
     vector = table.values(dict(table_errors_rad or {}))
     for name, value in zip(table.parameter_names, vector, strict=True):
@@ -385,18 +339,11 @@ def _table_rotation_errors(
                 f"table error '{name}' = {value:g} rad is no small error: it must be within "
                 f"+-{MAX_ANGULAR_ERROR_DEG:g} deg"
             )
-    errors = {k: v for k, v in table.to_user_units(vector).items() if v != 0.0}
-    angles = positions.angles_rad
-    if not table_effects:
-        return table.rotation_error(vector, list(angles.T)), errors, {}
+    return vector, {k: v for k, v in table.to_user_units(vector).items() if v != 0.0}
 
-    from ..measurement.catalogue import resolve_effect
-    from ..measurement.effect_model import OrientationModel
-    from ..measurement.effects.base import PositionVariables
-    from ..measurement.table import measured_table
 
-    measured = measured_table(table)
-    variables = PositionVariables(np.array(angles), time_s=np.array(time_s))
+def _resolved_effects(table_effects, measured, variables, catalogue):
+    """The catalogued table effects named in ``table_effects`` and their parameters by name."""
     objects, effects = [], {}
     for name, params in dict(table_effects).items():
         effect = resolve_effect(str(name), measured, tuple(catalogue))
@@ -413,11 +360,12 @@ def _table_rotation_errors(
             )
         objects.append(effect)
         effects[effect.name] = {str(k): float(v) for k, v in params.items()}
-    model = OrientationModel(variables, objects, measured)
-    values = {
-        n: float(v) for n, v in zip(table.parameter_names, vector, strict=True)
-        if n in measured.base_names
-    }  # fmt: skip
+    return objects, effects
+
+
+def _effect_values(objects, effects, variables) -> dict[str, float]:
+    """``{effect.parameter: internal value}`` of the effects' given parameters, each checked."""
+    values = {}
     for effect in objects:
         specs = {s.name: s for s in effect.parameters(variables)}
         for pname, value in effects[effect.name].items():
@@ -432,6 +380,32 @@ def _table_rotation_errors(
                     f"within +-{_MOUNT_LIMIT_ARCSEC:g} (in its user unit)"
                 )
             values[f"{effect.name}.{pname}"] = value * specs[pname].per_user_unit
+    return values
+
+
+def _table_rotation_errors(
+    positions: PositionSet,
+    table_errors_rad: Mapping[str, float],
+    table_effects: Mapping[str, Mapping[str, float]],
+    time_s: np.ndarray,
+    catalogue: Sequence,
+) -> tuple[np.ndarray, dict[str, float], dict[str, dict[str, float]]]:
+    """``dR`` (N, 3, 3) of the exact chain, the errors in user units (non-zero ones) and the
+    effects by their catalogue names."""
+    table = positions.table
+    vector, errors = _checked_errors(table, table_errors_rad)
+    angles = positions.angles_rad
+    if not table_effects:
+        return table.rotation_error(vector, list(angles.T)), errors, {}
+    measured = measured_table(table)
+    variables = PositionVariables(np.array(angles), time_s=np.array(time_s))
+    objects, effects = _resolved_effects(table_effects, measured, variables, catalogue)
+    model = OrientationModel(variables, objects, measured)
+    values = {
+        n: float(v) for n, v in zip(table.parameter_names, vector, strict=True)
+        if n in measured.base_names
+    }  # fmt: skip
+    values.update(_effect_values(objects, effects, variables))
     params = model.parameter_vector(values)
     rotation = model.rotation_error(params)
     # Terms a (user) effect adds to a measured angle itself, outside the chain, turn the payload
@@ -466,27 +440,24 @@ def simulate_calibration_run(
         positions: the commanded positions; ``positions.table`` is the table.
         latitude_rad: latitude of the test site, rad.
         gyrowheel: the true drift coefficients (default paper Table 1).
-        table_errors_rad: ``{error: value}`` in the table's ``parameter_names`` (rad; offsets
-            in m, which turn nothing); missing errors are zero.
-        table_effects: catalogued table effects ``{effect: {parameter: value in its user unit}}``
-            (arcsec, arcsec/g, arcsec/h), e.g. ``{"inner_wobble_harmonics": {"x_c1": 15}}``.
+        table_errors_rad: ``{error: value}`` of the table's ``parameter_names`` (rad; m for
+            offsets, which turn nothing); missing errors are zero.
+        table_effects: ``{effect: {parameter: value in its user unit}}``, e.g.
+            ``{"inner_wobble_harmonics": {"x_c1": 15}}`` (arcsec).
         instrument: instrument effects ``{effect: {parameter: value}}`` of
-            :data:`SIMULATED_INSTRUMENT_EFFECTS` (mount in arcsec, bias drift in deg/h per h,
-            temperature coefficient in deg/h/degC, earth-rate scale in ppm, g^2 terms in
-            deg/h/g^2).
+            :data:`SIMULATED_INSTRUMENT_EFFECTS` in their units.
         noise_dph: 1-sigma Gaussian noise of ``out_x, out_y`` (one number for both), deg/h.
         time_s: (N,) time of each row, s; default ``index * dwell_s`` in measurement order.
         dwell_s: time per position when ``time_s`` is not given, s.
-        temperature_c: (N,) temperature, degC, or a :class:`TemperatureProfile` (evaluated at
-            ``time_s``), or ``None``; written as the ``temperature_c`` column when given.
+        temperature_c: (N,) degC, or a :class:`TemperatureProfile` (at ``time_s``), or None.
         outliers: number of rows (a seeded pick) given a gross error on one channel.
         outlier_dph: size of that error, deg/h, sign seeded (default 30 sigma of the channel).
         seed: seed of the noise and the outliers (noise drawn first), 0 <= seed < 2**63.
         catalogue: user effects besides the table's catalogue that ``table_effects`` may name.
 
     Raises:
-        InputError: an unknown error, effect or parameter (naming the known ones), a value out
-            of range, a temperature coefficient without a temperature, too many outliers.
+        InputError: an unknown name (naming the known ones), a value out of range, a
+            temperature coefficient without a temperature, too many outliers.
     """
     seed = check_seed(seed)
     gyrowheel = GyroWheelModel.nominal() if gyrowheel is None else gyrowheel
@@ -494,101 +465,20 @@ def simulate_calibration_run(
     instrument = check_instrument_effects(instrument or {})
     n = len(positions)
     time_given = time_s is not None
-    if time_s is None:
-        if not (math.isfinite(dwell_s) and dwell_s > 0):
-            raise InputError(f"dwell_s must be a number > 0, got {dwell_s!r}")
-        time_s = np.arange(n) * float(dwell_s)
-    time_s = _column(time_s, n, "time_s", 0.0, MAX_RUN_TIME_S)
-    profile = None
-    if isinstance(temperature_c, TemperatureProfile):
-        profile, temperature_c = temperature_c, temperature_c.at(time_s)
-    if temperature_c is not None:
-        temperature_c = _column(temperature_c, n, "temperature_c", -273.15, 1000.0)
-    if "temperature_coefficient" in instrument and temperature_c is None:
-        raise InputError(
-            "instrument effect 'temperature_coefficient' needs a temperature: give temperature_c "
-            "(--temperature START,RAMP_PER_H,SWING,PERIOD_H)"
-        )
-    outliers = int(outliers)
-    if not 0 <= outliers <= n // 2:
-        raise InputError(f"outliers: expected 0 .. {n // 2} rows of a run of {n}, got {outliers}")
-    if outlier_dph is not None and not (math.isfinite(outlier_dph) and outlier_dph > 0):
-        raise InputError(f"outlier_dph must be a number > 0, got {outlier_dph!r}")
-    if outliers and outlier_dph is None and min(sigma) == 0.0:
-        raise InputError("outliers of a noise-free run need their size: give outlier_dph")
-
-    inputs = position_inputs(positions, latitude_rad)
+    time_s = _run_times(time_s, dwell_s, n)
+    profile, temperature_c = _temperatures(temperature_c, time_s, instrument)
+    outliers = _checked_outliers(outliers, outlier_dph, n, sigma)
     table_dR, errors, effects = _table_rotation_errors(
         positions, table_errors_rad or {}, table_effects or {}, time_s, catalogue
     )
-    mount = {"mx": 0.0, "my": 0.0, "mz": 0.0}
-    for name in ("instrument_tilt", "instrument_heading"):
-        mount.update(instrument.get(name, {}))
-    m_rad = {k: v / ARCSEC_PER_RAD for k, v in mount.items()}
-    mount_rotation = orientation_error_rotation(m_rad["my"], m_rad["mz"], m_rad["mx"], exact=True)
-    chain = inputs.payload_rotation @ table_dR @ mount_rotation
-    force0, rate0 = base_frame_inputs(latitude_rad)
-    force = np.einsum("i,nij->nj", force0, chain)
-    rate = np.einsum("i,nij->nj", rate0, chain)
-
-    scale = instrument.get("earth_rate_scale", {"x": 0.0, "y": 0.0})
-    drift = instrument.get("bias_drift", {"x": 0.0, "y": 0.0})
-    thermal = instrument.get("temperature_coefficient", {"x": 0.0, "y": 0.0})
-    g2 = instrument.get("g_squared_terms", dict.fromkeys(("x_xz", "x_yz", "y_xz", "y_yz"), 0.0))
-    exact = np.empty((n, 2))
-    for c, axis in enumerate(AXES):
-        out = (1.0 + scale[axis] * 1e-6) * rate[:, c]
-        out = out + regressor_matrix(axis, force) @ gyrowheel.axis(axis).as_array()
-        out = out + g2[f"{axis}_xz"] * force[:, 0] * force[:, 2]
-        out = out + g2[f"{axis}_yz"] * force[:, 1] * force[:, 2]
-        out = out + drift[axis] * time_s / 3600.0
-        if temperature_c is not None:
-            out = out + thermal[axis] * (temperature_c - temperature_c.mean())
-        exact[:, c] = out
-
-    rng = np.random.default_rng(seed)
-    measured = exact + rng.standard_normal((n, 2)) * np.array(sigma)
-    outlier_rows = []
-    if outliers:
-        rows = np.sort(rng.choice(n, size=outliers, replace=False))
-        channels = rng.integers(0, 2, outliers)
-        signs = rng.choice(np.array([-1.0, 1.0]), outliers)
-        for row, channel, sign in zip(rows, channels, signs, strict=True):
-            size = DEFAULT_OUTLIER_SIGMAS * sigma[channel] if outlier_dph is None else outlier_dph
-            measured[row, channel] += sign * size
-            outlier_rows.append(
-                {
-                    # the position (0 = the first data row): the file row depends on how many
-                    # comment lines the CSV is written with
-                    "index": int(row),
-                    "column": f"out_{AXES[channel]}_dph",
-                    "offset_dph": float(sign * size),
-                }
-            )
-    largest = float(np.max(np.abs(measured)))
-    if not largest <= MAX_RUN_OUTPUT_DPH:
-        raise InputError(
-            f"the simulated outputs reach {largest:g} deg/h, beyond the +-{MAX_RUN_OUTPUT_DPH:g} "
-            "deg/h a run may hold; give smaller coefficients, effects or noise"
-        )
-
-    table = positions.table
+    force, rate = _sensed(positions, latitude_rad, table_dR, instrument)
+    exact = _exact_outputs(force, rate, gyrowheel, instrument, time_s, temperature_c)
+    measured, outlier_rows = _measured(exact, sigma, seed, outliers, outlier_dph)
     truth = {
-        "simulator": "turntable_pin.instrument.simulate_calibration_run",
-        "seed": seed,
-        "table": table.label,
-        "positions": positions.name,
-        "n_positions": n,
-        "latitude_deg": float(rad_to_deg(latitude_rad)),
-        "noise_dph": {"x": sigma[0], "y": sigma[1]},
-        "time": "given" if time_given else {"dwell_s": float(dwell_s)},
-        "gyrowheel": {axis: gyrowheel.axis(axis).to_dict() for axis in AXES},
+        **_run_truth(positions, latitude_rad, seed, sigma, time_given, dwell_s, gyrowheel),
         "table_errors": errors,
         "table_effects": effects,
-        "instrument_effects": {
-            k: {p: v for p, v in ps.items() if v} for k, ps in instrument.items()
-        },
-        "instrument_units": {k: SIMULATED_INSTRUMENT_EFFECTS[k].unit for k in instrument},
+        **_instrument_truth(instrument),
         "temperature_profile": None if profile is None else profile.to_dict(),
         "outliers": outlier_rows,
     }
@@ -605,3 +495,132 @@ def simulate_calibration_run(
         truth=truth,
         seed=seed,
     )
+
+
+def _run_truth(positions, latitude_rad, seed, sigma, time_given, dwell_s, gyrowheel) -> dict:
+    """The truth's head: the simulator, the seed, the table, positions, site, noise, time and the
+    drift coefficients."""
+    return {
+        "simulator": "turntable_pin.instrument.simulate_calibration_run",
+        "seed": seed,
+        "table": positions.table.label,
+        "positions": positions.name,
+        "n_positions": len(positions),
+        "latitude_deg": float(rad_to_deg(latitude_rad)),
+        "noise_dph": {"x": sigma[0], "y": sigma[1]},
+        "time": "given" if time_given else {"dwell_s": float(dwell_s)},
+        "gyrowheel": {axis: gyrowheel.axis(axis).to_dict() for axis in AXES},
+    }
+
+
+def _instrument_truth(instrument) -> dict:
+    """The instrument effects of the truth: their non-zero parameters and their units."""
+    return {
+        "instrument_effects": {
+            k: {p: v for p, v in ps.items() if v} for k, ps in instrument.items()
+        },
+        "instrument_units": {k: SIMULATED_INSTRUMENT_EFFECTS[k].unit for k in instrument},
+    }
+
+
+def _temperatures(temperature_c, time_s, instrument):
+    """``(profile or None, temperature (N,) degC or None)``, checked; a temperature coefficient
+    needs one."""
+    profile = None
+    if isinstance(temperature_c, TemperatureProfile):
+        profile, temperature_c = temperature_c, temperature_c.at(time_s)
+    if temperature_c is not None:
+        temperature_c = _column(temperature_c, len(time_s), "temperature_c", -273.15, 1000.0)
+    if "temperature_coefficient" in instrument and temperature_c is None:
+        raise InputError(
+            "instrument effect 'temperature_coefficient' needs a temperature: give temperature_c "
+            "(--temperature START,RAMP_PER_H,SWING,PERIOD_H)"
+        )
+    return profile, temperature_c
+
+
+def _run_times(time_s, dwell_s: float, n: int) -> np.ndarray:
+    """The rows' times, s: ``time_s`` checked, or ``index * dwell_s``."""
+    if time_s is None:
+        if not (math.isfinite(dwell_s) and dwell_s > 0):
+            raise InputError(f"dwell_s must be a number > 0, got {dwell_s!r}")
+        time_s = np.arange(n) * float(dwell_s)
+    return _column(time_s, n, "time_s", 0.0, MAX_RUN_TIME_S)
+
+
+def _checked_outliers(outliers, outlier_dph, n: int, sigma) -> int:
+    """The number of outlier rows, checked with their size."""
+    outliers = int(outliers)
+    if not 0 <= outliers <= n // 2:
+        raise InputError(f"outliers: expected 0 .. {n // 2} rows of a run of {n}, got {outliers}")
+    if outlier_dph is not None and not (math.isfinite(outlier_dph) and outlier_dph > 0):
+        raise InputError(f"outlier_dph must be a number > 0, got {outlier_dph!r}")
+    if outliers and outlier_dph is None and min(sigma) == 0.0:
+        raise InputError("outliers of a noise-free run need their size: give outlier_dph")
+    return outliers
+
+
+def _sensed(positions, latitude_rad, table_dR, instrument):
+    """The specific force (g) and earth rate (deg/h) the GyroWheel senses (N, 3) through the
+    exact chain: the payload's rotation, the table's errors, the instrument's mount."""
+    inputs = position_inputs(positions, latitude_rad)
+    mount = {"mx": 0.0, "my": 0.0, "mz": 0.0}
+    for name in ("instrument_tilt", "instrument_heading"):
+        mount.update(instrument.get(name, {}))
+    m_rad = {k: v / ARCSEC_PER_RAD for k, v in mount.items()}
+    mount_rotation = orientation_error_rotation(m_rad["my"], m_rad["mz"], m_rad["mx"], exact=True)
+    chain = inputs.payload_rotation @ table_dR @ mount_rotation
+    force0, rate0 = base_frame_inputs(latitude_rad)
+    return np.einsum("i,nij->nj", force0, chain), np.einsum("i,nij->nj", rate0, chain)
+
+
+def _exact_outputs(force, rate, gyrowheel, instrument, time_s, temperature_c) -> np.ndarray:
+    """(N, 2) the noise-free outputs: eq. 1 plus the instrument effects."""
+    scale = instrument.get("earth_rate_scale", {"x": 0.0, "y": 0.0})
+    drift = instrument.get("bias_drift", {"x": 0.0, "y": 0.0})
+    thermal = instrument.get("temperature_coefficient", {"x": 0.0, "y": 0.0})
+    g2 = instrument.get("g_squared_terms", dict.fromkeys(("x_xz", "x_yz", "y_xz", "y_yz"), 0.0))
+    exact = np.empty((len(time_s), 2))
+    for c, axis in enumerate(AXES):
+        out = (1.0 + scale[axis] * 1e-6) * rate[:, c]
+        out = out + regressor_matrix(axis, force) @ gyrowheel.axis(axis).as_array()
+        out = out + g2[f"{axis}_xz"] * force[:, 0] * force[:, 2]
+        out = out + g2[f"{axis}_yz"] * force[:, 1] * force[:, 2]
+        out = out + drift[axis] * time_s / 3600.0
+        if temperature_c is not None:
+            out = out + thermal[axis] * (temperature_c - temperature_c.mean())
+        exact[:, c] = out
+    return exact
+
+
+def _measured(exact, sigma, seed: int, outliers: int, outlier_dph):
+    """The outputs as measured (seeded noise, then outliers: :func:`_add_outliers`), checked
+    against the range a run may hold, and the outliers' records."""
+    rng = np.random.default_rng(seed)
+    measured = exact + rng.standard_normal(exact.shape) * np.array(sigma)
+    outlier_rows = _add_outliers(measured, rng, outliers, outlier_dph, sigma)
+    largest = float(np.max(np.abs(measured)))
+    if not largest <= MAX_RUN_OUTPUT_DPH:
+        raise InputError(
+            f"the simulated outputs reach {largest:g} deg/h, beyond the +-{MAX_RUN_OUTPUT_DPH:g} "
+            "deg/h a run may hold; give smaller coefficients, effects or noise"
+        )
+    return measured, outlier_rows
+
+
+def _add_outliers(measured, rng, outliers: int, outlier_dph, sigma) -> list[dict]:
+    """Gross errors added in place to ``outliers`` seeded rows, one channel each; their records
+    (``index``: the position, 0 = the first data row, whatever comment lines the CSV has)."""
+    if not outliers:
+        return []
+    n = measured.shape[0]
+    rows = np.sort(rng.choice(n, size=outliers, replace=False))
+    channels = rng.integers(0, 2, outliers)
+    signs = rng.choice(np.array([-1.0, 1.0]), outliers)
+    out = []
+    for row, channel, sign in zip(rows, channels, signs, strict=True):
+        size = DEFAULT_OUTLIER_SIGMAS * sigma[channel] if outlier_dph is None else outlier_dph
+        measured[row, channel] += sign * size
+        record = {"index": int(row), "column": f"out_{AXES[channel]}_dph"}
+        out.append({**record, "offset_dph": float(sign * size)})
+    return out

@@ -1,12 +1,10 @@
 """What a calibration run tells about the table: its errors seen through the outputs.
 
-The earth rate and gravity, seen at many positions, carry the payload's orientation: a table
-error turns both away from where eq. 3 puts them, and the outputs follow through eqs. 8-13. Fit
-the 14 coefficients together with every base error of the table (:class:`~.effects.TableError`),
-and the run determines some combinations of the table's errors on their own (the rows of the
-determined combinations that hold table errors only), some only together with the coefficients
-(a table error that moves the outputs like a coefficient: the calibration absorbs it, and the
-run cannot tell it from the instrument), and none of the rest.
+A table error turns gravity and the earth rate away from where eq. 3 puts them, and the outputs
+follow (eqs. 8-13). Fitting the 14 coefficients with every base error of the table, the run
+determines some combinations of the table's errors on their own, some only together with the
+coefficients (the calibration absorbs them: the run cannot tell them from the instrument), and
+none of the rest.
 """
 
 from __future__ import annotations
@@ -15,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..measurement.table import measured_table
 from .effects.table_side import PREFIX, TableError
 from .model import BASE_NAMES, fit_run
 
@@ -33,14 +32,11 @@ class TableFromRun:
         errors: the table's base errors fitted (names without the ``table:`` prefix).
         determined: combinations of table errors alone the run determines: ``{name, value,
             std, unit}`` (arcsec).
-        with_coefficients: combinations the run determines only together with the
-            coefficients (it cannot tell these table errors from the instrument's terms).
+        with_coefficients: combinations determined only together with the coefficients.
         undetermined: flat directions (combinations the run does not see at all).
-        rank_added: how many independent table combinations the run adds to the 14
-            coefficients.
+        rank_added: independent table combinations the run adds to the 14 coefficients.
         per_error: for each error, ``{std_alone_arcsec, correlation}``: its standard error
-            when it alone is fitted with the coefficients (arcsec) and its multiple correlation
-            with them (1: absorbed by the calibration).
+            fitted alone with the coefficients and its multiple correlation with them.
         sigma_dph: the output noise the standard errors are computed with, deg/h.
     """
 
@@ -54,8 +50,7 @@ class TableFromRun:
 
     @property
     def absorbed(self) -> list[dict]:
-        """``{error, correlation}`` of the errors the calibration mostly absorbs (multiple
-        correlation with the coefficients above :data:`ABSORBED_CORRELATION`)."""
+        """``{error, correlation}`` of the errors the calibration mostly absorbs."""
         return [
             {"error": name, "correlation": entry["correlation"]}
             for name, entry in self.per_error.items()
@@ -86,8 +81,6 @@ def table_from_run(run, table=None, *, mask=None, context=None) -> TableFromRun:
         mask: (N, 2) the outputs to use (outliers left out), default all.
         context: the :class:`~.effects.base.RunContext` to evaluate in (default the run's).
     """
-    from ..measurement.table import measured_table
-
     table = measured_table(run.table if table is None else table)
     effects = [TableError(table, name) for name in table.base_names]
     base = fit_run(run, (), context=context, mask=mask)

@@ -1,12 +1,10 @@
-"""Run effects the user writes (``--effects-module FILE.py``), checked once where they enter.
+"""Run effects the user writes (Python files of effects modules), checked once where they enter.
 
 :func:`load_run_effects_modules` loads the :class:`~.effects.base.RunEffect` subclasses of Python
-files (:func:`~turntable_pin.measurement.user_effects.load_effects_module`: the file is code that
-runs) and :func:`check_user_run_effects` checks them before any fit: their names (not a name of
-the run catalogue, with or without its ``table:`` prefix; not one of another of the user's
-effects) and their contract (:func:`~.effects.contract.check_run_effect`) on a probe of a few of
-the run's positions and on the run itself. Every problem is one line naming the file and the
-effect (exit status 2 at the command line).
+files (the file is code that runs) and :func:`check_user_run_effects` checks them before any fit:
+their names (none of the run catalogue's, with or without ``table:``; no two alike) and their
+contract (:func:`~.effects.contract.check_run_effect`) on a probe of a few of the run's positions
+and on the run itself. Every problem is one line naming the file and the effect.
 """
 
 from __future__ import annotations
@@ -16,10 +14,18 @@ from pathlib import Path
 
 import numpy as np
 
+from ..calibration.positions import PositionSet, position_inputs
+from ..calibration.run import CalibrationRun
 from ..core.user_code import is_user_code
+from ..measurement.effects.base import PositionVariables
 from ..measurement.effects.contract import check_story
+from ..measurement.user_effects import check_user_effect_names, load_effects_module
+from .effects import run_catalogue
 from .effects.base import RunContext, RunEffect
 from .effects.contract import check_run_effect
+from .effects.table_side import PREFIX
+from .model import run_context
+from .sensitivity import rate_sensitivity_dph
 
 __all__ = ["PROBE_POSITIONS", "check_user_run_effects", "load_run_effects_modules", "probe_context"]
 
@@ -28,14 +34,9 @@ PROBE_POSITIONS = 7
 
 
 def probe_context(run, coefficients: np.ndarray) -> RunContext:
-    """A :class:`RunContext` of a few of ``run``'s positions (:data:`PROBE_POSITIONS`, taken
-    every third row, cycling; their times and extra columns too) at ``coefficients``: a run of
-    another size, on which an effect that built its arrays for the run's size shows it."""
-    from ..calibration.positions import PositionSet, position_inputs
-    from ..calibration.run import CalibrationRun
-    from ..measurement.effects.base import PositionVariables
-    from .sensitivity import rate_sensitivity_dph
-
+    """A :class:`RunContext` of a few of ``run``'s positions (:data:`PROBE_POSITIONS`, every
+    third row, cycling, with their times and extra columns) at ``coefficients``: a run of another
+    size, on which an effect that built its arrays for the run's size shows it."""
     count = PROBE_POSITIONS if run.n_positions != PROBE_POSITIONS else PROBE_POSITIONS - 2
     rows = (3 * np.arange(count)) % run.n_positions
     positions = PositionSet(run.joint_rad[rows], table=run.table, name="probe")
@@ -63,10 +64,7 @@ def probe_context(run, coefficients: np.ndarray) -> RunContext:
 
 def _catalogue_names(table) -> dict[str, RunEffect]:
     """``{name: effect}`` of the run catalogue, each table effect also without ``table:``
-    (``--effects`` takes it so)."""
-    from .effects import run_catalogue
-    from .effects.table_side import PREFIX
-
+    (``effects`` take it so)."""
     out: dict[str, RunEffect] = {}
     for effect in run_catalogue(table):
         out[effect.name] = effect
@@ -84,9 +82,6 @@ def check_user_run_effects(effects: Sequence[RunEffect], run) -> tuple[RunEffect
         UserCodeError: an effect that raises or breaks its contract: one line naming the file,
             the effect, the method, what it returned and what was expected.
     """
-    from ..measurement.user_effects import check_user_effect_names
-    from .model import run_context
-
     for effect in effects:
         if is_user_code(effect):
             check_story(effect, RunEffect)
@@ -107,7 +102,5 @@ def check_user_run_effects(effects: Sequence[RunEffect], run) -> tuple[RunEffect
 def load_run_effects_modules(paths: Sequence[str | Path], run) -> tuple[RunEffect, ...]:
     """The run effects of the Python files ``paths``, in order, checked against ``run``
     (:func:`check_user_run_effects`)."""
-    from ..measurement.user_effects import load_effects_module
-
     effects = [e for path in paths for e in load_effects_module(path, RunEffect)]
     return check_user_run_effects(effects, run)

@@ -6,10 +6,7 @@ Free of the names and units of any application: callers pass names, scales and u
 
 from ..core.lazy import lazy_exports
 
-_EXPORTS = {
-    "Diagnosis": "model_selection",
-    "FitResult": "least_squares",
-}
+_EXPORTS = {"Diagnosis": "model_selection", "FitResult": "least_squares"}
 
 __all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

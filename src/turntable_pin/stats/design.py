@@ -1,18 +1,14 @@
 """D-optimal exact designs of a linear model: choose n of C candidates to maximise log det.
 
-Each candidate adds ``k`` rows ``X_c`` (k, p) to the model's (weighted) design matrix, so the
-information matrix of a design is ``M = M0 + sum_c X_c^T X_c`` (``M0``: what is already known).
-A D-optimal design maximises ``log det M``: the smallest joint confidence region of the ``p``
-parameters, whatever their scale (a change of parameters adds a constant to ``log det``).
+Each candidate adds ``k`` rows ``X_c`` (k, p) to the (weighted) design matrix: ``M = M0 + sum_c
+X_c^T X_c`` (``M0`` already known). Maximising ``log det M`` gives the smallest joint confidence
+region, whatever the parameters' scale.
 
-The search is the classic one: a greedy start (each step adds the candidate that raises
-``log det`` most) and then the exchange of Fedorov (1972), in its point-by-point form (Cook and
-Nachtsheim 1980): for each design point in turn, the best candidate to take its place, taken when
-it raises ``log det``; sweeps until none does. Every gain is read from ``M^-1`` alone, for every
-candidate at once (the matrix determinant lemma, ``det(M + U S U^T) = det M det(S^-1 + U^T M^-1
-U) det S``), and ``M^-1`` follows each step by the Sherman-Morrison-Woodbury update; it is formed
-afresh after every sweep, so that rounding never accumulates. An exchange is taken only when it
-raises ``log det``: the criterion never decreases.
+A greedy start, then Fedorov's (1972) exchange point by point (Cook and Nachtsheim 1980): each
+design point's best replacement, taken when it raises ``log det``; sweeps until none does. Every
+gain is read from ``M^-1`` for every candidate at once (matrix determinant lemma), ``M^-1``
+follows by Sherman-Morrison-Woodbury and is formed afresh after every sweep (no rounding
+accumulates). The criterion never decreases.
 
 Generic: the candidates are rows of numbers; what they mean is the caller's.
 """
@@ -23,17 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = [
-    "ExchangeResult",
-    "d_optimal_design",
-    "fedorov_exchange",
-    "greedy_design",
-    "log_det",
-]
+__all__ = ["ExchangeResult", "d_optimal_design", "fedorov_exchange", "greedy_design", "log_det"]
 
 RIDGE_RTOL = 1e-9
-"""The greedy start adds this fraction of a candidate's mean information (times the design's
-size) to ``M``, so that it can start from nothing (``M`` singular until p rows are in)."""
+"""Ridge of the greedy start (of n candidates' mean information): ``M`` is singular until p rows
+are in."""
 
 EXCHANGE_TOL = 1e-10
 """An exchange is taken when it raises ``log det`` by more than this."""
@@ -44,7 +34,7 @@ MAX_SWEEPS = 100
 
 SINGULAR_RTOL = 1e-12
 """An information matrix whose smallest eigenvalue is below this fraction of its largest is
-singular (what is left is rounding: a direction no row sees)."""
+singular (a direction no row sees)."""
 
 
 def log_det(information: np.ndarray) -> float:
@@ -61,16 +51,10 @@ def log_det(information: np.ndarray) -> float:
 
 @dataclass(frozen=True)
 class ExchangeResult:
-    """A D-optimal design found by :func:`d_optimal_design`.
-
-    Attributes:
-        chosen: indices of the chosen candidates (n,), each at most once.
-        log_det: ``log det`` of the design's information (with the start's).
-        greedy_log_det: ``log det`` after the greedy start.
-        history: ``log det`` after the greedy start and after each exchange taken (the
-            criterion the exchange raised: never decreasing).
-        n_exchanges: exchanges taken; n_sweeps: sweeps over the design points.
-    """
+    """A D-optimal design (:func:`d_optimal_design`): the ``chosen`` indices (n,), ``log_det``
+    of its information (with the start's), ``greedy_log_det`` after the greedy start,
+    ``history`` after it and each exchange (never decreasing), ``n_exchanges`` and
+    ``n_sweeps``."""
 
     chosen: np.ndarray
     log_det: float
@@ -117,14 +101,10 @@ def _products(left: np.ndarray, middle: np.ndarray, right: np.ndarray) -> np.nda
 
 
 def _exchange_ratios(quad: np.ndarray, g: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``det(M + X_c^T X_c - X_i^T X_i) / det M`` of every candidate c taking the place of
-    design point i: ``det([[I + A_c, G_c], [-G_c^T, I - B]])`` with ``A_c = X_c M^-1 X_c^T``
-    (``quad``), ``G_c = X_c M^-1 X_i^T`` (``g``) and ``B = X_i M^-1 X_i^T`` (``b``).
-
-    When M stays well conditioned without point i (the eigenvalues of ``I - B`` away from 0),
-    by the Schur complement ``det(I - B) det(I + A_c + G_c (I - B)^-1 G_c^T)`` (k x k
-    determinants); else by the whole (2k x 2k) determinants.
-    """
+    """``det(M + X_c^T X_c - X_i^T X_i) / det M`` of every candidate c replacing point i:
+    ``det([[I + A_c, G_c], [-G_c^T, I - B]])``, ``A_c = X_c M^-1 X_c^T`` (``quad``), ``G_c =
+    X_c M^-1 X_i^T`` (``g``), ``B = X_i M^-1 X_i^T`` (``b``); by the Schur complement when
+    ``I - B`` is well conditioned, else the whole (2k x 2k) determinants."""
     c, k, _ = quad.shape
     rest = np.eye(k) - b
     if np.linalg.eigvalsh(rest).min() > 1e-6:
@@ -144,17 +124,9 @@ def _exchange_ratios(quad: np.ndarray, g: np.ndarray, b: np.ndarray) -> np.ndarr
 def greedy_design(
     rows: np.ndarray, n: int, start: np.ndarray | None = None, exclude=()
 ) -> np.ndarray:
-    """``n`` candidates, each the one that raises ``log det(start + ridge + ...)`` most.
-
-    Args:
-        rows: each candidate's rows (C, k, p) (or (C, p): one row each).
-        n: how many to choose (at most C).
-        start: information already known (p, p), or ``None``.
-        exclude: candidates not to choose.
-
-    Returns:
-        The chosen indices in the order chosen (n,).
-    """
+    """``n`` candidate indices among ``rows`` (C, k, p) (or (C, p)), in the order chosen, each
+    the one that raises ``log det(start + ridge + ...)`` most (``start``: information already
+    known (p, p), or ``None``), none of ``exclude``."""
     rows = _as_rows(rows)
     c, k, p = rows.shape
     if not 0 < n <= c - len(exclude):
@@ -192,19 +164,9 @@ def fedorov_exchange(
     tol: float = EXCHANGE_TOL,
     max_sweeps: int = MAX_SWEEPS,
 ) -> ExchangeResult:
-    """Improve a design by exchanges (module docstring) until no exchange raises ``log det``.
-
-    Args:
-        rows: each candidate's rows (C, k, p).
-        chosen: the design to start from (indices, each at most once); its information
-            (with ``start``) must be nonsingular.
-        start: information already known (p, p), or ``None``.
-        tol: the smallest rise of ``log det`` an exchange must bring.
-        max_sweeps: most sweeps over the design points.
-
-    Raises:
-        ValueError: the starting design's information is singular.
-    """
+    """Improve the design ``chosen`` (indices into ``rows`` (C, k, p); nonsingular with
+    ``start``, else ValueError) by exchanges raising ``log det`` by more than ``tol``, at most
+    ``max_sweeps`` sweeps."""
     rows = _as_rows(rows)
     c, k, p = rows.shape
     chosen = np.array(chosen, dtype=int)
@@ -264,8 +226,7 @@ def fedorov_exchange(
 
 
 def _completed(rows, n, start, seed) -> np.ndarray:
-    """The starting design ``seed`` made ``n`` long: its best ``n`` (greedy among them) when
-    longer, completed greedily when shorter."""
+    """The design ``seed`` made ``n`` long greedily (its best ``n``, or completed)."""
     seed = np.unique(np.asarray(seed, dtype=int))
     if seed.size >= n:
         return seed[greedy_design(rows[seed], n, start)]
@@ -282,20 +243,11 @@ def d_optimal_design(
     tol: float = EXCHANGE_TOL,
     max_sweeps: int = MAX_SWEEPS,
 ) -> ExchangeResult:
-    """The D-optimal choice of ``n`` of the candidates: :func:`greedy_design`, then
-    :func:`fedorov_exchange`; the exchange also runs from each design of ``also_from`` (made
-    ``n`` long: its greedy best ``n``, or completed greedily) and the best result is kept, so
-    that it is never worse than any of them (an exchange can stop in a local optimum).
-
-    When no start's information is nonsingular, the greedy design is returned with ``log_det``
-    ``-inf``: these candidates cannot determine every parameter with ``n`` of them.
-
-    Args:
-        rows: each candidate's rows (C, k, p) (or (C, p)).
-        n: how many candidates to choose.
-        start: information already known (p, p), or ``None``.
-        also_from: other designs to start from (index sequences), e.g. a regular grid.
-    """
+    """The D-optimal choice of ``n`` of the candidates ``rows`` (C, k, p) (or (C, p)), given
+    the information ``start`` (p, p) or ``None``: :func:`greedy_design`, then
+    :func:`fedorov_exchange`, also from each design of ``also_from`` (e.g. a regular grid, made
+    ``n`` long), keeping the best (an exchange can stop in a local optimum). When no start is
+    nonsingular, the greedy design with ``log_det`` ``-inf``."""
     rows = _as_rows(rows)
     best = None
     for first in (

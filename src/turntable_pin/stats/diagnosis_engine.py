@@ -1,24 +1,18 @@
-"""One diagnosis over families of data: the fits a family shares, the screen for gross outliers,
-a noise level per observation column, the two passes and the doubt about the family itself.
+"""One diagnosis over families of data (as statsmodels' GLM is one engine over families).
 
-As statsmodels' GLM is one fitting engine and each family supplies only its link and variance, a
-kind of data (orientation measurements, the outputs of a calibration run, a third later) is a
-:class:`DataFamily` that supplies only what is its own: the names and unit of its observation
-columns, the fit of its base model plus effects (:meth:`DataFamily.fit_model`), the candidate
-effects, the probes of the structure search and its words. Written here once, for every family:
+A kind of data (orientation measurements, a calibration run's outputs) is a :class:`DataFamily`
+supplying only what is its own: its observation columns and unit, the fit of its base model plus
+effects, the candidates, the structure search's probes and its words. Written here once:
 
-- the fits of one data set, cached per effect list and sharing one zero point
-  (:meth:`DataFamily.fit`), each model refitted at the per-column noise it estimates itself when
-  the columns' noise differ (:meth:`DataFamily.own_column_noise`);
-- which effect is missing (:func:`~.model_selection.diagnose`), with gross outliers left out by
-  the stated rule (:func:`~.outliers.screen_cells`) in two passes
-  (:func:`~.outliers.screened_diagnosis`) and listed (:func:`outlier_records`);
-- without sigmas, the F test of the columns' noise and the diagnosis made again with a noise level
-  per column (:func:`column_noise`);
+- the fits of one data set, cached per effect list, sharing one zero point, each refitted at its
+  own per-column noise when the columns' noise differ (:meth:`DataFamily.fit`);
+- which effect is missing (:func:`~.model_selection.diagnose`), gross outliers left out by the
+  stated rule in two passes (:func:`~.outliers.screened_diagnosis`) and listed;
+- without sigmas, the F test of the columns' noise and the diagnosis again with a noise level per
+  column (:func:`column_noise`);
 - the doubt when even the best model stays far from the stated noise (:data:`DOUBT_CHI2_REDUCED`).
 
-:func:`diagnose_data` is the one entry point. The engine carries no domain names or units: the
-family passes them in.
+:func:`diagnose_data` is the one entry point. The engine carries no domain names or units.
 """
 
 from __future__ import annotations
@@ -33,6 +27,7 @@ import numpy as np
 from ..core.exceptions import InputError
 from ..core.sizes import DIAGNOSIS_ROW_BYTES, MAX_DIAGNOSED_ROWS, check_count
 from .model_selection import Diagnosis, diagnose
+from .outliers import column_variances, screen_cells, screened_diagnosis, variances_differ
 from .structure_search import Probe, ProbeFactors
 
 __all__ = [
@@ -55,9 +50,8 @@ __all__ = [
 ]
 
 DOUBT_CHI2_REDUCED = 9.0
-"""With sigma given, a best model (every accepted effect in) still this far from the noise
-(residuals three times the stated sigma) makes the diagnosis doubt the family itself: the data may
-not come from this model at all (another table, a wrong stated sigma), said before the verdict."""
+"""With sigma given, a best model still this far from the noise (residuals three times the stated
+sigma) makes the diagnosis doubt the family itself (another table, a wrong stated sigma)."""
 
 NOISE_PER_COLUMN_ALPHA = 0.01
 """Without sigmas, the observation columns get their own noise level when an F test of their
@@ -67,12 +61,11 @@ NOISE_ITERATIONS = 20
 """Most refits of a model with its own per-column noise (:meth:`DataFamily.own_column_noise`)."""
 
 NOISE_RTOL = 1e-2
-"""The per-column noise levels of a model have converged when none moves by more than this
-fraction (the profiled likelihood is stationary there: what is left changes a score by its
-square)."""
+"""The per-column noise levels have converged when none moves by more than this fraction (the
+profiled likelihood is stationary: what is left changes a score by its square)."""
 
 DATA_PLACEHOLDER = "DATA.csv"
-"""The data file a command names when the data were not read from one (made in memory)."""
+"""The data file a command names when the data were made in memory."""
 
 SEPARATION_CHI2 = 25.0
 """Noise-free misfit chi2 above which a denser set of positions is said to separate two effects
@@ -81,21 +74,16 @@ SEPARATION_CHI2 = 25.0
 
 @dataclass(frozen=True)
 class PageWords:
-    """A family's words for the one HTML page of its diagnosis (``report.html_report`` lays it
-    out; the engine only carries them).
+    """A family's words for the HTML page of its diagnosis (``report.html_report`` lays it out).
 
     Attributes:
-        title: the page's heading when the caller gives none.
-        page_title: the browser's title when the caller gives none.
-        sections: ``(section, heading)`` of each section of the page, in order, among those the
-            report knows; an empty heading: the section has none.
-        fit_columns: the columns of each table of fits after the model's label, among ``rms``,
-            ``chi2_reduced``, ``rank``, ``n_params``, ``p_value``.
-        candidate_columns: the columns of the table of candidates after the effect, among
-            ``side``, ``delta_bic``, ``after_first``, ``rms``, ``chi2_reduced``, ``added_rank``,
-            ``alternatives``.
-        parts: the optional parts the page shows (e.g. an anchor on its verdict, the effect's
-            story, residual maps), by the names the report gives them.
+        title, page_title: the page's heading and the browser's title (when the caller gives none).
+        sections: ``(section, heading)`` of each section, in order (empty heading: none).
+        fit_columns: the columns of each table of fits, among ``rms``, ``chi2_reduced``,
+            ``rank``, ``n_params``, ``p_value``.
+        candidate_columns: the columns of the candidates' table, among ``side``, ``delta_bic``,
+            ``after_first``, ``rms``, ``chi2_reduced``, ``added_rank``, ``alternatives``.
+        parts: the optional parts the page shows, by the report's names.
         structure_shapes: the shapes the structure search tries, in words.
     """
 
@@ -112,14 +100,13 @@ class PageWords:
 
 @dataclass(frozen=True)
 class SeparationWords:
-    """A family's words for :meth:`DataFamily.separation` (``on a {grid}``...).
+    """A family's words for :meth:`DataFamily.separation`.
 
     Attributes:
-        grid: the dense set of positions, as the sentence that no position separates says it.
-        grid_cannot: the same, where the effect cannot be evaluated on it.
-        grid_mimics: the same, where it separates the effects (with its size).
+        grid: the dense set of positions (``on a {grid}``) where no position separates them;
+            grid_cannot: where the effect cannot be evaluated; grid_mimics: where they separate.
         position: what one position is (``at every {position}``).
-        check: the independent check that tells the effects apart (``an independent {check}``).
+        check: the independent check that tells them apart (``an independent {check}``).
         more_data: what separates two effects that only these positions confuse.
     """
 
@@ -132,16 +119,10 @@ class SeparationWords:
 
 
 class DataFamily:
-    """A family of data for the one diagnosis: a ``ModelFamily``
-    (:class:`~.model_selection.ModelFamily`) bound to one data set, with some cells left out as
-    outliers and maybe a noise level per column, and what :func:`diagnose_data` asks of it.
-
-    A subclass sets the class attributes below, calls ``DataFamily.__init__`` and implements the
-    hooks :meth:`fit_model`, :meth:`zero_point_of`, :meth:`refit`, :meth:`residual_table`,
-    :meth:`full_residuals`, :meth:`residual_set`, :meth:`without`, :meth:`with_column_noise`,
-    :meth:`screen_fit`, :attr:`data_columns`, :meth:`probes`, :meth:`dense_misfit`,
-    :meth:`separation_words`, :meth:`design_warnings`; it may fill the result with its own data
-    in :meth:`complete`.
+    """A family of data bound to one data set (some cells maybe left out as outliers, maybe a
+    noise level per column): what the diagnosis asks of a family. A subclass sets the
+    class attributes, calls ``DataFamily.__init__`` and implements the hooks that raise
+    ``NotImplementedError`` here; :meth:`complete` may add its own data to the result.
 
     Attributes:
         columns: the names of the K observation columns of a record.
@@ -150,15 +131,12 @@ class DataFamily:
         record_words: the records in words, for the size limit of a diagnosis.
         observations: the observations in words, plural (the outlier rule's note).
         observation_unit: the key suffix of ``rms_``/``sigma_`` in the result.
-        unit_words: the user unit in sentences.
-        user_unit_scale: user units per internal unit of the observations.
+        unit_words: the user unit in sentences; user_unit_scale: user units per internal unit.
         outlier_rule: the outlier rule in words (the result's ``outlier_rule``).
-        noise_subject, noise_column, noise_how: the words of the note on a noise level per
-            column (:func:`column_noise_note`).
+        noise_subject, noise_column, noise_how: the words of :func:`column_noise_note`.
         page: the words of the HTML page of its diagnosis (:class:`PageWords`).
         catalogue: the candidate effects (objects with a ``name``), in catalogue order.
-        n_records: number of records R.
-        observed: (R, K) the cells that hold an observation fitted here.
+        n_records: number of records R; observed: (R, K) the cells fitted here.
         noise_per_column: whether every model is fitted at its own per-column noise.
         sigma_scale: the observations' typical sigma in user units (the unit-weight noise).
     """
@@ -193,24 +171,21 @@ class DataFamily:
         self._cache: dict[tuple[str, ...], Any] = {}
         self._zero: tuple[Any] | None = None
 
-    # ---- hooks of the family --------------------------------------------------------------
     def fit_model(self, effects: Sequence[Any], zero_point) -> Any:
-        """The fit (an object with a ``result``, a ``FitResult``) of the base model plus
-        ``effects`` to this family's data, starting from ``zero_point`` (or None)."""
+        """The fit (with a ``result``, a ``FitResult``) of the base model plus ``effects``, from
+        ``zero_point`` (or None)."""
         raise NotImplementedError
 
     def zero_point_of(self, effects: Sequence[Any]):
-        """The reduced Jacobian at zero (``least_squares.zero_point``) of the base model plus
-        ``effects`` on these data, with the weights of :meth:`fit_model`'s fits."""
+        """The ``least_squares.zero_point`` of the base model plus ``effects`` on these data."""
         raise NotImplementedError
 
     def refit(self, fit, column_sigma: np.ndarray) -> Any:
-        """``fit``'s model fitted again with the relative noise ``column_sigma`` (K,) per column
-        (internal units)."""
+        """``fit``'s model refitted at the relative noise ``column_sigma`` (K,) per column."""
         raise NotImplementedError
 
     def residual_table(self, fit) -> np.ndarray:
-        """(R, K) the residuals of ``fit`` (internal units), NaN where no observation is fitted."""
+        """(R, K) the residuals of ``fit``, NaN where no observation is fitted."""
         raise NotImplementedError
 
     def full_residuals(self, fit) -> np.ndarray:
@@ -218,8 +193,7 @@ class DataFamily:
         raise NotImplementedError
 
     def residual_set(self, fit):
-        """The residuals of ``fit`` for the figures (a ``ResidualSet`` of the family's layer),
-        the observations left out as outliers kept apart."""
+        """The residuals of ``fit`` for the figures (the family's ``ResidualSet``)."""
         raise NotImplementedError
 
     @property
@@ -246,20 +220,17 @@ class DataFamily:
         raise NotImplementedError
 
     def with_column_noise(self, column_sigma: np.ndarray) -> DataFamily:
-        """The family on these data whose every model is fitted at its own per-column noise,
-        starting from ``column_sigma`` (K,)."""
+        """The family fitting every model at its own per-column noise, from ``column_sigma``."""
         raise NotImplementedError
 
     @property
     def data_columns(self):
-        """The data's columns, for the effects' required columns (an object with
-        ``column(name)`` and ``missing_columns_words(names)``)."""
+        """The data's columns (``column(name)``, ``missing_columns_words(names)``)."""
         raise NotImplementedError
 
     def dense_misfit(self, fit_a, effect_b) -> float:
         """The noise-free chi2 left when the model with ``effect_b`` in place of ``fit_a``'s last
-        effect is fitted to ``fit_a``'s fitted signal on a dense set of positions; raises
-        ``InputError`` when ``effect_b`` cannot be evaluated there."""
+        effect is fitted to ``fit_a``'s signal on dense positions (``InputError``: not there)."""
         raise NotImplementedError
 
     def separation_words(self) -> SeparationWords:
@@ -276,13 +247,11 @@ class DataFamily:
         return "no catalogued effect makes these data; is the stated sigma too small?"
 
     def complete(self, diagnosis: Diagnosis) -> None:
-        """Fill ``diagnosis`` with the family's own data (its ``separation_commands``,
-        ``family_verdict``, ``family_results``); by default nothing."""
+        """Fill ``diagnosis``'s ``separation_commands``, ``family_verdict``, ``family_results``."""
 
-    # ---- the fits, written once -------------------------------------------------------------
     def fit(self, effects: Sequence[Any], noise_variance: float | None = None) -> Any:
-        """The fit of the base model plus ``effects`` (cached per effect list; every fit of the
-        family shares :meth:`zero_point`; with a noise level per column, at its own noise)."""
+        """The fit of the base model plus ``effects`` (cached; sharing :meth:`zero_point`; with a
+        noise level per column, at its own noise)."""
         key = tuple(e.name for e in effects)
         if key not in self._cache:
             fit = self.fit_model(effects, self.zero_point())
@@ -290,9 +259,8 @@ class DataFamily:
         return self._cache[key]
 
     def zero_point(self):
-        """The reduced Jacobian at zero of the base and every testable catalogued effect,
-        shared by all fits of the family (computed on first use; None when the effects cannot
-        share one model: each fit is then made on its own)."""
+        """The zero point of the base and every testable effect, shared by the family's fits
+        (None when they cannot share one model: each fit is then made on its own)."""
         if self._zero is None:
             testable = [e for e in self.catalogue if not self.untestable_reason(e)]
             try:
@@ -306,9 +274,8 @@ class DataFamily:
         return None
 
     def own_column_noise(self, fit) -> Any:
-        """``fit`` refitted with the per-column noise levels it estimates itself, until they
-        stop moving (:data:`NOISE_RTOL`, at most :data:`NOISE_ITERATIONS` refits); its result
-        carries the column of each observation as its noise group."""
+        """``fit`` refitted at the per-column noise it estimates itself until it settles
+        (:data:`NOISE_RTOL`, :data:`NOISE_ITERATIONS`); each observation's column is its group."""
         sigma = self.initial_column_sigma()
         for _ in range(NOISE_ITERATIONS):
             variance, counts, _ = self.column_variances(fit)
@@ -323,16 +290,11 @@ class DataFamily:
         return dataclasses.replace(fit, result=result)
 
     def column_variances(self, fit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(variance, counts, degrees of freedom)`` of each column's residuals under ``fit``
-        (:func:`~.outliers.column_variances`), internal units squared."""
-        from .outliers import column_variances
-
+        """``(variance, counts, dof)`` of each column's residuals under ``fit``."""
         return column_variances(self.residual_table(fit), fit.result.dof, fit.result.n_obs)
 
-    # ---- what the diagnosis asks, written once ----------------------------------------------
     def untestable_reason(self, effect) -> str | None:
-        """Why ``effect`` cannot be tested here (its data columns are missing, or not numbers),
-        or None."""
+        """Why ``effect`` cannot be tested here (its data columns are missing), or None."""
         columns = self.data_columns
         missing = effect.missing_columns(columns)
         if missing:
@@ -341,9 +303,7 @@ class DataFamily:
 
     def separation(self, fit_a, effect_b) -> str:
         """Whether more positions would separate effect A (``fit_a``'s last) from ``effect_b``,
-        or only an independent check: B's noise-free misfit to A's fitted signal on a dense set
-        of positions (:meth:`dense_misfit`) against :data:`SEPARATION_CHI2`, in the family's
-        words (:meth:`separation_words`)."""
+        or only an independent check: :meth:`dense_misfit` against :data:`SEPARATION_CHI2`."""
         a, b = fit_a.model.effects[-1], effect_b
         words = self.separation_words()
         both = f"For {a.name}: {a.confirm} For {b.name}: {b.confirm}"
@@ -375,8 +335,7 @@ class DataFamily:
         return (self.effect(effect) if isinstance(effect, str) else effect).describe()
 
     def inputs(self, effect) -> set[str]:
-        """The data columns ``effect`` depends on beyond the base model's inputs (its
-        ``required_columns``): a shape in one of them is its own kind, not one it mimics."""
+        """``effect``'s ``required_columns``: a shape in one is its own kind, not a mimic's."""
         return set(getattr(effect, "required_columns", ()))
 
     def probes(self, fit) -> list[Probe]:
@@ -384,14 +343,12 @@ class DataFamily:
         raise NotImplementedError
 
     def base_inputs(self) -> set[str]:
-        """The names of the base model's own inputs (the probes' variables made of them are not
-        suspects: :meth:`suspect_probes`)."""
+        """The base model's own inputs (probes in them are no suspects)."""
         return set()
 
     def suspect_probes(self, fit) -> list[Probe]:
-        """The probes of shapes in inputs other than the base model's own (time, other data
-        columns, and combinations ``a+b``/``a-b`` of base inputs count as base inputs): what a
-        catalogued effect may mimic through the measurement order, but cannot be."""
+        """The probes in inputs other than the base model's (``a+b``/``a-b`` of base inputs
+        count as base): what an effect may mimic through the measurement order, but not be."""
         own = self.base_inputs()
 
         def of_base(probe) -> bool:
@@ -403,9 +360,8 @@ class DataFamily:
     def probe(
         self, name: str, description: str, factors: ProbeFactors, spec: str, basis: np.ndarray
     ) -> Probe:
-        """A probe whose columns are ``factors``' direction (R, K) times its functions at the
-        data, ``basis`` (R, g) (computed once for the probes that share them), as rows of the
-        observations fitted; ``spec``: its ``effect_spec`` (what a fit takes to add it)."""
+        """A probe: ``factors``' direction (R, K) times ``basis`` (R, g), its functions at the
+        data, over the observations fitted; ``spec``: its ``effect_spec``."""
         mask = self.observed.reshape(-1)
         factors = dataclasses.replace(factors, basis=basis)
 
@@ -418,11 +374,9 @@ class DataFamily:
                      effect_spec=spec)  # fmt: skip
 
     def shape_probes(self, plot: tuple, shape: str, spec: str, directions) -> list[Probe]:
-        """One probe per ``(site, direction, description)`` of ``directions`` for one shape:
-        ``plot`` is ``(variable, values, functions, value scale, unit)`` (the functions' basis
-        computed once for all the sites), the direction (R, K) (or a function giving it) where
-        the shape enters the observations at ``site``; each probe is named ``<site> <shape>``,
-        its ``effect_spec`` ``<site>~<spec>``."""
+        """One probe ``<site> <shape>`` (``effect_spec`` ``<site>~<spec>``) per ``(site,
+        direction (R, K) or a function giving it, description)`` of ``directions``; ``plot`` is
+        ``(variable, values, functions, value scale, unit)``, its basis computed once."""
         var, values, functions, scale, unit = plot
         basis = functions(values)
         probes = []
@@ -435,8 +389,7 @@ class DataFamily:
 
 
 def residual_sets(diagnosis: Diagnosis) -> tuple[Any, Any]:
-    """The residual sets of a diagnosis' base and best fits (:meth:`DataFamily.residual_set`),
-    both judged with its noise variance."""
+    """The residual sets of a diagnosis' base and best fits, judged at its noise variance."""
     family = diagnosis.family
     return tuple(
         family.residual_set(fit.with_noise_variance(diagnosis.noise_variance))
@@ -447,15 +400,12 @@ def residual_sets(diagnosis: Diagnosis) -> tuple[Any, Any]:
 def diagnose_data(
     family: DataFamily, *, until_explained: bool = False, outliers: bool = True
 ) -> Diagnosis:
-    """Diagnose a family's data (module docstring): which catalogued effect is missing.
+    """Which catalogued effect is missing from ``family``'s data (module docstring).
 
-    ``family`` holds all the data (no cell left out, no per-column noise). With ``outliers``
-    (the default) gross outliers are found by the family's rule, left out of every fit of the
-    verdict and listed in ``Diagnosis.outliers`` (:func:`diagnose_screened`); ``outliers=False``
-    keeps every observation. Without sigmas, when the residuals show that the columns' noise
-    differ (:func:`column_noise`), the diagnosis is made again with every model fitted at its own
-    per-column noise, and a warning says so. The doubt about the family (:func:`doubt`) and the
-    family's own data (:meth:`DataFamily.complete`) complete the result.
+    ``family`` holds all the data. With ``outliers`` gross outliers are left out by the family's
+    rule and listed (:func:`diagnose_screened`). Without sigmas, when the columns' noise differ
+    (:func:`column_noise`), the diagnosis is made again at each model's own per-column noise, and
+    a warning says so. :func:`doubt` and :meth:`DataFamily.complete` complete the result.
 
     Raises:
         InputError: more records than :data:`MAX_DIAGNOSED_ROWS` (of ``core.sizes``).
@@ -479,10 +429,8 @@ def diagnose_data(
 def diagnose_screened(
     family: DataFamily, *, until_explained: bool = False, outliers: bool = True
 ) -> Diagnosis:
-    """One pass of :func:`diagnose_data`: the diagnosis of ``family``'s data with the outlier rule
-    (screened under the base model, then under the accepted effects:
-    :func:`~.outliers.screened_diagnosis`) or, without ``outliers``, of every observation."""
-    from .outliers import screen_cells, screened_diagnosis
+    """One pass of :func:`diagnose_data`, with the outlier rule
+    (:func:`~.outliers.screened_diagnosis`) or, without ``outliers``, on every observation."""
 
     def diagnose_without(cells):
         return diagnose(family.without(cells), until_explained=until_explained)
@@ -507,10 +455,9 @@ def diagnose_screened(
 
 
 def outlier_records(diagnosis: Diagnosis, family: DataFamily, cells: np.ndarray) -> list[dict]:
-    """``{"row", <family.column_key>, "residual_sigma"}`` of each outlier cell of ``family``'s
-    data under the diagnosis' final model, worst first. Sigma is the noise the verdict uses: the
-    best model's own per column when it has one, else the data's sigmas (stated or relative)
-    times the unit-weight noise, else the unit-weight noise."""
+    """``{"row", <family.column_key>, "residual_sigma"}`` of each outlier cell under the final
+    model, worst first, in the verdict's noise: the best model's per column, else the data's
+    sigmas (stated or relative) times the unit-weight noise, else the unit-weight noise."""
     residual = family.full_residuals(diagnosis.best_fit)
     table = family.sigma_table()
     if diagnosis.group_variance is not None:  # per noise group: the columns with observations
@@ -536,10 +483,9 @@ def _levels(family: DataFamily, sigma: np.ndarray, columns) -> str:
 
 
 def column_noise(diagnosis: Diagnosis) -> tuple[np.ndarray, str] | None:
-    """Without sigmas: the residual rms of each column under the best model (internal units; a
-    column with too few observations to test gets the mean level) and a sentence, when the
-    columns' noise differ (F test at :data:`NOISE_PER_COLUMN_ALPHA`), else None."""
-    from .outliers import variances_differ
+    """Without sigmas, when the columns' noise differ (F test at
+    :data:`NOISE_PER_COLUMN_ALPHA`): each column's residual rms under the best model (the mean
+    level for a column too small to test) and a sentence; else None."""
 
     family = diagnosis.family
     variance, counts, dof = family.column_variances(diagnosis.best_fit)
@@ -557,8 +503,8 @@ def column_noise(diagnosis: Diagnosis) -> tuple[np.ndarray, str] | None:
 
 
 def column_noise_note(diagnosis: Diagnosis, found: str) -> str:
-    """The warning of a diagnosis made with each model's own per-column noise: why (``found``,
-    the first pass' sentence of :func:`column_noise`) and the best model's levels."""
+    """The warning of a diagnosis at each model's own per-column noise: why (``found``, from
+    :func:`column_noise`) and the best model's levels."""
     family = diagnosis.family
     variance, counts, _ = family.column_variances(diagnosis.best_fit)
     levels = _levels(family, np.sqrt(variance), [c for c in range(len(counts)) if counts[c]])
@@ -569,8 +515,7 @@ def column_noise_note(diagnosis: Diagnosis, found: str) -> str:
 
 
 def doubt(diagnosis: Diagnosis) -> str | None:
-    """Why the family itself is in doubt (with sigma given, the best model's residuals stay
-    above :data:`DOUBT_CHI2_REDUCED` times the noise), in the family's words, or None."""
+    """Why the family itself is in doubt (:data:`DOUBT_CHI2_REDUCED`), or None."""
     best = diagnosis.best_fit.result
     if not best.sigma_known or best.dof <= 0:
         return None

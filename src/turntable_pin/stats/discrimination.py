@@ -1,31 +1,21 @@
 """Telling two rival linear models apart: their misfit on a design, the design that maximises
 it (T-optimal), and the chance that the model choice names the right one.
 
-Two models share a block of columns ``S`` (what both fit, e.g. a base model) and add their own,
-``X1`` and ``X2``; every column and signal is *whitened* (divided by the noise sigma), so that a
-squared norm is a chi2. When model 1 is true with parameters ``a`` (signal ``mu = X1 a``), fitting
-model 2 to its noise-free prediction leaves the misfit
+Two models share columns ``S`` and add their own, ``X1`` and ``X2``, all *whitened* (over the
+noise sigma: a squared norm is a chi2). When model 1 is true (signal ``mu = X1 a``), fitting model
+2 to it leaves ``lambda_12 = || (I - P_2) mu ||^2`` (``P_2`` the projector onto ``[S X2]``), the
+non-centrality of the test of model 2 (Atkinson and Fedorov 1975). A *T-optimal* design
+maximises the smaller of ``lambda_12`` and ``lambda_21`` (:func:`t_optimal_exchange`).
 
-    lambda_12 = || (I - P_2) mu ||^2,        P_2 the projector onto [S X2] over the design,
-
-the non-centrality of the test of model 2 against the truth (Atkinson and Fedorov 1975). A
-*T-optimal* design of N observation groups (positions) maximises it; with both models plausible
-(each with the parameters it fitted on earlier data), the smaller of ``lambda_12`` and
-``lambda_21`` (:func:`t_optimal_exchange`: a seeded random start, then Fedorov exchange).
-
-The choice. A rule that names the model with the smaller penalised misfit ``rss + k ln m`` (BIC
-with sigma known; ``k`` the ranks each model adds to ``S``, ``m`` the observations) names model 1
-when ``D = rss_2 - rss_1 > (k_1 - k_2) ln m``. With ``y = mu + e``, ``e ~ N(0, I)``,
-``D = y^T (P_1 - P_2) y``: the matrix has eigenvalues in ``[-1, 1]`` (plus and minus the sines
-of the principal angles between the two models' own spans), so ``D`` is a generalised chi-square
-``sum_i w_i (z_i + delta_i)^2`` (:func:`rss_difference`), whose tail Imhof's formula gives
-(:func:`generalized_chi2_sf`). When model 2 contains model 1 (nested) and model 2 is true,
-``D = -chi2'(k_2 - k_1, lambda_21)``: the non-central chi-square of the nested test, against the
-margin ``(k_2 - k_1) ln m``; when model 1 is true, ``-chi2(k_2 - k_1)`` (the parsimony of the rule
-names the smaller model unless the noise alone pays the penalty).
+The choice. BIC (sigma known; ``k`` the ranks each model adds to ``S``) names model 1 when ``D =
+rss_2 - rss_1 > (k_1 - k_2) ln m``. With ``y = mu + e``, ``D = y^T (P_1 - P_2) y``, eigenvalues
+in ``[-1, 1]``: a generalised chi-square (:func:`rss_difference`), its tail by Imhof's formula
+(:func:`generalized_chi2_sf`). Nested (model 2 contains 1) and model 2 true: ``D =
+-chi2'(k_2 - k_1, lambda_21)``; model 1 true: ``-chi2(k_2 - k_1)``.
 
 Nothing here knows what the columns are: the caller whitens its Jacobians and names the models.
 """
+# scipy (integrate, special) is imported inside functions: the package's import stays light
 
 from __future__ import annotations
 
@@ -36,6 +26,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .least_squares import RANK_RTOL
+from .model_selection import (
+    MAX_CORRELATION,
+    MAX_CORRELATION_ALL,
+    column_span,
+    multiple_correlations,
+)
 
 __all__ = [
     "RIDGE",
@@ -55,15 +51,13 @@ __all__ = [
 ]
 
 RIDGE = 1e-9
-"""Ridge added to the Gram matrices of the exchange (relative to one candidate's mean diagonal):
-it keeps them invertible while the design does not yet determine every column (the misfits it
-reports are computed again exactly, :func:`misfit`)."""
+"""Ridge of the exchange's Gram matrices (of one candidate's mean diagonal): invertible before
+the design determines every column (the reported misfits are exact, :func:`misfit`)."""
 
 
 def orthonormal_span(columns: np.ndarray, rtol: float = RANK_RTOL) -> np.ndarray:
-    """An orthonormal basis (m, r) of the span of ``columns`` (m, p), each column scaled to unit
-    norm first (so that the rank does not depend on their units); directions with singular
-    values below ``rtol`` of the largest are not in the span."""
+    """An orthonormal basis (m, r) of the span of the unit-normalised ``columns`` (m, p) (singular
+    values above ``rtol`` of the largest)."""
     columns = np.asarray(columns, dtype=float)
     if columns.size == 0:
         return np.zeros((columns.shape[0], 0))
@@ -87,12 +81,10 @@ def misfit(fitted: np.ndarray, signal: np.ndarray) -> float:
 def quadratic_form(
     terms: Sequence[tuple[np.ndarray, float]], signal: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The distribution of ``Q = y^T (sum_j c_j P_j) y`` for ``y = signal + e``, ``e`` unit
-    noise, ``P_j`` the projector on the columns of term ``j`` = ``(columns (m, p_j), c_j)``
-    (whitened): ``Q = sum_i weights_i chi2'_1(nc_i)``, the eigenvalues of the matrix that are
-    not zero (in the span of all the columns) and the squared projections of ``signal`` on
-    their eigenvectors. A difference of two fits' rss is one (``rss_2 - rss_1 = y^T (P_1 - P_2)
-    y``), and so is a difference of their gains over a smaller model."""
+    """``(weights, nc)`` of ``Q = y^T (sum_j c_j P_j) y = sum_i weights_i chi2'_1(nc_i)`` for
+    ``y = signal + e`` (unit noise), ``P_j`` the projector on the whitened columns of term ``j``
+    = ``(columns (m, p_j), c_j)``: the non-zero eigenvalues and the squared projections of
+    ``signal`` on their eigenvectors (e.g. ``rss_2 - rss_1 = y^T (P_1 - P_2) y``)."""
     signal = np.asarray(signal, dtype=float).reshape(-1)
     spans = [(orthonormal_span(columns), float(c)) for columns, c in terms]
     both = orthonormal_span(np.hstack([u for u, _ in spans]))
@@ -109,14 +101,9 @@ def quadratic_form(
 def rss_difference(
     shared: np.ndarray, own_1: np.ndarray, own_2: np.ndarray, signal: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, int, int]:
-    """The distribution of ``D = rss_2 - rss_1`` when ``signal`` (m,) plus unit noise is fitted
-    by model 1 (``[shared, own_1]``) and by model 2 (``[shared, own_2]``), all whitened.
-
-    Returns:
-        ``(weights, noncentralities, k_1, k_2)``: ``D = sum_i weights_i chi2'_1(nc_i)``
-        (:func:`quadratic_form` of ``P_1 - P_2``: eigenvalues in [-1, 1]), and the ranks each
-        model adds to ``shared``.
-    """
+    """``(weights, noncentralities, k_1, k_2)`` of ``D = rss_2 - rss_1`` (:func:`quadratic_form`
+    of ``P_1 - P_2``) when ``signal`` (m,) plus unit noise is fitted by ``[shared, own_1]`` and
+    by ``[shared, own_2]`` (whitened), and the ranks each model adds to ``shared``."""
     one, two = np.hstack([shared, own_1]), np.hstack([shared, own_2])
     weights, nc = quadratic_form([(one, 1.0), (two, -1.0)], signal)
     rank_0 = orthonormal_span(shared).shape[1]
@@ -127,13 +114,9 @@ def rss_difference(
 
 def traded_off(shared: np.ndarray, own: np.ndarray) -> bool:
     """Whether the data leave a model's own parameters undetermined by the correlation rule of
-    :func:`~.model_selection.parameter_determination`: of the own columns whose parameter the
-    data see on its own, one has a multiple correlation above
-    :data:`~.model_selection.MAX_CORRELATION` with the shared columns (their span cut to their
-    rank) or above :data:`~.model_selection.MAX_CORRELATION_ALL` with all the other columns
-    (cut to the model's rank - 1); or none is seen on its own. Whether one reaches three
-    standard errors depends on the noise and is not asked here."""
-    from .model_selection import MAX_CORRELATION, MAX_CORRELATION_ALL
+    :func:`~.model_selection.parameter_determination`: an own column seen on its own correlates
+    above ``MAX_CORRELATION`` with the shared columns or above ``MAX_CORRELATION_ALL`` with all
+    the others; or none is seen on its own (significance depends on the noise: not asked)."""
 
     columns = np.hstack([shared, own])
     norms = np.linalg.norm(columns, axis=0)
@@ -142,24 +125,14 @@ def traded_off(shared: np.ndarray, own: np.ndarray) -> bool:
     rank = int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
     flat = vt[rank:]  # directions the columns do not see
     n_shared = shared.shape[1]
-    rank_shared = orthonormal_span(shared).shape[1]
-
-    def span(index: list[int], cut: int) -> np.ndarray:
-        u, _, _ = np.linalg.svd(scaled[:, index], full_matrices=False)
-        return u[:, : max(cut, 0)]
-
-    base = span(list(range(n_shared)), rank_shared)
+    base = column_span(scaled, range(n_shared), orthonormal_span(shared).shape[1])
     seen = 0
     for i in range(n_shared, columns.shape[1]):
         if norms[i] <= 0 or np.linalg.norm(flat[:, i]) > 1e-8:
             continue  # not seen on its own: counts neither way
         seen += 1
-        column = scaled[:, i]
-        others = span([k for k in range(columns.shape[1]) if k != i], rank - 1)
-        if (
-            np.linalg.norm(base.T @ column) > MAX_CORRELATION
-            or np.linalg.norm(others.T @ column) > MAX_CORRELATION_ALL
-        ):
+        correlation, correlation_all = multiple_correlations(scaled, i, base, rank)
+        if correlation > MAX_CORRELATION or correlation_all > MAX_CORRELATION_ALL:
             return True
     return seen == 0
 
@@ -167,16 +140,15 @@ def traded_off(shared: np.ndarray, own: np.ndarray) -> bool:
 def generalized_chi2_sf(
     x: float, weights: Sequence[float], noncentralities: Sequence[float]
 ) -> float:
-    """``P(sum_i w_i (z_i + delta_i)^2 > x)``, ``z_i ~ N(0, 1)`` independent, ``delta_i^2`` the
-    ``noncentralities``: Imhof's (1961) inversion of the characteristic function (any signs of
-    the weights; one degree of freedom each),
+    """``P(sum_i w_i (z_i + delta_i)^2 > x)``, ``z_i ~ N(0, 1)``, ``delta_i^2`` the
+    ``noncentralities``, any signs of the weights: Imhof's (1961) inversion,
 
         P(Q > x) = 1/2 + (1/pi) int_0^inf sin(theta(u)) / (u rho(u)) du,
         theta(u) = 1/2 sum_i [atan(w_i u) + delta_i^2 w_i u / (1 + w_i^2 u^2)] - x u / 2,
         rho(u) = prod_i (1 + w_i^2 u^2)^(1/4) exp(1/2 sum_i (delta_i w_i u)^2 / (1 + w_i^2 u^2)),
 
-    in units of Q's standard deviation (so that the integrand's features lie at u of order 1);
-    beyond :data:`TAIL_SIGMAS` standard deviations from the mean the answer is 0 or 1.
+    in units of Q's standard deviation (features at u of order 1); 0 or 1 beyond
+    :data:`TAIL_SIGMAS` standard deviations from the mean.
     """
     from scipy import integrate
 
@@ -204,9 +176,8 @@ def generalized_chi2_sf(
         phase, envelope = phase_and_envelope(u)
         return math.sin(phase - 0.5 * x * u) * envelope
 
-    # Smooth at 0 (sin(theta) / u -> theta'(0)); beyond the knot the phase varies slowly and
-    # the oscillation is that of x u / 2: a Fourier integral (QUADPACK's QAWF) of the slowly
-    # varying parts, sin(theta) = sin(phase) cos(x u / 2) - cos(phase) sin(x u / 2).
+    # Smooth at 0; beyond the knot the oscillation is x u / 2's: a Fourier integral (QAWF) of
+    # the slow parts, sin(theta) = sin(phase) cos(x u / 2) - cos(phase) sin(x u / 2).
     knot = 20.0
     head, _ = integrate.quad(integrand, 0.0, knot, limit=500)
     omega = 0.5 * abs(x)
@@ -227,8 +198,8 @@ def generalized_chi2_sf(
 
 
 TAIL_SIGMAS = 40.0
-"""Beyond this many standard deviations from its mean a generalised chi-square's tail is taken
-as 0 (a chi-square of one degree of freedom, the heaviest, has 1e-13 there)."""
+"""A generalised chi-square's tail beyond this many standard deviations is 0 (chi2_1, the
+heaviest, has 1e-13 there)."""
 
 
 def noncentral_chi2_sf(x: float, dof: float, noncentrality: float) -> float:
@@ -249,24 +220,18 @@ def choice_margin(k_true: int, k_rival: int, m: int) -> float:
 
 
 def detection_power(noncentrality: float, added: int, m: int, threshold: float) -> float:
-    """The chance that a model adding ``added`` ranks is accepted by the rule
-    ``delta_bic = -(rss_0 - rss) + added ln m <= threshold`` when the noise-free misfit of the
-    model without it is ``noncentrality``: ``P(chi2'(added, nc) > added ln m - threshold)``."""
+    """The chance that a model adding ``added`` ranks is accepted (``delta_bic <= threshold``)
+    when the misfit without it is ``noncentrality``: ``P(chi2'(added, nc) > added ln m -
+    threshold)``."""
     return noncentral_chi2_sf(added * math.log(max(m, 2)) - threshold, added, noncentrality)
 
 
 @dataclass(frozen=True)
 class Direction:
-    """One direction of a discrimination: the columns a rival fits and the signal it must
-    reproduce, at every candidate observation group (whitened).
-
-    Attributes:
-        fitted: (C, k, q) the rival model's columns (the shared ones and its own), candidate by
-            candidate (k observations each).
-        signal: (C, k) the true model's noise-free signal.
-        fixed_fitted: (m0, q) the same columns at observations already made (or ``None``).
-        fixed_signal: (m0,) the signal there.
-    """
+    """One direction of a discrimination (whitened): the rival's columns ``fitted`` (C, k, q)
+    and the true model's noise-free ``signal`` (C, k) at each candidate group of k
+    observations, and the same at observations already made, ``fixed_fitted`` (m0, q) and
+    ``fixed_signal`` (m0,) (or ``None``)."""
 
     fitted: np.ndarray
     signal: np.ndarray
@@ -286,14 +251,9 @@ class Direction:
 
 @dataclass(frozen=True)
 class Exchange:
-    """A T-optimal design found by :func:`t_optimal_exchange`.
-
-    Attributes:
-        chosen: the chosen candidates' indices (n,), in the order they entered.
-        noncentralities: the exact misfit of each direction on the design (fixed ones included).
-        swaps: exchanges accepted; passes: passes over the design.
-        seed: the seed of the random start.
-    """
+    """A T-optimal design (:func:`t_optimal_exchange`): the ``chosen`` indices (n,), the exact
+    misfit of each direction on it (``noncentralities``, fixed observations included), the
+    ``swaps`` accepted, the ``passes`` made and the random start's ``seed``."""
 
     chosen: np.ndarray
     noncentralities: tuple[float, ...]
@@ -361,14 +321,10 @@ def t_optimal_exchange(
     max_passes: int = 20,
     rtol: float = 1e-6,
 ) -> Exchange:
-    """The ``n`` distinct candidates that maximise the smallest misfit over ``directions``.
-
-    A seeded random start of ``n`` candidates, then Fedorov's exchange: for each chosen
-    candidate in turn, the candidate (not chosen) whose swap for it raises the criterion most
-    is swapped in, when it raises it by more than ``rtol``; passes repeat until one changes
-    nothing (at most ``max_passes``). Each swap is scored for every candidate at once by rank-k
-    updates of each direction's inverse Gram matrix.
-    """
+    """The ``n`` distinct candidates that maximise the smallest misfit over ``directions``: a
+    seeded random start, then Fedorov's exchange (each chosen candidate swapped for the one
+    raising the criterion most, by more than ``rtol``; passes until none changes, at most
+    ``max_passes``), every swap scored at once by rank-k updates of the inverse Gram matrices."""
     count = directions[0].fitted.shape[0]
     if not 1 <= n <= count:
         raise ValueError(f"n must be within 1 .. {count} candidates, got {n}")

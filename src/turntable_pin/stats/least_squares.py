@@ -1,28 +1,24 @@
-"""Weighted nonlinear least squares with identifiability analysis, for any model of the protocol.
+"""Weighted nonlinear least squares with identifiability analysis, for any :class:`FitProblem`
+(observations, sigmas, parameter names and units, ``predict`` and ``jacobian``): the result knows
+its rank, the combinations the data determine and those they cannot, standard errors, goodness of
+fit.
 
-The machinery is not tied to any kind of data: any :class:`FitProblem` (observations, their
-sigmas, parameter names and units, the unit of the observations, ``predict`` and ``jacobian``)
-can be fitted, and the result
-knows its rank, the parameter combinations the data determine and those they cannot, their
-standard errors, and its goodness of fit.
+Identifiability is read from the SVD of the column-normalised weighted Jacobian at zero (the
+models are first-order exact there; second-order terms, ~1e-10 rad, cannot be resolved):
+singular values below ``RANK_RTOL`` of the largest are flat directions. The fit runs in the
+determined subspace (the minimum-norm representative, in normalised units, of the equivalent
+solutions); determined combinations are the row space's reduced row-echelon form (``a + b`` when
+only a sum is determined).
 
-Identifiability is read from the SVD of the column-normalised weighted Jacobian at zero
-parameters (the models here are first-order exact there; second-order terms of size |error|^2,
-~1e-10 rad, cannot be resolved by data): singular values below ``RANK_RTOL`` times the largest
-are flat directions. The fit then runs in the coordinates of the determined subspace, which gives
-the minimum-norm (in normalised units) representative of the family of equivalent solutions; the
-determined combinations are the reduced row-echelon form of the row space, so they read
-like ``a + b`` when only the sum of two parameters is determined.
-
-Noise: with sigmas given, ``chi2 = sum((r / sigma)^2)`` and its p-value test the fit. Without
-them the observations get unit weights and the noise variance is estimated (``rss / dof`` of this
-fit, or a value supplied by the caller, e.g. the best model of a diagnosis): a chi2 computed with
-an estimated sigma is 1 per degree of freedom by construction, so no p-value is reported then.
+Noise: with sigmas, ``chi2 = sum((r / sigma)^2)`` and its p-value test the fit. Without, unit
+weights and the variance estimated (``rss / dof``, or the caller's, e.g. a diagnosis' best model):
+chi2 is then 1 per degree of freedom by construction, so no p-value is reported.
 """
+# scipy (special, optimize) is imported inside functions: the package's import stays light
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
 
 import numpy as np
@@ -76,22 +72,16 @@ class FitProblem(Protocol):
 
 
 def chi2_sf(chi2: float, dof: float) -> float:
-    """``P(X > chi2)`` for X chi-squared with ``dof`` degrees of freedom.
-
-    ``scipy.special.chdtrc``: the function ``scipy.stats.chi2.sf`` evaluates (the same numbers),
-    without importing ``scipy.stats`` (about a second of start-up).
-    """
-    from scipy import special  # imported on use: keeps the package's import light
+    """``P(X > chi2)`` for X chi-squared with ``dof`` degrees of freedom (``scipy.special``: what
+    ``scipy.stats.chi2.sf`` evaluates, without a second of importing ``scipy.stats``)."""
+    from scipy import special
 
     return float(special.chdtrc(dof, chi2))
 
 
 def chi2_quantile(probability: float, dof: float) -> float:
-    """The ``probability`` quantile of chi-squared with ``dof`` degrees of freedom.
-
-    ``2 * gammaincinv(dof / 2, p)``: what ``scipy.stats.chi2.ppf`` evaluates, without importing
-    ``scipy.stats``.
-    """
+    """The ``probability`` quantile of chi-squared with ``dof`` degrees of freedom
+    (``2 gammaincinv(dof / 2, p)``, as ``scipy.stats.chi2.ppf``)."""
     from scipy import special
 
     return float(2.0 * special.gammaincinv(dof / 2.0, probability))
@@ -121,21 +111,14 @@ def _rref(matrix: np.ndarray, tol: float = 1e-9) -> np.ndarray:
 
 def combination_name(coefficients: np.ndarray, names: tuple[str, ...]) -> str:
     """``"a + b"``, ``"a - 0.5 c.d"``, from coefficients per name."""
-    parts = []
+    out = ""
     for c, name in zip(coefficients, names, strict=True):
         if c == 0:
             continue
+        text = name if abs(abs(c) - 1.0) < 1e-6 else f"{abs(c):.4g} {name}"
         sign = "-" if c < 0 else "+"
-        mag = abs(c)
-        text = name if abs(mag - 1.0) < 1e-6 else f"{mag:.4g} {name}"
-        parts.append((sign, text))
-    if not parts:
-        return "0"
-    first_sign, first = parts[0]
-    out = ("-" if first_sign == "-" else "") + first
-    for sign, text in parts[1:]:
-        out += f" {sign} {text}"
-    return out
+        out = f"{out} {sign} {text}" if out else ("-" if c < 0 else "") + text
+    return out or "0"
 
 
 @dataclass(frozen=True)
@@ -160,18 +143,14 @@ class Identifiability:
 
 
 TALL_ROWS = 256
-"""Row blocks of :func:`tall_r_factor`; matrices with at most ``2 * TALL_ROWS`` rows and those
-not many times taller than wide are decomposed directly."""
+"""Row blocks of :func:`tall_r_factor` (matrices of at most ``2 * TALL_ROWS`` rows, or not many
+times taller than wide, are decomposed directly)."""
 
 
 def tall_r_factor(matrix: np.ndarray) -> np.ndarray:
-    """The triangular factor R (n, n) of a tall matrix (m, n), ``matrix = Q R``, by blocks.
-
-    Blocks of :data:`TALL_ROWS` rows are reduced to their R factors at once (a stacked QR that
-    stays in cache) and the stacked factors reduced again: the same R up to the signs of its
-    rows as one QR of the whole matrix, several times faster on long tall matrices. The SVD of
-    R has the singular values and right singular vectors of ``matrix``.
-    """
+    """The triangular factor R (n, n) of a tall matrix (m, n), ``matrix = Q R``, by blocks of
+    :data:`TALL_ROWS` rows (a stacked QR that stays in cache) reduced again: R up to its rows'
+    signs, several times faster. The SVD of R has ``matrix``'s singular values and vectors."""
     m, n = matrix.shape
     block = max(TALL_ROWS, 4 * n)
     full = (m // block) * block
@@ -190,7 +169,7 @@ def _singular_values_vt(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if m > 2 * TALL_ROWS and m >= 8 * n:
         _, s, vt = np.linalg.svd(tall_r_factor(matrix))
         return s, vt
-    # vt must be square (n x n) to hold the null space; U need not be (m can be large).
+    # vt square (n x n) holds the null space; U need not be.
     _, s, vt = np.linalg.svd(matrix, full_matrices=m < n)
     return s, vt
 
@@ -198,8 +177,7 @@ def _singular_values_vt(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def analyse_identifiability(jacobian_weighted: np.ndarray, names) -> Identifiability:
     """Rank, determined combinations and flat directions of a weighted Jacobian (m, n)."""
     norms = np.linalg.norm(jacobian_weighted, axis=0)
-    # A column many orders below the largest is rounding of a zero derivative (a parameter the
-    # data do not see), not a direction to normalise up to unit length and call determined.
+    # A column many orders below the largest is rounding of a zero derivative, not a direction.
     dead = norms <= DEAD_COLUMN_RTOL * max(float(norms.max(initial=0.0)), 1e-300)
     scale = np.where(dead, 1.0, norms)
     n = jacobian_weighted.shape[1]
@@ -224,23 +202,20 @@ def analyse_identifiability(jacobian_weighted: np.ndarray, names) -> Identifiabi
 
 @dataclass(frozen=True)
 class FitResult:
-    """The outcome of one weighted least-squares fit.
+    """The outcome of one weighted least-squares fit (internal units).
 
     Attributes:
         parameter_names, parameter_units, per_user_unit: of the model.
-        params: the minimum-norm representative of the best-fitting parameters (internal units).
-        covariance: of ``params`` (internal units), on the determined subspace (pseudo-inverse).
-        residuals: observed - predicted (internal units), (m,).
+        params: the minimum-norm representative of the best-fitting parameters.
+        covariance: of ``params``, on the determined subspace (pseudo-inverse).
+        residuals: observed - predicted, (m,).
         weights: 1/sigma per observation (unit weights when sigma is unknown).
         rss: sum of squared weighted residuals.
         rank, dof: determined combinations and ``m - rank``.
-        noise_variance: variance of a unit-weight residual used for chi2 and covariances (1 when
-            sigmas are given).
+        noise_variance: unit-weight residual variance for chi2 and covariances (1 with sigmas).
         sigma_known: whether sigmas were given (then chi2 has a p-value).
-        identifiability: see :class:`Identifiability`.
-        noise_groups: with sigma unknown, the group (an integer) of each observation when every
-            group has a noise level of its own, estimated with this model (the fit is then
-            weighted by them); ``None``: one noise level (see :attr:`profiled_rss`).
+        noise_groups: with sigma unknown, each observation's group (int) when every group has
+            its own noise level, estimated with this model; ``None``: one level.
     """
 
     parameter_names: tuple[str, ...]
@@ -265,22 +240,20 @@ class FitResult:
     @property
     def jacobian_weighted(self) -> np.ndarray:
         """The weighted Jacobian (m, n) at ``params`` (computed on each use: a diagnosis holds
-        many fits and needs the Jacobian of one, once)."""
+        many fits and needs few Jacobians)."""
         return self._jacobian() if callable(self._jacobian) else self._jacobian
 
     @property
     def determined_jacobian_weighted(self) -> np.ndarray:
-        """The weighted Jacobian along the directions the fit determines, (m, rank): the span
-        the fitted model really has. The full Jacobian at ``params`` can also hold directions
-        the data do not determine at zero that large fitted errors make barely visible at
-        second order (a roll about a telescope's boresight next to a 0.3 deg azimuth offset);
-        projecting residuals on those would credit the model with fits it did not make."""
+        """The weighted Jacobian along the determined directions, (m, rank): the model's real
+        span. At ``params`` large fitted errors can make undetermined directions barely visible
+        at second order (a roll about a boresight next to a 0.3 deg azimuth offset); projecting
+        residuals on those would credit the model with fits it did not make."""
         return self.jacobian_weighted @ self.identifiability.basis
 
     @property
     def group_rss(self) -> np.ndarray:
-        """Unweighted residual sum of squares of each noise group (of :attr:`noise_groups`, in
-        group order; one group when there are none), internal units squared."""
+        """Unweighted rss of each noise group, in group order (one group when there are none)."""
         if self.noise_groups is None:
             return np.array([float(self.residuals @ self.residuals)])
         _, inverse = np.unique(self.noise_groups, return_inverse=True)
@@ -288,11 +261,10 @@ class FitResult:
 
     @property
     def profiled_rss(self) -> float:
-        """The rss the likelihood with the noise profiled out depends on: :attr:`rss` with one
-        noise level; with a noise level per group (:attr:`noise_groups`), each profiled, the
-        weighted geometric mean ``exp(sum_g (n_g / m) ln S_g)`` of the groups' unweighted rss
-        ``S_g``, so that ``m ln(profiled_rss) = sum_g n_g ln S_g`` (minus two log-likelihood,
-        up to a constant): ratios of it compare two models each at its own noise levels."""
+        """The rss of the likelihood with the noise profiled out: :attr:`rss`; with a level per
+        group, each profiled, ``exp(sum_g (n_g / m) ln S_g)`` of the groups' unweighted rss
+        ``S_g`` (``m ln`` of it is -2 log-likelihood up to a constant): its ratios compare two
+        models each at its own noise levels."""
         if self.noise_groups is None:
             return self.rss
         _, counts = np.unique(self.noise_groups, return_counts=True)
@@ -339,7 +311,7 @@ class FitResult:
     def with_noise_variance(self, noise_variance: float) -> FitResult:
         """The same fit judged with another unit-weight noise variance (sigma unknown case)."""
         ratio = noise_variance / self.noise_variance
-        return _replace(
+        return replace(
             self, noise_variance=float(noise_variance), covariance=self.covariance * ratio
         )
 
@@ -447,15 +419,8 @@ class FitResult:
         }
 
 
-def _replace(result: FitResult, **changes) -> FitResult:
-    from dataclasses import replace
-
-    return replace(result, **changes)
-
-
 GAUSS_NEWTON_RTOL = 1e-8
-"""The iteration stops once a step is below this fraction of the solution (whitened
-coordinates); the point it leads to, where the fit is evaluated, is converged far beyond it."""
+"""The iteration stops once a step is below this fraction of the solution (whitened)."""
 
 CHORD_MAX_STEPS = 20
 """Steps with one Jacobian before the fit falls back to scipy's Levenberg-Marquardt."""
@@ -463,19 +428,15 @@ CHORD_MAX_STEPS = 20
 
 @dataclass(frozen=True)
 class ZeroPoint:
-    """A model's weighted Jacobian at zero parameters, reduced to what a fit of any subset of its
-    parameters needs (a model whose parameters at zero leave every other parameter's response
-    unchanged, so the columns of a smaller model are columns of this one).
+    """A model's weighted Jacobian J at zero, reduced to what a fit of any subset of its
+    parameters needs (at zero a smaller model's columns are columns of this one).
 
     Attributes:
         names: the parameters (n,).
-        r_factor: (k, n) with ``R^T R = J^T J`` for the weighted Jacobian J at zero (its
-            triangular factor; J itself when it has fewer rows than columns): the SVD of
-            ``R[:, S]`` has the singular values and right vectors of ``J[:, S]``.
-        gradient: ``J^T r0`` (n,), ``r0`` the weighted residuals at zero.
-        cost: ``r0 . r0``.
-        weights: the weights (m,) of the observations (1/sigma): a fit that uses this zero
-            point checks them against its own and keeps this array (one for all the fits).
+        r_factor: (k, n), ``R^T R = J^T J`` (J itself when it has fewer rows than columns): the
+            SVD of ``R[:, S]`` has the singular values and right vectors of ``J[:, S]``.
+        gradient: ``J^T r0`` (n,), ``r0`` the weighted residuals at zero; cost: ``r0 . r0``.
+        weights: (m,) 1/sigma (a fit with the same weights keeps this array).
     """
 
     names: tuple[str, ...]
@@ -493,14 +454,9 @@ class ZeroPoint:
 
 
 def zero_point(names, blocks) -> ZeroPoint:
-    """The :class:`ZeroPoint` of a model from its weighted Jacobian at zero given in row blocks.
-
-    Args:
-        names: the parameters (n,).
-        blocks: ``(weighted jacobian (m_b, n), weighted residuals (m_b,), weights (m_b,))`` at
-            zero parameters, block by block of rows (so that a long data set never holds its
-            whole Jacobian).
-    """
+    """The :class:`ZeroPoint` of parameters ``names`` from ``blocks`` of rows ``(weighted
+    jacobian (m_b, n), weighted residuals (m_b,), weights (m_b,))`` at zero (a long data set
+    never holds its whole Jacobian)."""
     n = len(names)
     factors, gradient, cost, weights = [], np.zeros(n), 0.0, []
     for jac, res, w in blocks:
@@ -519,22 +475,17 @@ def _evaluator(problem: FitProblem):
     both = getattr(problem, "predict_and_jacobian", None)
     if both is not None:
         return both  # its Jacobian is a new array: the fit scales it in place
-    return lambda params: (
-        problem.predict(params),
-        np.array(problem.jacobian(params), dtype=float),
-    )
+    return lambda params: (problem.predict(params), np.array(problem.jacobian(params), dtype=float))
 
 
 def tall_times(tall: np.ndarray, small: np.ndarray) -> np.ndarray:
-    """``tall @ small`` for a tall (m, n) and a small (n, k) matrix, computed as
-    ``(small^T tall^T)^T``: the same numbers, but OpenBLAS's threaded kernel for the direct
-    product was 10-20 times slower on a busy two-core machine."""
+    """``tall @ small`` (m, n) @ (n, k) as ``(small^T tall^T)^T``: OpenBLAS's threaded kernel
+    for the direct product was 10-20 times slower on a busy two-core machine."""
     return (small.T @ tall.T).T
 
 
 def _point(origin: np.ndarray | None, basis: np.ndarray, z: np.ndarray) -> np.ndarray:
-    """The parameters at whitened coordinates ``z``: ``origin + basis @ z`` (``origin`` None:
-    zero)."""
+    """The parameters at whitened coordinates ``z``: ``origin + basis @ z`` (origin None: 0)."""
     return basis @ z if origin is None else origin + basis @ z
 
 
@@ -542,20 +493,15 @@ def _iterate(problem, evaluate, weights, basis, start, origin):
     """Gauss-Newton, then chord steps, from ``z = 0`` in whitened coordinates (parameters
     ``_point(origin, basis, z)``).
 
-    ``start`` is ``(cost, normal matrix, gradient)`` at ``z = 0`` (``jz^T jz`` and ``jz^T r`` for
-    the weighted Jacobian ``jz`` in these coordinates, orthonormal there). The first step uses
-    it; the model's Jacobian is evaluated once, at that first point ``z1``, and every further
-    step solves with it against fresh residuals (``predict`` only). Their fixed point differs
-    from the least-squares solution by ``(J(z) - J(z1))^T r``: the Jacobian changes by the
-    size of the first step's error in radians (the fitted errors squared, ~1e-10 relative), so
-    the solution is reached to ~1e-10 of its statistical uncertainty, and the steps shrink by
-    that factor each time. A step smaller than :data:`GAUSS_NEWTON_RTOL` of the solution ends
-    the iteration at the point it leads to, whose residuals are those before it minus the
-    Jacobian times the step (exact to the step squared times the nonlinearity).
+    ``start`` is ``(cost, jz^T jz, jz^T r)`` at ``z = 0``. The Jacobian is evaluated once, at
+    the first step's point ``z1``; every further step solves with it against fresh residuals.
+    The fixed point differs from the solution by ``(J(z) - J(z1))^T r`` (the fitted errors
+    squared, ~1e-10 relative): reached to ~1e-10 of its uncertainty, the steps shrinking by that
+    factor. A step below :data:`GAUSS_NEWTON_RTOL` of the solution ends it, its residuals
+    updated linearly (exact to the step squared times the nonlinearity).
 
     Returns ``(z, weighted residuals, normal matrix at z1, evaluations)``, or None when a step
-    fails to lower the residual sum of squares or the steps do not settle (the caller then uses
-    scipy's Levenberg-Marquardt).
+    does not lower the rss or the steps do not settle.
     """
     observed = problem.observed
     cost, normal, gradient = start
@@ -576,8 +522,6 @@ def _iterate(problem, evaluate, weights, basis, start, origin):
         z = z + step
         size = float(np.linalg.norm(step))
         if size <= GAUSS_NEWTON_RTOL * float(np.linalg.norm(z)) or size <= 1e-15:
-            # The residuals after this last, tiny step: linear in it to its size squared times
-            # the nonlinearity (< 1e-20 relative), so no further evaluation is needed.
             return z, res - jz @ step, normal, count
         predicted = problem.predict(_point(origin, basis, z))
         count += 1
@@ -591,62 +535,38 @@ def fit_least_squares(
     zero_point: ZeroPoint | None = None,
     origin: np.ndarray | None = None,
 ) -> FitResult:
-    """Fit ``problem`` by weighted nonlinear least squares (Gauss-Newton and chord steps, else
-    scipy's Levenberg-Marquardt).
+    """Fit ``problem`` by weighted nonlinear least squares.
 
-    The models are nearly linear (second-order terms of the size of the fitted errors): in
-    coordinates where the weighted Jacobian at zero is orthonormal, one Gauss-Newton step from
-    zero lands within that nonlinearity of the solution, and steps with the Jacobian there reach
-    it in two or three evaluations of ``predict`` (:func:`_iterate`); a step that does not lower
-    the residuals hands the fit to scipy's ``least_squares`` (Levenberg-Marquardt).
+    The models are nearly linear: in coordinates where the weighted Jacobian at zero is
+    orthonormal, one Gauss-Newton step lands within the nonlinearity of the solution, and chord
+    steps reach it in two or three evaluations of ``predict`` (:func:`_iterate`); a step that does
+    not lower the residuals hands the fit to scipy's Levenberg-Marquardt.
 
     Args:
         problem: the model and data (``predict_and_jacobian``, when present, is used for one
-            pass per step).
+            pass per step; ``sigma_relative``: the sigmas are relative weights only).
         noise_variance: unit-weight noise variance to judge the fit with when sigmas are unknown
-            (default: estimated from this fit, ``rss / dof``). Ignored when sigmas are given.
+            (default ``rss / dof`` of this fit). Ignored when sigmas are given.
         zero_point: the reduced Jacobian at zero of a model with these parameters and maybe more
-            (:func:`zero_point`): the identifiability and the first step are then read from it
-            instead of evaluating the Jacobian at zero (fits of many models of one data set).
-        origin: start from these parameters instead of zero: ``params`` is then ``origin``
-            plus a combination of the directions determined at zero (which also give the
-            identifiability), found from the Jacobian at ``origin``. For a model whose solution
-            is far from zero (large constant offsets), started from a nearby solution (e.g.
-            that of fewer parameters): the minimum-norm representative at zero can miss it.
+            (:func:`zero_point`): identifiability and first step are read from it (fits of many
+            models of one data set).
+        origin: start from these parameters instead of zero: ``params`` is ``origin`` plus a
+            combination of the directions determined at zero, found from the Jacobian at
+            ``origin`` (a solution far from zero, e.g. large offsets, started from a nearby one:
+            the minimum-norm representative at zero can miss it).
 
     Raises:
         IdentifiabilityError: no parameter is determined, or no degree of freedom is left.
     """
-    # ``sigma_relative``: the sigmas give the observations' relative noise only (weights), and the
-    # unit-weight variance is estimated as when no sigma is given.
     relative = bool(getattr(problem, "sigma_relative", False))
     sigma_known = problem.sigma is not None and not relative
     weights = 1.0 / problem.sigma if problem.sigma is not None else np.ones_like(problem.observed)
     names = tuple(problem.parameter_names)
-    n = len(names)
     evaluate = _evaluator(problem)
-    columns = zero_point.indices(names) if zero_point is not None else None
-    if columns is not None and np.array_equal(zero_point.weights, weights):
-        weights = zero_point.weights  # one array for all the fits of a data set
-    else:
-        columns = None
-    if columns is not None:
-        j0 = zero_point.r_factor[:, columns]
-        gradient0, cost0 = zero_point.gradient[columns], zero_point.cost
-    else:
-        predicted0, j0 = evaluate(np.zeros(n))
-        j0 *= weights[:, None]
-        res0 = (problem.observed - predicted0) * weights
-        gradient0, cost0 = j0.T @ res0, float(res0 @ res0)
+    weights, j0, gradient0, cost0 = _at_zero(problem, evaluate, weights, zero_point)
     ident = analyse_identifiability(j0, names)
     m = problem.observed.size
-    if ident.rank == 0:
-        raise IdentifiabilityError("the data determine no parameter of the model")
-    if m - ident.rank <= 0:
-        raise IdentifiabilityError(
-            f"{m} observations cannot fit {ident.rank} independent parameter combinations with a "
-            "degree of freedom left; measure more positions"
-        )
+    _check_rank(ident.rank, m)
     # Whitened coordinates: the weighted Jacobian at zero times ``basis`` is orthonormal, so the
     # normal equations of every step are as well conditioned as the problem is nonlinear.
     basis = ident.basis / ident.singular_values[: ident.rank]
@@ -654,23 +574,10 @@ def fit_least_squares(
     del j0
     start = (cost0, jz0.T @ jz0, basis.T @ gradient0)
     del jz0
-    if origin is not None:  # the first step from ``origin``, with the Jacobian there
+    if origin is not None:
         origin = np.asarray(origin, dtype=float)
-        predicted1, j1 = evaluate(origin)
-        j1 *= weights[:, None]
-        res1 = (problem.observed - predicted1) * weights
-        jz1 = tall_times(j1, basis)
-        del j1
-        start = (float(res1 @ res1), jz1.T @ jz1, jz1.T @ res1)
-        del jz1
-    solved = _iterate(problem, evaluate, weights, basis, start, origin)
-    if solved is None:
-        z, weighted_res, jac_weighted, nfev = _levenberg_marquardt(problem, weights, basis, origin)
-        jz = tall_times(jac_weighted, basis)
-        normal = jz.T @ jz
-        del jac_weighted, jz
-    else:
-        z, weighted_res, normal, nfev = solved
+        start = _start_at(problem, evaluate, weights, basis, origin)
+    z, weighted_res, normal, nfev = _solve(problem, evaluate, weights, basis, start, origin)
     params = _point(origin, basis, z)
     rss = float(weighted_res @ weighted_res)
     dof = m - ident.rank
@@ -702,6 +609,54 @@ def fit_least_squares(
     )
 
 
+def _check_rank(rank: int, m: int) -> None:
+    """Refuse a fit that determines no parameter or leaves no degree of freedom."""
+    if rank == 0:
+        raise IdentifiabilityError("the data determine no parameter of the model")
+    if m - rank <= 0:
+        raise IdentifiabilityError(
+            f"{m} observations cannot fit {rank} independent parameter combinations with a "
+            "degree of freedom left; measure more positions"
+        )
+
+
+def _at_zero(problem, evaluate, weights, zero_point):
+    """``(weights, weighted Jacobian at zero or its R factor, gradient, cost)``: read from
+    ``zero_point`` when it has these parameters and weights (its weights array is then kept: one
+    for all the fits of a data set), else evaluated."""
+    names = tuple(problem.parameter_names)
+    columns = zero_point.indices(names) if zero_point is not None else None
+    if columns is not None and np.array_equal(zero_point.weights, weights):
+        r_factor = zero_point.r_factor[:, columns]
+        return zero_point.weights, r_factor, zero_point.gradient[columns], zero_point.cost
+    predicted0, j0 = evaluate(np.zeros(len(names)))
+    j0 *= weights[:, None]
+    res0 = (problem.observed - predicted0) * weights
+    return weights, j0, j0.T @ res0, float(res0 @ res0)
+
+
+def _start_at(problem, evaluate, weights, basis, origin):
+    """``(cost, normal matrix, gradient)`` of the first step from ``origin`` in the whitened
+    coordinates ``basis``, with the Jacobian there."""
+    predicted1, j1 = evaluate(origin)
+    j1 *= weights[:, None]
+    res1 = (problem.observed - predicted1) * weights
+    jz1 = tall_times(j1, basis)
+    del j1
+    return float(res1 @ res1), jz1.T @ jz1, jz1.T @ res1
+
+
+def _solve(problem, evaluate, weights, basis, start, origin):
+    """``(z, weighted residuals, normal matrix, evaluations)``: :func:`_iterate`, else scipy's
+    Levenberg-Marquardt."""
+    solved = _iterate(problem, evaluate, weights, basis, start, origin)
+    if solved is not None:
+        return solved
+    z, weighted_res, jac_weighted, nfev = _levenberg_marquardt(problem, weights, basis, origin)
+    jz = tall_times(jac_weighted, basis)
+    return z, weighted_res, jz.T @ jz, nfev
+
+
 def _weighted_jacobian(problem: FitProblem, params: np.ndarray, weights: np.ndarray):
     """A function of no argument: the weighted Jacobian (m, n) at ``params``."""
 
@@ -716,7 +671,7 @@ def _levenberg_marquardt(
 ):
     """scipy's Levenberg-Marquardt in the coordinates ``basis`` about ``origin``: ``(z,
     weighted residuals, weighted jacobian (m, n), evaluations)``."""
-    from scipy import optimize  # imported on use: keeps the package's import light
+    from scipy import optimize
 
     def fun(z):
         return (problem.observed - problem.predict(_point(origin, basis, z))) * weights
@@ -724,7 +679,7 @@ def _levenberg_marquardt(
     def jac(z):
         return -tall_times(problem.jacobian(_point(origin, basis, z)) * weights[:, None], basis)
 
-    # The models are nearly linear: one Gauss-Newton step from zero lands close to the optimum.
+    # Nearly linear: one Gauss-Newton step from zero lands close to the optimum.
     rank = basis.shape[1]
     z0 = np.linalg.lstsq(-jac(np.zeros(rank)), -fun(np.zeros(rank)), rcond=None)[0]
     solution = optimize.least_squares(fun, z0, jac=jac, method="lm", xtol=1e-12, ftol=1e-12)

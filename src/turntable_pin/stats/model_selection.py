@@ -1,34 +1,28 @@
 """Which catalogued effect is missing from a model: compare, rank, decide, and say so.
 
-Generic over a :class:`ModelFamily` (a base model, a catalogue of effects that extend it, and
-probes for the structure search), so any model with a catalogue of extensions can use it.
+Generic over a family of data (:class:`~.diagnosis_engine.DataFamily`: a base model, a catalogue
+of effects that extend it, probes for the structure search, its words).
 
-Decision rule, and why. Each testable effect is fitted together with the current model and
-compared by the Bayesian information criterion, ``delta_bic = delta_chi2 + added_rank ln m``
-(sigma given) or ``w ln(rss_new / rss_old) + added_rank ln m`` (sigma estimated: the variance
-profiled out, ``w`` about the residual degrees of freedom so that the ratio keeps the F test's
-tail on small samples, :func:`~.structure_search.profiled_weight`), where ``added_rank`` is the
-number of *new* determined combinations (parameters the current model already absorbs do not
-count) and ``m`` the number of observations. An effect is
-accepted when ``delta_bic <= -6 - 2 ln K`` for the K candidates tested in that round (the
-look-elsewhere penalty the structure search pays for its probes: trying K effects is K chances of
-a false alarm). On clean data the improvement is chi2-distributed with ``added_rank`` degrees of
-freedom, so for m = 432 observations and K = 9 the false-alarm probability of one candidate is
-P(chi2_k > k ln m + 10.4): 5e-5 (k=1), 1.4e-5 (k=2); on small designs (m = 72..120, where
-``ln m`` is small) the penalty is what keeps the whole catalogue quiet, while an effect of a few
-sigma lowers chi2 by hundreds. A plain
-likelihood-ratio test at a fixed level would not penalise the 8-parameter
-wobble series more than a 1-parameter sag, and BIC does.
+Decision rule. Each testable effect is fitted with the current model and scored by BIC,
+``delta_bic = delta_chi2 + added_rank ln m`` (sigma given) or ``w ln(rss_new / rss_old) +
+added_rank ln m`` (sigma estimated, the variance profiled out; ``w`` about the residual degrees of
+freedom so that the ratio keeps the F test's tail on small samples,
+:func:`~.structure_search.profiled_weight`); ``added_rank`` counts only the *new* determined
+combinations, ``m`` the observations. An effect is accepted when ``delta_bic <= -6 - 2 ln K`` for
+the K candidates of the round: trying K effects is K chances of a false alarm, the look-elsewhere
+penalty the structure search pays too. On clean data (m = 432, K = 9) one candidate's false-alarm
+probability is P(chi2_k > k ln m + 10.4): 5e-5 (k=1), 1.4e-5 (k=2); on small designs (m = 72..120)
+the penalty keeps the catalogue quiet, while an effect of a few sigma lowers chi2 by hundreds. A
+plain likelihood-ratio test at a fixed level would not penalise an 8-parameter wobble series more
+than a 1-parameter sag; BIC does.
 
-Alternatives: effects that are themselves accepted and whose fit is as good as the best one's
-(``|chi2_B - chi2_A| <= chi2_0.99(max(added_rank_A, added_rank_B))``) explain the data as well; the
-family then says whether more data could separate them or only an independent measurement.
+Alternatives: accepted effects whose fit is as good as the best one's (``|chi2_B - chi2_A| <=
+chi2_0.99(max(added_rank_A, added_rank_B))``); the family says whether more data could separate
+them or only an independent measurement.
 
-Unexplained: the best model still fails the fit test, i.e. its chi2 p-value is below
-``FIT_TEST_ALPHA`` (sigma given), or the structure search finds a term it lacks (any sigma; the
-only test possible when sigma is estimated, because chi2 with an estimated sigma is 1 by
-construction). The structure search pays a look-elsewhere penalty of ``2 ln G`` for its G probes
-(:mod:`structure_search`).
+Unexplained: the best model's chi2 p-value is below ``FIT_TEST_ALPHA`` (sigma given), or the
+structure search finds a term it lacks (any sigma; the only test when sigma is estimated, chi2
+being 1 by construction then), paying ``2 ln G`` for its G probes (:mod:`structure_search`).
 """
 
 from __future__ import annotations
@@ -37,7 +31,7 @@ import copy
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
@@ -58,6 +52,8 @@ __all__ = [
     "DETERMINED_SIGMAS",
     "MAX_CORRELATION",
     "MAX_CORRELATION_ALL",
+    "column_span",
+    "multiple_correlations",
     "UNDETERMINED_GAIN_RATIO",
     "parameter_determination",
     "undetermined_parameters",
@@ -65,7 +61,6 @@ __all__ = [
     "FIT_TEST_ALPHA",
     "Candidate",
     "Diagnosis",
-    "ModelFamily",
     "Step",
     "compare_effects",
     "diagnose",
@@ -78,8 +73,7 @@ ALTERNATIVE_LEVEL = 0.99
 """Quantile of chi2(added_rank) within which another effect's fit counts as equally good."""
 
 DETERMINED_SIGMAS = 3.0
-"""An effect is significant in its values when one of its parameters reaches this many standard
-errors (:func:`undetermined_parameters`)."""
+"""An effect is significant in its values when a parameter reaches this many standard errors."""
 
 UNDETERMINED_GAIN_RATIO = 2.0
 """A significant undetermined effect still ranks first when it lowers the misfit (rss) by more
@@ -90,51 +84,6 @@ MAX_CORRELATION = 0.95
 
 MAX_CORRELATION_ALL = 0.995
 """... and against all the model's other parameters (its own effect's too) above this one."""
-
-
-class ModelFamily(Protocol):
-    """What :func:`diagnose` needs: fits of base + effects, reasons, probes, separation advice.
-
-    Attributes:
-        catalogue: the candidate effects (objects with a ``name``), in catalogue order.
-        n_records: number of data records (e.g. rows of a data file).
-        record_label: what a record is, for the key ``n_<label>`` of :meth:`Diagnosis.to_dict`.
-        observation_unit: name of the observations' user unit (key suffix of ``rms_``/``sigma_``).
-        sigma_scale: the observations' typical sigma in user units (the unit-weight noise).
-    """
-
-    catalogue: tuple[Any, ...]
-    n_records: int
-    record_label: str
-    observation_unit: str
-    sigma_scale: float
-
-    def fit(self, effects: Sequence[Any], noise_variance: float | None = None) -> Any:
-        """A fit object with a ``result`` (:class:`FitResult`)."""
-
-    def untestable_reason(self, effect: Any) -> str | None:
-        """Why ``effect`` cannot be tested on these data, or None."""
-
-    def probes(self, fit: Any) -> list[Probe]:
-        """Candidate shapes for the structure search in the residuals of ``fit``."""
-
-    def separation(self, fit_a: Any, effect_b: Any) -> str:
-        """Whether more data could separate the fitted effect of ``fit_a`` from ``effect_b``."""
-
-    def describe(self, effect: Any) -> dict:
-        """The effect's story (``title``, ``explanation``, ``confirm``...) for the reports."""
-
-    def design_warnings(self, base_fit: Any) -> list[str]:
-        """What the data's design cannot tell (e.g. too few distinct inputs), in words."""
-
-    def suspect_probes(self, fit: Any) -> list[Probe]:
-        """Optional: the probes of shapes no catalogued effect has (terms in other inputs of
-        the data), tried when judging whether an accepted effect only mimics one of them."""
-
-    def inputs(self, effect: Any) -> set[str]:
-        """Optional: the data inputs ``effect`` itself depends on beyond the base model's (a
-        drift's time): a suspect shape in one of them is the effect's own kind, not one it
-        mimics (the probes' ``factors.variable`` names the inputs)."""
 
 
 @dataclass
@@ -153,16 +102,13 @@ class Candidate:
 
     @property
     def significant(self) -> bool:
-        """Whether the effect lowers BIC by at least its round's threshold (:func:`threshold`)."""
+        """Whether the effect lowers BIC by at least its round's threshold."""
         return self.delta_bic is not None and self.delta_bic <= self.threshold
 
     @property
     def determined(self) -> bool:
-        """Whether the data determine the effect (:func:`parameter_determination`; true when its
-        parameters were not examined): at least one of its parameters is determined on its own,
-        and every such one is determined (significant, not traded off against the model). The
-        parameters that only move along combinations the data cannot see (absorbed into the
-        model's errors, or acting on an angle not measured) do not count either way."""
+        """Whether the data determine the effect (:func:`undetermined_parameters` is empty;
+        true when its parameters were not examined)."""
         return not self.parameters or not undetermined_parameters(self.parameters)
 
     @property
@@ -173,15 +119,12 @@ class Candidate:
 
 def undetermined_parameters(entries: Sequence[dict]) -> list[str]:
     """The names among :func:`parameter_determination` ``entries`` that make an effect
-    undetermined; empty: the effect is determined.
+    undetermined; empty: determined.
 
-    An effect is determined when the data see at least one of its parameters on its own, every
-    such parameter is determined (not traded off: :func:`parameter_determination`) and at
-    least one is significant (``|value| >=``
-    :data:`DETERMINED_SIGMAS` ``std``). Parameters that only move along combinations the data
-    cannot see (absorbed into the model's errors, or acting on an angle not measured) count
-    neither way; a coefficient determined to be near zero (the 2/rev term of a 1/rev
-    eccentricity) is determined, not a flaw.
+    Determined: the data see at least one parameter on its own, every such one is determined (not
+    traded off) and one is significant (``|value| >= DETERMINED_SIGMAS std``). Parameters moving
+    only along combinations the data cannot see count neither way; a coefficient determined to be
+    near zero (the 2/rev term of a 1/rev eccentricity) is determined, not a flaw.
     """
     seen = [p for p in entries if p["std"] is not None]
     if not seen:
@@ -199,45 +142,28 @@ def parameter_determination(
 ) -> list[dict]:
     """Whether the data determine each parameter ``names`` of a fit, in user units.
 
-    Each entry: ``name``, ``value``, ``std`` (None when the parameter is not determined on its
-    own: it moves along a combination the data cannot see), ``unit``, ``sigmas``
-    (``|value| / std``), ``correlation``, ``correlation_all`` and ``determined``.
-
-    ``correlation`` is the parameter's largest correlation with any combination of the base
-    parameters ``base_names``: the multiple correlation ``|P_base J_i| / |J_i|`` of its
-    weighted Jacobian column with the span of theirs, cut to ``base_rank`` directions (the
-    base model's rank, so that directions a large error makes barely visible at second order
-    do not count); ``correlation_all`` the same with all the other parameters (the effect's own
-    others too, span cut to the fit's rank - 1). Both are 1 when the parameter is not
-    determined alone. A parameter is ``determined`` when ``correlation <=``
-    :data:`MAX_CORRELATION` and ``correlation_all <=`` :data:`MAX_CORRELATION_ALL`: it is not
-    traded off against the base errors, nor hopelessly against its siblings (the practice of
-    pointing-model fitting). Whether the effect as a whole is significant is
-    :func:`undetermined_parameters`' question.
+    Each entry: ``name``, ``value``, ``std`` (None when not determined on its own), ``unit``,
+    ``sigmas`` (``|value| / std``), ``correlation``, ``correlation_all`` and ``determined``.
+    ``correlation`` is the multiple correlation ``|P_base J_i| / |J_i|`` of the parameter's
+    weighted Jacobian column with the span of the base parameters', cut to ``base_rank``
+    directions (directions a large error makes barely visible at second order do not count);
+    ``correlation_all`` the same with all the other parameters (span cut to the fit's rank - 1).
+    Both are 1 when the parameter is not determined alone. ``determined``: ``correlation <=
+    MAX_CORRELATION`` and ``correlation_all <= MAX_CORRELATION_ALL`` (pointing-model practice).
     """
     table = result.parameter_table()
     index = {n: i for i, n in enumerate(result.parameter_names)}
-    # Angles between columns are those of the small triangular factor R (J = Q R, Q with
-    # orthonormal columns): every projection below is done on R, not on the tall Jacobian.
+    # Angles between columns are those of R (J = Q R): every projection is done on the small R.
     jac = tall_r_factor(result.jacobian_weighted)
-
-    def span(columns: list[int], rank: int) -> np.ndarray:
-        u, _, _ = np.linalg.svd(jac[:, columns], full_matrices=False)
-        return u[:, : max(int(rank), 0)]
-
-    base = span([index[n] for n in base_names], base_rank)
+    base = column_span(jac, [index[n] for n in base_names], base_rank)
     out = []
     for name in names:
         i = index[name]
         entry = table[name]
         std = entry["std"]
         correlation = correlation_all = 1.0
-        column = jac[:, i]
-        norm = float(np.linalg.norm(column))
-        if std is not None and std > 0 and norm > 0:
-            correlation = min(float(np.linalg.norm(base.T @ column)) / norm, 1.0)
-            others = span([k for k in range(jac.shape[1]) if k != i], result.rank - 1)
-            correlation_all = min(float(np.linalg.norm(others.T @ column)) / norm, 1.0)
+        if std is not None and std > 0 and np.linalg.norm(jac[:, i]) > 0:
+            correlation, correlation_all = multiple_correlations(jac, i, base, result.rank)
         out.append(
             {
                 "name": name,
@@ -257,25 +183,41 @@ def parameter_determination(
     return out
 
 
+def column_span(matrix: np.ndarray, columns: Sequence[int], rank: int) -> np.ndarray:
+    """An orthonormal basis of the span of ``matrix[:, columns]`` cut to ``rank`` directions."""
+    u, _, _ = np.linalg.svd(matrix[:, list(columns)], full_matrices=False)
+    return u[:, : max(int(rank), 0)]
+
+
+def multiple_correlations(matrix, i: int, base: np.ndarray, rank: int) -> tuple[float, float]:
+    """The multiple correlations (at most 1) of column ``i`` of ``matrix`` with the orthonormal
+    ``base`` and with the span of its other columns cut to ``rank - 1`` directions."""
+    column = matrix[:, i]
+    norm = float(np.linalg.norm(column))
+    others = column_span(matrix, [k for k in range(matrix.shape[1]) if k != i], rank - 1)
+    return (
+        min(float(np.linalg.norm(base.T @ column)) / norm, 1.0),
+        min(float(np.linalg.norm(others.T @ column)) / norm, 1.0),
+    )
+
+
 def acceptance_threshold(n_testable: int) -> float:
     """The delta_bic an effect must reach when ``n_testable`` candidates are tried at once:
-    ``-6 - 2 ln K``, the look-elsewhere penalty of the structure search applied to the catalogue
-    (K chances of a false alarm; -6 for a single candidate)."""
+    ``-6 - 2 ln K`` (K chances of a false alarm)."""
     return BIC_THRESHOLD - 2.0 * math.log(max(n_testable, 1))
 
 
 def _chi2(result: FitResult, noise_variance: float, group_variance=None) -> float:
-    """chi2 of ``result`` with the unit-weight ``noise_variance``; with the best model's noise
-    per group (``group_variance``, :func:`_group_variance`) for a fit with noise groups, the
-    groups' unweighted rss over those variances (every model judged at one noise)."""
+    """chi2 of ``result`` at the unit-weight ``noise_variance``; with noise groups and the best
+    model's ``group_variance``, the groups' unweighted rss over it (one noise for every model)."""
     if group_variance is not None and result.noise_groups is not None:
         return float(np.sum(result.group_rss / group_variance))
     return result.rss / noise_variance
 
 
 def _group_variance(best: FitResult) -> np.ndarray | None:
-    """The best model's noise variance per group (its degrees of freedom shared out by the
-    groups' sizes), or None without noise groups (or with sigma given)."""
+    """The best model's noise variance per group (its dof shared out by the groups' sizes), or
+    None without noise groups (or with sigma given)."""
     if best.sigma_known or best.noise_groups is None:
         return None
     _, counts = np.unique(best.noise_groups, return_counts=True)
@@ -293,37 +235,37 @@ def _summary(result: FitResult, noise_variance: float, group_variance=None) -> d
     }
 
 
-def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, candidates):
-    """Fit each candidate effect on top of ``current`` and score it (delta_bic vs current)."""
+def _scored(family, current, base: FitResult, effect) -> Candidate:
+    """``effect`` fitted on top of ``current`` and scored against ``base`` (delta_bic)."""
+    reason = family.untestable_reason(effect)
+    if reason:
+        return Candidate(effect.name, False, reason)
+    try:
+        fit = family.fit([*current, effect])
+    except (IdentifiabilityError, InputError) as exc:  # InputError: not defined here
+        return Candidate(effect.name, False, f"cannot be fitted on these data: {exc}")
+    added = fit.result.rank - base.rank
+    if added <= 0:
+        names = [c for c in fit.result.undetermined_combinations() if effect.name in c]
+        reason = "indistinguishable from the model already fitted on these data: its parameters "
+        reason += "only move along " + "; ".join(names[:4])
+        return Candidate(effect.name, False, reason, fit=fit)
+    return Candidate(effect.name, True, None, fit, added, _delta_bic(fit.result, base))
+
+
+def _delta_bic(result: FitResult, previous: FitResult) -> float:
+    """delta_bic of ``result`` against the smaller model ``previous`` (its added rank)."""
+    known = 1.0 if previous.sigma_known else None
+    added = result.rank - previous.rank
+    dbic = delta_bic(_rss(result), _rss(previous), added, result.n_obs, known, result.rank)
+    return float(dbic)
+
+
+def compare_effects(family, current: Sequence[Any], current_fit, candidates):
+    """Fit each candidate effect on top of ``current`` and score it (delta_bic vs current),
+    best first."""
     base = current_fit.result
-    m = base.n_obs
-    known = 1.0 if base.sigma_known else None
-    out = []
-    for effect in candidates:
-        reason = family.untestable_reason(effect)
-        if reason:
-            out.append(Candidate(effect.name, False, reason))
-            continue
-        try:
-            fit = family.fit([*current, effect])
-        except (IdentifiabilityError, InputError) as exc:  # InputError: not defined here
-            out.append(Candidate(effect.name, False, f"cannot be fitted on these data: {exc}"))
-            continue
-        added = fit.result.rank - base.rank
-        if added <= 0:
-            names = [c for c in fit.result.undetermined_combinations() if effect.name in c]
-            out.append(
-                Candidate(
-                    effect.name,
-                    False,
-                    "indistinguishable from the model already fitted on these data: its "
-                    "parameters only move along " + "; ".join(names[:4]),
-                    fit=fit,
-                )
-            )
-            continue
-        dbic = delta_bic(_rss(fit.result), _rss(base), added, m, known, fit.result.rank)
-        out.append(Candidate(effect.name, True, None, fit, added, float(dbic)))
+    out = [_scored(family, current, base, effect) for effect in candidates]
     threshold = acceptance_threshold(sum(c.testable for c in out))
     known_names = set(base.parameter_names)
     for c in out:
@@ -333,11 +275,9 @@ def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, ca
             c.parameters = parameter_determination(
                 c.fit.result, added_names, base.parameter_names, base.rank
             )
-    # Best first: the significant effects whose parameters are determined, then the others by
-    # delta_bic (a richer effect whose extra parameters the data do not determine is not
-    # preferred to the simpler one that explains the signal with determined ones) -- unless the
-    # undetermined one explains more than twice as much: a determined effect whose gain is
-    # small beside it is not the same signal, and is not put first.
+    # Best first: the significant determined effects, then the others by delta_bic (a richer
+    # effect whose extra parameters are undetermined is not preferred to the simpler one) --
+    # unless the undetermined one explains more than UNDETERMINED_GAIN_RATIO times as much.
     base_rss = _rss(base)
 
     def gain(c: Candidate) -> float:
@@ -359,14 +299,13 @@ def compare_effects(family: ModelFamily, current: Sequence[Any], current_fit, ca
 
 
 def _rss(result: FitResult) -> float:
-    """The rss a score compares: the weighted rss with sigma given; with the noise profiled, the
-    one of :attr:`FitResult.profiled_rss` (per noise group, each model at its own noise)."""
+    """The rss a score compares: weighted with sigma given, else :attr:`FitResult.profiled_rss`."""
     return result.rss if result.sigma_known else result.profiled_rss
 
 
 def _described_rss(result: FitResult, structure, probes) -> float | None:
-    """The rss (as :func:`_rss` compares) of ``result`` with the probe columns of the structure
-    found added, or None when not comparable (a noise level per group and structure found)."""
+    """:func:`_rss` of ``result`` with the found structure's probe columns added, or None when
+    not comparable (a noise level per group and structure found)."""
     if not structure:
         return _rss(result)
     if result.noise_groups is not None and not result.sigma_known:
@@ -397,7 +336,7 @@ def _mark_alternatives(
 
 @dataclass
 class Step:
-    """One step of the forward selection (``--until-explained``)."""
+    """One step of the forward selection (``until_explained``)."""
 
     added: str
     delta_bic: float
@@ -410,41 +349,22 @@ class Diagnosis:
     """The outcome of :func:`diagnose`.
 
     Attributes:
-        base_fit: the base model's fit.
         candidates: every catalogued effect tested against the base, best first.
-        steps: accepted effects in order (forward selection while delta_bic <= -6; always run,
-            because whether structure remains "that no catalogued effect removes" can only be
-            judged on the model with every significant effect).
-        best_fit: the fit of base + all accepted effects.
+        steps: accepted effects in order (forward selection, always run: remaining structure
+            is judged on the model with every significant effect); best_fit: with them all.
         noise_variance: unit-weight variance chi2 is reported with (1 when sigma is given).
         structure: terms the structure search finds in the best model's residuals.
-        fails_fit_test: the best model's chi2 p-value is below ``FIT_TEST_ALPHA``.
-        separations: advice per alternative of the accepted first effect.
-        separation_commands: for entries of ``separations``, the command that would settle
-            each (the caller's: e.g. a design of the next measurements); in the JSON only when
-            there are some.
-        until_explained: whether the verdict names every accepted effect (``missing_effects``)
-            or the first one, with the others as ``also_significant``.
-        after_first: delta_bic of each other effect on top of the first accepted one: an effect
-            that only looked significant against a base that lacked the real effect (because
-            it soaked up part of that effect's signal) is no longer significant there.
-        warnings: what the data's design cannot tell (the family's ``design_warnings``).
-        outliers: the records left out as gross outliers (the caller's rule and words; each a
-            dict the caller defines), empty when none or when the rule was off.
-        outlier_rule: the rule in words, or ``None`` when no rule was applied.
-        unneeded_given_structure: effects the forward selection accepted that the best
-            description of the data does not need (:func:`_least_needed`), with what removing
-            each cost in BIC (below 6): they are not named.
-        doubt: the caller's doubt about the model family itself (the data may not come from
-            this model at all), said before the verdict; ``None`` when it has none.
-        group_variance: with a noise level per group estimated with each model, the best
-            model's (:func:`_group_variance`): every fit's chi2 is reported at it.
-        family_verdict: the family's own entries of the verdict (JSON-ready; a calibration
-            run's side of each effect and the effects of the other side), after the generic ones
-            in :meth:`to_dict`; ``separation_commands`` then follow them (they settle the
-            family's rivals too).
-        family_results: the family's own entries of the result (JSON-ready; a calibration run's
-            calibrated coefficients), after the generic ones in :meth:`to_dict`.
+        separations: advice per alternative of the first effect; separation_commands: the
+            caller's command settling each (in the JSON only when there are some).
+        until_explained: whether the verdict names every accepted effect or the first one.
+        after_first: delta_bic of each other effect on top of the first accepted one.
+        outliers: the records left out (the caller's dicts); outlier_rule: the rule in words.
+        unneeded_given_structure: accepted effects the best description does not need, with
+            the BIC cost of removing each (:func:`_least_needed`): not named.
+        doubt: the caller's doubt about the model family itself, said before the verdict.
+        group_variance: with a noise level per group, the best model's (every chi2 is at it).
+        family_verdict, family_results: the family's own entries of the verdict and result,
+            after the generic ones.
     """
 
     family: Any = field(repr=False)
@@ -464,7 +384,7 @@ class Diagnosis:
     unneeded_given_structure: dict[str, float] = field(default_factory=dict)
     doubt: str | None = None
     group_variance: np.ndarray | None = field(default=None, repr=False)
-    separation_commands: dict[str, str] = field(default_factory=dict)
+    separation_commands: dict[str, Any] = field(default_factory=dict)
     family_verdict: dict[str, Any] = field(default_factory=dict)
     family_results: dict[str, Any] = field(default_factory=dict)
 
@@ -513,8 +433,7 @@ class Diagnosis:
         return self.base_fit.result.sigma_known
 
     def _sigma_user(self) -> float:
-        """The noise the verdict uses, in user units: the unit-weight noise times the family's
-        typical sigma; with a noise level per group, their rms over the observations."""
+        """The verdict's noise in user units (with a noise level per group, their rms)."""
         if self.group_variance is None:
             return float(math.sqrt(self.noise_variance) * self.family.sigma_scale)
         best = self.best_fit.result
@@ -523,8 +442,7 @@ class Diagnosis:
         return math.sqrt(pooled) * best.user_unit_scale
 
     def named_parameters(self) -> dict[str, list[dict]]:
-        """``{effect: parameter_determination entries}`` of every named effect in the best fit
-        (values, standard errors, correlations with the base errors and with all the others)."""
+        """``{effect: parameter_determination entries}`` of every named effect in the best fit."""
         result = self.best_fit.result
         prefixes = tuple(f"{s.added}." for s in self.steps)
         base = [n for n in result.parameter_names if not n.startswith(prefixes)]
@@ -570,9 +488,10 @@ class Diagnosis:
         return entry
 
     def _verdict_dict(self) -> dict:
-        """The ``verdict`` of :meth:`to_dict`: the generic entries, then the family's own
-        (``family_verdict``); the ``separation_commands`` after the rivals they settle."""
+        """The ``verdict`` of :meth:`to_dict`: the generic entries, then ``family_verdict``; the
+        ``separation_commands`` after the rivals they settle."""
         named = {s.added for s in self.steps}
+        commands = {name: str(c) for name, c in self.separation_commands.items()}
         verdict = {
             "doubt": self.doubt,
             "missing_effect": self.missing_effect,
@@ -590,8 +509,8 @@ class Diagnosis:
                 for name, value in self.unneeded_given_structure.items()
             ],
         }
-        if self.separation_commands and not self.family_verdict:
-            verdict["separation_commands"] = dict(self.separation_commands)
+        if commands and not self.family_verdict:
+            verdict["separation_commands"] = commands
         named_parameters = self.named_parameters()
         verdict["named_parameters"] = named_parameters
         loose = {name: undetermined_parameters(e) for name, e in named_parameters.items() if e}
@@ -609,14 +528,13 @@ class Diagnosis:
         if self.missing_effect:
             verdict["effect_story"] = self.family.describe(self.missing_effect)
         verdict.update(copy.deepcopy(self.family_verdict))
-        if self.separation_commands and self.family_verdict:
-            verdict["separation_commands"] = dict(self.separation_commands)
+        if commands and self.family_verdict:
+            verdict["separation_commands"] = commands
         return verdict
 
     def to_dict(self) -> dict:
-        """The spec's diagnosis JSON (plus steps, structure and per-effect explanations), with
-        the family's own results last (``family_results``): the one structured result the text
-        and HTML reports render."""
+        """The diagnosis JSON (plus steps, structure and per-effect explanations), the family's
+        own results last: the one structured result the text and HTML reports render."""
         nv, gv = self.noise_variance, self.group_variance
         unit = self.family.observation_unit
         return {
@@ -649,19 +567,21 @@ class Diagnosis:
         }
 
 
-def diagnose(family: ModelFamily, *, until_explained: bool = False) -> Diagnosis:
+def diagnose(family, *, until_explained: bool = False) -> Diagnosis:
     """Test every catalogued effect against the base model and decide (module docstring).
 
-    Runs with one BLAS thread (:func:`one_blas_thread` of ``core.blas_threads``): its
-    products of tall, thin matrices were many times slower split over the threads of busy
-    cores."""
+    Runs with one BLAS thread (``core.blas_threads``): its products of tall, thin matrices were
+    many times slower split over the threads of busy cores."""
     with one_blas_thread():
         return _diagnose(family, until_explained=until_explained)
 
 
-def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
-    base_fit = family.fit([])
-    candidates = compare_effects(family, [], base_fit, family.catalogue)
+def _effect(family, name: str):
+    return next(e for e in family.catalogue if e.name == name)
+
+
+def _forward(family, candidates, base_fit):
+    """The forward selection from the base: ``(steps, effects, best fit, after_first)``."""
     steps: list[Step] = []
     current: list[Any] = []
     current_fit = base_fit
@@ -672,7 +592,7 @@ def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
         if not accepted:
             break
         chosen = accepted[0]
-        current.append(next(e for e in family.catalogue if e.name == chosen.effect))
+        current.append(_effect(family, chosen.effect))
         current_fit = chosen.fit
         steps.append(Step(chosen.effect, float(chosen.delta_bic), chosen.fit, round_candidates))
         rest = [e for e in family.catalogue if e not in current]
@@ -681,16 +601,19 @@ def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
         round_candidates = compare_effects(family, current, current_fit, rest)
         if len(steps) == 1:
             after_first = {c.effect: c.delta_bic for c in round_candidates}
-    known = 1.0 if current_fit.result.sigma_known else None
+    return steps, current, current_fit, after_first
+
+
+def _pruned(family, candidates, current, current_fit, known):
+    """The accepted effects an effect of which earns its place judged against the best
+    description of the data -- the other accepted effects *and* the structure found -- not
+    against a model whose chi2 the unexplained structure inflates (a 3/rev term makes any 1/rev
+    effect look good): ``(effects, fit, structure, probes, unneeded {name: BIC cost})``."""
     structure, probes = _search(family, current_fit, known)
-    # An accepted effect must explain its own share: judged against the best description of the
-    # data -- the other accepted effects *and* the structure found -- not against a model whose
-    # chi2 the unexplained structure inflates (a 3/rev term makes any 1/rev effect look good).
     unneeded: dict[str, float] = {}
+    threshold = candidates[0].threshold
     while current:
-        worst = _least_needed(
-            family, current, current_fit, structure, probes, known, candidates[0].threshold
-        )
+        worst = _least_needed(family, current, current_fit, structure, probes, known, threshold)
         if worst is None:
             break
         name, dbic = worst
@@ -699,9 +622,8 @@ def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
         current_fit = family.fit(current)
         structure, probes = _search(family, current_fit, known)
     if unneeded:
-        # The final description (the effects kept and the structure found) never fits worse
-        # than a determined candidate it passed over: one that alone leaves less misfit is put
-        # back first.
+        # The final description never fits worse than a determined candidate it passed over: one
+        # that alone leaves less misfit is put back first.
         kept = {e.name for e in current}
         described = _described_rss(current_fit.result, structure, probes)
         better = [
@@ -714,31 +636,43 @@ def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
             and _rss(c.fit.result) < described
         ]
         if better:
-            restored = better[0].effect
-            unneeded.pop(restored, None)
-            current = [next(e for e in family.catalogue if e.name == restored), *current]
+            unneeded.pop(better[0].effect, None)
+            current = [_effect(family, better[0].effect), *current]
             current_fit = family.fit(current)
             structure, probes = _search(family, current_fit, known)
+    return current, current_fit, structure, probes, unneeded
+
+
+def _separations(family, candidates, steps) -> dict[str, str]:
+    """The family's separation advice for the first effect's equally good alternatives and the
+    significant candidates not named because undetermined (the same signal, another name?)."""
+    if not steps:
+        return {}
+    first = next(c for c in candidates if c.effect == steps[0].added)
+    named = {s.added for s in steps}
+    passed_over = [
+        c.effect for c in candidates if c.significant and not c.determined and c.effect not in named
+    ]
+    return {
+        name: family.separation(first.fit, _effect(family, name))
+        for name in dict.fromkeys([*first.alternatives, *passed_over])
+    }
+
+
+def _diagnose(family, *, until_explained: bool) -> Diagnosis:
+    base_fit = family.fit([])
+    candidates = compare_effects(family, [], base_fit, family.catalogue)
+    steps, current, current_fit, after_first = _forward(family, candidates, base_fit)
+    known = 1.0 if current_fit.result.sigma_known else None
+    current, current_fit, structure, _, unneeded = _pruned(
+        family, candidates, current, current_fit, known
+    )
+    if unneeded:
         steps = _steps_of(family, current, base_fit)
     best = current_fit.result
     noise_variance = _noise_variance(best)
     group_variance = _group_variance(best)
     _mark_alternatives(candidates, noise_variance, group_variance)
-    fails = bool(best.sigma_known and best.dof > 0 and best.p_value < FIT_TEST_ALPHA)
-    separations = {}
-    if steps:
-        first = next(c for c in candidates if c.effect == steps[0].added)
-        named = {s.added for s in steps}
-        # The equally good alternatives, and the significant candidates not named because
-        # their parameters are not determined: each may be the same signal under another name.
-        passed_over = [
-            c.effect
-            for c in candidates
-            if c.significant and not c.determined and c.effect not in named
-        ]
-        for name in dict.fromkeys([*first.alternatives, *passed_over]):
-            effect = next(e for e in family.catalogue if e.name == name)
-            separations[name] = family.separation(first.fit, effect)
     return Diagnosis(
         family=family,
         base_fit=base_fit,
@@ -747,8 +681,8 @@ def _diagnose(family: ModelFamily, *, until_explained: bool) -> Diagnosis:
         best_fit=current_fit,
         noise_variance=noise_variance,
         structure=structure,
-        fails_fit_test=fails,
-        separations=separations,
+        fails_fit_test=bool(best.sigma_known and best.dof > 0 and best.p_value < FIT_TEST_ALPHA),
+        separations=_separations(family, candidates, steps),
         until_explained=until_explained,
         after_first=after_first,
         warnings=list(family.design_warnings(base_fit)),
@@ -761,9 +695,8 @@ def _search(
     family, fit, known, max_terms: int = 5, suspects_only: bool = False, skip_inputs=frozenset()
 ) -> tuple[list[FoundTerm], list[Probe]]:
     """The structure search in the residuals of ``fit``, with the probes it used (with
-    ``suspects_only``, the family's ``suspect_probes`` when it has them, without those in the
-    inputs ``skip_inputs``)."""
-    if suspects_only and hasattr(family, "suspect_probes"):
+    ``suspects_only``, the family's ``suspect_probes`` except those in ``skip_inputs``)."""
+    if suspects_only:
         probes = [
             p
             for p in family.suspect_probes(fit)
@@ -786,10 +719,9 @@ def _projected_rss(residuals: np.ndarray, blocks: Sequence[np.ndarray]) -> tuple
     """The rss of ``residuals`` (m,) left after projecting out the columns of ``blocks`` (tall
     matrices side by side), and their rank; residuals (m, g) give the sum over their columns.
 
-    From the small Gram matrix of the unit-normalised columns (no tall matrix is copied or
-    decomposed): ``rss = r.r - b^T G^+ b`` with ``b`` the columns' products with ``r``; the
-    directions with eigenvalues below 1e-12 of the largest (singular values below 1e-6) are not
-    in the span.
+    From the small Gram matrix of the unit-normalised columns (no tall matrix copied or
+    decomposed): ``rss = r.r - b^T G^+ b``, ``b`` the columns' products with ``r``; eigenvalues
+    below 1e-12 of the largest are not in the span.
     """
     k = sum(b.shape[1] for b in blocks)
     gram = np.zeros((k, k))
@@ -801,8 +733,7 @@ def _projected_rss(residuals: np.ndarray, blocks: Sequence[np.ndarray]) -> tuple
             block = a.T @ blocks[j]
             gram[starts[i] : starts[i + 1], starts[j] : starts[j + 1]] = block
             gram[starts[j] : starts[j + 1], starts[i] : starts[i + 1]] = block.T
-    # Unit-normalised columns (zero columns left out), scaled on the small matrices: no copy of
-    # the tall blocks.
+    # Unit-normalised columns (zero columns left out), scaled on the small matrices.
     norms = np.sqrt(np.diag(gram))
     nonzero = norms > 0
     scale = 1.0 / norms[nonzero]
@@ -815,97 +746,66 @@ def _projected_rss(residuals: np.ndarray, blocks: Sequence[np.ndarray]) -> tuple
     return max(float(np.sum(residuals**2)) - explained, 0.0), int(keep.sum())
 
 
-def _least_needed(family, current, current_fit, structure, probes, known, threshold):
-    """The accepted effect least needed in the best description of the data, with what removing
-    it costs in BIC, or ``None`` when every accepted effect still earns its place.
+class _Description:
+    """The BIC of fits with structure terms' probe columns added, all judged in the weights of
+    the best description (``best``: its fit, the structure found and its probes). Linearised at
+    the fits (the models are nearly linear); each term pays the search's ``2 ln G``."""
 
-    The best description is the accepted effects plus the structure found on top of them. An
-    effect E earns its place when removing it costs at least ``-threshold`` (the acceptance
-    rule itself, :func:`acceptance_threshold`), judged two ways:
+    def __init__(self, best, structure, probes, known) -> None:
+        result = best.result
+        self.structure_and_probes = (structure, probes)
+        self.m = result.n_obs
+        self.penalty = 2.0 * math.log(max(len(probes), 1))
+        # With a noise level per group estimated with each model the fits' weights differ: all
+        # are judged in the best description's (unit variance there), as with sigma given.
+        self.reference, self.known = None, known
+        if known is None and result.noise_groups is not None:
+            self.reference, self.known = result.weights, 1.0
+        rss, rank = self.projected(best, structure, probes)
+        # ln(rss) weighs as in delta_bic, with the best description's residual dof.
+        self.weight = profiled_weight(self.m, rank, 2)
+        self.full, self.full_fit = self.bic(rss, rank, len(structure))
 
-    - with the same structure: an effect that only soaked up part of a structure it does not
-      explain (a backlash taking a little of a 3/rev term) costs little to remove;
-    - with the structure the search finds, among the family's suspect shapes (terms in inputs
-      no catalogued effect depends on: time, other columns), in the residuals of the model
-      without E (what E was standing for), when that structure is not E's own shape (it lies
-      outside the span of the model with E) and fits the data at least as well as E does: then
-      E is a mimic of a shape it does not have (an 8-parameter wobble following a slow
-      temperature change through the measurement order), and the found shape describes the
-      data better. When the found shape is E's own (a step with dir where E is a backlash) or
-      fits worse, E is kept: it is the
-      physical hypothesis, and its extra harmonics are not held against it.
-
-    Each structure term pays the search's look-elsewhere penalty ``2 ln G`` besides its
-    parameters. Linearised at the fits: the structure's probe columns join each model's
-    Jacobian (the models are nearly linear).
-    """
-    m = current_fit.result.n_obs
-    penalty = 2.0 * math.log(max(len(probes), 1))
-    # With a noise level per group estimated with each model, the fits carry different
-    # weights: they are all judged in the weights of the best description (its own noise
-    # levels, unit variance there), as with sigma given.
-    reference = None
-    score_known = known
-    if known is None and current_fit.result.noise_groups is not None:
-        reference, score_known = current_fit.result.weights, 1.0
-
-    def projected(fit, terms, term_probes, own_probes=False) -> tuple[float, int]:
-        """(rss, rank) of ``fit`` with the probe columns of ``terms`` added (``own_probes``:
-        the probes were weighted like ``fit``, not like the best description)."""
+    def projected(self, fit, terms, term_probes, own_probes=False) -> tuple[float, int]:
+        """(rss, rank) of ``fit`` with the probe columns of ``terms`` added (``own_probes``: the
+        probes were weighted like ``fit``, not like the best description)."""
         result = fit.result
         columns = [result.determined_jacobian_weighted, *_term_columns(terms, term_probes)]
-        if reference is None:
+        if self.reference is None:
             return _projected_rss(result.residuals * result.weights, columns)
-        scale = (reference / result.weights)[:, None]
+        scale = (self.reference / result.weights)[:, None]
         columns = [c * scale if k == 0 or own_probes else c for k, c in enumerate(columns)]
-        return _projected_rss(result.residuals * reference, columns)
+        return _projected_rss(result.residuals * self.reference, columns)
 
-    full_rss, full_rank = projected(current_fit, structure, probes)
-    # With the variance profiled, ln(rss) weighs as in delta_bic, with the residual degrees of
-    # freedom of the best description (the larger model of each comparison).
-    weight = profiled_weight(m, full_rank, 2)
-
-    def score(fit, terms, term_probes, own_probes=False) -> tuple[float, float]:
-        """(BIC, its fit part) of ``fit`` with the probe columns of ``terms`` added."""
-        return bic(*projected(fit, terms, term_probes, own_probes), len(terms))
-
-    def bic(rss: float, rank: int, n_terms: int) -> tuple[float, float]:
-        if score_known is not None:
-            fit_term = rss / score_known
+    def bic(self, rss: float, rank: int, n_terms: int) -> tuple[float, float]:
+        """(BIC, its fit part)."""
+        if self.known is not None:
+            fit_term = rss / self.known
         else:
-            fit_term = weight * math.log(max(rss, 1e-300))
-        return fit_term + rank * math.log(m) + penalty * n_terms, fit_term
+            fit_term = self.weight * math.log(max(rss, 1e-300))
+        return fit_term + rank * math.log(self.m) + self.penalty * n_terms, fit_term
 
-    full, full_fit = bic(full_rss, full_rank, len(structure))
+    def score(self, fit, terms, term_probes, own_probes=False) -> tuple[float, float]:
+        """(BIC, its fit part) of ``fit`` with the probe columns of ``terms`` added."""
+        return self.bic(*self.projected(fit, terms, term_probes, own_probes), len(terms))
+
+
+def _least_needed(family, current, current_fit, structure, probes, known, threshold):
+    """The accepted effect least needed in the best description of the data (the accepted
+    effects plus the structure found), with the BIC cost of removing it, or ``None`` when each
+    costs at least ``-threshold``, judged with the same structure (an effect that soaked up part
+    of a structure it does not explain costs little) and with the suspect shapes found without
+    it, when not its own and fitting as well (it mimics them: a wobble following a slow
+    temperature change through the measurement order); else it, the physical hypothesis, stays.
+    """
+    description = _Description(current_fit, structure, probes, known)
     worst = None
     for effect in current:
         try:
             without = family.fit([e for e in current if e is not effect])
         except IdentifiabilityError:
             continue
-        # Structure terms describe what remains after the catalogued effects: when they span
-        # E's own signal (a harmonic of the very error E moves), E is the physical name of
-        # that signal and is not judged against them.
-        costs = []
-        if not _duplicated(current_fit.result, without.result, structure, probes):
-            costs.append(score(without, structure, probes)[0] - full)
-        # What E stood for, in at most two shapes (more would pay more than E's own
-        # parameters in penalties), among inputs E does not depend on itself (a drift in time
-        # is a thermal drift's own kind) and in no more parameters than E adds (a physical
-        # effect does not lose to a generic shape with more parameters).
-        inputs = family.inputs(effect) if hasattr(family, "inputs") else set()
-        own, own_probes = _search(
-            family, without, known, max_terms=2, suspects_only=True, skip_inputs=inputs
-        )
-        if (
-            own
-            and sum(len(t.coefficients) for t in own)
-            <= current_fit.result.rank - without.result.rank
-            and not _within(own, own_probes, current_fit.result.determined_jacobian_weighted)
-        ):
-            bic_own, fit_own = score(without, own, own_probes, own_probes=True)
-            if fit_own <= full_fit:
-                costs.append(bic_own - full)
+        costs = _removal_costs(family, effect, without, current_fit, description, known)
         if not costs:
             continue
         cost = float(min(costs))
@@ -914,14 +814,37 @@ def _least_needed(family, current, current_fit, structure, probes, known, thresh
     return worst
 
 
+def _removal_costs(family, effect, without, current_fit, description, known) -> list[float]:
+    """The BIC costs of removing ``effect`` (:func:`_least_needed`'s two ways)."""
+    structure, probes = description.structure_and_probes
+    costs = []
+    # Structure spanning E's own signal (a harmonic of the very error E moves): E is its
+    # physical name and is not judged against it.
+    if not _duplicated(current_fit.result, without.result, structure, probes):
+        costs.append(description.score(without, structure, probes)[0] - description.full)
+    # What E stood for, in at most two shapes, in inputs E does not depend on itself (a drift in
+    # time is a thermal drift's own kind) and in no more parameters than E adds.
+    own, own_probes = _search(
+        family, without, known, max_terms=2, suspects_only=True, skip_inputs=family.inputs(effect)
+    )
+    if (
+        own
+        and sum(len(t.coefficients) for t in own) <= current_fit.result.rank - without.result.rank
+        and not _within(own, own_probes, current_fit.result.determined_jacobian_weighted)
+    ):
+        bic_own, fit_own = description.score(without, own, own_probes, own_probes=True)
+        if fit_own <= description.full_fit:
+            costs.append(bic_own - description.full)
+    return costs
+
+
 OWN_SHAPE_FRACTION = 0.05
 """A found shape is an effect's own when less than this fraction of its columns (Frobenius norm)
 lies outside the span of the model with the effect."""
 
 
 def _inside(columns: np.ndarray, blocks: Sequence[np.ndarray]) -> bool:
-    """Whether ``columns`` lie (up to :data:`OWN_SHAPE_FRACTION` of their Frobenius norm) in
-    the span of the tall ``blocks`` side by side."""
+    """Whether ``columns`` lie (to :data:`OWN_SHAPE_FRACTION`) in the span of ``blocks``."""
     outside = _projected_rss(columns, blocks)[0]
     return bool(outside <= OWN_SHAPE_FRACTION**2 * float(np.sum(columns**2)))
 
@@ -933,9 +856,8 @@ def _term_columns(terms, term_probes) -> list[np.ndarray]:
 
 
 def _duplicated(full: FitResult, without: FitResult, terms, term_probes) -> bool:
-    """Whether the columns of the effect that ``full`` has and ``without`` lacks lie in the span
-    of ``without``'s Jacobian and the probe columns of the structure ``terms`` (:func:`_inside`):
-    the structure then describes the effect's own signal."""
+    """Whether the columns of the effect ``full`` has and ``without`` lacks lie in the span of
+    ``without``'s Jacobian and the structure's probe columns: the structure is its own signal."""
     if not terms:
         return False
     known = set(without.parameter_names)
@@ -947,24 +869,17 @@ def _duplicated(full: FitResult, without: FitResult, terms, term_probes) -> bool
 
 
 def _within(terms, term_probes, jacobian_weighted: np.ndarray) -> bool:
-    """Whether the probe columns of ``terms`` lie in the span of ``jacobian_weighted``
-    (:func:`_inside`)."""
+    """Whether the probe columns of ``terms`` lie in the span of ``jacobian_weighted``."""
     return _inside(np.concatenate(_term_columns(terms, term_probes), axis=1), [jacobian_weighted])
 
 
 def _steps_of(family, effects, base_fit) -> list[Step]:
-    """The forward-selection steps of ``effects`` in their order (each fit cached by the
-    family), with the delta_bic of each against the previous model."""
+    """The forward-selection steps of ``effects`` in their order, each with its delta_bic
+    against the previous model."""
     steps = []
     previous = base_fit
-    known = 1.0 if base_fit.result.sigma_known else None
     for k in range(len(effects)):
         fit = family.fit(effects[: k + 1])
-        added = fit.result.rank - previous.result.rank
-        result = fit.result
-        dbic = delta_bic(
-            _rss(result), _rss(previous.result), added, result.n_obs, known, result.rank
-        )
-        steps.append(Step(effects[k].name, float(dbic), fit, []))
+        steps.append(Step(effects[k].name, _delta_bic(fit.result, previous.result), fit, []))
         previous = fit
     return steps

@@ -1,24 +1,24 @@
 """Gross outliers in a least-squares fit: a stated robust rule.
 
-Rule (one pass): for weighted residuals ``r`` (divided by sigma, or unit-weighted) of a fit with
-weighted Jacobian ``J``, the studentized residual of observation i is
-``t_i = r_i / (s sqrt(1 - h_i))``, with ``h_i`` the leverage (the diagonal of the hat matrix of
-``J``) and ``s = 1.4826 median(|r_j| / sqrt(1 - h_j))`` a robust scale (the median absolute value,
-which a few gross errors cannot inflate, and which a real unmodelled effect does inflate, so that
-its points are not taken for outliers). Observation i is an outlier when ``|t_i| > z``, with
-``z`` the two-sided normal quantile at ``alpha / m`` for m observations (Bonferroni: on clean data
-the chance of flagging any observation is about ``alpha``). With groups of observations (kinds of
-measurement), ``s`` of a group is the larger of its own and the pooled one. The caller iterates:
-leaves the outliers out, refits, and applies the rule again until nothing new is flagged, and
-refuses to call more than ``MAX_OUTLIER_FRACTION`` of the data outliers (then the model or the
-noise is wrong).
+One pass: for weighted residuals ``r`` of a fit with weighted Jacobian ``J``, the studentized
+residual is ``t_i = r_i / (s sqrt(1 - h_i))``, ``h_i`` the leverage and ``s = 1.4826
+median(|r_j| / sqrt(1 - h_j))`` a robust scale (a few gross errors cannot inflate it; a real
+unmodelled effect does, so its points are not taken for outliers). Observation i is an outlier
+when ``|t_i| > z``, the two-sided normal quantile at ``alpha / m`` (Bonferroni: on clean data the
+chance of flagging any is about ``alpha``). A group's ``s`` is the larger of its own and the
+pooled one. Iterated (:func:`screen_cells`): left out, refitted, tested again; never more than
+``MAX_OUTLIER_FRACTION`` of the data (then the model or the noise is wrong).
 """
+# scipy.special is imported inside functions: the package's import stays light
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
+
+from ..core.exceptions import IdentifiabilityError
+from .structure_search import orthonormal_columns
 
 __all__ = [
     "MAX_OUTLIER_FRACTION",
@@ -45,14 +45,8 @@ _MAD_TO_SIGMA = 1.4826  # 1 / Phi^-1(3/4): the MAD of a normal sample estimates 
 
 @dataclass(frozen=True)
 class OutlierTest:
-    """One pass of the rule.
-
-    Attributes:
-        studentized: ``|t_i|`` of every observation (robust scale), (m,).
-        scale: the robust scale ``s`` (in units of the weighted residuals).
-        threshold: ``z``.
-        flagged: indices with ``|t_i| > z``, worst first.
-    """
+    """One pass of the rule: ``|t_i|`` of every observation (``studentized``, (m,)), the robust
+    ``scale`` s, the ``threshold`` z and the indices ``flagged`` (``|t_i| > z``, worst first)."""
 
     studentized: np.ndarray
     scale: float
@@ -62,7 +56,7 @@ class OutlierTest:
 
 def outlier_threshold(m: int, alpha: float = OUTLIER_ALPHA) -> float:
     """The Bonferroni threshold ``z`` for m observations: ``P(|N(0,1)| > z) = alpha / m``."""
-    from scipy import special  # not scipy.stats: its import alone takes about half a second
+    from scipy import special  # not scipy.stats: half a second to import
 
     return float(-special.ndtri(alpha / (2.0 * max(m, 1))))
 
@@ -72,8 +66,6 @@ def leverages(jacobian_weighted: np.ndarray) -> np.ndarray:
     j = np.asarray(jacobian_weighted, dtype=float)
     if j.size == 0:
         return np.zeros(j.shape[0])
-    from .structure_search import orthonormal_columns
-
     norms = np.linalg.norm(j, axis=0)
     u = orthonormal_columns(j[:, norms > 0] / norms[norms > 0])
     return np.clip(np.sum(u * u, axis=1), 0.0, 1.0)
@@ -85,14 +77,10 @@ def screen_outliers(
     alpha: float = OUTLIER_ALPHA,
     groups: np.ndarray | None = None,
 ) -> OutlierTest:
-    """One pass of the rule of the module docstring on the observations given.
-
-    ``groups`` (m,) labels observations that share a noise level (e.g. the same kind of
-    measurement): a group's scale is then the larger of its own and the pooled one, so that a
-    group whose residuals an unmodelled effect or a larger noise widens does not have its points
-    taken for outliers, while a quiet group is not made more sensitive than the pool.
-    ``OutlierTest.scale`` is then the median of the scales.
-    """
+    """One pass of the rule (module docstring). ``groups`` (m,) labels observations sharing a
+    noise level: a group's scale is the larger of its own and the pooled one (a widened group's
+    points are not outliers; a quiet group is not made more sensitive than the pool), and
+    ``OutlierTest.scale`` the median of the scales."""
     r = np.asarray(weighted_residuals, dtype=float)
     h = leverages(jacobian_weighted)
     scaled = np.abs(r) / np.sqrt(np.clip(1.0 - h, 1e-12, None))
@@ -110,10 +98,8 @@ def screen_outliers(
 
 
 def outlier_rule_words(observations: str, group: str, pool: str, share: str) -> str:
-    """The iterated rule (:func:`screen_cells`, :func:`screened_diagnosis`) in words, from its
-    constants, for a family that names its ``observations`` (``m <observations>``), a noise
-    ``group`` and the ``pool`` of all groups (the robust scale of a group is the larger of
-    theirs) and the observations a ``share`` of which may be left out."""
+    """The iterated rule in words, from its constants, for a family's ``observations``, noise
+    ``group``, ``pool`` of all groups and the observations a ``share`` of which may go."""
     return (
         "studentized residual |t| = |r| / (s sqrt(1 - h)) above the two-sided normal quantile at "
         f"{OUTLIER_ALPHA:g} / m (m {observations}; h the leverage; s the robust scale "
@@ -130,22 +116,18 @@ MAX_SCREEN_ROUNDS = 20
 
 def screen_cells(fit_without, observed: np.ndarray, what: str) -> tuple[np.ndarray, str | None]:
     """The iterated rule over a table of observations: the cells left out as gross outliers, and
-    a note (in words, ``what`` naming the observations) when the rule would leave out more than
-    :data:`MAX_OUTLIER_FRACTION` of them (then none is left out).
+    a note (``what`` naming the observations) when it would leave out more than
+    :data:`MAX_OUTLIER_FRACTION` (then none is).
 
     Args:
-        fit_without: ``flagged (R, K) bool -> FitResult`` of the model fitted without the cells
-            ``flagged`` (its observations the cells ``observed & ~flagged``, record-major); an
-            ``IdentifiabilityError`` there ends the rule with no outlier.
+        fit_without: ``flagged (R, K) bool -> FitResult`` without the cells ``flagged`` (record-
+            major); an ``IdentifiabilityError`` there ends the rule with no outlier.
         observed: (R, K) the cells that hold an observation; a column is a noise group.
         what: the observations in words (``measured angles``, ``outputs``).
 
-    Each round fits, tests every observation (:func:`screen_outliers`, the columns as noise
-    groups) and leaves out the clearly worst ones only (at least half the largest ``|t|``)
-    before refitting: a gross outlier pulls the fit and makes its neighbours look bad too
-    (swamping), which the refit undoes.
+    Each round leaves out only the clearly worst (at least half the largest ``|t|``) before
+    refitting: a gross outlier makes its neighbours look bad too (swamping).
     """
-    from ..core.exceptions import IdentifiabilityError
 
     observed = np.asarray(observed, bool)
     flagged = np.zeros(observed.shape, bool)
@@ -157,7 +139,7 @@ def screen_cells(fit_without, observed: np.ndarray, what: str) -> tuple[np.ndarr
             return np.zeros_like(flagged), None
         live = observed & ~flagged
         groups = np.broadcast_to(np.arange(observed.shape[1]), observed.shape)[live]
-        # The leverages need the span of the Jacobian only: its determined part is enough.
+        # The leverages need the span only: the determined part is enough.
         span = result.jacobian_weighted @ result.identifiability.basis
         test = screen_outliers(result.residuals * result.weights, span, groups=groups)
         if not test.flagged.size:
@@ -174,16 +156,14 @@ def screen_cells(fit_without, observed: np.ndarray, what: str) -> tuple[np.ndarr
 
 
 def screened_diagnosis(diagnose_without, screen, records, rule: str):
-    """A diagnosis with gross outliers left out, in two passes: screened under the base model,
-    diagnosed without those cells, then screened again under the model with the accepted
-    effects (points of a real effect the base could not follow are not outliers, and an outlier
-    the effects' fit shows up is) and diagnosed again when the cells changed.
+    """A diagnosis with gross outliers left out in two passes: screened under the base model and
+    diagnosed, then screened under the accepted effects (a real effect's points are no outliers;
+    an outlier their fit shows up is) and diagnosed again if the cells changed.
 
     Args:
         diagnose_without: ``cells -> Diagnosis`` without the cells ``cells`` (a bool table).
-        screen: ``(effects, first) -> (cells, note)``: the iterated rule under base +
-            ``effects`` (:func:`screen_cells`); ``first`` is the fit of that model on all the
-            data when it is at hand, else ``None``.
+        screen: ``(effects, first) -> (cells, note)``, :func:`screen_cells` under base +
+            ``effects``; ``first``: that model's fit on all the data when at hand, else None.
         records: ``(diagnosis, cells) -> list`` of the outliers as the caller reports them.
         rule: the rule in words (``Diagnosis.outlier_rule``).
     """
@@ -206,9 +186,8 @@ def screened_diagnosis(diagnose_without, screen, records, rule: str):
 
 
 def column_variances(residuals: np.ndarray, dof: float, n_obs: int):
-    """``(variance, counts, degrees of freedom)`` of each column of a residual table (R, K), NaN
-    where a cell holds no observation: each column's sum of squares over its share of the fit's
-    ``dof`` (shared out by the columns' counts of the ``n_obs`` observations)."""
+    """``(variance, counts, dof)`` of each column of a residual table (R, K) (NaN: no
+    observation): its sum of squares over its share of the fit's ``dof`` by its count."""
     counts = np.sum(np.isfinite(residuals), axis=0)
     column_dof = counts * (dof / max(n_obs, 1))
     return np.nansum(residuals**2, axis=0) / np.maximum(column_dof, 1.0), counts, column_dof
@@ -219,9 +198,8 @@ MIN_NOISE_COUNT = 10
 
 
 def variances_differ(variance, counts, dof, alpha: float) -> tuple[bool, list[int]]:
-    """Whether the columns' noise differ: a two-sided F test of every pair of the columns with at
-    least :data:`MIN_NOISE_COUNT` observations, at ``alpha`` over the pairs (Bonferroni); and
-    those columns (fewer than two: never)."""
+    """Whether the columns' noise differ (two-sided F test of every pair of columns with at least
+    :data:`MIN_NOISE_COUNT` observations, Bonferroni ``alpha``), and those columns."""
     from scipy import special
 
     present = [a for a in range(len(counts)) if counts[a] >= MIN_NOISE_COUNT]

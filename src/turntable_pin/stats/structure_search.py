@@ -1,21 +1,16 @@
 """A generic search for structure left in fit residuals: which shape is still missing.
 
-Telescope pointing analysts, when their physical terms do not suffice, search harmonic terms in
-either axis angle to name the *shape* of what is missing. This module does that for any fit: the
-model family supplies *probes* (groups of columns, each a candidate shape such as "a 3/rev
-harmonic of one model parameter in one input variable"), and a greedy forward search adds the
-probe that removes most of the weighted residual sum of squares, *after* projecting out what the
-fitted model can already absorb, while it lowers BIC by at least ``-BIC_THRESHOLD + 2 ln G`` for
-G probes: searching G shapes at once is G chances of a false alarm, and ``2 ln G`` is the
-likelihood-scale form of a Bonferroni correction (on clean data of 432 observations with about
-130 probes, the chance of any false term falls from about 1.5 % to about 0.01 %, while a term of
-3 sigma amplitude lowers chi2 by several hundred).
+As telescope pointing analysts search harmonic terms when their physical terms do not suffice,
+the model family supplies *probes* (groups of columns, each a candidate shape, e.g. a 3/rev
+harmonic of one parameter in one input), and a greedy forward search adds the probe that removes
+most of the weighted rss *after* projecting out what the model absorbs, while it lowers BIC by at
+least ``-BIC_THRESHOLD + 2 ln G`` for G probes: ``2 ln G`` is a Bonferroni correction on the
+likelihood scale (432 clean observations, ~130 probes: the chance of any false term falls from
+~1.5 % to ~0.01 %, while a 3-sigma term lowers chi2 by several hundred).
 
-Each found term keeps, outside its JSON form, what a plot of it needs: its fitted contribution
-and its partial residual per observation and, when the probe says how its columns factor record
-by record (:class:`ProbeFactors`: a direction times functions of one variable), the residual
-projected record by record onto that direction, against that variable
-(:meth:`FoundTerm.projection`).
+Each found term keeps what a plot of it needs: its fitted contribution and partial residual and,
+when the probe factors record by record (:class:`ProbeFactors`), the residual projected onto its
+direction against its variable (:meth:`FoundTerm.projection`).
 """
 
 from __future__ import annotations
@@ -43,42 +38,29 @@ __all__ = [
 ]
 
 BIC_THRESHOLD = -6.0
-"""A term is accepted when it lowers BIC by at least 6 (strong evidence on the Kass-Raftery
-scale; the acceptance rule of telescope-pointing practice)."""
+"""A term is accepted when it lowers BIC by at least 6 (strong evidence, Kass-Raftery)."""
 
 NEW_FRACTION = 1e-2
-"""A probe direction counts as new only if more than this fraction of it (relative to the probe's
-own largest singular value) survives projecting out the model and the terms already found. Shapes
-the model spans to first order leave only second-order remainders (of the relative size of the
-fitted parameters, 1e-5..1e-3); fitting one of those to the residuals gave absurd amplitudes
-(1e5 times the noise)."""
+"""A probe direction is new only if more than this fraction of it (of the probe's largest singular
+value) survives projecting out the model and the terms found: shapes the model spans to first
+order leave second-order remainders (1e-5..1e-3), whose fits gave absurd amplitudes."""
 
 
 @dataclass(frozen=True)
 class ProbeFactors:
-    """How a probe's columns factor record by record: a direction times functions of a variable.
-
-    For data of n records of k observations each (m = n k, record-major), the probe's columns are
-    ``columns[i k + c, j] = direction[i, c] * functions(values)[i, j]``: at record i the shape
-    enters the observations along ``direction[i]`` with the size ``functions(values[i]) @ coef``.
-    This lets a plot show one number per record against the variable (see
-    :meth:`FoundTerm.projection`).
+    """How a probe's columns factor record by record: a direction times functions of a variable,
+    ``columns[i k + c, j] = direction[i, c] * functions(values)[i, j]`` for n records of k
+    observations (record-major). Probes sharing one ``direction`` object are scored together
+    (:func:`_scored_factored`).
 
     Attributes:
         variable: name of the variable the shape is a function of.
         values: (n,) that variable per record, in internal units.
         functions: maps values (p,) to the g basis functions (p, g) (any values, for a curve).
-        direction: (n, k) weighted like the residuals, or a function without arguments that
-            returns it.
-        value_scale: user units per internal unit of ``values`` (for the plot's axis).
-        value_unit: the user unit of ``values``.
-        observed: (n, k) which observations the data hold (``None``: all); the residuals and
-            columns list only these.
-        basis: ``functions(values)`` (n, g) when already computed (probes of one shape share it).
-
-    Probes whose factors share one ``direction`` object are scored together by the search: the
-    model's basis is contracted with that direction once, record by record, and each probe then
-    costs a product with its ``(n, g)`` functions only (:func:`_scored_factored`).
+        direction: (n, k) weighted like the residuals, or a function returning it.
+        value_scale, value_unit: user units per internal unit of ``values``, and that unit.
+        observed: (n, k) which observations the data hold (``None``: all).
+        basis: ``functions(values)`` (n, g) when already computed (shared by a shape's probes).
     """
 
     variable: str
@@ -91,12 +73,12 @@ class ProbeFactors:
     basis: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def direction_matrix(self) -> np.ndarray:
-        """The (n, k) direction (computed now when it was given as a function)."""
+        """The (n, k) direction."""
         d = self.direction() if callable(self.direction) else self.direction
         return np.asarray(d, dtype=float)
 
     def basis_matrix(self) -> np.ndarray:
-        """``functions(values)`` as an (n, g) matrix (the given ``basis`` when there is one)."""
+        """``functions(values)`` as an (n, g) matrix."""
         b = self.basis if self.basis is not None else self.functions(np.asarray(self.values))
         b = np.asarray(b, dtype=float)
         return b.reshape(b.shape[0], -1)
@@ -107,18 +89,13 @@ class Probe:
     """One candidate shape: weighted columns (m, g) and how to describe them.
 
     Attributes:
-        name: short id (``a 3/rev in x``).
-        description: for people.
-        columns: (m, g) weighted like the residuals (divided by sigma), or a function without
-            arguments that returns them: the search then holds one probe's columns at a time,
-            so its memory stays that of a few columns however many probes there are.
-        unit_scale: user units per internal unit of the probe's coefficients (for amplitudes).
-        unit: the user unit of the coefficients.
-        factors: how the columns factor per record (optional: lets the report plot a found
-            term against its variable, and the search score the probe without forming its
-            columns, which it then forms only for a probe it accepts).
-        effect_spec: how the model family's users add this shape to their model (a text the
-            family defines), or ``None``.
+        name: short id (``a 3/rev in x``); description: for people.
+        columns: (m, g) weighted like the residuals, or a function returning them (the search
+            then holds one probe's columns at a time).
+        unit_scale, unit: user units per internal unit of the coefficients, and that unit.
+        factors: how the columns factor per record (optional: a plot against the variable, and
+            scoring without forming the columns).
+        effect_spec: how the family's users add this shape to their model, or ``None``.
     """
 
     name: str
@@ -130,23 +107,20 @@ class Probe:
     effect_spec: str | None = None
 
     def matrix(self) -> np.ndarray:
-        """The (m, g) columns (computed now when they were given as a function)."""
+        """The (m, g) columns."""
         return np.asarray(self.columns() if callable(self.columns) else self.columns, dtype=float)
 
 
 @dataclass(frozen=True)
 class TermProjection:
-    """A found term seen record by record, in the user units of its coefficients.
+    """A found term seen record by record, in user units.
 
     Attributes:
-        variable: name of the variable the term is a function of.
-        values: (n,) that variable per record, in user units (``value_unit``).
-        value_unit: the unit of ``values``.
-        projected: (n,) the partial residual (the residual left by the model with every found
-            term, plus this term's fitted contribution) projected at each record onto the
-            direction the term enters the observations along: a noisy sample of the term.
-        noise: (n,) 1-sigma noise of each ``projected`` value.
-        fitted: (n,) the fitted term at each record.
+        variable: the variable the term is a function of; values: (n,) it per record, in
+            ``value_unit``.
+        projected: (n,) the partial residual (with every found term, plus this one's fit)
+            projected at each record onto the term's direction: a noisy sample of the term.
+        noise: (n,) 1-sigma noise of ``projected``; fitted: (n,) the fitted term.
         unit: the user unit of ``projected``, ``noise`` and ``fitted``.
     """
 
@@ -163,13 +137,11 @@ class TermProjection:
 class FoundTerm:
     """A probe accepted by the search, with its fitted size.
 
-    The fields after ``coefficients`` are kept for plots and left out of :meth:`to_dict`:
-    ``fitted_weighted`` (m,) is the term's fitted contribution to the weighted observations (the
-    probe's columns times its coefficients); ``residual_weighted`` (m,) the weighted residual
-    left by the model with every found term, plus ``fitted_weighted`` (the partial residual of
-    this term); ``explained_weighted`` (m,) the part of the weighted residual explained by the
-    probe's columns after projecting out the model and the terms found before it;
-    ``noise_std_weighted`` the noise of one weighted observation (1 when sigmas are given).
+    Kept for plots, not in :meth:`to_dict`: ``fitted_weighted`` (m,) the term's contribution to
+    the weighted observations; ``residual_weighted`` its partial residual (the residual with
+    every found term, plus ``fitted_weighted``); ``explained_weighted`` what its columns explain
+    beyond the model and the terms found before; ``noise_std_weighted`` one weighted
+    observation's noise (1 with sigmas).
     """
 
     name: str
@@ -187,11 +159,8 @@ class FoundTerm:
     effect_spec: str | None = None
 
     def curve(self, values: np.ndarray) -> np.ndarray:
-        """The fitted term at ``values`` of its variable (internal units), in user units.
-
-        Raises:
-            ValueError: the probe did not say how its columns factor (no ``factors``).
-        """
+        """The fitted term at ``values`` of its variable (internal units), in user units
+        (ValueError without ``factors``)."""
         if self.factors is None:
             raise ValueError(f"term '{self.name}' has no factors: it cannot be drawn as a curve")
         values = np.atleast_1d(np.asarray(values, dtype=float))
@@ -199,12 +168,9 @@ class FoundTerm:
         return basis.reshape(values.size, -1) @ np.asarray(self.coefficients)
 
     def projection(self) -> TermProjection:
-        """The term record by record: partial residual on its direction, noise, fitted value.
-
-        At record i with direction d_i (weighted), the projected value is ``d_i . p_i / |d_i|^2``
-        of the partial residual p_i (scaled to user units): the least-squares size of the term
-        that record alone sees, whose noise is ``noise_std_weighted / |d_i|``. Records the term
-        does not reach (d_i = 0) give NaN.
+        """The term record by record: at record i with direction d_i, ``d_i . p_i / |d_i|^2`` of
+        the partial residual p_i (the size that record alone sees; noise
+        ``noise_std_weighted / |d_i|``); NaN where d_i = 0.
 
         Raises:
             ValueError: the search kept no per-observation data or the probe had no factors.
@@ -251,37 +217,24 @@ class FoundTerm:
 
 
 def profiled_weight(m: int, rank_new: int, added: int) -> float:
-    """The weight ``w`` of ``ln(rss_old / rss_new)`` that makes the likelihood ratio of two nested
-    least-squares models with the noise variance estimated (profiled out) follow its chi2
-    reference on small samples: ``w = m - rank_new + added / 2 - 1``.
+    """The weight ``w = m - rank_new + added / 2 - 1`` of ``ln(rss_old / rss_new)`` that makes the
+    profiled likelihood ratio of two nested models follow its chi2 reference on small samples.
 
-    The textbook profiled ratio weighs with ``m``, and overstates the evidence when ``m`` is a
-    few times the number of parameters: for ``m = 72``, ten parameters and two added, a chance
-    improvement with an exact (F test) tail probability of 1e-4 scores 21.5 instead of 18.4.
-    With the residual degrees of freedom of the larger model the ratio is the F test exactly for
-    two added parameters (the F tail is then ``(rss_new / rss_old) ** ((m - rank_new) / 2)``, the
-    chi2(2) tail ``exp(-x / 2)``); the ``added / 2 - 1`` term (a Bartlett-type correction) keeps
-    the tail probability within 10 % of the F test's for up to eight added parameters once
-    ``m - rank_new >= 60`` (tests check it against scipy's F and chi2 distributions).
+    The textbook weight ``m`` overstates the evidence when ``m`` is a few times the parameters
+    (m = 72, ten parameters, two added: an F-tail 1e-4 improvement scores 21.5, not 18.4). With
+    the larger model's residual dof the ratio is the F test exactly for two added parameters; the
+    ``added / 2 - 1`` (Bartlett-type) term keeps the tail within 10 % of the F test's for up to
+    eight added once ``m - rank_new >= 60`` (tests check it against scipy).
     """
     return max(m - rank_new + added / 2.0 - 1.0, 1.0)
 
 
 def delta_bic(
-    rss_new: float,
-    rss_old: float,
-    added: int,
-    m: int,
-    noise_variance: float | None,
-    rank_new: int,
+    rss_new: float, rss_old: float, added: int, m: int, noise_variance: float | None, rank_new: int
 ):
-    """BIC change of a model that lowers the weighted rss by adding ``added`` parameters.
-
-    With a known noise variance (sigmas given): ``(rss_new - rss_old) / var + added ln m``.
-    Unknown: the Gaussian likelihood with the variance profiled out,
-    ``w ln(rss_new / rss_old) + added ln m``, ``w`` the small-sample weight of
-    :func:`profiled_weight` (``m`` minus the larger model's ``rank_new``, plus ``added / 2 - 1``).
-    """
+    """BIC change of a model adding ``added`` parameters: ``(rss_new - rss_old) / var + added
+    ln m`` with a known noise variance, else ``w ln(rss_new / rss_old) + added ln m`` (the
+    variance profiled out, ``w`` of :func:`profiled_weight`)."""
     if noise_variance is not None:
         return (rss_new - rss_old) / noise_variance + added * math.log(m)
     ratio = max(rss_new, 1e-300) / max(rss_old, 1e-300)
@@ -297,9 +250,8 @@ def orthonormal_columns(matrix: np.ndarray) -> np.ndarray:
     if m <= 2 * TALL_ROWS or m < 8 * n:
         u, s, _ = np.linalg.svd(matrix, full_matrices=False)
         return u[:, s > 1e-9 * (s[0] if s.size else 1.0)]
-    # Long and thin: the right singular vectors from the small R factor, U = A V / s, then
-    # made orthonormal once more against the rounding of the directions with small s (in place,
-    # block by block of rows: no third tall matrix).
+    # Long and thin: U = A V / s from the small R factor, made orthonormal once more against the
+    # rounding of small s (in place, by blocks of rows).
     _, s, vt = np.linalg.svd(tall_r_factor(matrix))
     keep = s > 1e-9 * (s[0] if s.size else 1.0)
     u = tall_times(matrix, vt[keep].T / s[keep])
@@ -312,18 +264,14 @@ def orthonormal_columns(matrix: np.ndarray) -> np.ndarray:
 
 
 BATCH_VALUES = 1 << 21
-"""Probe columns scored together hold at most about this many values (16 MB): one pass over
-the model's basis and the residuals serves the whole batch."""
+"""Probe columns scored together hold at most about this many values (16 MB)."""
 
 
 def _probe_fit(gram: np.ndarray, qc: np.ndarray, cr: np.ndarray, qr_: np.ndarray):
-    """What a probe's columns C (m, g) add beyond the span of ``q`` (m, k) to explain ``r``.
-
-    Works on small matrices only: ``gram = C^T C``, ``qc = q^T C``, ``cr = C^T r``,
-    ``qr_ = q^T r``. With ``t = C - q q^T C`` (the part ``q`` does not span),
-    ``t^T t = C^T C - (q^T C)^T (q^T C)`` and ``t^T r = C^T r - (q^T C)^T (q^T r)``; the
-    eigen-decomposition ``t^T t = V S^2 V^T`` gives the singular values of ``t`` and, for the
-    kept directions, ``U = t V / S``.
+    """What a probe's columns C (m, g) add beyond the span of ``q`` (m, k) to explain ``r``,
+    from small matrices only: ``gram = C^T C``, ``qc = q^T C``, ``cr = C^T r``, ``qr_ = q^T r``.
+    With ``t = C - q q^T C``, ``t^T t = gram - qc^T qc``, ``t^T r = cr - qc^T qr_``, and
+    ``t^T t = V S^2 V^T`` (``U = t V / S`` for the kept directions).
 
     Returns:
         ``(reduction, V kept (g, k), S kept, S U^T r)`` or None when no direction is new.
@@ -343,9 +291,8 @@ def _probe_fit(gram: np.ndarray, qc: np.ndarray, cr: np.ndarray, qr_: np.ndarray
 
 
 def _scored(probes: Sequence[Probe], q: np.ndarray, r: np.ndarray):
-    """``(probe, _probe_fit result)`` for each probe, in the order of ``probes``: those with
-    factors from their factors (:func:`_scored_factored`), the others from their columns taken
-    in batches (:func:`_scored_columns`)."""
+    """``(probe, _probe_fit result)`` for each probe, in order: from their factors when they
+    have them, else from their columns in batches."""
     m = r.size
     qr_ = q.T @ r
     factored = [p for p in probes if _factorable(p, m)]
@@ -370,8 +317,7 @@ def _factorable(probe: Probe, m: int) -> bool:
 
 
 def _by_observation(q: np.ndarray, r: np.ndarray, n: int, k: int, observed) -> np.ndarray:
-    """``[q r]`` laid out as (k, K + 1, n): for each of a record's k observations, the model's
-    basis and the residual at every record (zero where not observed)."""
+    """``[q r]`` laid out as (k, K + 1, n) by observation of a record (zero where not observed)."""
     out = np.zeros((k, q.shape[1] + 1, n))
     if observed is None:
         for c in range(k):
@@ -388,15 +334,10 @@ def _by_observation(q: np.ndarray, r: np.ndarray, n: int, k: int, observed) -> n
 
 
 def _scored_factored(probes: Sequence[Probe], q: np.ndarray, r: np.ndarray, qr_: np.ndarray):
-    """``(id(probe), _probe_fit result)`` of probes whose columns are ``direction[i, c] *
-    basis[i, j]`` at observation ``i k + c`` (:class:`ProbeFactors`), without forming them.
-
-    With the model's basis ``q`` and the residuals ``r`` laid out by observation,
-    ``Q[c, :, i]``, the products are ``[q r]^T C = (sum_c Q[c] direction[:, c]) @ basis`` and the
-    Gram matrix is ``basis^T (|direction|^2 basis)``: the contraction with a direction is done
-    once for all the probes that share that direction object, and each probe then costs one
-    (K + 1, n) by (n, g) product.
-    """
+    """``(id(probe), _probe_fit result)`` of factored probes without forming their columns:
+    with ``[q r]`` laid out by observation, ``Q[c, :, i]``, ``[q r]^T C = (sum_c Q[c]
+    direction[:, c]) @ basis`` and the Gram matrix is ``basis^T (|direction|^2 basis)``; the
+    contraction is done once per shared direction object."""
     by_direction: dict[int, list[Probe]] = {}
     for probe in probes:
         by_direction.setdefault(id(probe.factors.direction), []).append(probe)
@@ -465,17 +406,13 @@ def search_structure(
     noise_variance: float | None,
     max_terms: int = 5,
 ) -> list[FoundTerm]:
-    """Greedy forward search of probes that explain residual structure.
-
-    Each probe is scored from small matrices (its Gram matrix and its products with the model's
-    orthonormal basis and the residuals, :func:`_probe_fit`), probes in batches of columns: no
-    decomposition of a tall matrix per probe; only an accepted probe's new directions are
-    formed.
+    """Greedy forward search of probes that explain residual structure, each scored from small
+    matrices (:func:`_probe_fit`); only an accepted probe's new directions are formed.
 
     Args:
         weighted_residuals: (m,) residuals divided by sigma (unit weights if sigma unknown).
-        model_jacobian_weighted: (m, n) the fitted model's weighted Jacobian (its span is
-            projected out of every probe: what the model absorbs is not structure).
+        model_jacobian_weighted: (m, n) the fitted model's weighted Jacobian (its span, what the
+            model absorbs, is projected out of every probe).
         probes: candidate shapes.
         noise_variance: 1 when sigmas are known; ``None`` to profile the variance out.
         max_terms: most terms to add.

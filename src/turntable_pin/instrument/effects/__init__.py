@@ -1,16 +1,13 @@
 """Candidate effects of a calibration run, on the table's side and on the instrument's.
 
-- table side (:mod:`.table_side`): each base error of the table (``table:<error>``) and each
-  effect of its orientation catalogue (``table:<effect>``), through eqs. 8-13;
-- instrument side: :mod:`.mount` (``instrument_tilt``, ``instrument_heading``),
-  :mod:`.bias_drift` (``bias_drift``), :mod:`.temperature` (``temperature_coefficient``),
-  :mod:`.earth_rate_scale` (``earth_rate_scale``), :mod:`.g_squared` (``g_squared_terms``);
-- :mod:`.output_terms`: inline terms on an output (``out_x~h2(phi1)``), what the structure
-  search names.
+- table side (:mod:`.table_side`): each base error (``table:<error>``) and orientation effect
+  (``table:<effect>``) of the table, through eqs. 8-13 (not ``payload_mount``: the instrument's
+  tilt and heading are the same rotation);
+- instrument side: :mod:`.mount`, :mod:`.bias_drift`, :mod:`.temperature`,
+  :mod:`.earth_rate_scale`, :mod:`.g_squared`;
+- :mod:`.output_terms`: inline terms on an output (``out_x~h2(phi1)``).
 
-The table's own ``payload_mount`` is the instrument's tilt and heading seen from the table (the
-same rotation in the payload frame), so it is left out of the table side. A user's effect
-is a :class:`~.base.RunEffect` subclass passed in the catalogue.
+A user's effect is a :class:`~.base.RunEffect` subclass passed in the catalogue.
 """
 
 from __future__ import annotations
@@ -18,11 +15,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ...core.exceptions import InputError
+from ...measurement.catalogue import catalogue
+from ...measurement.table import measured_table
 from .base import INSTRUMENT, TABLE, RunContext, RunEffect
 from .bias_drift import BiasDrift
 from .earth_rate_scale import EarthRateScale
 from .g_squared import GSquaredTerms
 from .mount import InstrumentHeading, InstrumentTilt
+from .output_terms import run_term
 from .table_side import PREFIX, TableEffect, TableError
 from .temperature import TemperatureCoefficient
 
@@ -53,9 +53,6 @@ _LEFT_OUT_KINDS = ("payload_mount",)
 def run_catalogue(table=None) -> tuple[RunEffect, ...]:
     """The candidate effects of a run on ``table`` (module docstring): the table side first,
     then the instrument's."""
-    from ...measurement.catalogue import catalogue
-    from ...measurement.table import measured_table
-
     measured = measured_table(table)
     out: list[RunEffect] = [TableError(measured, name) for name in measured.base_names]
     out += [
@@ -71,9 +68,6 @@ def resolve_run_effects(names: Sequence[str], table=None, extra=()) -> list[RunE
     """The effects called ``names`` in the run catalogue of ``table`` (plus ``extra``, the
     user's); a table effect may be named without its ``table:`` prefix; an inline term
     (``out_x~h2(phi1)``, ``dpsi~h1(phi2)``) is :func:`~.output_terms.run_term`'s."""
-    from ...measurement.table import measured_table
-    from .output_terms import run_term
-
     known = {e.name: e for e in (*run_catalogue(table), *extra)}
     out = []
     for name in names:

@@ -1,21 +1,14 @@
 """The contract of a :class:`~.base.RunEffect` plug-in, checked once where the user's effect
-enters.
-
-A run effect the user writes (a class of a Python module given to ``--effects-module``, an object
-passed from Python) must give, on a run of N positions:
+enters (a class of an effects module, or an object passed from Python). On a run of N positions:
 
 - its story as text (``name``, ``title``, ``definition``, ``explanation``, ``confirm``), its
   ``side`` (``"table"`` or ``"instrument"``) and its ``required_columns`` as a tuple of names;
-- ``parameters(run)``: a tuple of at least one
-  :class:`~turntable_pin.measurement.effects.base.ParameterSpec`, names unique, ``per_user_unit``
-  a finite number > 0;
-- ``columns(context)``: ``d(out_x, out_y)/d(parameter)``, an array of finite numbers of shape
-  (N, 2, p), p the number of its parameters.
+- ``parameters(run)``: a tuple of at least one ``ParameterSpec``, names unique,
+  ``per_user_unit`` a finite number > 0;
+- ``columns(context)``: ``d(out_x, out_y)/d(parameter)``, finite numbers of shape (N, 2, p).
 
-:func:`check_run_effect` calls the methods (through
-:func:`~turntable_pin.core.user_code.call_user`) and raises a one-line
-:class:`~turntable_pin.core.exceptions.UserCodeError` naming the file, the effect, the method,
-what it returned and what was expected.
+:func:`check_run_effect` calls them (``core.user_code.call_user``) and raises a one-line
+``UserCodeError`` naming the file, the effect, the method, what it returned and what was expected.
 """
 
 from __future__ import annotations
@@ -41,12 +34,10 @@ def check_run_effect(
     effect, context: RunContext, *, on: str | None = None
 ) -> tuple[tuple[ParameterSpec, ...], np.ndarray]:
     """``(parameters, columns)`` of the user's run ``effect`` in ``context``, each checked
-    against the contract (module docstring); ``on`` is how the message names the run (default:
-    ``the run (N positions)``).
+    against the contract (module docstring); ``on`` names the run in messages.
 
     Raises:
-        UserCodeError: a method raised, or returned something the contract does not allow: one
-            line naming the file, the effect, the method, what it returned and what was expected.
+        UserCodeError: a method raised, or returned what the contract does not allow.
     """
     run = context.run
     n = run.n_positions
@@ -59,15 +50,9 @@ def check_run_effect(
     expected = (f"an array of shape ({n}, 2, {len(specs)}): d(out_x, out_y)/d(parameter) at each "
                 f"of the {n} positions for its {len(specs)} parameter(s)")  # fmt: skip
     array = numbers_returned(columns)
-    if array is None:
+    if array is None or array.shape != (n, 2, len(specs)):
         raise contract_error(
-            effect,
-            f"columns(context) returned {described(columns)} on {on}; expected {expected}",
-        )
-    if array.shape != (n, 2, len(specs)):
-        raise contract_error(
-            effect,
-            f"columns(context) returned {described(columns)} on {on}; expected {expected}",
+            effect, f"columns(context) returned {described(columns)} on {on}; expected {expected}"
         )
     array = array.astype(float)
     bad = ~np.isfinite(array)

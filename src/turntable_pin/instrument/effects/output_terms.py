@@ -3,7 +3,7 @@
 The same inline shapes as the orientation terms (:mod:`turntable_pin.measurement.effect_terms`:
 harmonics of a joint angle or of the sum or difference of two, a polynomial in a column, the sign
 of an approach direction), added to ``out_x`` or ``out_y`` in deg/h: what the structure search
-of a run names when no catalogued effect has the shape, and what ``calibrate --effects`` adds.
+of a run names when no catalogued effect has the shape, and what a calibration's ``effects`` add.
 A term on a table site (``dphi_z2~h3(phi2)``, ``dpsi~h1(phi2)``) is an orientation term and goes
 through the rate sensitivity (:class:`~.table_side.TableEffect`).
 """
@@ -14,7 +14,9 @@ import numpy as np
 
 from ...core.exceptions import InputError
 from ...measurement.effect_terms import parse_term
+from ...measurement.user_effects import inline_effect
 from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect
+from .table_side import TableEffect
 
 __all__ = ["OUTPUT_SITES", "OutputTerm", "run_term"]
 
@@ -66,9 +68,6 @@ class OutputTerm(RunEffect):
 def run_term(text: str, table) -> RunEffect:
     """The run effect of one inline term: on an output (:class:`OutputTerm`) or on the table's
     orientation (:class:`~.table_side.TableEffect` of the orientation term)."""
-    from ...measurement.user_effects import inline_effect
-    from .table_side import TableEffect
-
     if str(text).strip().split("~", 1)[0] in OUTPUT_SITES:
         return OutputTerm(text, table)
     return TableEffect(table, inline_effect(text, table))

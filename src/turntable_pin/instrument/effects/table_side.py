@@ -1,13 +1,10 @@
 """The table's errors and effects, as a calibration run sees them (eqs. 7-14).
 
-Any orientation error the table's URDF can carry (a base error of
-:class:`~turntable_pin.measurement.table.MeasuredTable`: an orthogonality, a wobble, a
-position error) and any effect of the table's orientation catalogue (encoder and wobble
-harmonics, gravity sag, base tilt...) moves the payload by ``(dpsi, dtheta, dgamma)`` at each
-position; the outputs change by the rate sensitivity times that (:mod:`..sensitivity`). The
-orientation derivatives come from the measurement layer's exact chain
-(:class:`~turntable_pin.measurement.effect_model.OrientationModel`), so every table the
-orientation diagnosis knows is known here, under the same names, prefixed ``table:``.
+A base error of the table (orthogonality, wobble, position) or an effect of its orientation
+catalogue moves the payload by ``(dpsi, dtheta, dgamma)``; the outputs change by the rate
+sensitivity times that. The orientation derivatives come from the measurement layer's exact chain
+(``OrientationModel``): every table the orientation diagnosis knows, under its names prefixed
+``table:``.
 """
 
 from __future__ import annotations
@@ -16,7 +13,7 @@ import numpy as np
 
 from ...measurement.effect_model import OrientationModel
 from ...measurement.effects.base import ARCSEC, Effect
-from .base import TABLE, ParameterSpec, RunContext, RunEffect
+from .base import TABLE, ParameterSpec, RunContext, RunEffect, run_variables
 
 __all__ = ["PREFIX", "TableEffect", "TableError", "TableErrors"]
 
@@ -111,14 +108,10 @@ class TableEffect(RunEffect):
 
     def missing_columns(self, run) -> tuple[str, ...]:
         """The run columns the orientation effect needs and ``run`` lacks."""
-        from ..model import run_variables
-
         return self.effect.missing_columns(run_variables(run))
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
         """This effect's parameters on ``run`` (their user units and scales)."""
-        from ..model import run_variables
-
         return tuple(self.effect.parameters(run_variables(run)))
 
     def columns(self, context: RunContext) -> np.ndarray:
