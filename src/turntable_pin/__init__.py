@@ -89,6 +89,7 @@ def _version() -> str:
     except metadata.PackageNotFoundError:  # a source tree on the path, not installed
         return "0+unknown"
 
+
 if TYPE_CHECKING:  # names for static checkers; nothing is imported at run time
     from .allocation.capability import ManufacturingCapability  # noqa: F401
     from .allocation.monte_carlo import MonteCarloResult, run_monte_carlo  # noqa: F401
