@@ -11,5 +11,6 @@ CLI_WORDS = CommandLineWords(
     "turntable-pin",
     {
         "from_data": "--from",
+        "turntable": "--urdf",
     },
 )
