@@ -36,7 +36,7 @@ def test_every_detectable_effect_is_named_and_its_fit_reaches_the_noise(name):
         for data in (sim.data, sim.data.without_sigma()):
             verdict = diagnose_measurements(data).to_dict()["verdict"]
             assert name == verdict["missing_effect"] or name in verdict["alternatives"], (
-                seed, data.has_sigma, verdict,
+                seed, data.sigma_rad is not None, verdict,
             )  # fmt: skip
             assert not verdict["unexplained"], (seed, verdict)
         fit = fit_orientation(sim.data, [EFFECTS[name]])

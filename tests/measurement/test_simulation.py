@@ -194,12 +194,17 @@ def test_the_existing_options_draw_the_same_numbers():
         "approach=random\n" in sim.comment()  # fmt: skip
 
 
+def test_a_sweep_of_an_axis_the_table_lacks_is_refused():
+    with pytest.raises(InputError, match="the table has no axis phi4"):
+        simulate_measurements(schedule=Schedule(sweep=("phi4",)))
+
+
 @pytest.mark.parametrize(
     ("kwargs", "fragment"),
     [
         ({"positions": ((0, 0),), "sweep": ("phi1",)}, "give one design of positions"),
         ({"random_positions": 5, "order": "random"}, "measured in their own order"),
-        ({"sweep": ("phi4",)}, "unknown axis 'phi4'"),
+        ({"sweep": ("theta1",)}, "unknown axis 'theta1'"),
         ({"sweep": ("phi1", "phi1")}, "swept twice"),
         ({"positions": ((0, 0),), "positions_time_s": (0,), "repeats": 2}, "give their times"),
         ({"positions": ((0, 0),), "positions_dirs": ((1,),), "passes": 1}, "passes set"),

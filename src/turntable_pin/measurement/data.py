@@ -54,6 +54,7 @@ __all__ = [
     "OPTIONAL_COLUMNS",
     "REQUIRED_COLUMNS",
     "OrientationMeasurements",
+    "check_times_and_directions",
     "read_measurements",
 ]
 
@@ -64,6 +65,7 @@ OPTIONAL_COLUMNS = ("sigma_arcsec", "time_s", "dir1", "dir2")
 also ``sigma_dpsi_arcsec, sigma_dtheta_arcsec, sigma_dgamma_arcsec`` (a sigma per angle) and
 ``dirK`` for joint K of a table with more axes."""
 _RESERVED = frozenset(("sigma_arcsec", "time_s"))
+_SIGMA_COLUMNS = tuple(f"sigma_{n}_arcsec" for n in ANGLE_NAMES)
 
 MAX_MEASURED_ANGLE_ARCSEC = MAX_ORIENTATION_ERROR_DEG * 3600.0
 """Largest ``|dpsi|, |dtheta|, |dgamma|`` of a row, arc seconds (30 deg,
@@ -185,15 +187,6 @@ class OrientationMeasurements:
             row = int(self.rows[np.flatnonzero(bad)[0]])
             raise InputError(f"{what} (row {row} of {self.source or 'the data'})")
 
-    @classmethod
-    def two_axis(
-        cls, phi1_rad, phi2_rad, angles_rad, sigma_rad=None, time_s=None, dir1=None, dir2=None,
-        rows=None, source: str = "",
-    ) -> OrientationMeasurements:  # fmt: skip
-        """Measurements of a two-axis table from its two angle arrays (the paper's layout)."""
-        joints = np.stack([np.reshape(phi1_rad, -1), np.reshape(phi2_rad, -1)], axis=1)
-        return cls(joints, angles_rad, sigma_rad, time_s, (dir1, dir2), {}, rows, source)
-
     @property
     def n_positions(self) -> int:
         """Number of positions N."""
@@ -228,11 +221,6 @@ class OrientationMeasurements:
     def measured(self) -> np.ndarray:
         """Which angles were measured, (N, 3) bool (an empty cell is ``False``)."""
         return np.isfinite(self.angles_rad)
-
-    @property
-    def has_sigma(self) -> bool:
-        """Whether the data give a 1-sigma noise per row."""
-        return self.sigma_rad is not None
 
     def variables(self) -> PositionVariables:
         """What effects may depend on at each position: one object while any model built on
@@ -293,17 +281,6 @@ class OrientationMeasurements:
         """The same data with the noise level left to be estimated from the fit."""
         return self.replace(sigma_rad=None, sigma_relative=False)
 
-    def select(self, keep) -> OrientationMeasurements:
-        """The rows where ``keep`` (a mask or index array over the rows) holds."""
-        keep = np.asarray(keep)
-        return self.replace(
-            joint_rad=self.joint_rad[keep], angles_rad=self.angles_rad[keep],
-            sigma_rad=None if self.sigma_rad is None else self.sigma_rad[keep],
-            time_s=None if self.time_s is None else self.time_s[keep],
-            dirs=tuple(None if d is None else d[keep] for d in self.dirs),
-            extra={k: v[keep] for k, v in self.extra.items()}, rows=self.rows[keep],
-        )  # fmt: skip
-
 
 def _looks_like_radians(values_deg: np.ndarray) -> str | None:
     """Why an angle column in degrees looks like radians, or ``None`` (rule: module docstring)."""
@@ -328,6 +305,22 @@ def _check_at_most(table, column: str, limit: float, rule: str) -> None:
     table.refuse(column, np.abs(table[column]) > limit, rule)
 
 
+def check_times_and_directions(table, dir_columns: Sequence[str]) -> None:
+    """Refuse a ``time_s`` below 0 or above :data:`MAX_TIME_S` and a ``dirK`` not +1 or -1 of
+    ``table`` (a ``CsvTable``), naming file, row and column."""
+    if table.has("time_s"):
+        table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
+        _check_at_most(
+            table, "time_s", MAX_TIME_S,
+            f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
+        )  # fmt: skip
+    for column in dir_columns:
+        if table.has(column):
+            table.refuse(
+                column, np.abs(table[column]) != 1, "an approach direction must be +1 or -1"
+            )
+
+
 def read_measurements(
     path: str | Path, joint_names: Sequence[str] | None = None
 ) -> OrientationMeasurements:
@@ -348,22 +341,46 @@ def read_measurements(
     )
     n_joints = len(joint_names) if joint_names else 2
     value_columns = tuple(f"{n}_arcsec" for n in ANGLE_NAMES)
-    sigma_columns = tuple(f"sigma_{n}_arcsec" for n in ANGLE_NAMES)
     dir_columns = tuple(f"dir{k}" for k in range(1, n_joints + 1))
     table = read_csv_table(
         path, (*joint_columns, *value_columns),
-        ("sigma_arcsec", *sigma_columns, "time_s", *dir_columns),
+        ("sigma_arcsec", *_SIGMA_COLUMNS, "time_s", *dir_columns),
         min_rows=1, blank=value_columns, extra=True,
     )  # fmt: skip
-    rows = table.rows
     check_commanded_angles(table, joint_columns)
+    values = _measured_angles(table, value_columns, joint_columns)
+    sigma = _sigma_arcsec(table)
+    check_times_and_directions(table, dir_columns)
+    refuse_repeated_rows(
+        table,
+        (*joint_columns, *dir_columns, "time_s"),
+        "repeats must differ in time_s or approach direction",
+    )
+    return OrientationMeasurements(
+        joint_rad=np.stack([table[c] for c in joint_columns], axis=1) / DEG_PER_RAD,
+        angles_rad=values / ARCSEC_PER_RAD,
+        sigma_rad=None if sigma is None else sigma / ARCSEC_PER_RAD,
+        time_s=table["time_s"] if table.has("time_s") else None,
+        dirs=tuple(table[c] if table.has(c) else None for c in dir_columns),
+        extra={k: v for k, v in table.extra.items() if k not in _RESERVED},
+        rows=table.rows,
+        source=str(table.path),
+        joint_names=tuple(joint_names or ()),
+        ignored_columns=table.skipped,
+    )
+
+
+def _measured_angles(table, value_columns, joint_columns) -> np.ndarray:
+    """The measured angles (N, 3) arcsec, NaN where empty: refused where a row measures none or
+    one is beyond :data:`MAX_MEASURED_ANGLE_ARCSEC`, and where a joint column looks like
+    radians."""
     values = np.stack([table[c] for c in value_columns], axis=1)
     none = np.flatnonzero(~np.isfinite(values).any(axis=1))
     if none.size:
         raise InputError(
             "none of dpsi_arcsec, dtheta_arcsec, dgamma_arcsec is given: a row needs at least "
             "one measured angle",
-            path=table.path, row=int(rows[none[0]]), column=value_columns[0],
+            path=table.path, row=int(table.rows[none[0]]), column=value_columns[0],
         )  # fmt: skip
     limit = MAX_MEASURED_ANGLE_ARCSEC
     for column in value_columns:
@@ -379,15 +396,23 @@ def read_measurements(
                 f"these angles look like radians, not degrees ({why}); convert the column to "
                 "degrees",
                 path=table.path,
-                row=int(rows[0]),
+                row=int(table.rows[0]),
                 column=column,
             )
-    if table.has("sigma_arcsec") and any(table.has(c) for c in sigma_columns):
+    return values
+
+
+def _sigma_arcsec(table) -> np.ndarray | None:
+    """The sigma of each measured angle (N, 3) arcsec from ``sigma_arcsec`` or the three
+    ``sigma_<angle>_arcsec``, checked to be in [:data:`MIN_SIGMA_ARCSEC`,
+    :data:`MAX_SIGMA_ARCSEC`]; ``None`` without them."""
+    per_angle = any(table.has(c) for c in _SIGMA_COLUMNS)
+    if table.has("sigma_arcsec") and per_angle:
         raise InputError(
             "give either sigma_arcsec or the per-angle sigma_<angle>_arcsec columns, not both",
             path=table.path, row=1, column="sigma_arcsec",
         )  # fmt: skip
-    for column in ("sigma_arcsec", *sigma_columns):
+    for column in ("sigma_arcsec", *_SIGMA_COLUMNS):
         if not table.has(column):
             continue
         table.refuse(column, table[column] <= 0, "sigma must be > 0")
@@ -399,42 +424,14 @@ def read_measurements(
             table, column, MAX_SIGMA_ARCSEC,
             f"sigma must be at most {MAX_SIGMA_ARCSEC:g} arcsec ({MAX_ANGULAR_ERROR_DEG:g} deg)",
         )  # fmt: skip
-    sigma = None
     if table.has("sigma_arcsec"):
-        sigma = np.repeat(table["sigma_arcsec"][:, None], 3, axis=1)
-    elif any(table.has(c) for c in sigma_columns):
-        missing = [c for c in sigma_columns if not table.has(c)]
-        if missing:
-            raise InputError(
-                f"per-angle sigma needs all three columns; missing {', '.join(missing)}",
-                path=table.path, row=1,
-            )  # fmt: skip
-        sigma = np.stack([table[c] for c in sigma_columns], axis=1)
-    if table.has("time_s"):
-        table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
-        _check_at_most(
-            table, "time_s", MAX_TIME_S,
-            f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
+        return np.repeat(table["sigma_arcsec"][:, None], 3, axis=1)
+    if not per_angle:
+        return None
+    missing = [c for c in _SIGMA_COLUMNS if not table.has(c)]
+    if missing:
+        raise InputError(
+            f"per-angle sigma needs all three columns; missing {', '.join(missing)}",
+            path=table.path, row=1,
         )  # fmt: skip
-    for column in dir_columns:
-        if table.has(column):
-            table.refuse(
-                column, np.abs(table[column]) != 1, "an approach direction must be +1 or -1"
-            )
-    refuse_repeated_rows(
-        table,
-        (*joint_columns, *dir_columns, "time_s"),
-        "repeats must differ in time_s or approach direction",
-    )
-    return OrientationMeasurements(
-        joint_rad=np.stack([table[c] for c in joint_columns], axis=1) / DEG_PER_RAD,
-        angles_rad=values / ARCSEC_PER_RAD,
-        sigma_rad=None if sigma is None else sigma / ARCSEC_PER_RAD,
-        time_s=table["time_s"] if table.has("time_s") else None,
-        dirs=tuple(table[c] if table.has(c) else None for c in dir_columns),
-        extra={k: v for k, v in table.extra.items() if k not in _RESERVED},
-        rows=rows,
-        source=str(table.path),
-        joint_names=tuple(joint_names or ()),
-        ignored_columns=table.skipped,
-    )
+    return np.stack([table[c] for c in _SIGMA_COLUMNS], axis=1)
