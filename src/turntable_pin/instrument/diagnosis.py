@@ -28,6 +28,7 @@ import numpy as np
 from ..calibration.drift_fit import gravity_words
 from ..core.exceptions import InputError
 from ..core.units import DEG_PER_RAD
+from ..core.words import Command
 from ..measurement.diagnosis import (
     dense_joint_grid,
     harmonic_basis,
@@ -407,9 +408,9 @@ class RunFamily(DataFamily):
         return sorted(out, key=lambda e: e["chi2_run"])
 
 
-def run_design_command(run, pair: tuple[str, str]) -> str:
-    """The ``turntable-pin design --separate A,B --run RUN`` command (with ``--urdf``, ``--mount``
-    and ``--latitude-deg`` when they are not the defaults) that chooses the calibration positions
+def run_design_command(run, pair: tuple[str, str]) -> Command:
+    """The ``design`` command (``separate``, ``run``, with ``urdf``, ``mount`` and
+    ``latitude_deg`` when they are not the defaults) that chooses the calibration positions
     telling the two effects apart, or says that none do (:mod:`.separate`; the one
     :func:`~turntable_pin.measurement.diagnosis.design_command`)."""
     from ..calibration.site import DEFAULT_LATITUDE_DEG
@@ -417,9 +418,9 @@ def run_design_command(run, pair: tuple[str, str]) -> str:
 
     latitude = float(np.degrees(run.inputs.latitude_rad))
     default = abs(latitude - DEFAULT_LATITUDE_DEG) <= 1e-9
-    extra = [] if default else ["--latitude-deg", f"{latitude:g}"]
     return design_command(run.source, pair, urdf_option(run.table), mount_option(run.table),
-                          data_option="--run", extra=extra)  # fmt: skip
+                          data_argument="run",
+                          latitude_deg=None if default else f"{latitude:g}")  # fmt: skip
 
 
 def diagnose_run(

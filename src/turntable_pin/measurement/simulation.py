@@ -510,31 +510,28 @@ def simulate_measurements(
     """Simulate a measurement run.
 
     Args:
-        errors: turntable errors (default none): the table's error vector (rad, m) in its
-            ``parameter_names`` order (the paper's ``TurntableErrors`` on the paper's table).
-        effects: ``{effect name: {parameter name: value in user units}}`` (parameters not given
-            are zero; units are the effect's, e.g. arcsec, arcsec/g, arcsec/h).
+        errors: the table's error vector (rad, m) in its ``parameter_names`` order (the paper's
+            ``TurntableErrors`` on the paper's table); default none.
+        effects: ``{effect: {parameter: value in the effect's user unit}}`` (arcsec, arcsec/g,
+            arcsec/h; parameters not given are zero).
         schedule: positions, order, time and approach directions (default: 30-degree grid).
-        noise_arcsec: 1-sigma Gaussian noise on each angle (in ``[MIN_SIGMA_ARCSEC,
-            MAX_NOISE_ARCSEC]``: the file must read back); three numbers give the noise of
-            ``dpsi, dtheta, dgamma`` separately (written as ``sigma_<angle>_arcsec``).
-        seed: seed of every random choice (order, directions, noise): a whole number
-            0 <= seed < 2**63.
+        noise_arcsec: 1-sigma Gaussian noise of each angle, in ``[MIN_SIGMA_ARCSEC,
+            MAX_NOISE_ARCSEC]`` (the file must read back); three numbers: one per angle
+            (written as ``sigma_<angle>_arcsec``).
+        seed: seed of every random choice (order, directions, noise), 0 <= seed < 2**63.
         turntable: the table (``GenericTable``, ``TurntableModel`` or ``None``: the paper's).
         catalogue: effects besides the table's catalogue that ``effects`` may name (the user's).
         noise_spread: F >= 1: each row's sigma is ``noise_arcsec`` times a factor drawn
-            log-uniform in [1/F, F] (seeded, after the noise), and the row's noise has that sigma;
-            every sigma stays within the noise range. 1 (the default): even noise.
+            log-uniform in [1/F, F] (seeded, after the noise), within the noise range; 1: even.
         not_measured: angles left empty at every position (``dgamma`` for a pointing run or an
-            autocollimator's two tilts). Without ``dgamma`` a row measures the direction of the
-            payload's x axis, and its ``dpsi`` is that direction's own component (``-dR[2,0]``,
-            docs/measurements.md section 1), as a real run of that kind measures it.
+            autocollimator's two tilts). Without ``dgamma`` a row's ``dpsi`` is the payload x
+            axis' own component (``-dR[2,0]``, docs/measurements.md section 1), as such a run
+            measures it.
 
     Raises:
-        InputError: an effect without parameters or one beyond +-18000 (the small-error limit
-            ``MAX_ANGULAR_ERROR_DEG`` in arcsec) in its user unit; a run longer than
-            ``MAX_TIME_S``; simulated angles beyond what a measurement file may hold
-            (``MAX_MEASURED_ANGLE_ARCSEC``).
+        InputError: an effect without parameters or beyond +-18000 (``MAX_ANGULAR_ERROR_DEG`` in
+            arcsec) in its user unit; a run longer than ``MAX_TIME_S``; angles beyond what a
+            measurement file may hold (``MAX_MEASURED_ANGLE_ARCSEC``).
     """
     noise = _checked_noise(noise_arcsec, noise_spread)
     seed = check_seed(seed)
@@ -543,30 +540,14 @@ def simulate_measurements(
     n_joints = table.n_joints
     if isinstance(errors, TurntableErrors):
         errors = errors.as_array()
-    vector = np.zeros(len(source.parameter_names)) if errors is None else errors
-    vector = np.asarray(vector, dtype=float)
+    vector = np.zeros(len(source.parameter_names)) if errors is None else np.asarray(errors, float)
     values = {
         n: v for n, v in zip(source.parameter_names, vector, strict=True) if n in table.base_names
     }
     schedule = schedule or Schedule()
-    check_count(schedule.count(n_joints), MAX_SIMULATED_ROWS, "rows of simulated measurements",
-                ROW_BYTES)  # fmt: skip
     effects = _checked_effects(effects)
     rng = np.random.default_rng(seed)
-    angles_deg = schedule.positions_deg(rng, n_joints)
-    n = angles_deg[0].size
-    if schedule.duration_s(n_joints) > MAX_TIME_S:
-        raise InputError(
-            f"dwell_s {schedule.dwell_s:g}: the run of {n} measurements would last "
-            f"{schedule.duration_s(n_joints):.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
-        )
-    blank = [ANGLE_NAMES.index(a) for a in _angle_names(not_measured)]
-    variables = PositionVariables(
-        np.stack(angles_deg, axis=1) / DEG_PER_RAD,
-        time_s=schedule.times_s(n),
-        dirs=tuple(schedule.directions(a, rng, k) for k, a in enumerate(angles_deg, start=1)),
-        boresight_only=np.full(n, 2 in blank and 0 not in blank),
-    )
+    variables, blank = _positions(schedule, rng, n_joints, not_measured)
     effect_objects = [resolve_effect(name, table, catalogue) for name in effects]
     effects = {e.name: effects[name] for e, name in zip(effect_objects, effects, strict=True)}
     model = OrientationModel(variables, effect_objects, table)
@@ -574,13 +555,7 @@ def simulate_measurements(
     truth = model.predict(model.parameter_vector(values))
     measured, sigma_rad = _noisy(truth, noise, noise_spread, rng)
     measured[:, blank] = np.nan
-    largest = float(np.nanmax(np.abs(measured))) * ARCSEC_PER_RAD
-    if not largest <= MAX_MEASURED_ANGLE_ARCSEC:
-        raise InputError(
-            f"the simulated orientation errors reach {largest:g} arcsec, beyond the "
-            f"+-{MAX_MEASURED_ANGLE_ARCSEC:g} arcsec a measurement may have "
-            "(docs/measurements.md); give smaller errors, effect parameters or noise"
-        )
+    _refuse_beyond_a_file(measured)
     data = OrientationMeasurements(
         joint_rad=variables.joint_rad,
         angles_rad=measured,
@@ -600,6 +575,39 @@ def simulate_measurements(
         truth_rad=truth,
         noise_spread=float(noise_spread),
     )
+
+
+def _positions(schedule: Schedule, rng, n_joints: int, not_measured) -> tuple:
+    """The positions ``schedule`` measures (with their times and approach directions) and the
+    indices of the angles ``not_measured``."""
+    check_count(schedule.count(n_joints), MAX_SIMULATED_ROWS, "rows of simulated measurements",
+                ROW_BYTES)  # fmt: skip
+    angles_deg = schedule.positions_deg(rng, n_joints)
+    n = angles_deg[0].size
+    if schedule.duration_s(n_joints) > MAX_TIME_S:
+        raise InputError(
+            f"dwell_s {schedule.dwell_s:g}: the run of {n} measurements would last "
+            f"{schedule.duration_s(n_joints):.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
+        )
+    blank = [ANGLE_NAMES.index(a) for a in _angle_names(not_measured)]
+    variables = PositionVariables(
+        np.stack(angles_deg, axis=1) / DEG_PER_RAD,
+        time_s=schedule.times_s(n),
+        dirs=tuple(schedule.directions(a, rng, k) for k, a in enumerate(angles_deg, start=1)),
+        boresight_only=np.full(n, 2 in blank and 0 not in blank),
+    )
+    return variables, blank
+
+
+def _refuse_beyond_a_file(measured: np.ndarray) -> None:
+    """Refuse simulated angles (rad) beyond what a measurement file may hold."""
+    largest = float(np.nanmax(np.abs(measured))) * ARCSEC_PER_RAD
+    if not largest <= MAX_MEASURED_ANGLE_ARCSEC:
+        raise InputError(
+            f"the simulated orientation errors reach {largest:g} arcsec, beyond the "
+            f"+-{MAX_MEASURED_ANGLE_ARCSEC:g} arcsec a measurement may have "
+            "(docs/measurements.md); give smaller errors, effect parameters or noise"
+        )
 
 
 def _checked_noise(noise_arcsec, noise_spread: float) -> np.ndarray:

@@ -421,8 +421,8 @@ class Diagnosis:
         fails_fit_test: the best model's chi2 p-value is below ``FIT_TEST_ALPHA``.
         separations: advice per alternative of the accepted first effect.
         separation_commands: for entries of ``separations``, the command that would settle
-            each (the caller's: e.g. a design of the next measurements); in the JSON only when
-            there are some.
+            each (the caller's: e.g. a design of the next measurements); in the JSON, as its
+            ``str``, only when there are some.
         until_explained: whether the verdict names every accepted effect (``missing_effects``)
             or the first one, with the others as ``also_significant``.
         after_first: delta_bic of each other effect on top of the first accepted one: an effect
@@ -464,7 +464,7 @@ class Diagnosis:
     unneeded_given_structure: dict[str, float] = field(default_factory=dict)
     doubt: str | None = None
     group_variance: np.ndarray | None = field(default=None, repr=False)
-    separation_commands: dict[str, str] = field(default_factory=dict)
+    separation_commands: dict[str, object] = field(default_factory=dict)
     family_verdict: dict[str, Any] = field(default_factory=dict)
     family_results: dict[str, Any] = field(default_factory=dict)
 
@@ -591,7 +591,9 @@ class Diagnosis:
             ],
         }
         if self.separation_commands and not self.family_verdict:
-            verdict["separation_commands"] = dict(self.separation_commands)
+            verdict["separation_commands"] = {
+                k: str(c) for k, c in self.separation_commands.items()
+            }
         named_parameters = self.named_parameters()
         verdict["named_parameters"] = named_parameters
         loose = {name: undetermined_parameters(e) for name, e in named_parameters.items() if e}
@@ -610,7 +612,9 @@ class Diagnosis:
             verdict["effect_story"] = self.family.describe(self.missing_effect)
         verdict.update(copy.deepcopy(self.family_verdict))
         if self.separation_commands and self.family_verdict:
-            verdict["separation_commands"] = dict(self.separation_commands)
+            verdict["separation_commands"] = {
+                k: str(c) for k, c in self.separation_commands.items()
+            }
         return verdict
 
     def to_dict(self) -> dict:
