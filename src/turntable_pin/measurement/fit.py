@@ -14,12 +14,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.exceptions import InputError
 from ..core.sizes import FIT_ROW_BYTES, MAX_FITTED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD
-from ..stats.least_squares import FitResult, ZeroPoint, fit_least_squares, zero_point
+from ..stats.least_squares import (
+    RANK_RTOL,
+    FitResult,
+    ZeroPoint,
+    analyse_identifiability,
+    combination_name,
+    fit_least_squares,
+    zero_point,
+)
 from .data import ANGLE_NAMES, OrientationMeasurements
 from .effect_model import OrientationModel
 from .effects.base import Effect
+from .pointing_terms import fitted_pointing_terms
 
 __all__ = [
     "MAX_UNEXPLAINED_ARCSEC",
@@ -159,8 +169,6 @@ class OrientationFit:
         """The error combinations these positions would determine with every angle measured but
         do not with the cells left empty (``[]`` when every angle was measured); e.g. without
         ``dtheta`` on the paper's table, ``dphi_z2 + dalpha_z1``."""
-        from ..stats.least_squares import analyse_identifiability, combination_name
-
         if self.data.measured.all():
             return []
         names = self.model.parameter_names
@@ -201,8 +209,6 @@ class OrientationFit:
             "unobserved_combinations": self.unobserved_combinations(),
         }
         out.update(self.result.to_dict())
-        from .pointing_terms import fitted_pointing_terms
-
         terms = fitted_pointing_terms(self)
         if terms is not None:  # a telescope mount: TPOINT's terms by name
             out["pointing_terms"] = terms
@@ -267,9 +273,6 @@ def refuse_repeated_shapes(data: OrientationMeasurements, effects, turntable=Non
     these data (its Jacobian columns, beyond the base errors, lie in the span of another's:
     ``inner_encoder_harmonics`` and ``dphi_z2~h1(phi2)`` together), naming both; a fit would
     otherwise show a lower rank and split the shape between them silently."""
-    from ..core.exceptions import InputError
-    from ..stats.least_squares import RANK_RTOL
-
     if len(effects) < 2:
         return
     model = OrientationModel(data.variables(), effects, turntable)
@@ -308,8 +311,6 @@ def refuse_repeated_shapes(data: OrientationMeasurements, effects, turntable=Non
 def _refuse_unexplained(fit: OrientationFit) -> None:
     """:class:`InputError` naming the rows whose residual exceeds
     :data:`MAX_UNEXPLAINED_ARCSEC`."""
-    from ..core.exceptions import InputError
-
     residual_arcsec = np.abs(fit.residuals_rad) * ARCSEC_PER_RAD
     bad = np.flatnonzero(np.nanmax(np.where(fit.data.measured, residual_arcsec, 0.0), axis=1)
                          > MAX_UNEXPLAINED_ARCSEC)  # fmt: skip

@@ -37,6 +37,9 @@ from ..core.rotations import axis_rotation
 from ..core.units import ARCSEC_PER_RAD
 from ..model.angles import ANGLE_NAMES
 from ..model.mount_declaration import ALTAZ, EQUATORIAL, declaration_text
+from ..stats.least_squares import combination_name
+from .effect_model import OrientationModel
+from .effects.base import PositionVariables
 from .table import measured_table
 
 __all__ = [
@@ -467,16 +470,11 @@ class RigidTermMap:
 
     def combinations(self) -> dict[str, str]:
         """``{term: its combination of base errors in words}`` (``-azimuth.position - ...``)."""
-        from ..stats.least_squares import combination_name
-
         rows = zip(self.names, self.matrix, strict=True)
         return {n: combination_name(r, self.base_names) for n, r in rows}
 
 
 def _rigid_map(table, mount: Mount) -> RigidTermMap | None:
-    from .effect_model import OrientationModel
-    from .effects.base import PositionVariables
-
     joints = _generic_positions()
     model = OrientationModel(PositionVariables(joints), (), table)
     # d(dpsi, dtheta)/d(base errors) at zero errors, stacked position by position.

@@ -8,12 +8,14 @@ reads the ``NAME:P=V,...`` form the simulator takes.
 
 from __future__ import annotations
 
+# ..catalogue is imported inside _paper_effects: it imports this package (a cycle at import)
 import math
 
 import numpy as np
 
 from ...core.exceptions import InputError
 from .base import ChainTerm, Effect, EffectText, ParameterSpec, PositionVariables
+from .contract import checked_parameters
 from .paper_names import PAPER_EFFECTS
 
 EFFECT_NAMES: tuple[str, ...] = tuple(e.name for e in PAPER_EFFECTS)
@@ -56,8 +58,6 @@ def parameter_names(effect: Effect) -> tuple[str, ...]:
 
 
 def _every_parameter(effect: Effect):
-    from .contract import checked_parameters
-
     one = np.zeros((1, 3))
     dirs = (one[:, 0] + 1,) * 3
     return checked_parameters(effect, PositionVariables(one, one[:, 0], dirs), "one position")

@@ -27,10 +27,10 @@ from collections.abc import Mapping
 import numpy as np
 
 from ...core.exceptions import UserCodeError
-from ...core.user_code import call_user, class_file
+from ...core.user_code import call_user, class_file, is_user_code
 from ...model.angles import ANGLE_NAMES
 from ...stats.candidate_effect import STORY_TEXTS
-from .base import MEASURED, POST, PRE, ChainTerm, ParameterSpec, PositionVariables
+from .base import MEASURED, POST, PRE, ChainTerm, Effect, ParameterSpec, PositionVariables
 
 __all__ = [
     "PROBE_POSITIONS",
@@ -198,8 +198,6 @@ def checked_parameters(effect, variables: PositionVariables, on: str) -> tuple[P
     """``effect.parameters(variables)``; for the user's effect called through
     :func:`~turntable_pin.core.user_code.call_user` and checked (:func:`check_parameters`),
     ``on`` naming the variables in a message."""
-    from ...core.user_code import is_user_code
-
     if not is_user_code(effect):
         return tuple(effect.parameters(variables))
     label = effect_label(effect)
@@ -321,8 +319,6 @@ def check_effect(
         UserCodeError: a method raised, or returned something the contract does not allow: one
             line naming the file, the effect, the method, what it returned and what was expected.
     """
-    from .base import Effect
-
     on = on or f"the data ({variables.n} positions)"
     check_story(effect, Effect)
     path = effect_file(effect)
@@ -355,8 +351,6 @@ def check_effect_on_probe(effect, table, columns=()) -> None:
     """Check the user's ``effect`` (:func:`check_effect`) on :func:`probe_variables` of
     ``table`` (a :class:`~turntable_pin.measurement.table.MeasuredTable`) with its required
     columns and ``columns``."""
-    from .base import Effect
-
     check_story(effect, Effect)
     probe = probe_variables(table.n_joints, (*effect.required_columns, *columns))
     check_effect(effect, probe, table.base_names,
