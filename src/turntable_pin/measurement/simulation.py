@@ -22,6 +22,7 @@ from ..core.exceptions import InputError, check_seed
 from ..core.sizes import MAX_SIMULATED_ROWS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
 from ..core.turn_grid import full_turn_grid_deg, random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
+from ..core.words import argument
 from ..model.angles import ANGLE_NAMES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors
 from ..model.paper_table import paper_table
@@ -465,7 +466,8 @@ class SimulatedMeasurements:
             "schedule: " + self.schedule.describe(self.data.n_joints),
         ]
         if hide_truth:
-            return "\n".join([*lines, "errors and hidden effects: not recorded (--hide-truth)"])
+            hidden = f"errors and hidden effects: not recorded ({argument('hide_truth')})"
+            return "\n".join([*lines, hidden])
         return "\n".join(
             [*lines, f"errors (arcsec): {errors}", f"hidden effects: {effects or 'none'}"]
         )
