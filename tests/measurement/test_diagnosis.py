@@ -96,7 +96,7 @@ def test_an_effect_outside_the_catalogue_is_unexplained():
         rng = np.random.default_rng(seed)
         sim = simulate_measurements(random_errors(rng), seed=seed)
         extra = np.zeros_like(sim.data.angles_rad)
-        extra[:, 1] = 3.0 / ARCSEC_PER_RAD * np.cos(3 * sim.data.phi2_rad + 0.4)  # 3/rev
+        extra[:, 1] = 3.0 / ARCSEC_PER_RAD * np.cos(3 * sim.data.joint_rad[:, 1] + 0.4)  # 3/rev
         data = _with_extra(sim.data, extra)
         for variant in (data, data.without_sigma()):
             d = diagnose_measurements(variant)

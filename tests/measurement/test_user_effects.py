@@ -222,7 +222,7 @@ class Settling(Effect):
         return (ParameterSpec("a", "arcsec", ARCSEC, "settling"),)
 
     def chain_terms(self, variables):
-        return (ChainTerm("post", "z", {"a": (1 - variables.dir1) / 2}),)
+        return (ChainTerm("post", "z", {"a": (1 - variables.dirs[0]) / 2}),)
 
 
 def test_a_module_effect_is_fitted_and_named_by_the_diagnosis(tmp_path, encoder_data):

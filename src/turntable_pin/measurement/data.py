@@ -198,26 +198,6 @@ class OrientationMeasurements:
         return int(self.joint_rad.shape[1])
 
     @property
-    def phi1_rad(self) -> np.ndarray:
-        """Commanded angle of joint 1, rad (N,)."""
-        return self.joint_rad[:, 0]
-
-    @property
-    def phi2_rad(self) -> np.ndarray:
-        """Commanded angle of joint 2, rad (N,)."""
-        return self.joint_rad[:, 1]
-
-    @property
-    def dir1(self) -> np.ndarray | None:
-        """Approach direction of joint 1, or ``None``."""
-        return self.dirs[0]
-
-    @property
-    def dir2(self) -> np.ndarray | None:
-        """Approach direction of joint 2, or ``None``."""
-        return self.dirs[1] if self.n_joints > 1 else None
-
-    @property
     def measured(self) -> np.ndarray:
         """Which angles were measured, (N, 3) bool (an empty cell is ``False``)."""
         return np.isfinite(self.angles_rad)
@@ -305,20 +285,18 @@ def _check_at_most(table, column: str, limit: float, rule: str) -> None:
     table.refuse(column, np.abs(table[column]) > limit, rule)
 
 
-def check_times_and_directions(table, dir_columns: Sequence[str]) -> None:
+def check_times_and_directions(rows, dir_columns: Sequence[str]) -> None:
     """Refuse a ``time_s`` below 0 or above :data:`MAX_TIME_S` and a ``dirK`` not +1 or -1 of
-    ``table`` (a ``CsvTable``), naming file, row and column."""
-    if table.has("time_s"):
-        table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
+    ``rows`` (a ``CsvTable``), naming file, row and column."""
+    if rows.has("time_s"):
+        rows.refuse("time_s", rows["time_s"] < 0, "time since the start of the run must be >= 0")
         _check_at_most(
-            table, "time_s", MAX_TIME_S,
+            rows, "time_s", MAX_TIME_S,
             f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
         )  # fmt: skip
     for column in dir_columns:
-        if table.has(column):
-            table.refuse(
-                column, np.abs(table[column]) != 1, "an approach direction must be +1 or -1"
-            )
+        if rows.has(column):
+            rows.refuse(column, np.abs(rows[column]) != 1, "an approach direction must be +1 or -1")
 
 
 def read_measurements(

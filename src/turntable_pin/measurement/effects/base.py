@@ -187,26 +187,6 @@ class PositionVariables:
             raise InputError(f"these positions have {self.n_joints} joint(s), no joint {k}")
         return self.joint_rad[:, k - 1]
 
-    @property
-    def phi1_rad(self) -> np.ndarray:
-        """The first joint's commanded angle (the paper's outer axis), rad (N,)."""
-        return self.angle(1)
-
-    @property
-    def phi2_rad(self) -> np.ndarray:
-        """The second joint's commanded angle (the paper's inner axis), rad (N,)."""
-        return self.angle(2)
-
-    @property
-    def dir1(self) -> np.ndarray | None:
-        """Approach direction of joint 1, or ``None``."""
-        return self.dirs[0] if self.dirs else None
-
-    @property
-    def dir2(self) -> np.ndarray | None:
-        """Approach direction of joint 2, or ``None``."""
-        return self.dirs[1] if len(self.dirs) > 1 else None
-
     def column(self, name: str) -> np.ndarray | None:
         """The data column ``name``: ``time_s``, ``dirK``, ``phiK`` (rad) or an extra column."""
         if name == "time_s":
