@@ -226,7 +226,6 @@ class OrientationFamily(DataFamily):
         self.data = data
         self.left_out_rad = left_out_rad
         self.table = measured_table(turntable)
-        self.turntable = self.table
         scale = ARCSEC_PER_RAD
         if data.sigma_rad is not None:
             scale *= float(np.nanmedian(np.where(data.measured, data.sigma_rad, np.nan)))
@@ -236,11 +235,6 @@ class OrientationFamily(DataFamily):
             sigma_scale=scale,
             noise_per_column=noise_per_angle,
         )
-
-    @property
-    def noise_per_angle(self) -> bool:
-        """Whether every model is fitted at its own per-angle noise."""
-        return self.noise_per_column
 
     # ---- the hooks of the one diagnosis (stats.diagnosis_engine) ---------------------------
     def fit_model(self, effects: Sequence[Effect], zero_point) -> OrientationFit:
@@ -307,7 +301,7 @@ class OrientationFamily(DataFamily):
         """The family on these data with the angles ``cells`` (N, 3) left out as outliers."""
         return OrientationFamily(
             _without(self.data, cells), self.catalogue, self.table,
-            np.where(cells, self.data.angles_rad, np.nan), self.noise_per_angle,
+            np.where(cells, self.data.angles_rad, np.nan), self.noise_per_column,
         )  # fmt: skip
 
     def with_column_noise(self, column_sigma: np.ndarray) -> OrientationFamily:
@@ -677,8 +671,7 @@ def _without(data: OrientationMeasurements, cells: np.ndarray) -> OrientationMea
 def _weighted(data: OrientationMeasurements, column_sigma: np.ndarray) -> OrientationMeasurements:
     """``data`` weighted by the relative noise ``column_sigma`` (3,) rad of each angle."""
     return data.replace(
-        sigma_rad=np.broadcast_to(column_sigma, data.angles_rad.shape).copy(),
-        sigma_relative=True,
+        sigma_rad=np.broadcast_to(column_sigma, data.angles_rad.shape).copy(), sigma_relative=True
     )
 
 

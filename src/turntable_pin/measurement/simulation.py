@@ -77,41 +77,36 @@ DEFAULT_GRID_STEP_DEG = 30.0
 class Schedule:
     """Which positions are measured, in which order, when, and from which side.
 
-    The positions come from one of four designs: a grid over every joint (the default), an
-    explicit list (``positions``), single-axis sweeps (``sweep``) or random positions
-    (``random_positions``). The list is then measured ``repeats`` times over, and with ``passes``
-    K > 0 it is measured forward and then backward, K times.
-
-    ``Schedule(45, 30, order="random")``: the grid steps are given one per joint from the base
-    (``phi1``, ``phi2``, ...), as the positional arguments.
+    The positions: a grid over every joint (the default), a list (``positions``), single-axis
+    sweeps (``sweep``) or random positions (``random_positions``); measured ``repeats`` times
+    over, and with ``passes`` K > 0 forward then backward, K times. The grid steps are the
+    positional arguments, one per joint from the base: ``Schedule(45, 30, order="random")``.
 
     Attributes:
-        steps_deg: grid step of each joint from the base, degrees (a joint beyond the sequence:
+        steps_deg: grid step of each joint from the base, degrees (beyond the sequence:
             :data:`DEFAULT_GRID_STEP_DEG`; a table with fewer joints ignores the rest); the grid
             covers [start, start + 360). Reported as ``phiK_step_deg``.
-        starts_deg: first grid angle of each joint from the base, degrees (beyond the sequence:
-            0); in a sweep, the angle at which the joints not being swept are held. Reported as
-            ``phiK_start_deg``.
-        order: ``grid`` (phi1 outer loop, the last joint's angle inner loop) or ``random``
-            (shuffled; grids only).
+        starts_deg: first grid angle of each joint, degrees (beyond the sequence: 0); a sweep
+            holds the other joints there. Reported as ``phiK_start_deg``.
+        order: ``grid`` (phi1 the outer loop, the last joint the inner) or ``random`` (shuffled;
+            grids only).
         repeats: how many times each position is measured.
         dwell_s: time between consecutive measurements.
-        approach: ``random`` (each axis from a random side), ``motion`` (the side the move from the
-            previous position came from; unchanged when the axis did not move; on ``passes``, the
-            pass's direction: +1 forward, -1 backward for every joint) or ``positive``. ``None``
-            (the default): ``motion`` with ``passes``, else ``random``.
-        positions: an explicit list of positions, ``((phi1_deg, phi2_deg, ...), ...)``, measured
-            in its order (one angle per joint of the table).
+        approach: ``random`` (each axis from a random side), ``motion`` (the side the move came
+            from, unchanged when the axis did not move; with ``passes``, +1 forward and -1
+            backward for every joint) or ``positive``; ``None``: ``motion`` with ``passes``,
+            else ``random``.
+        positions: a list of positions ``((phi1_deg, phi2_deg, ...), ...)``, one angle per
+            joint, measured in its order.
         positions_time_s: the time of each listed position (default: ``dwell_s`` apart); not
             with ``repeats`` or ``passes``.
         positions_dirs: per joint, the approach direction (+1/-1) of each listed position, or
-            ``None`` for a joint the list does not give (the ``approach`` rule then applies);
-            not with ``passes``.
+            ``None`` (the ``approach`` rule applies); not with ``passes``.
         positions_source: where the list came from (a file name), for the comment header.
-        sweep: joints swept one after the other, e.g. ``("phi1", "phi2")``: phi1 over its grid
-            with the others held at their start angle, then phi2 likewise.
-        random_positions: N > 0: N positions drawn uniformly over [start, start + 360) of every
-            joint (seeded; rounded to 1e-6 deg).
+        sweep: joints swept one after the other (``("phi1", "phi2")``: phi1 over its grid with
+            the others held at their start, then phi2).
+        random_positions: N > 0: N positions uniform over [start, start + 360) of every joint
+            (seeded; rounded to 1e-6 deg).
         passes: K > 0: the positions forward then backward, K times (2K traversals).
     """
 

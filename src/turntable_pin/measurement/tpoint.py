@@ -631,8 +631,7 @@ def _angles_pointing_at(placements, target: np.ndarray, start_rad: np.ndarray) -
     for _ in range(20):
         f = _boresight(placements, q)
         jac = np.stack(
-            [(_boresight(placements, q + step * e[:, None]) - f) / step for e in np.eye(2)],
-            axis=-1,
+            [(_boresight(placements, q + step * e[:, None]) - f) / step for e in np.eye(2)], axis=-1
         )  # (N, 3, 2)
         dq = np.einsum("nij,nj->ni", np.linalg.pinv(jac), target - f).T
         q = q + dq

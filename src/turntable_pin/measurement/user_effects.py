@@ -266,8 +266,7 @@ def load_effects_module(path: str | Path, base: type = Effect) -> tuple:
     if not effects:
         where = f"{base.__module__.replace('.base', '')}.{base.__name__}"
         raise InputError(
-            f"defines no effect (expected subclasses of {where} or instances of them)",
-            path=path,
+            f"defines no effect (expected subclasses of {where} or instances of them)", path=path
         )
     for effect in effects:
         _set_source(effect, str(path))

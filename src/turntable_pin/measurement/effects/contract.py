@@ -112,10 +112,7 @@ def check_story(effect, base: type) -> None:
     for key in STORY_ATTRIBUTES:
         value = getattr(effect, key, "")
         if not isinstance(value, str):
-            raise contract_error(
-                effect,
-                f"its {key} is {described(value)}; expected a text",
-            )
+            raise contract_error(effect, f"its {key} is {described(value)}; expected a text")
     columns = getattr(effect, "required_columns", ())
     if isinstance(columns, str):
         raise contract_error(
@@ -170,10 +167,7 @@ def check_parameters(effect, specs, call: str, on: str) -> tuple[ParameterSpec, 
                 "text without spaces (c1, k, rz)",
             )
         if name in seen:
-            raise contract_error(
-                effect,
-                f"{call} declares the parameter '{name}' twice",
-            )
+            raise contract_error(effect, f"{call} declares the parameter '{name}' twice")
         seen.add(name)
         for key in ("unit", "description"):
             if not isinstance(getattr(spec, key), str):
@@ -240,10 +234,7 @@ def _check_weight(effect, value, where: str, n: int, on: str) -> None:
     expected = f"a number or an array of shape ({n},), one value per position"
     array = numbers_returned(value)
     if array is None:
-        raise contract_error(
-            effect,
-            f"{where} is {described(value)} on {on}; expected {expected}",
-        )
+        raise contract_error(effect, f"{where} is {described(value)} on {on}; expected {expected}")
     if array.shape not in ((), (n,)):
         raise contract_error(
             effect, f"{where} has shape {array.shape} on {on}; expected {expected}"
@@ -256,8 +247,7 @@ def _check_weight(effect, value, where: str, n: int, on: str) -> None:
         )  # fmt: skip
         count = f" at {int(bad.sum())} of {n} positions" if array.ndim else ""
         raise contract_error(
-            effect,
-            f"{where} is not finite ({kinds}{count}) on {on}; expected finite numbers",
+            effect, f"{where} is not finite ({kinds}{count}) on {on}; expected finite numbers"
         )
 
 
