@@ -417,20 +417,18 @@ class OrientationFamily(DataFamily):
             names = " or ".join(labels[k] for k in held)
             out.append(
                 f"the rows hold {where}: effects that vary with {names} cannot be tested here "
-                "(the diagnosis lists them as indistinguishable from the base); move "
-                f"{names} over its turn too (simulate {argument('sweep')} {','.join(labels)}, or "
-                "a grid)"
+                f"(the diagnosis lists them as indistinguishable from the base); move {names} "
+                f"over its turn too (simulate {argument('sweep')} {','.join(labels)}, or a grid)"
             )
         for k, count in enumerate(counts):
             if 1 < count < 5:
                 top = (count - 1) // 2
                 out.append(
-                    f"{labels[k]} takes only {count} distinct angles: a k/rev term in "
-                    f"{labels[k]} needs at least 2k+1 angles over the turn, so terms of order "
-                    f"{top + 1} and above (the 2/rev terms of encoders and wobble) alias with "
-                    "lower orders or vanish at every row and cannot be tested; measure "
-                    f"{labels[k]} at 5 or more angles spread over the turn (a step of at most "
-                    "72 deg)"
+                    f"{labels[k]} takes only {count} distinct angles: a k/rev term in {labels[k]} "
+                    f"needs at least 2k+1 angles over the turn, so terms of order {top + 1} and "
+                    "above (the 2/rev terms of encoders and wobble) alias with lower orders or "
+                    f"vanish at every row and cannot be tested; measure {labels[k]} at 5 or more "
+                    "angles spread over the turn (a step of at most 72 deg)"
                 )
         moving = [k for k, c in enumerate(counts) if c > 1]
         if len(moving) > 1:

@@ -155,9 +155,8 @@ def check_parameters(effect, specs, call: str, on: str) -> tuple[ParameterSpec, 
         if not isinstance(spec, ParameterSpec):
             raise contract_error(
                 effect,
-                f"{call} returned {described(spec)} as parameter {k} on {on}; "
-                "expected a ParameterSpec(name, unit, per_user_unit, "
-                "description)",
+                f"{call} returned {described(spec)} as parameter {k} on {on}; expected a "
+                "ParameterSpec(name, unit, per_user_unit, description)",
             )
         name = spec.name
         if not isinstance(name, str) or not name.strip() or any(c.isspace() for c in name):
@@ -181,9 +180,8 @@ def check_parameters(effect, specs, call: str, on: str) -> tuple[ParameterSpec, 
         if not number or not math.isfinite(float(scale)) or float(scale) <= 0:
             raise contract_error(
                 effect,
-                f"{call}: parameter '{name}': per_user_unit is {described(scale)}; "
-                "expected a finite number > 0 (the internal value, rad, of one "
-                "user unit: ARCSEC for arcsec)",
+                f"{call}: parameter '{name}': per_user_unit is {described(scale)}; expected a "
+                "finite number > 0 (the internal value, rad, of one user unit: ARCSEC for arcsec)",
             )
     return tuple(specs)
 
@@ -273,17 +271,15 @@ def _check_terms(effect, terms, specs, n: int, base_names, on: str) -> tuple[Cha
         if not isinstance(term.weights, Mapping):
             raise contract_error(
                 effect,
-                f"{where}: weights is {described(term.weights)}; expected a dict "
-                "{parameter name: number or array of one value per "
-                "position}",
+                f"{where}: weights is {described(term.weights)}; expected a dict {{parameter "
+                "name: number or array of one value per position}",
             )
         for name, value in term.weights.items():
             if name not in declared:
                 raise contract_error(
                     effect,
-                    f"{where}: weight {described(name)} is not a parameter of the "
-                    f"effect; parameters(variables) declares "
-                    f"{', '.join(declared)}",
+                    f"{where}: weight {described(name)} is not a parameter of the effect; "
+                    f"parameters(variables) declares {', '.join(declared)}",
                 )
             _check_weight(effect, value, f"{where}: weight '{name}'", n, on)
             weighed.add(name)
