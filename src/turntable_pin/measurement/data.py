@@ -1,28 +1,23 @@
 """Orientation measurements: the CSV of ``docs/measurements.md``, read and validated.
 
 Required columns ``phi1_deg, phi2_deg, dpsi_arcsec, dtheta_arcsec, dgamma_arcsec``; optional
-``sigma_arcsec``, ``time_s``, ``dir1``, ``dir2``. Any other column is numeric when at least half
-of its filled cells are numbers: it is kept (:attr:`OrientationMeasurements.extra`, a suspect for
-the diagnosis) and every cell must be a finite number (a ``warm`` in a ``temperature_c`` column
-is refused naming row and column); a column of text (a ``note``) is left out and named in
-:attr:`OrientationMeasurements.ignored_columns`. Beyond the shared reader's checks (missing
-columns, non-numbers, NaN), a file is refused, naming row and column, when:
+``sigma_arcsec``, ``time_s``, ``dir1``, ``dir2``. Another column is numeric when at least half its
+filled cells are numbers: it is kept (:attr:`OrientationMeasurements.extra`, a suspect for the
+diagnosis) and every cell must be a finite number (``warm`` in ``temperature_c`` is refused); a
+text column (a ``note``) is left out and named (``ignored_columns``). Beyond the shared reader's
+checks (missing columns, non-numbers, NaN), a file is refused, naming row and column, when:
 
-- a value is outside its valid range: ``|phi1_deg|``, ``|phi2_deg|`` above
-  :data:`MAX_COMMANDED_ANGLE_DEG`; ``|dpsi|, |dtheta|, |dgamma|`` above
-  :data:`MAX_MEASURED_ANGLE_ARCSEC` (30 deg: beyond, no orientation error of the table); a
-  ``sigma_arcsec`` <= 0, below :data:`MIN_SIGMA_ARCSEC` or above :data:`MAX_SIGMA_ARCSEC` (the
-  small-error limit); a ``time_s`` negative or above
-  :data:`MAX_TIME_S`; a ``dir1``/``dir2`` not +1 or -1;
-- two rows are the same measurement: equal ``phi1_deg, phi2_deg`` and equal values of every
-  present ``dir1, dir2, time_s`` column. Repeats of a position are legitimate when they differ in
-  time or approach direction; a file without ``time_s`` that repeats a position with the same
-  directions holds a copied row (angles are compared as written, so 0 and 360 differ);
-- an angle column looks like radians: every value is within +-2 pi, some are not whole numbers,
-  and either (a) all of them, read as radians, are whole degrees (e.g. 0.5235987756 = 30 deg:
-  a degree schedule written in radians), or (b) they span more than pi and none is a multiple of
-  0.25 deg besides 0 (irregular values spread over a radian-sized range). A small-angle data set
-  in degrees (say -3, -1.5, 0, 1.5, 3) passes: its values are quarter-degree multiples.
+- a value is out of range: ``|phiK_deg|`` above :data:`MAX_COMMANDED_ANGLE_DEG`; ``|dpsi|,
+  |dtheta|, |dgamma|`` above :data:`MAX_MEASURED_ANGLE_ARCSEC` (30 deg: no orientation error of
+  the table); a sigma <= 0, below :data:`MIN_SIGMA_ARCSEC` or above :data:`MAX_SIGMA_ARCSEC`; a
+  ``time_s`` below 0 or above :data:`MAX_TIME_S`; a ``dirK`` not +1 or -1;
+- two rows are the same measurement: equal angles and equal ``dir1, dir2, time_s`` where present
+  (repeats must differ in time or approach direction; angles compared as written, 0 and 360
+  differ);
+- an angle column looks like radians: every value within +-2 pi, some not whole, and either (a)
+  all of them, read as radians, whole degrees (0.5235987756 = 30 deg), or (b) spanning more than
+  pi with none a multiple of 0.25 deg besides 0. Small angles in degrees (-3, -1.5, 0, 1.5, 3)
+  pass: they are quarter-degree multiples.
 """
 
 from __future__ import annotations
@@ -97,17 +92,17 @@ class OrientationMeasurements:
 
     Attributes:
         joint_rad: commanded joint angles (N, J), chain order from the base (phi1 .. phiJ).
-        angles_rad: measured ``dpsi, dtheta, dgamma`` (N, 3); NaN where an angle was not measured.
-        sigma_rad: 1-sigma noise of each angle (N, 3), or ``None`` (to be estimated from the fit).
+        angles_rad: measured ``dpsi, dtheta, dgamma`` (N, 3); NaN where not measured.
+        sigma_rad: 1-sigma noise of each angle (N, 3), or ``None`` (estimated from the fit).
         time_s: time of each row (N,) or ``None``.
         dirs: per joint, the approach direction ``dirK`` (N,) or ``None``.
         extra: other numeric columns of the file, ``{name: (N,)}`` (suspects for the diagnosis).
         rows: spreadsheet row of each position in the file (N,) (2 = first data row).
         source: the file read, or a description.
         joint_names: the table's joint names (for column names and labels), or ``()``.
-        sigma_relative: ``sigma_rad`` gives only the relative noise of the angles (weights); the
-            noise level itself is estimated from the fit (the diagnosis sets this when no sigma
-            is given and the three angles' noise differ).
+        sigma_relative: ``sigma_rad`` gives only the angles' relative noise (weights), the level
+            is estimated from the fit (the diagnosis' choice when no sigma is given and the
+            angles' noise differ).
         ignored_columns: the file's columns left out as not numbers (text or empty throughout).
     """
 

@@ -2,8 +2,8 @@
 
 Each physical effect is one module holding one :class:`Effect` subclass, for any table; a table's
 catalogue of them is :func:`turntable_pin.measurement.catalogue.catalogue`. :data:`EFFECTS` is the
-paper's table's catalogue by the paper's names (:mod:`.paper_names`). :func:`parse_effect_spec`
-reads the ``NAME:P=V,...`` form the simulator takes.
+paper's table's catalogue by the paper's names (``model.paper_table.PAPER_EFFECTS``);
+:func:`parse_effect_spec` reads the ``NAME:P=V,...`` form the simulator takes.
 """
 
 from __future__ import annotations
@@ -14,9 +14,9 @@ import math
 import numpy as np
 
 from ...core.exceptions import InputError
+from ...model.paper_table import PAPER_EFFECTS
 from .base import ChainTerm, Effect, EffectText, ParameterSpec, PositionVariables
 from .contract import checked_parameters
-from .paper_names import PAPER_EFFECTS
 
 EFFECT_NAMES: tuple[str, ...] = tuple(e.name for e in PAPER_EFFECTS)
 """The paper's table's catalogue names, in catalogue order."""
