@@ -127,19 +127,16 @@ class TpointRun:
     """A TPOINT run as read (angles in degrees, in the table's conventions).
 
     Attributes:
-        path: the file.
-        caption: its caption line.
+        path, caption: the file and its caption line.
         options: the option names in file order (``ALTAZ``, ``NODA``, ...).
-        mount: :data:`ALTAZ` or :data:`EQUATORIAL`.
-        mount_line: the line of the option naming the mount (``None`` if given by the caller).
-        latitude_deg: the site latitude of the run-parameter line (deg, North positive).
-        latitude_text: the latitude as written (``+31 41 19.6``).
-        run_parameters: ``date`` (y, m, d) and the present fields of the run-parameter line:
-            ``temperature_c`` (C), ``pressure_mbar`` (mbar), ``height_m`` (m), ``humidity``
-            (0..1), ``wavelength_um`` (micron), ``lapse_rate_k_per_m`` (K/m).
-        observed_deg: (N, 2) observed first and second angle: alt-az: azimuth (South = 0, East =
-            90) and elevation; equatorial: hour angle (positive West) and declination (deg).
-        raw_deg: (N, 2) the raw (encoder) angles in the same convention (deg).
+        mount: :data:`ALTAZ` or :data:`EQUATORIAL`; mount_line: the line of the option naming it
+            (``None`` if given by the caller).
+        latitude_deg: the site latitude (deg, North positive); latitude_text: as written.
+        run_parameters: ``date`` (y, m, d) and the fields given of ``temperature_c`` (C),
+            ``pressure_mbar``, ``height_m``, ``humidity`` (0..1), ``wavelength_um``,
+            ``lapse_rate_k_per_m``.
+        observed_deg, raw_deg: (N, 2) the star's and the encoders' angles (deg): azimuth (South
+            = 0, East = 90) and elevation, or hour angle (positive West) and declination.
         lines: (N,) line number of each star's record (1 = first line of the file).
         azimuth_origin, azimuth_direction: the file's azimuth convention (alt-az), converted.
     """
@@ -166,19 +163,17 @@ class TpointRun:
 
 @dataclass(frozen=True)
 class TpointConversion:
-    """A run converted to measurement rows (see the module docstring for the definitions).
+    """A run converted to measurement rows (definitions: the module docstring).
 
     Attributes:
         run: the :class:`TpointRun`.
-        phi_deg: (N, 2) the raw (commanded) joint angles written as ``phi1_deg, phi2_deg`` (deg).
-        dpsi_arcsec, dtheta_arcsec: (N,) the measured orientation error angles (arcsec).
-        refraction: ``apply`` or ``none``: what was done.
-        refraction_arcsec: (N,) the refraction added to each observed elevation (arcsec; zeros
-            for ``none``).
+        phi_deg: (N, 2) the raw (commanded) joint angles, ``phi1_deg, phi2_deg``.
+        dpsi_arcsec, dtheta_arcsec: (N,) the measured orientation error angles.
+        refraction: ``apply`` or ``none``; refraction_arcsec: (N,) what was added to each
+            observed elevation (zeros for ``none``).
         latitude_deg: the latitude of the URDF's polar axis (equatorial; the file's for alt-az).
-        urdf_name: the bundled URDF the rows belong to.
-        urdf_text: that URDF (for an equatorial run: tilted to ``latitude_deg``).
-        urdf_written: where that URDF was written, if it was (named in the comments).
+        urdf_name, urdf_text: the bundled URDF the rows belong to and its text (an equatorial
+            run's tilted to ``latitude_deg``); urdf_written: where it was written, if it was.
     """
 
     run: TpointRun
@@ -644,13 +639,11 @@ def _angles_pointing_at(placements, target: np.ndarray, start_rad: np.ndarray) -
 def refuse_repeated_positions(run: TpointRun) -> None:
     """Refuse two records of ``run`` at the same raw position, naming both lines of the file.
 
-    The rows of the measurement CSV are the raw positions (``phi1_deg, phi2_deg``), and its
-    reader refuses two rows at one position (to 1e-9 deg) unless they differ in ``time_s`` or
-    approach direction (:func:`~turntable_pin.core.csv_table.refuse_repeated_rows`), which a
-    TPOINT run does not record: the rule is applied here, with the same comparison, so that the
-    import never writes a file that ``fit`` and ``diagnose`` refuse. A copied line (the same star
-    at the same raw position) and two pointings that read the same encoder position are told
-    apart in the message.
+    The CSV's rows are the raw positions, and its reader refuses two at one position unless they
+    differ in ``time_s`` or approach direction (:func:`~.core.csv_table.refuse_repeated_rows`),
+    which a TPOINT run does not record: the same rule here keeps the import from writing a file
+    ``fit`` and ``diagnose`` refuse. The message tells a copied line (the same star) from two
+    pointings that read the same encoder position.
     """
     found = first_repeated_row(list(run.raw_deg.T), run.n_stars)
     if found is None:
