@@ -46,19 +46,11 @@ __all__ = [
     "MAX_SIGMA_ARCSEC",
     "MAX_TIME_S",
     "MIN_SIGMA_ARCSEC",
-    "OPTIONAL_COLUMNS",
-    "REQUIRED_COLUMNS",
     "OrientationMeasurements",
     "check_times_and_directions",
     "read_measurements",
 ]
 
-REQUIRED_COLUMNS = ("phi1_deg", "phi2_deg", "dpsi_arcsec", "dtheta_arcsec", "dgamma_arcsec")
-"""Columns every measurement CSV must have (angles in degrees, errors in arcsec)."""
-OPTIONAL_COLUMNS = ("sigma_arcsec", "time_s", "dir1", "dir2")
-"""Columns read when present: 1-sigma noise (arcsec), time (s), approach directions (+1/-1);
-also ``sigma_dpsi_arcsec, sigma_dtheta_arcsec, sigma_dgamma_arcsec`` (a sigma per angle) and
-``dirK`` for joint K of a table with more axes."""
 _RESERVED = frozenset(("sigma_arcsec", "time_s"))
 _SIGMA_COLUMNS = tuple(f"sigma_{n}_arcsec" for n in ANGLE_NAMES)
 
