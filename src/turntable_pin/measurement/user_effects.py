@@ -237,16 +237,11 @@ def _effects_in(objects: Iterable, where: str, base: type = Effect, path=None) -
 
 
 def load_effects_module(path: str | Path, base: type = Effect) -> tuple:
-    """The effects a Python file defines: instances of :class:`Effect` (or of ``base``: the
-    run effects of :mod:`turntable_pin.instrument` use
-    :class:`~turntable_pin.instrument.effects.base.RunEffect`), and the subclasses defined in
-    the file (built without arguments), in the order they appear. Each effect's ``source`` is
-    the file.
-
-    The file is code that runs: importing it runs its top level
-    (:func:`~turntable_pin.core.user_code.import_module_file`). The effects are not checked
-    here: :func:`check_user_effects` (orientation effects) and
-    :func:`turntable_pin.instrument.effects.contract.check_user_run_effects` (run effects) do.
+    """The effects a Python file defines, in order: instances of :class:`Effect` (or of ``base``:
+    a run's ``RunEffect``) and the subclasses defined there (built without arguments), each
+    with the file as its ``source``. Importing the file runs its top level
+    (:func:`~turntable_pin.core.user_code.import_module_file`); the effects are checked by
+    :func:`check_user_effects` (orientation) or ``check_user_run_effects`` (runs), not here.
 
     Raises:
         InputError: the file cannot be read or defines no effect.

@@ -1,7 +1,7 @@
 """The contract of an :class:`~.base.Effect` plug-in, checked once where the user's effect enters.
 
-An effect the user writes (a class of a Python module, an installed plug-in, an object passed from
-Python) must give, for the variables of N positions:
+An effect the user writes (a Python module's class, a plug-in, an object from Python) must give,
+for the variables of N positions:
 
 - its story as text (``name``, ``title``, ``definition``, ``explanation``, ``confirm``) and its
   ``required_columns`` as a tuple of column names;
@@ -12,10 +12,10 @@ Python) must give, for the variables of N positions:
   whose ``weights`` map parameters it declared to a finite number or a finite array of shape
   (N,); every declared parameter weighed by some term.
 
-:func:`check_effect` calls the methods (through :func:`~turntable_pin.core.user_code.call_user`)
-on the data's variables or on a probe (:func:`probe_variables`) and raises a one-line
-:class:`~turntable_pin.core.exceptions.UserCodeError` naming the file, the effect, the method,
-what it returned and what was expected; the package's own effects are not checked.
+:func:`check_effect` calls the methods (:func:`~turntable_pin.core.user_code.call_user`) on the
+data's variables or a probe (:func:`probe_variables`); a one-line ``UserCodeError`` names the
+file, the effect, the method, what it returned and what was expected. The package's own effects
+are not checked.
 """
 
 from __future__ import annotations
