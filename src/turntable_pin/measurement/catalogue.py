@@ -10,11 +10,10 @@
 Which entries of ``K`` and which base axes are kept is found like the base errors: QR with column
 pivoting of the effect's columns, after projecting out the base errors, on generic positions.
 
-A table whose layout names effects (the paper's nine names, data:
+A table whose layout names effects (the paper's nine,
 :data:`~turntable_pin.model.paper_table.PAPER_EFFECTS`) has the same catalogue under those names;
-on any table ``<kind>@<joint>`` is the catalogue's
-effect of that kind on that joint alone (``encoder_harmonics@outer_axis`` is
-``outer_encoder_harmonics``).
+on any table ``<kind>@<joint>`` is the catalogue's effect of that kind on that joint alone
+(``encoder_harmonics@outer_axis`` is ``outer_encoder_harmonics``).
 """
 
 from __future__ import annotations
