@@ -115,32 +115,31 @@ class OrientationMeasurements:
         if joints.ndim == 1:
             joints = joints[:, None]
         n, n_joints = joints.shape
-        object.__setattr__(self, "joint_rad", _frozen(joints))
-        object.__setattr__(self, "angles_rad", _frozen(np.reshape(self.angles_rad, (n, 3))))
-        if self.sigma_rad is not None:
-            sigma = np.asarray(self.sigma_rad, dtype=float)
-            sigma = np.repeat(sigma.reshape(n, 1), 3, axis=1) if sigma.size == n else sigma
-            object.__setattr__(self, "sigma_rad", _frozen(sigma.reshape(n, 3)))
         dirs = (tuple(self.dirs) + (None,) * n_joints)[:n_joints]
-        checked = []
         for name, value in (("time_s", self.time_s), ("rows", self.rows),
                             *((f"dir{k + 1}", d) for k, d in enumerate(dirs)),
                             *self.extra.items()):  # fmt: skip
             if value is not None and np.asarray(value).size != n:
                 raise InputError(f"{name} has {np.asarray(value).size} values, expected {n}")
-            checked.append(value)
-        if self.time_s is not None:
-            object.__setattr__(self, "time_s", _frozen(np.reshape(self.time_s, -1)))
-        object.__setattr__(
-            self, "dirs", tuple(None if d is None else _frozen(np.reshape(d, -1)) for d in dirs)
-        )
-        object.__setattr__(
-            self, "extra", {k: _frozen(np.reshape(v, -1)) for k, v in self.extra.items()}
-        )
+        sigma = self.sigma_rad
+        if sigma is not None:
+            sigma = np.asarray(sigma, dtype=float)
+            sigma = np.repeat(sigma.reshape(n, 1), 3, axis=1) if sigma.size == n else sigma
+            sigma = _frozen(sigma.reshape(n, 3))
         rows = np.arange(2, n + 2) if self.rows is None else np.reshape(self.rows, -1)
-        object.__setattr__(self, "rows", _frozen(rows, int))
-        object.__setattr__(self, "joint_names", tuple(self.joint_names))
-        object.__setattr__(self, "ignored_columns", tuple(self.ignored_columns))
+        checked = {
+            "joint_rad": _frozen(joints),
+            "angles_rad": _frozen(np.reshape(self.angles_rad, (n, 3))),
+            "sigma_rad": sigma,
+            "time_s": None if self.time_s is None else _frozen(np.reshape(self.time_s, -1)),
+            "dirs": tuple(None if d is None else _frozen(np.reshape(d, -1)) for d in dirs),
+            "extra": {k: _frozen(np.reshape(v, -1)) for k, v in self.extra.items()},
+            "rows": _frozen(rows, int),
+            "joint_names": tuple(self.joint_names),
+            "ignored_columns": tuple(self.ignored_columns),
+        }
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
         self._check_values()
 
     def _check_values(self) -> None:
