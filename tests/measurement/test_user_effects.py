@@ -180,9 +180,9 @@ def test_effect_spec_round_trip_a_planted_term_falls_to_the_noise(encoder_data, 
     assert 0.75 < after["chi2_reduced"] < 1.25
     assert after["p_value"] > 0.001
     text = "\n".join(diagnosis_lines(out, data="run.csv"))
-    assert (
-        "turntable-pin fit run.csv --effects 'inner_encoder_harmonics,"
-        f"{','.join(t['effect_spec'] for t in terms)}'"
+    assert (  # from Python, the Python call (the command line prints its shell command)
+        "fit('run.csv', effects='inner_encoder_harmonics,"
+        f"{','.join(t['effect_spec'] for t in terms)}')"
     ) in text
 
 

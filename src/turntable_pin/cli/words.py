@@ -12,5 +12,6 @@ CLI_WORDS = CommandLineWords(
     {
         "from_data": "--from",
         "turntable": "--urdf",
+        "outliers=False": "--keep-outliers",
     },
 )

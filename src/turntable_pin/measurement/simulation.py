@@ -516,7 +516,7 @@ def simulate_measurements(
             MAX_NOISE_ARCSEC]`` (the file must read back); three numbers: one per angle
             (written as ``sigma_<angle>_arcsec``).
         seed: seed of every random choice (order, directions, noise), 0 <= seed < 2**63.
-        turntable: the table (``GenericTable``, ``TurntableModel`` or ``None``: the paper's).
+        turntable: the table (a ``GenericTable``; ``None``: the paper's).
         catalogue: effects besides the table's catalogue that ``effects`` may name (the user's).
         noise_spread: F >= 1: each row's sigma is ``noise_arcsec`` times a factor drawn
             log-uniform in [1/F, F] (seeded, after the noise), within the noise range; 1: even.
