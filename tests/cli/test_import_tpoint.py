@@ -6,6 +6,8 @@ from __future__ import annotations
 import pytest
 
 from conftest import EXAMPLES_DIR, REPO_DIR, cli, write_file
+from turntable_pin.cli.words import CLI_WORDS
+from turntable_pin.core.words import speaking
 from turntable_pin.measurement.data import read_measurements
 from turntable_pin.measurement.tpoint import convert_tpoint, read_tpoint
 from turntable_pin.model.generic_table import GenericTable
@@ -34,7 +36,8 @@ def test_the_mmt_run_is_imported_and_read_back(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert "80 stars, altaz mount (: ALTAZ)" in proc.stdout
     assert "refraction: none" in proc.stdout and "--urdf models/altaz_mount.urdf" in proc.stdout
-    expected = convert_tpoint(read_tpoint(MMT)).csv_text()
+    with speaking(CLI_WORDS):  # the file names the command line's flag, as the CLI speaks
+        expected = convert_tpoint(read_tpoint(MMT)).csv_text()
     assert out.read_text() == expected
     data = read_measurements(out, GenericTable(ALTAZ_URDF).joint_names)
     assert data.n_positions == 80

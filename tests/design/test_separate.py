@@ -257,6 +257,6 @@ def test_the_paper_tables_commands_name_no_urdf_and_simulated_data_a_placeholder
     sim = simulate_measurements(None, {"gravity_sag": {"k": 3.0}}, seed=7)
     verdict = diagnose_measurements(sim.data).to_dict()["verdict"]
     command = verdict["separation_commands"]["outer_encoder_harmonics"]
-    assert command == (
-        "turntable-pin design --separate gravity_sag,outer_encoder_harmonics --from DATA.csv"
+    assert command == (  # from Python, the Python call; the CLI prints the shell command
+        "design(separate='gravity_sag,outer_encoder_harmonics', from_data='DATA.csv')"
     )

@@ -23,11 +23,13 @@ def test_reads_columns_in_any_order_with_extras(tmp_path):
     text += "x,3,45,30,2,1,0.5,10,-1\ny,6,90,30,5,4,0.5,20,1\n"
     data = read_measurements(write_file(tmp_path, text))
     assert data.n_positions == 2
-    np.testing.assert_allclose(np.degrees(data.phi1_rad), [30, 30])
+    np.testing.assert_allclose(np.degrees(data.joint_rad[:, 0]), [30, 30])
     np.testing.assert_allclose(data.angles_rad[0] * 206264.80624709636, [1, 2, 3])
     np.testing.assert_allclose(data.sigma_rad * 206264.80624709636, np.full((2, 3), 0.5))
     assert data.extra == {}  # the text column "note" is not a suspect
-    assert data.dir2 is None and data.dir1.tolist() == [-1, 1] and data.rows.tolist() == [3, 4]
+    assert (
+        data.dirs[1] is None and data.dirs[0].tolist() == [-1, 1] and data.rows.tolist() == [3, 4]
+    )
 
 
 @pytest.mark.parametrize(
@@ -159,7 +161,7 @@ def test_a_text_column_is_ignored_and_named_and_an_effect_on_it_is_told_so(tmp_p
     text = HEAD + ",temperature_c,note\n" + grid_rows(lambda i: ",n/a,ok" if i else ",21,ok")
     data = read_measurements(write_file(tmp_path, text))
     assert data.extra == {} and data.ignored_columns == ("temperature_c", "note")
-    assert data.select(np.arange(4)).ignored_columns == ("temperature_c", "note")
+    assert data.without_sigma().ignored_columns == ("temperature_c", "note")  # copies keep it
     with pytest.raises(InputError) as info:
         OrientationModel(data.variables(), resolve_effects(["dpsi~poly1(temperature_c)"]))
     message = str(info.value)

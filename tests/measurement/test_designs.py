@@ -241,7 +241,7 @@ def test_a_sweep_that_holds_phi2_cannot_test_effects_of_phi2_and_says_so():
     )
     text = " ".join(d["warnings"])
     assert "the rows hold phi2 at 90 deg: effects that vary with phi2 cannot be tested" in text
-    assert "--sweep phi1,phi2" in text
+    assert "(simulate sweep phi1,phi2, or a grid)" in text  # the CLI says --sweep
     assert "so effects that vary with phi2 cannot be tested" in text  # the rank warning, precise
     # the reverse sweep added (one command: --sweep phi1,phi2) sees it
     both = _diagnosis(Schedule(30, 30, sweep=("phi1", "phi2"), starts_deg=(0, 90)),

@@ -36,7 +36,7 @@ def test_every_detectable_effect_is_named_and_its_fit_reaches_the_noise(name):
         for data in (sim.data, sim.data.without_sigma()):
             verdict = diagnose_measurements(data).to_dict()["verdict"]
             assert name == verdict["missing_effect"] or name in verdict["alternatives"], (
-                seed, data.has_sigma, verdict,
+                seed, data.sigma_rad is not None, verdict,
             )  # fmt: skip
             assert not verdict["unexplained"], (seed, verdict)
         fit = fit_orientation(sim.data, [EFFECTS[name]])
@@ -96,7 +96,7 @@ def test_an_effect_outside_the_catalogue_is_unexplained():
         rng = np.random.default_rng(seed)
         sim = simulate_measurements(random_errors(rng), seed=seed)
         extra = np.zeros_like(sim.data.angles_rad)
-        extra[:, 1] = 3.0 / ARCSEC_PER_RAD * np.cos(3 * sim.data.phi2_rad + 0.4)  # 3/rev
+        extra[:, 1] = 3.0 / ARCSEC_PER_RAD * np.cos(3 * sim.data.joint_rad[:, 1] + 0.4)  # 3/rev
         data = _with_extra(sim.data, extra)
         for variant in (data, data.without_sigma()):
             d = diagnose_measurements(variant)
@@ -353,7 +353,7 @@ def test_data_of_another_table_make_the_first_line_ask_for_the_urdf():
 
     data = read_measurements(EXAMPLES_DIR / "measurements_vertical_outer.csv")
     d = diagnose_measurements(data).to_dict()  # forgot --urdf: the paper's table
-    assert headline(d).startswith("Check the table:") and "--urdf" in d["verdict"]["doubt"]
+    assert headline(d).startswith("Check the table:") and "(turntable)" in d["verdict"]["doubt"]
     clean = diagnose_measurements(read_measurements(EXAMPLES_DIR / "measurements_example.csv"))
     assert clean.to_dict()["verdict"]["doubt"] is None
 
@@ -441,6 +441,8 @@ def test_the_final_model_never_fits_worse_than_a_candidate_it_passed_over(monkey
 
 def test_the_design_command_says_mount_only_when_the_table_is_not_what_its_urdf_declares():
     from conftest import REPO_DIR
+    from turntable_pin.cli.words import CLI_WORDS
+    from turntable_pin.core.words import speaking
     from turntable_pin.measurement.diagnosis import design_command, mount_option
     from turntable_pin.model.generic_table import GenericTable
 
@@ -449,8 +451,14 @@ def test_the_design_command_says_mount_only_when_the_table_is_not_what_its_urdf_
     assert mount_option(GenericTable(zy)) is None
     assert mount_option(GenericTable(altaz, telescope_mount="none")) == "none"
     assert mount_option(GenericTable(zy, telescope_mount="altaz")) == "altaz"
-    assert design_command("d.csv", ("TF", "gravity_sag"), "zy.urdf", "altaz") == (
-        "turntable-pin design --separate TF,gravity_sag --from d.csv --urdf zy.urdf --mount altaz"
+    command = design_command("d.csv", ("TF", "gravity_sag"), "zy.urdf", "altaz")
+    with speaking(CLI_WORDS):
+        assert str(command) == (
+            "turntable-pin design --separate TF,gravity_sag --from d.csv --urdf zy.urdf "
+            "--mount altaz"
+        )
+    assert str(command) == (
+        "design(separate='TF,gravity_sag', from_data='d.csv', urdf='zy.urdf', mount='altaz')"
     )
 
 

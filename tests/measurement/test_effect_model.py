@@ -27,7 +27,7 @@ def test_base_model_equals_the_batch_path(seed):
     errors = rng.normal(0, 1e-3, 8)  # large: the exact chain, not its small-angle form
     values = np.append(errors, 0.0)[None]
     expected = OrientationErrorField.from_chain(paper_table().chain, values).angles(
-        v.phi1_rad, v.phi2_rad
+        v.joint_rad[:, 0], v.joint_rad[:, 1]
     )[0]
     np.testing.assert_allclose(OrientationModel(v).predict(errors), expected, atol=1e-15)
 
@@ -41,7 +41,10 @@ def test_zero_parameter_jacobian_is_the_small_angle_matrix(rng):
     for k in range(8):
         unit = np.eye(8)[k]
         np.testing.assert_allclose(
-            jac[:, :, k], small_angle_orientation_error(unit, v.phi2_rad), rtol=0, atol=rounding
+            jac[:, :, k],
+            small_angle_orientation_error(unit, v.joint_rad[:, 1]),
+            rtol=0,
+            atol=rounding,
         )
 
 

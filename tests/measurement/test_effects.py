@@ -45,7 +45,7 @@ def _variables(rng, n=7):
 def _independent(effect, v, base, p, i):
     """dpsi, dtheta, dgamma at position i from the spec's words, via per-call Pinocchio."""
     e = dict(zip(ANGULAR_ERROR_NAMES, base, strict=True))
-    phi1, phi2 = v.phi1_rad[i], v.phi2_rad[i]
+    phi1, phi2 = v.joint_rad[:, 0][i], v.joint_rad[:, 1][i]
     pre, post = np.eye(3), np.eye(3)
     if effect == "outer_encoder_harmonics":
         e["dphi_y1"] += ref.h(phi1, p["c1"], p["s1"], p["c2"], p["s2"])
@@ -67,8 +67,8 @@ def _independent(effect, v, base, p, i):
         t = v.time_s[i]
         post = rot_z(p["rz"] * t) @ rot_y(p["ry"] * t) @ rot_x(p["rx"] * t)
     elif effect == "backlash":
-        e["dphi_y1"] += p["b1"] * v.dir1[i] / 2
-        e["dphi_z2"] += p["b2"] * v.dir2[i] / 2
+        e["dphi_y1"] += p["b1"] * v.dirs[0][i] / 2
+        e["dphi_z2"] += p["b2"] * v.dirs[1][i] / 2
     elif effect == "payload_mount":
         post = rot_z(p["mz"]) @ rot_y(p["my"]) @ rot_x(p["mx"])
     table = paper_table()

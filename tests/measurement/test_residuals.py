@@ -26,7 +26,9 @@ def test_an_outlier_is_the_failing_position_and_harmonics_show_a_missing_term(tm
     sim = simulate_measurements(seed=4, noise_arcsec=0.5)
     angles = sim.data.angles_rad.copy()
     angles[17, 2] += 6.0 / ARCSEC_PER_RAD  # 12 sigma on dgamma
-    angles[:, 1] += 2.0 / ARCSEC_PER_RAD * np.sin(2 * sim.data.phi1_rad)  # 2/rev in phi1 on dtheta
+    angles[:, 1] += (
+        2.0 / ARCSEC_PER_RAD * np.sin(2 * sim.data.joint_rad[:, 0])
+    )  # 2/rev in phi1 on dtheta
     data = sim.data.replace(angles_rad=angles, dirs=())
     analysis = analyse_residuals(orientation_residuals(fit_orientation(data)), k_sigma=3)
     worst = analysis.failing[0]

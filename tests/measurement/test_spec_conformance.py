@@ -128,13 +128,13 @@ def test_simulator_user_units_match_reference(turntable, effect):
     d = sim.data
     ref_errors = dict(zip(ref.ERROR_NAMES, errors.angular_array_rad(), strict=True))
     expected = ref.reference_angles(
-        d.phi1_rad,
-        d.phi2_rad,
+        d.joint_rad[:, 0],
+        d.joint_rad[:, 1],
         ref_errors,
         {effect: {p: v * per for p, v in user.items()}},
         time_s=d.time_s,
-        dir1=d.dir1,
-        dir2=d.dir2,
+        dir1=d.dirs[0],
+        dir2=d.dirs[1],
     )
     # Both read the angles off dR, a product of 15 rotations (10 of Table 3, up to 3 of the effect,
     # 2 of Rd) in the reference and as many in the simulator: absolute rounding.

@@ -268,7 +268,7 @@ def test_north_based_azimuths_are_converted(tmp_path):
         tmp_path, np.c_[180.0 - obs[:, 0], obs[:, 1]], np.c_[180.0 - raw[:, 0], raw[:, 1]],
         header=header, name="n.dat",
     )  # fmt: skip
-    with pytest.raises(InputError, match=r"line 1: .*'North = 0'.*--azimuth-origin north"):
+    with pytest.raises(InputError, match=r"line 1: .*'North = 0'.*azimuth_origin north"):
         read_tpoint(north)
     converted = convert_tpoint(read_tpoint(north, azimuth_origin="north"))
     assert np.allclose(converted.dtheta_arcsec, south.dtheta_arcsec, atol=1e-9)

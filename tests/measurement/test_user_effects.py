@@ -180,9 +180,9 @@ def test_effect_spec_round_trip_a_planted_term_falls_to_the_noise(encoder_data, 
     assert 0.75 < after["chi2_reduced"] < 1.25
     assert after["p_value"] > 0.001
     text = "\n".join(diagnosis_lines(out, data="run.csv"))
-    assert (
-        "turntable-pin fit run.csv --effects 'inner_encoder_harmonics,"
-        f"{','.join(t['effect_spec'] for t in terms)}'"
+    assert (  # from Python, the Python call (the command line prints its shell command)
+        "fit('run.csv', effects='inner_encoder_harmonics,"
+        f"{','.join(t['effect_spec'] for t in terms)}')"
     ) in text
 
 
@@ -222,7 +222,7 @@ class Settling(Effect):
         return (ParameterSpec("a", "arcsec", ARCSEC, "settling"),)
 
     def chain_terms(self, variables):
-        return (ChainTerm("post", "z", {"a": (1 - variables.dir1) / 2}),)
+        return (ChainTerm("post", "z", {"a": (1 - variables.dirs[0]) / 2}),)
 
 
 def test_a_module_effect_is_fitted_and_named_by_the_diagnosis(tmp_path, encoder_data):

@@ -64,7 +64,7 @@ def partial_page():
         TurntableErrors.from_arcsec(deps_y=4, dalpha_x1=2), {"gravity_sag": {"k": 3.0}}, seed=3
     )
     angles = np.array(sim.data.angles_rad)
-    angles[:, 1] += 2.0 * np.cos(3 * sim.data.phi2_rad - 0.7) / ARCSEC_PER_RAD
+    angles[:, 1] += 2.0 * np.cos(3 * sim.data.joint_rad[:, 1] - 0.7) / ARCSEC_PER_RAD
     diagnosis = diagnose_measurements(dataclasses.replace(sim.data, angles_rad=angles))
     return diagnosis, diagnosis_html(diagnosis, title="t")
 

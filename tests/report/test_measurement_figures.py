@@ -47,7 +47,7 @@ def planted():
     sim = simulate_measurements(TurntableErrors.from_arcsec(deps_y=4, dalpha_x1=2), seed=3)
     data = sim.data
     angles = np.array(data.angles_rad)
-    angles[:, 1] += PLANTED_ARCSEC * np.cos(3 * data.phi2_rad - PHASE_RAD) / ARCSEC_PER_RAD
+    angles[:, 1] += PLANTED_ARCSEC * np.cos(3 * data.joint_rad[:, 1] - PHASE_RAD) / ARCSEC_PER_RAD
     data = dataclasses.replace(data, angles_rad=angles)
     return data, diagnose_measurements(data)
 
@@ -124,7 +124,7 @@ def test_forward_and_backward_passes_are_told_apart():
     sim = simulate_measurements(seed=4)
     rs = orientation_residuals(diagnose_measurements(sim.data).base_fit)
     assert set(direction_of(rs, "phi1_deg")) == {-1.0, 1.0}
-    assert np.array_equal(direction_of(rs, "phi2_deg"), sim.data.dir2)
+    assert np.array_equal(direction_of(rs, "phi2_deg"), sim.data.dirs[1])
     assert direction_of(rs, "time_s") is None
     assert direction_of(dataclasses.replace(rs, others={}), "phi1_deg") is None
     assert _png_size(residual_figure([rs]))[1] > 1000

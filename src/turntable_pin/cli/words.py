@@ -12,6 +12,7 @@ CLI_WORDS = CommandLineWords(
     {
         "from_data": "--from",
         "n": "-n",
+        "turntable": "--urdf",
         "outliers=False": "--keep-outliers",
     },
 )

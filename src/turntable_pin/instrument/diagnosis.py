@@ -24,9 +24,10 @@ from ..calibration.run import CalibrationRun
 from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.exceptions import InputError
 from ..core.units import DEG_PER_RAD
-from ..core.words import Command, argument, command
+from ..core.words import Command, argument
 from ..measurement.diagnosis import (
     dense_joint_grid,
+    design_command,
     harmonic_basis,
     joint_harmonics,
     mount_option,
@@ -391,17 +392,13 @@ class RunFamily(DataFamily):
 def run_design_command(run, pair: tuple[str, str]) -> Command:
     """The ``design`` command that chooses the calibration positions telling the two effects
     apart, or says that none do (:mod:`.separate`), with ``urdf``, ``mount`` and
-    ``latitude_deg`` when they are not the defaults."""
+    ``latitude_deg`` when they are not the defaults (the one
+    :func:`~turntable_pin.measurement.diagnosis.design_command`)."""
     latitude = float(np.degrees(run.inputs.latitude_rad))
     default = abs(latitude - DEFAULT_LATITUDE_DEG) <= 1e-9
-    return command(
-        "design",
-        separate=",".join(pair),
-        run=run.source,
-        urdf=urdf_option(run.table),
-        mount=mount_option(run.table),
-        latitude_deg=None if default else f"{latitude:g}",
-    )
+    return design_command(run.source, pair, urdf_option(run.table), mount_option(run.table),
+                          data_argument="run",
+                          latitude_deg=None if default else f"{latitude:g}")  # fmt: skip
 
 
 def diagnose_run(

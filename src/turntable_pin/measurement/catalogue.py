@@ -10,15 +10,15 @@
 Which entries of ``K`` and which base axes are kept is found like the base errors: QR with column
 pivoting of the effect's columns, after projecting out the base errors, on generic positions.
 
-A table whose layout names effects (the paper's nine names, data:
+A table whose layout names effects (the paper's nine,
 :data:`~turntable_pin.model.paper_table.PAPER_EFFECTS`) has the same catalogue under those names;
-on any table ``<kind>@<joint>`` is the catalogue's
-effect of that kind on that joint alone (``encoder_harmonics@outer_axis`` is
-``outer_encoder_harmonics``).
+on any table ``<kind>@<joint>`` is the catalogue's effect of that kind on that joint alone
+(``encoder_harmonics@outer_axis`` is ``outer_encoder_harmonics``).
 """
 
 from __future__ import annotations
 
+# scipy.linalg is imported inside _determined: importing the catalogue stays light
 import weakref
 from collections.abc import Sequence
 
@@ -26,6 +26,7 @@ import numpy as np
 
 from ..core.exceptions import InputError
 from ..model.named_effects import NamedEffect
+from ..stats.least_squares import RANK_RTOL
 from .effect_model import OrientationModel
 from .effects.backlash import Backlash
 from .effects.base import Effect, PositionVariables
@@ -33,6 +34,7 @@ from .effects.base_rotation import BaseRotation
 from .effects.encoder_harmonics import EncoderHarmonics
 from .effects.gravity_compliance import COMPLIANCE_ENTRIES, GravityCompliance
 from .effects.payload_mount import PayloadMount
+from .effects.pointing_flexure import pointing_flexures
 from .effects.thermal_drift import ThermalDrift
 from .effects.wobble_harmonics import WobbleHarmonics
 from .table import JointErrors, MeasuredTable, measured_table
@@ -51,8 +53,6 @@ _CATALOGUES: weakref.WeakKeyDictionary[MeasuredTable, tuple[Effect, ...]] = (
 
 def catalogue(turntable=None) -> tuple[Effect, ...]:
     """The candidate effects of a table, in catalogue order (module docstring)."""
-    from .effects.pointing_flexure import pointing_flexures
-
     table = measured_table(turntable)
     cached = _CATALOGUES.get(table)
     if cached is not None:
@@ -123,8 +123,6 @@ def _effect(table, kind: str, joints=(), named: NamedEffect | None = None) -> Ef
 def _determined(table: MeasuredTable, effect: Effect) -> tuple[str, ...]:
     """The parameters of ``effect`` orientation data determine beyond the base errors."""
     from scipy.linalg import qr
-
-    from ..stats.least_squares import RANK_RTOL
 
     rng = np.random.default_rng(0)  # generic positions: any random draw is generic
     variables = PositionVariables(rng.uniform(-np.pi, np.pi, (64, table.n_joints)))

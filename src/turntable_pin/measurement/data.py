@@ -1,28 +1,23 @@
 """Orientation measurements: the CSV of ``docs/measurements.md``, read and validated.
 
 Required columns ``phi1_deg, phi2_deg, dpsi_arcsec, dtheta_arcsec, dgamma_arcsec``; optional
-``sigma_arcsec``, ``time_s``, ``dir1``, ``dir2``. Any other column is numeric when at least half
-of its filled cells are numbers: it is kept (:attr:`OrientationMeasurements.extra`, a suspect for
-the diagnosis) and every cell must be a finite number (a ``warm`` in a ``temperature_c`` column
-is refused naming row and column); a column of text (a ``note``) is left out and named in
-:attr:`OrientationMeasurements.ignored_columns`. Beyond the shared reader's checks (missing
-columns, non-numbers, NaN), a file is refused, naming row and column, when:
+``sigma_arcsec``, ``time_s``, ``dir1``, ``dir2``. Another column is numeric when at least half its
+filled cells are numbers: it is kept (:attr:`OrientationMeasurements.extra`, a suspect for the
+diagnosis) and every cell must be a finite number (``warm`` in ``temperature_c`` is refused); a
+text column (a ``note``) is left out and named (``ignored_columns``). Beyond the shared reader's
+checks (missing columns, non-numbers, NaN), a file is refused, naming row and column, when:
 
-- a value is outside its valid range: ``|phi1_deg|``, ``|phi2_deg|`` above
-  :data:`MAX_COMMANDED_ANGLE_DEG`; ``|dpsi|, |dtheta|, |dgamma|`` above
-  :data:`MAX_MEASURED_ANGLE_ARCSEC` (30 deg: beyond, no orientation error of the table); a
-  ``sigma_arcsec`` <= 0, below :data:`MIN_SIGMA_ARCSEC` or above :data:`MAX_SIGMA_ARCSEC` (the
-  small-error limit); a ``time_s`` negative or above
-  :data:`MAX_TIME_S`; a ``dir1``/``dir2`` not +1 or -1;
-- two rows are the same measurement: equal ``phi1_deg, phi2_deg`` and equal values of every
-  present ``dir1, dir2, time_s`` column. Repeats of a position are legitimate when they differ in
-  time or approach direction; a file without ``time_s`` that repeats a position with the same
-  directions holds a copied row (angles are compared as written, so 0 and 360 differ);
-- an angle column looks like radians: every value is within +-2 pi, some are not whole numbers,
-  and either (a) all of them, read as radians, are whole degrees (e.g. 0.5235987756 = 30 deg:
-  a degree schedule written in radians), or (b) they span more than pi and none is a multiple of
-  0.25 deg besides 0 (irregular values spread over a radian-sized range). A small-angle data set
-  in degrees (say -3, -1.5, 0, 1.5, 3) passes: its values are quarter-degree multiples.
+- a value is out of range: ``|phiK_deg|`` above :data:`MAX_COMMANDED_ANGLE_DEG`; ``|dpsi|,
+  |dtheta|, |dgamma|`` above :data:`MAX_MEASURED_ANGLE_ARCSEC` (30 deg: no orientation error of
+  the table); a sigma <= 0, below :data:`MIN_SIGMA_ARCSEC` or above :data:`MAX_SIGMA_ARCSEC`; a
+  ``time_s`` below 0 or above :data:`MAX_TIME_S`; a ``dirK`` not +1 or -1;
+- two rows are the same measurement: equal angles and equal ``dir1, dir2, time_s`` where present
+  (repeats must differ in time or approach direction; angles compared as written, 0 and 360
+  differ);
+- an angle column looks like radians: every value within +-2 pi, some not whole, and either (a)
+  all of them, read as radians, whole degrees (0.5235987756 = 30 deg), or (b) spanning more than
+  pi with none a multiple of 0.25 deg besides 0. Small angles in degrees (-3, -1.5, 0, 1.5, 3)
+  pass: they are quarter-degree multiples.
 """
 
 from __future__ import annotations
@@ -51,19 +46,13 @@ __all__ = [
     "MAX_SIGMA_ARCSEC",
     "MAX_TIME_S",
     "MIN_SIGMA_ARCSEC",
-    "OPTIONAL_COLUMNS",
-    "REQUIRED_COLUMNS",
     "OrientationMeasurements",
+    "check_times_and_directions",
     "read_measurements",
 ]
 
-REQUIRED_COLUMNS = ("phi1_deg", "phi2_deg", "dpsi_arcsec", "dtheta_arcsec", "dgamma_arcsec")
-"""Columns every measurement CSV must have (angles in degrees, errors in arcsec)."""
-OPTIONAL_COLUMNS = ("sigma_arcsec", "time_s", "dir1", "dir2")
-"""Columns read when present: 1-sigma noise (arcsec), time (s), approach directions (+1/-1);
-also ``sigma_dpsi_arcsec, sigma_dtheta_arcsec, sigma_dgamma_arcsec`` (a sigma per angle) and
-``dirK`` for joint K of a table with more axes."""
 _RESERVED = frozenset(("sigma_arcsec", "time_s"))
+_SIGMA_COLUMNS = tuple(f"sigma_{n}_arcsec" for n in ANGLE_NAMES)
 
 MAX_MEASURED_ANGLE_ARCSEC = MAX_ORIENTATION_ERROR_DEG * 3600.0
 """Largest ``|dpsi|, |dtheta|, |dgamma|`` of a row, arc seconds (30 deg,
@@ -95,17 +84,17 @@ class OrientationMeasurements:
 
     Attributes:
         joint_rad: commanded joint angles (N, J), chain order from the base (phi1 .. phiJ).
-        angles_rad: measured ``dpsi, dtheta, dgamma`` (N, 3); NaN where an angle was not measured.
-        sigma_rad: 1-sigma noise of each angle (N, 3), or ``None`` (to be estimated from the fit).
+        angles_rad: measured ``dpsi, dtheta, dgamma`` (N, 3); NaN where not measured.
+        sigma_rad: 1-sigma noise of each angle (N, 3), or ``None`` (estimated from the fit).
         time_s: time of each row (N,) or ``None``.
         dirs: per joint, the approach direction ``dirK`` (N,) or ``None``.
         extra: other numeric columns of the file, ``{name: (N,)}`` (suspects for the diagnosis).
         rows: spreadsheet row of each position in the file (N,) (2 = first data row).
         source: the file read, or a description.
         joint_names: the table's joint names (for column names and labels), or ``()``.
-        sigma_relative: ``sigma_rad`` gives only the relative noise of the angles (weights); the
-            noise level itself is estimated from the fit (the diagnosis sets this when no sigma
-            is given and the three angles' noise differ).
+        sigma_relative: ``sigma_rad`` gives only the angles' relative noise (weights), the level
+            is estimated from the fit (the diagnosis' choice when no sigma is given and the
+            angles' noise differ).
         ignored_columns: the file's columns left out as not numbers (text or empty throughout).
     """
 
@@ -126,32 +115,31 @@ class OrientationMeasurements:
         if joints.ndim == 1:
             joints = joints[:, None]
         n, n_joints = joints.shape
-        object.__setattr__(self, "joint_rad", _frozen(joints))
-        object.__setattr__(self, "angles_rad", _frozen(np.reshape(self.angles_rad, (n, 3))))
-        if self.sigma_rad is not None:
-            sigma = np.asarray(self.sigma_rad, dtype=float)
-            sigma = np.repeat(sigma.reshape(n, 1), 3, axis=1) if sigma.size == n else sigma
-            object.__setattr__(self, "sigma_rad", _frozen(sigma.reshape(n, 3)))
         dirs = (tuple(self.dirs) + (None,) * n_joints)[:n_joints]
-        checked = []
         for name, value in (("time_s", self.time_s), ("rows", self.rows),
                             *((f"dir{k + 1}", d) for k, d in enumerate(dirs)),
                             *self.extra.items()):  # fmt: skip
             if value is not None and np.asarray(value).size != n:
                 raise InputError(f"{name} has {np.asarray(value).size} values, expected {n}")
-            checked.append(value)
-        if self.time_s is not None:
-            object.__setattr__(self, "time_s", _frozen(np.reshape(self.time_s, -1)))
-        object.__setattr__(
-            self, "dirs", tuple(None if d is None else _frozen(np.reshape(d, -1)) for d in dirs)
-        )
-        object.__setattr__(
-            self, "extra", {k: _frozen(np.reshape(v, -1)) for k, v in self.extra.items()}
-        )
+        sigma = self.sigma_rad
+        if sigma is not None:
+            sigma = np.asarray(sigma, dtype=float)
+            sigma = np.repeat(sigma.reshape(n, 1), 3, axis=1) if sigma.size == n else sigma
+            sigma = _frozen(sigma.reshape(n, 3))
         rows = np.arange(2, n + 2) if self.rows is None else np.reshape(self.rows, -1)
-        object.__setattr__(self, "rows", _frozen(rows, int))
-        object.__setattr__(self, "joint_names", tuple(self.joint_names))
-        object.__setattr__(self, "ignored_columns", tuple(self.ignored_columns))
+        checked = {
+            "joint_rad": _frozen(joints),
+            "angles_rad": _frozen(np.reshape(self.angles_rad, (n, 3))),
+            "sigma_rad": sigma,
+            "time_s": None if self.time_s is None else _frozen(np.reshape(self.time_s, -1)),
+            "dirs": tuple(None if d is None else _frozen(np.reshape(d, -1)) for d in dirs),
+            "extra": {k: _frozen(np.reshape(v, -1)) for k, v in self.extra.items()},
+            "rows": _frozen(rows, int),
+            "joint_names": tuple(self.joint_names),
+            "ignored_columns": tuple(self.ignored_columns),
+        }
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
         self._check_values()
 
     def _check_values(self) -> None:
@@ -185,15 +173,6 @@ class OrientationMeasurements:
             row = int(self.rows[np.flatnonzero(bad)[0]])
             raise InputError(f"{what} (row {row} of {self.source or 'the data'})")
 
-    @classmethod
-    def two_axis(
-        cls, phi1_rad, phi2_rad, angles_rad, sigma_rad=None, time_s=None, dir1=None, dir2=None,
-        rows=None, source: str = "",
-    ) -> OrientationMeasurements:  # fmt: skip
-        """Measurements of a two-axis table from its two angle arrays (the paper's layout)."""
-        joints = np.stack([np.reshape(phi1_rad, -1), np.reshape(phi2_rad, -1)], axis=1)
-        return cls(joints, angles_rad, sigma_rad, time_s, (dir1, dir2), {}, rows, source)
-
     @property
     def n_positions(self) -> int:
         """Number of positions N."""
@@ -205,34 +184,9 @@ class OrientationMeasurements:
         return int(self.joint_rad.shape[1])
 
     @property
-    def phi1_rad(self) -> np.ndarray:
-        """Commanded angle of joint 1, rad (N,)."""
-        return self.joint_rad[:, 0]
-
-    @property
-    def phi2_rad(self) -> np.ndarray:
-        """Commanded angle of joint 2, rad (N,)."""
-        return self.joint_rad[:, 1]
-
-    @property
-    def dir1(self) -> np.ndarray | None:
-        """Approach direction of joint 1, or ``None``."""
-        return self.dirs[0]
-
-    @property
-    def dir2(self) -> np.ndarray | None:
-        """Approach direction of joint 2, or ``None``."""
-        return self.dirs[1] if self.n_joints > 1 else None
-
-    @property
     def measured(self) -> np.ndarray:
         """Which angles were measured, (N, 3) bool (an empty cell is ``False``)."""
         return np.isfinite(self.angles_rad)
-
-    @property
-    def has_sigma(self) -> bool:
-        """Whether the data give a 1-sigma noise per row."""
-        return self.sigma_rad is not None
 
     def variables(self) -> PositionVariables:
         """What effects may depend on at each position: one object while any model built on
@@ -293,17 +247,6 @@ class OrientationMeasurements:
         """The same data with the noise level left to be estimated from the fit."""
         return self.replace(sigma_rad=None, sigma_relative=False)
 
-    def select(self, keep) -> OrientationMeasurements:
-        """The rows where ``keep`` (a mask or index array over the rows) holds."""
-        keep = np.asarray(keep)
-        return self.replace(
-            joint_rad=self.joint_rad[keep], angles_rad=self.angles_rad[keep],
-            sigma_rad=None if self.sigma_rad is None else self.sigma_rad[keep],
-            time_s=None if self.time_s is None else self.time_s[keep],
-            dirs=tuple(None if d is None else d[keep] for d in self.dirs),
-            extra={k: v[keep] for k, v in self.extra.items()}, rows=self.rows[keep],
-        )  # fmt: skip
-
 
 def _looks_like_radians(values_deg: np.ndarray) -> str | None:
     """Why an angle column in degrees looks like radians, or ``None`` (rule: module docstring)."""
@@ -328,6 +271,20 @@ def _check_at_most(table, column: str, limit: float, rule: str) -> None:
     table.refuse(column, np.abs(table[column]) > limit, rule)
 
 
+def check_times_and_directions(rows, dir_columns: Sequence[str]) -> None:
+    """Refuse a ``time_s`` below 0 or above :data:`MAX_TIME_S` and a ``dirK`` not +1 or -1 of
+    ``rows`` (a ``CsvTable``), naming file, row and column."""
+    if rows.has("time_s"):
+        rows.refuse("time_s", rows["time_s"] < 0, "time since the start of the run must be >= 0")
+        _check_at_most(
+            rows, "time_s", MAX_TIME_S,
+            f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
+        )  # fmt: skip
+    for column in dir_columns:
+        if rows.has(column):
+            rows.refuse(column, np.abs(rows[column]) != 1, "an approach direction must be +1 or -1")
+
+
 def read_measurements(
     path: str | Path, joint_names: Sequence[str] | None = None
 ) -> OrientationMeasurements:
@@ -348,22 +305,46 @@ def read_measurements(
     )
     n_joints = len(joint_names) if joint_names else 2
     value_columns = tuple(f"{n}_arcsec" for n in ANGLE_NAMES)
-    sigma_columns = tuple(f"sigma_{n}_arcsec" for n in ANGLE_NAMES)
     dir_columns = tuple(f"dir{k}" for k in range(1, n_joints + 1))
     table = read_csv_table(
         path, (*joint_columns, *value_columns),
-        ("sigma_arcsec", *sigma_columns, "time_s", *dir_columns),
+        ("sigma_arcsec", *_SIGMA_COLUMNS, "time_s", *dir_columns),
         min_rows=1, blank=value_columns, extra=True,
     )  # fmt: skip
-    rows = table.rows
     check_commanded_angles(table, joint_columns)
+    values = _measured_angles(table, value_columns, joint_columns)
+    sigma = _sigma_arcsec(table)
+    check_times_and_directions(table, dir_columns)
+    refuse_repeated_rows(
+        table,
+        (*joint_columns, *dir_columns, "time_s"),
+        "repeats must differ in time_s or approach direction",
+    )
+    return OrientationMeasurements(
+        joint_rad=np.stack([table[c] for c in joint_columns], axis=1) / DEG_PER_RAD,
+        angles_rad=values / ARCSEC_PER_RAD,
+        sigma_rad=None if sigma is None else sigma / ARCSEC_PER_RAD,
+        time_s=table["time_s"] if table.has("time_s") else None,
+        dirs=tuple(table[c] if table.has(c) else None for c in dir_columns),
+        extra={k: v for k, v in table.extra.items() if k not in _RESERVED},
+        rows=table.rows,
+        source=str(table.path),
+        joint_names=tuple(joint_names or ()),
+        ignored_columns=table.skipped,
+    )
+
+
+def _measured_angles(table, value_columns, joint_columns) -> np.ndarray:
+    """The measured angles (N, 3) arcsec, NaN where empty: refused where a row measures none or
+    one is beyond :data:`MAX_MEASURED_ANGLE_ARCSEC`, and where a joint column looks like
+    radians."""
     values = np.stack([table[c] for c in value_columns], axis=1)
     none = np.flatnonzero(~np.isfinite(values).any(axis=1))
     if none.size:
         raise InputError(
             "none of dpsi_arcsec, dtheta_arcsec, dgamma_arcsec is given: a row needs at least "
             "one measured angle",
-            path=table.path, row=int(rows[none[0]]), column=value_columns[0],
+            path=table.path, row=int(table.rows[none[0]]), column=value_columns[0],
         )  # fmt: skip
     limit = MAX_MEASURED_ANGLE_ARCSEC
     for column in value_columns:
@@ -379,15 +360,23 @@ def read_measurements(
                 f"these angles look like radians, not degrees ({why}); convert the column to "
                 "degrees",
                 path=table.path,
-                row=int(rows[0]),
+                row=int(table.rows[0]),
                 column=column,
             )
-    if table.has("sigma_arcsec") and any(table.has(c) for c in sigma_columns):
+    return values
+
+
+def _sigma_arcsec(table) -> np.ndarray | None:
+    """The sigma of each measured angle (N, 3) arcsec from ``sigma_arcsec`` or the three
+    ``sigma_<angle>_arcsec``, checked to be in [:data:`MIN_SIGMA_ARCSEC`,
+    :data:`MAX_SIGMA_ARCSEC`]; ``None`` without them."""
+    per_angle = any(table.has(c) for c in _SIGMA_COLUMNS)
+    if table.has("sigma_arcsec") and per_angle:
         raise InputError(
             "give either sigma_arcsec or the per-angle sigma_<angle>_arcsec columns, not both",
             path=table.path, row=1, column="sigma_arcsec",
         )  # fmt: skip
-    for column in ("sigma_arcsec", *sigma_columns):
+    for column in ("sigma_arcsec", *_SIGMA_COLUMNS):
         if not table.has(column):
             continue
         table.refuse(column, table[column] <= 0, "sigma must be > 0")
@@ -399,42 +388,14 @@ def read_measurements(
             table, column, MAX_SIGMA_ARCSEC,
             f"sigma must be at most {MAX_SIGMA_ARCSEC:g} arcsec ({MAX_ANGULAR_ERROR_DEG:g} deg)",
         )  # fmt: skip
-    sigma = None
     if table.has("sigma_arcsec"):
-        sigma = np.repeat(table["sigma_arcsec"][:, None], 3, axis=1)
-    elif any(table.has(c) for c in sigma_columns):
-        missing = [c for c in sigma_columns if not table.has(c)]
-        if missing:
-            raise InputError(
-                f"per-angle sigma needs all three columns; missing {', '.join(missing)}",
-                path=table.path, row=1,
-            )  # fmt: skip
-        sigma = np.stack([table[c] for c in sigma_columns], axis=1)
-    if table.has("time_s"):
-        table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
-        _check_at_most(
-            table, "time_s", MAX_TIME_S,
-            f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
+        return np.repeat(table["sigma_arcsec"][:, None], 3, axis=1)
+    if not per_angle:
+        return None
+    missing = [c for c in _SIGMA_COLUMNS if not table.has(c)]
+    if missing:
+        raise InputError(
+            f"per-angle sigma needs all three columns; missing {', '.join(missing)}",
+            path=table.path, row=1,
         )  # fmt: skip
-    for column in dir_columns:
-        if table.has(column):
-            table.refuse(
-                column, np.abs(table[column]) != 1, "an approach direction must be +1 or -1"
-            )
-    refuse_repeated_rows(
-        table,
-        (*joint_columns, *dir_columns, "time_s"),
-        "repeats must differ in time_s or approach direction",
-    )
-    return OrientationMeasurements(
-        joint_rad=np.stack([table[c] for c in joint_columns], axis=1) / DEG_PER_RAD,
-        angles_rad=values / ARCSEC_PER_RAD,
-        sigma_rad=None if sigma is None else sigma / ARCSEC_PER_RAD,
-        time_s=table["time_s"] if table.has("time_s") else None,
-        dirs=tuple(table[c] if table.has(c) else None for c in dir_columns),
-        extra={k: v for k, v in table.extra.items() if k not in _RESERVED},
-        rows=rows,
-        source=str(table.path),
-        joint_names=tuple(joint_names or ()),
-        ignored_columns=table.skipped,
-    )
+    return np.stack([table[c] for c in _SIGMA_COLUMNS], axis=1)

@@ -18,8 +18,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.resources import default_urdf_path, models_dir
 from ..core.turn_grid import every_combination, full_turn_grid_deg
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
+from ..core.words import Command, argument, command
+from ..model.mount_declaration import NO_MOUNT
 from ..stats.diagnosis_engine import (
     DATA_PLACEHOLDER,
     DataFamily,
@@ -223,7 +226,6 @@ class OrientationFamily(DataFamily):
         self.data = data
         self.left_out_rad = left_out_rad
         self.table = measured_table(turntable)
-        self.turntable = self.table
         scale = ARCSEC_PER_RAD
         if data.sigma_rad is not None:
             scale *= float(np.nanmedian(np.where(data.measured, data.sigma_rad, np.nan)))
@@ -233,11 +235,6 @@ class OrientationFamily(DataFamily):
             sigma_scale=scale,
             noise_per_column=noise_per_angle,
         )
-
-    @property
-    def noise_per_angle(self) -> bool:
-        """Whether every model is fitted at its own per-angle noise."""
-        return self.noise_per_column
 
     # ---- the hooks of the one diagnosis (stats.diagnosis_engine) ---------------------------
     def fit_model(self, effects: Sequence[Effect], zero_point) -> OrientationFit:
@@ -304,7 +301,7 @@ class OrientationFamily(DataFamily):
         """The family on these data with the angles ``cells`` (N, 3) left out as outliers."""
         return OrientationFamily(
             _without(self.data, cells), self.catalogue, self.table,
-            np.where(cells, self.data.angles_rad, np.nan), self.noise_per_angle,
+            np.where(cells, self.data.angles_rad, np.nan), self.noise_per_column,
         )  # fmt: skip
 
     def with_column_noise(self, column_sigma: np.ndarray) -> OrientationFamily:
@@ -324,11 +321,12 @@ class OrientationFamily(DataFamily):
         urdf = f"the URDF {Path(where).name}" if where is not None else "the default URDF"
         return (
             f"no rigid error set of {urdf} and no catalogued effect makes these data; were they "
-            "measured on another table (--urdf)? Or is the stated sigma too small?"
+            f"measured on another table ({argument('turntable')})? Or is the stated sigma too "
+            "small?"
         )
 
     def complete(self, diagnosis: Diagnosis) -> None:
-        """The ``design --separate`` command that settles each separation of the verdict."""
+        """The ``design`` command (``separate``) that settles each separation of the verdict."""
         if not diagnosis.separations:
             return
         data = self.data
@@ -411,63 +409,70 @@ class OrientationFamily(DataFamily):
         """What positions at more than one place still cannot tell: an axis held at one angle,
         too few angles of an axis for the 2/rev terms, single-axis sweeps (no coupled terms), an
         approach direction that never changes (no backlash)."""
-        data = self.data
+        counts = [np.unique(wrapped_deg[:, k]).size for k in range(self.data.n_joints)]
         out = []
-        counts = [np.unique(wrapped_deg[:, k]).size for k in range(data.n_joints)]
         held = [k for k, c in enumerate(counts) if c == 1]
         if held:
             where = ", ".join(f"{labels[k]} at {wrapped_deg[0, k]:g} deg" for k in held)
             names = " or ".join(labels[k] for k in held)
             out.append(
                 f"the rows hold {where}: effects that vary with {names} cannot be tested here "
-                "(the diagnosis lists them as indistinguishable from the base); move "
-                f"{names} over its turn too (simulate --sweep {','.join(labels)}, or a grid)"
+                f"(the diagnosis lists them as indistinguishable from the base); move {names} "
+                f"over its turn too (simulate {argument('sweep')} {','.join(labels)}, or a grid)"
             )
         for k, count in enumerate(counts):
             if 1 < count < 5:
                 top = (count - 1) // 2
                 out.append(
-                    f"{labels[k]} takes only {count} distinct angles: a k/rev term in "
-                    f"{labels[k]} needs at least 2k+1 angles over the turn, so terms of order "
-                    f"{top + 1} and above (the 2/rev terms of encoders and wobble) alias with "
-                    "lower orders or vanish at every row and cannot be tested; measure "
-                    f"{labels[k]} at 5 or more angles spread over the turn (a step of at most "
-                    "72 deg)"
+                    f"{labels[k]} takes only {count} distinct angles: a k/rev term in {labels[k]} "
+                    f"needs at least 2k+1 angles over the turn, so terms of order {top + 1} and "
+                    "above (the 2/rev terms of encoders and wobble) alias with lower orders or "
+                    f"vanish at every row and cannot be tested; measure {labels[k]} at 5 or more "
+                    "angles spread over the turn (a step of at most 72 deg)"
                 )
         moving = [k for k, c in enumerate(counts) if c > 1]
         if len(moving) > 1:
-            base = [np.unique(wrapped_deg[:, k], return_counts=True) for k in range(data.n_joints)]
-            centre = np.array([v[np.argmax(c)] for v, c in base])
-            if np.all(np.sum(wrapped_deg != centre, axis=1) <= 1):
-                lines = ", ".join(
-                    f"{labels[k]} swept at " + ", ".join(
-                        f"{labels[j]} {centre[j]:g}" for j in range(data.n_joints) if j != k
-                    ) + " deg"
-                    for k in moving
-                )  # fmt: skip
-                out.append(
-                    f"the rows are single-axis sweeps ({lines}): an effect is seen only along "
-                    "these lines, so one that varies with several axes together (a term in "
-                    "phi1+phi2 or phi1-phi2, a product such as the gravity sag) cannot be told "
-                    "from terms in one axis each; measure positions where the axes move together "
-                    "(a grid or random positions) to see it"
-                )
+            out += self._sweep_warning(wrapped_deg, labels, moving)
+        return out + self._fixed_direction_warning(labels)
+
+    def _sweep_warning(self, wrapped_deg: np.ndarray, labels: list[str], moving) -> list[str]:
+        """The rows are single-axis sweeps of the axes ``moving``: no coupled terms."""
+        n_joints = self.data.n_joints
+        base = [np.unique(wrapped_deg[:, k], return_counts=True) for k in range(n_joints)]
+        centre = np.array([v[np.argmax(c)] for v, c in base])
+        if not np.all(np.sum(wrapped_deg != centre, axis=1) <= 1):
+            return []
+        lines = ", ".join(
+            f"{labels[k]} swept at "
+            + ", ".join(f"{labels[j]} {centre[j]:g}" for j in range(n_joints) if j != k)
+            + " deg"
+            for k in moving
+        )
+        return [
+            f"the rows are single-axis sweeps ({lines}): an effect is seen only along these "
+            "lines, so one that varies with several axes together (a term in phi1+phi2 or "
+            "phi1-phi2, a product such as the gravity sag) cannot be told from terms in one axis "
+            "each; measure positions where the axes move together (a grid or random positions) "
+            "to see it"
+        ]
+
+    def _fixed_direction_warning(self, labels: list[str]) -> list[str]:
+        """An approach direction the same at every row: no step with it (backlash)."""
         fixed = [
-            (k, float(d[0])) for k, d in enumerate(data.dirs, start=1)
+            (k, float(d[0])) for k, d in enumerate(self.data.dirs, start=1)
             if d is not None and np.unique(d).size == 1
         ]  # fmt: skip
-        if fixed:
-            dirs = ", ".join(f"dir{k}" for k, _ in fixed)
-            sides = ", ".join(
-                f"{labels[k - 1]} from {'below' if v > 0 else 'above'}" for k, v in fixed
-            )
-            out.append(
-                f"{dirs} {'is' if len(fixed) == 1 else 'are'} the same at every row ({sides}): a "
-                "step with the approach direction (backlash) cannot be told from a constant offset "
-                "of the axis, so it is indistinguishable from the base here; approach the "
-                "positions from both sides (simulate --approach random, or --passes) to see it"
-            )
-        return out
+        if not fixed:
+            return []
+        dirs = ", ".join(f"dir{k}" for k, _ in fixed)
+        sides = ", ".join(f"{labels[k - 1]} from {'below' if v > 0 else 'above'}" for k, v in fixed)
+        return [
+            f"{dirs} {'is' if len(fixed) == 1 else 'are'} the same at every row ({sides}): a "
+            "step with the approach direction (backlash) cannot be told from a constant offset "
+            "of the axis, so it is indistinguishable from the base here; approach the positions "
+            f"from both sides (simulate {argument('approach')} random, or {argument('passes')}) "
+            "to see it"
+        ]
 
     def _measured_angle_probes(
         self, shape: str, text: str, plot: tuple, directions, spec: str
@@ -664,8 +669,7 @@ def _without(data: OrientationMeasurements, cells: np.ndarray) -> OrientationMea
 def _weighted(data: OrientationMeasurements, column_sigma: np.ndarray) -> OrientationMeasurements:
     """``data`` weighted by the relative noise ``column_sigma`` (3,) rad of each angle."""
     return data.replace(
-        sigma_rad=np.broadcast_to(column_sigma, data.angles_rad.shape).copy(),
-        sigma_relative=True,
+        sigma_rad=np.broadcast_to(column_sigma, data.angles_rad.shape).copy(), sigma_relative=True
     )
 
 
@@ -700,28 +704,20 @@ def design_command(
     urdf: str | None = None,
     mount: str | None = None,
     *,
-    data_option: str = "--from",
-    extra: Sequence[str] = (),
-) -> str:
-    """The ``turntable-pin design --separate A,B --from DATA`` command (``data_option``: ``--run``
-    for a calibration run; with ``--urdf`` when the table is not the paper's, ``--mount`` when
-    the table is not what its URDF declares, then the words ``extra``) that chooses the positions
-    telling the two effects apart, or says that none do (``turntable_pin.design.separate``)."""
-    import shlex
-
-    words = ["turntable-pin", "design", "--separate", ",".join(pair), data_option, data]
-    if urdf:
-        words += ["--urdf", urdf]
-    if mount:
-        words += ["--mount", mount]
-    return " ".join(shlex.quote(w) for w in [*words, *extra])
+    data_argument: str = "from_data",
+    **more: object,
+) -> Command:
+    """The ``design`` command that chooses the positions telling the two effects ``pair`` apart,
+    or says that none do (``turntable_pin.design.separate``): ``separate``, the data under
+    ``data_argument`` (``run`` for a calibration run), ``urdf`` when the table is not the
+    paper's, ``mount`` when it is not what its URDF declares, then ``more``."""
+    data_given = {data_argument: data}
+    return command("design", separate=",".join(pair), **data_given, urdf=urdf, mount=mount, **more)
 
 
 def urdf_option(turntable) -> str | None:
-    """What ``--urdf`` names the table by: nothing for the paper's bundled table, the name of a
+    """What ``urdf`` names the table by: nothing for the paper's bundled table, the name of a
     bundled table, else its URDF's path."""
-    from ..core.resources import default_urdf_path, models_dir
-
     table = getattr(turntable, "table", turntable)
     path = getattr(table, "urdf_path", None)
     if path is None:
@@ -733,11 +729,8 @@ def urdf_option(turntable) -> str | None:
 
 
 def mount_option(turntable) -> str | None:
-    """What ``--mount`` says of the table: nothing when it is what its URDF declares, else its
+    """What ``mount`` says of the table: nothing when it is what its URDF declares, else its
     mount kind or ``none`` (a turntable whose URDF declares a mount)."""
-    from ..model.mount_declaration import NO_MOUNT
-    from .table import measured_table
-
     table = measured_table(turntable)
     if table.telescope_mount == table.declared_mount:
         return None

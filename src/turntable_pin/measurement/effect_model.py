@@ -27,21 +27,16 @@ from ..core.units import ARCSEC_PER_RAD
 from ..core.user_code import is_user_code
 from ..model.angles import ANGLE_ENTRIES, ANGLE_NAMES
 from ..model.chain import ROTATION
-from ..model.errors import ANGULAR_ERROR_NAMES
 from .effects.base import MEASURED, POST, PRE, Effect, ParameterSpec, PositionVariables
 from .effects.contract import check_effect
 from .table import MeasuredTable, measured_table
 
-__all__ = ["AXIS_INDEX", "BASE_PARAMETERS", "OrientationModel", "base_parameters"]
+__all__ = ["OrientationModel", "base_parameters"]
 
 
 def base_parameters(names) -> tuple[ParameterSpec, ...]:
     """The base errors ``names`` as parameters in arcsec."""
     return tuple(ParameterSpec(name, "arcsec", 1.0 / ARCSEC_PER_RAD, name) for name in names)
-
-
-BASE_PARAMETERS: tuple[ParameterSpec, ...] = base_parameters(ANGULAR_ERROR_NAMES)
-"""The paper's base errors as parameters."""
 
 
 @dataclass(frozen=True)
@@ -258,10 +253,7 @@ class OrientationModel:
             # diagnosis's base and candidates) share their stacked weights while any uses them.
             effects = tuple(by_id[o[0]] for origin in origins for o in origin if o[0] != "unit")
             weights = variables.memo(
-                ("gain", origins),
-                effects,
-                lambda: _stacked_gain(rows, variables.n),
-                weak=True,
+                ("gain", origins), effects, lambda: _stacked_gain(rows, variables.n), weak=True
             )
             return _Factor(axis=axis, columns=columns, weights=weights)
 

@@ -13,7 +13,7 @@ A term says *where* an angle is added and *how* it varies from position to posit
 
 The inline form of a term is ``SITE~SHAPE(VARIABLE)``: ``dphi_z2~h3(phi2)`` (order 3),
 ``dphi_z2~h1..2(phi2)`` (orders 1 to 2), ``dpsi~poly1(temperature_c)``, ``dphi_y1~sign(dir1)``.
-It contains no comma, so a comma-separated ``--effects`` list can hold it. Parameters: ``cK, sK``
+It contains no comma, so a comma-separated ``effects`` list can hold it. Parameters: ``cK, sK``
 (arcsec) of a harmonic of order K, ``pK`` (arcsec per unit of the column to the power K) of a
 polynomial, ``b`` (arcsec) of a sign term; each may carry the term's ``prefix``.
 """
@@ -29,7 +29,14 @@ from ..core.exceptions import InputError
 from ..model.angles import ANGLE_NAMES
 from .effects.base import ARCSEC, MEASURED, ChainTerm, ParameterSpec, PositionVariables
 
-__all__ = ["MAX_HARMONIC_ORDER", "MAX_POLYNOMIAL_DEGREE", "SHAPES", "EffectTerm", "parse_term"]
+__all__ = [
+    "MAX_HARMONIC_ORDER",
+    "MAX_POLYNOMIAL_DEGREE",
+    "SHAPES",
+    "EffectTerm",
+    "parse_orders",
+    "parse_term",
+]
 
 SHAPES = ("harmonics", "polynomial", "sign")
 """The ways a term can vary with the position."""
@@ -169,43 +176,50 @@ class EffectTerm:
             raise InputError(f"unknown site '{self.site}'; sites of this table: {', '.join(sites)}")
         if self.shape not in SHAPES:
             raise InputError(f"unknown shape '{self.shape}'; shapes: {', '.join(SHAPES)}")
-        v, n = self.variable, table.n_joints
-        joint = [int(j) for j in re.findall(r"phi([0-9]+)", v)]
-        if self.shape == "harmonics":
-            if not (_JOINT.match(v) or _PAIR.match(v)) or any(j > n for j in joint):
-                angles = ", ".join(f"phi{k}" for k in range(1, n + 1))
-                raise InputError(
-                    f"harmonics of '{v}': expected a joint angle ({angles}) or the sum or "
-                    f"difference of two (phi1+phi2, phi1-phi2)"
-                )
-            if _PAIR.match(v) and joint[0] == joint[1]:
-                raise InputError(f"harmonics of '{v}': the two angles must differ")
-            bad = [k for k in self.orders if not 1 <= k <= MAX_HARMONIC_ORDER]
-            if not self.orders or bad or len(set(self.orders)) != len(self.orders):
-                raise InputError(
-                    f"harmonic orders {list(self.orders)}: give distinct whole numbers 1.."
-                    f"{MAX_HARMONIC_ORDER}"
-                )
-        elif self.shape == "polynomial":
-            if not _COLUMN.match(v) or _JOINT.match(v) or _DIR.match(v):
-                raise InputError(
-                    f"polynomial in '{v}': expected a numeric column of the data file (time_s, "
-                    "temperature_c, ...); use harmonics for a joint angle, sign for dirK"
-                )
-            d = max(self.orders, default=0)
-            if not 1 <= d <= MAX_POLYNOMIAL_DEGREE:
-                raise InputError(f"polynomial degree {d}: expected 1..{MAX_POLYNOMIAL_DEGREE}")
-        else:
-            match = _DIR.match(v)
-            if not match or int(match[1]) > n:
-                dirs = ", ".join(f"dir{k}" for k in range(1, n + 1))
-                raise InputError(f"sign of '{v}': expected an approach direction ({dirs})")
+        getattr(self, f"_check_{self.shape}")(self.variable, table.n_joints)
         if self.prefix and not _COLUMN.match(self.prefix):
             raise InputError(f"prefix '{self.prefix}': use letters, digits and '_' (e.g. x_)")
         return self
 
+    def _check_harmonics(self, v: str, n: int) -> None:
+        """Harmonics of one of the ``n`` joint angles or of the sum or difference of two."""
+        joint = [int(j) for j in re.findall(r"phi([0-9]+)", v)]
+        if not (_JOINT.match(v) or _PAIR.match(v)) or any(j > n for j in joint):
+            angles = ", ".join(f"phi{k}" for k in range(1, n + 1))
+            raise InputError(
+                f"harmonics of '{v}': expected a joint angle ({angles}) or the sum or "
+                f"difference of two (phi1+phi2, phi1-phi2)"
+            )
+        if _PAIR.match(v) and joint[0] == joint[1]:
+            raise InputError(f"harmonics of '{v}': the two angles must differ")
+        bad = [k for k in self.orders if not 1 <= k <= MAX_HARMONIC_ORDER]
+        if not self.orders or bad or len(set(self.orders)) != len(self.orders):
+            raise InputError(
+                f"harmonic orders {list(self.orders)}: give distinct whole numbers 1.."
+                f"{MAX_HARMONIC_ORDER}"
+            )
 
-def _orders(text: str, what: str) -> tuple[int, ...]:
+    def _check_polynomial(self, v: str, n: int) -> None:
+        """A polynomial of a numeric data column (not a joint angle or a direction)."""
+        if not _COLUMN.match(v) or _JOINT.match(v) or _DIR.match(v):
+            raise InputError(
+                f"polynomial in '{v}': expected a numeric column of the data file (time_s, "
+                "temperature_c, ...); use harmonics for a joint angle, sign for dirK"
+            )
+        d = max(self.orders, default=0)
+        if not 1 <= d <= MAX_POLYNOMIAL_DEGREE:
+            raise InputError(f"polynomial degree {d}: expected 1..{MAX_POLYNOMIAL_DEGREE}")
+
+    def _check_sign(self, v: str, n: int) -> None:
+        """The sign of one of the ``n`` joints' approach directions."""
+        match = _DIR.match(v)
+        if not match or int(match[1]) > n:
+            dirs = ", ".join(f"dir{k}" for k in range(1, n + 1))
+            raise InputError(f"sign of '{v}': expected an approach direction ({dirs})")
+
+
+def parse_orders(text: str, what: str) -> tuple[int, ...]:
+    """The orders of ``K`` or ``A..B`` (``what`` names them in the messages)."""
     lo, dots, hi = text.partition("..")
     try:
         first = int(lo)
@@ -244,7 +258,7 @@ def parse_term(text: str, table) -> EffectTerm:
             if not orders:
                 raise InputError("give the order: SITE~hK(VAR) or SITE~hA..B(VAR)")
             term = EffectTerm(match["site"], "harmonics", match["variable"],
-                              _orders(orders, "harmonic orders"))  # fmt: skip
+                              parse_orders(orders, "harmonic orders"))  # fmt: skip
         return term.check(table)
     except InputError as exc:
         raise InputError(f"term '{text}': {exc.detail}") from None

@@ -1,10 +1,9 @@
 """Fitting orientation measurements with the base error model plus chosen effects.
 
 :class:`OrientationFitProblem` adapts :class:`OrientationModel` and :class:`OrientationMeasurements`
-to the generic :class:`FitProblem` of :mod:`turntable_pin.stats.least_squares` (observations
-flattened position by position as ``dpsi, dtheta, dgamma``, the angles not measured left out);
-:func:`fit_orientation` fits and
-returns an :class:`OrientationFit` that knows its data, model, residuals and parameters.
+to the :class:`FitProblem` of :mod:`turntable_pin.stats.least_squares` (observations position by
+position, ``dpsi, dtheta, dgamma``, those not measured left out); :func:`fit_orientation` returns
+an :class:`OrientationFit` that knows its data, model, residuals and parameters.
 """
 
 from __future__ import annotations
@@ -14,12 +13,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.exceptions import InputError
 from ..core.sizes import FIT_ROW_BYTES, MAX_FITTED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD
-from ..stats.least_squares import FitResult, ZeroPoint, fit_least_squares, zero_point
+from ..stats.least_squares import (
+    RANK_RTOL,
+    FitResult,
+    ZeroPoint,
+    analyse_identifiability,
+    combination_name,
+    fit_least_squares,
+    zero_point,
+)
 from .data import ANGLE_NAMES, OrientationMeasurements
 from .effect_model import OrientationModel
 from .effects.base import Effect
+from .pointing_terms import fitted_pointing_terms
 
 __all__ = [
     "MAX_UNEXPLAINED_ARCSEC",
@@ -36,14 +45,12 @@ ZERO_POINT_BLOCK = 8192
 """Positions per block of :meth:`OrientationFitProblem.zero_point_blocks` (a few MB each)."""
 
 RELINEARISE_RAD = 1e-3
-"""Fitted base errors beyond this (rad, 3.4 arcmin; a constant offset of a mount not synced, an
-encoder index off) make :func:`fit_orientation` fit a model with effects again, from the
-solution of the base errors alone: the fit from zero takes the minimum-norm representative of
-what the data do not determine at zero errors, and with degrees of offset that split (e.g. an
-hour-angle offset shared with an effect's harmonics) is no longer equivalent: a
-German-equatorial mount with a 1 deg hour-angle offset and no roll measured fitted chi2 3273
-with declination wobble against 385 without it; 384 from the base solution. Arc-second tables
-never reach it."""
+"""Fitted base errors beyond this (rad, 3.4 arcmin: a mount not synced, an encoder index off)
+make :func:`fit_orientation` fit a model with effects again from the base errors' solution: the
+fit from zero takes the minimum-norm split of what the data do not determine at zero errors,
+which with degrees of offset is no longer equivalent (a German-equatorial mount 1 deg off in
+hour angle, roll not measured: chi2 3273 with declination wobble, 385 without, 384 from the
+base solution). Arc-second tables never reach it."""
 
 MAX_UNEXPLAINED_ARCSEC = 18000.0
 """Largest residual a fit may leave, arc seconds (5 deg, the small-error limit
@@ -159,8 +166,6 @@ class OrientationFit:
         """The error combinations these positions would determine with every angle measured but
         do not with the cells left empty (``[]`` when every angle was measured); e.g. without
         ``dtheta`` on the paper's table, ``dphi_z2 + dalpha_z1``."""
-        from ..stats.least_squares import analyse_identifiability, combination_name
-
         if self.data.measured.all():
             return []
         names = self.model.parameter_names
@@ -201,8 +206,6 @@ class OrientationFit:
             "unobserved_combinations": self.unobserved_combinations(),
         }
         out.update(self.result.to_dict())
-        from .pointing_terms import fitted_pointing_terms
-
         terms = fitted_pointing_terms(self)
         if terms is not None:  # a telescope mount: TPOINT's terms by name
             out["pointing_terms"] = terms
@@ -218,7 +221,9 @@ def fit_orientation(
     zero_point: ZeroPoint | None = None,
     base_fit: OrientationFit | None = None,
 ) -> OrientationFit:
-    """Fit the base error model plus ``effects`` to ``data``.
+    """Fit the base error model plus ``effects`` to ``data``, from zero errors; with effects and
+    base errors beyond :data:`RELINEARISE_RAD`, again from the base errors' own solution (effects
+    at zero), the better fit kept.
 
     Args:
         data: the measurements.
@@ -229,13 +234,8 @@ def fit_orientation(
             paper table).
         zero_point: :func:`orientation_zero_point` of these data with these effects and maybe
             more (fits of many effect sets of one data set share it).
-        base_fit: the fit of the base errors alone to these ``data``, when at hand (the start
-            of a fit again from large offsets, below; fitted here when needed and not given).
-
-    The fit starts from zero errors. With effects, when the fitted base errors exceed
-    :data:`RELINEARISE_RAD` (large constant offsets), the base errors are fitted alone first and
-    the model again from their solution (effects at zero), along the same determined
-    combinations; the better of the two fits is kept.
+        base_fit: the fit of the base errors alone to these ``data``, when at hand (fitted here
+            when needed and not given).
 
     Raises:
         InputError: more rows than :data:`~turntable_pin.core.sizes.MAX_FITTED_ROWS`; residuals
@@ -267,9 +267,6 @@ def refuse_repeated_shapes(data: OrientationMeasurements, effects, turntable=Non
     these data (its Jacobian columns, beyond the base errors, lie in the span of another's:
     ``inner_encoder_harmonics`` and ``dphi_z2~h1(phi2)`` together), naming both; a fit would
     otherwise show a lower rank and split the shape between them silently."""
-    from ..core.exceptions import InputError
-    from ..stats.least_squares import RANK_RTOL
-
     if len(effects) < 2:
         return
     model = OrientationModel(data.variables(), effects, turntable)
@@ -308,8 +305,6 @@ def refuse_repeated_shapes(data: OrientationMeasurements, effects, turntable=Non
 def _refuse_unexplained(fit: OrientationFit) -> None:
     """:class:`InputError` naming the rows whose residual exceeds
     :data:`MAX_UNEXPLAINED_ARCSEC`."""
-    from ..core.exceptions import InputError
-
     residual_arcsec = np.abs(fit.residuals_rad) * ARCSEC_PER_RAD
     bad = np.flatnonzero(np.nanmax(np.where(fit.data.measured, residual_arcsec, 0.0), axis=1)
                          > MAX_UNEXPLAINED_ARCSEC)  # fmt: skip

@@ -1,13 +1,12 @@
 """The identified table written back: the user's URDF with the fitted errors in its placements.
 
 As geometric-calibration tools do, the fitted base errors go into the joint ``<origin>``s of the
-nominal URDF, so that plain Pinocchio (or any URDF consumer) on the written file reproduces the
-fitted orientation error ``dR``. Orientation data determine only some combinations of the errors;
-the least-squares fit returns the minimum-norm member (in arc seconds, each parameter's column
-normalised) of the family of error sets that fit equally well, and that member is written: every
-member gives the same ``dR`` at every position. Offsets (``deta``, ``<joint>.offset_a``...) never
-change the orientation and are written as zero; effects beyond the base errors (harmonics,
-backlash, sag...) vary with the position and are not placements, so they are not written.
+nominal URDF, so that any URDF consumer (plain Pinocchio) reproduces the fitted ``dR``. The data
+determine only some combinations of the errors; the fit's minimum-norm member (arcsec, columns
+normalised) of the equally good error sets is written: all give the same ``dR`` at every
+position. Offsets (``deta``, ``<joint>.offset_a``...) never turn the payload and are written as
+zero; effects (harmonics, backlash, sag...) vary with the position, are no placements and are
+not written.
 """
 
 from __future__ import annotations

@@ -1,28 +1,26 @@
 """TPOINT's pointing terms by name on a telescope mount (``docs/measurements.md``, "TPOINT terms
 on a mount").
 
-A telescope mount is a two-axis table whose measured orientation errors are pointing errors. Two
-kinds are known, each in the frames of its bundled URDF (``models/altaz_mount.urdf``,
-``models/german_equatorial_mount.urdf``; base x South, y East, z up; payload x the boresight):
+A telescope mount is a two-axis table whose orientation errors are pointing errors. Two kinds,
+in the frames of their bundled URDFs (``models/altaz_mount.urdf``,
+``models/german_equatorial_mount.urdf``: base x South, y East, z up; payload x the boresight):
 
 - **alt-az**: first axis vertical, phi1 = azimuth A (South 0, East 90), phi2 = elevation E;
   ``dtheta ~ dA cos E``, ``dpsi ~ -dE``;
 - **equatorial**: first axis tilted to the latitude phi, phi1 = hour angle H (positive West),
   phi2 = declination d; ``dtheta ~ -dH cos d``, ``dpsi ~ -dd``.
 
-``dA, dE, dH, dd`` are TPOINT's corrections *observed minus raw* (encoder) coordinates, first
-order in the coefficients, exactly as TPOINT's term formulas write them (the convention of the
-published MMT fit, ``obs = raw + D``). A table is a mount only when it says so: its URDF's
-``<turntable_pin mount="altaz"/>`` (or ``"equatorial"``) or the caller
-(:mod:`turntable_pin.model.mount_declaration`); its axes are never read to guess it. A declared
-mount's chain must be the documented one (:func:`mount_kind`), else it is refused.
+``dA, dE, dH, dd`` are TPOINT's corrections *observed minus raw* (encoder), first order in the
+coefficients, as TPOINT's formulas write them (the published MMT fit's ``obs = raw + D``). A table
+is a mount only when it says so (its URDF's ``<turntable_pin mount="altaz"/>`` or
+``"equatorial"``, or the caller: :mod:`turntable_pin.model.mount_declaration`), never guessed
+from its axes; a declared mount's chain must be the documented one (:func:`mount_kind`).
 
-*Rigid* terms (IA IE NPAE CA AN AW; IH ID CH NP MA ME) are the rigid placement errors of the
-mount seen on the two measured angles: :func:`rigid_term_map` finds, numerically, each term as a
-linear functional of the generic errors (``<joint>.position``, ``.tilt_a``, ``.tilt_b``,
-``<mount>.rot_x|y|z``); the map is exact (first order) because both span the same space, and it
-is checked. *Flexure* terms (TF, TX; TF, FO, DAF) are catalogue effects of the mount
-(:mod:`.effects.pointing_flexure`).
+*Rigid* terms (IA IE NPAE CA AN AW; IH ID CH NP MA ME) are the mount's rigid placement errors
+seen on the two measured angles: :func:`rigid_term_map` finds each numerically as a linear
+functional of the generic errors (``<joint>.position``, ``.tilt_a``, ``.tilt_b``,
+``<mount>.rot_x|y|z``), exact to first order (both span the same space; checked). *Flexure*
+terms (TF, TX; TF, FO, DAF) are catalogue effects (:mod:`.effects.pointing_flexure`).
 """
 
 from __future__ import annotations
@@ -37,6 +35,9 @@ from ..core.rotations import axis_rotation
 from ..core.units import ARCSEC_PER_RAD
 from ..model.angles import ANGLE_NAMES
 from ..model.mount_declaration import ALTAZ, EQUATORIAL, declaration_text
+from ..stats.least_squares import combination_name
+from .effect_model import OrientationModel
+from .effects.base import PositionVariables
 from .table import measured_table
 
 __all__ = [
@@ -467,16 +468,11 @@ class RigidTermMap:
 
     def combinations(self) -> dict[str, str]:
         """``{term: its combination of base errors in words}`` (``-azimuth.position - ...``)."""
-        from ..stats.least_squares import combination_name
-
         rows = zip(self.names, self.matrix, strict=True)
         return {n: combination_name(r, self.base_names) for n, r in rows}
 
 
 def _rigid_map(table, mount: Mount) -> RigidTermMap | None:
-    from .effect_model import OrientationModel
-    from .effects.base import PositionVariables
-
     joints = _generic_positions()
     model = OrientationModel(PositionVariables(joints), (), table)
     # d(dpsi, dtheta)/d(base errors) at zero errors, stacked position by position.

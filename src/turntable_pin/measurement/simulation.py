@@ -9,17 +9,20 @@ The output is the CSV of ``docs/measurements.md`` with the seed and the truth in
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from ..calibration.positions import angle_columns, check_commanded_angles
 from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows, write_csv_table
 from ..core.exceptions import InputError, check_seed
 from ..core.sizes import MAX_SIMULATED_ROWS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
 from ..core.turn_grid import full_turn_grid_deg, random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
+from ..core.words import argument
 from ..model.angles import ANGLE_NAMES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors
 from ..model.paper_table import paper_table
@@ -31,6 +34,7 @@ from .data import (
     MAX_TIME_S,
     MIN_SIGMA_ARCSEC,
     OrientationMeasurements,
+    check_times_and_directions,
 )
 from .effect_model import OrientationModel
 from .effects.base import Effect, PositionVariables
@@ -73,41 +77,36 @@ DEFAULT_GRID_STEP_DEG = 30.0
 class Schedule:
     """Which positions are measured, in which order, when, and from which side.
 
-    The positions come from one of four designs: a grid over every joint (the default), an
-    explicit list (``positions``), single-axis sweeps (``sweep``) or random positions
-    (``random_positions``). The list is then measured ``repeats`` times over, and with ``passes``
-    K > 0 it is measured forward and then backward, K times.
-
-    ``Schedule(45, 30, order="random")``: the grid steps are given one per joint from the base
-    (``phi1``, ``phi2``, ...), as the positional arguments.
+    The positions: a grid over every joint (the default), a list (``positions``), single-axis
+    sweeps (``sweep``) or random positions (``random_positions``); measured ``repeats`` times
+    over, and with ``passes`` K > 0 forward then backward, K times. The grid steps are the
+    positional arguments, one per joint from the base: ``Schedule(45, 30, order="random")``.
 
     Attributes:
-        steps_deg: grid step of each joint from the base, degrees (a joint beyond the sequence:
+        steps_deg: grid step of each joint from the base, degrees (beyond the sequence:
             :data:`DEFAULT_GRID_STEP_DEG`; a table with fewer joints ignores the rest); the grid
             covers [start, start + 360). Reported as ``phiK_step_deg``.
-        starts_deg: first grid angle of each joint from the base, degrees (beyond the sequence:
-            0); in a sweep, the angle at which the joints not being swept are held. Reported as
-            ``phiK_start_deg``.
-        order: ``grid`` (phi1 outer loop, the last joint's angle inner loop) or ``random``
-            (shuffled; grids only).
+        starts_deg: first grid angle of each joint, degrees (beyond the sequence: 0); a sweep
+            holds the other joints there. Reported as ``phiK_start_deg``.
+        order: ``grid`` (phi1 the outer loop, the last joint the inner) or ``random`` (shuffled;
+            grids only).
         repeats: how many times each position is measured.
         dwell_s: time between consecutive measurements.
-        approach: ``random`` (each axis from a random side), ``motion`` (the side the move from the
-            previous position came from; unchanged when the axis did not move; on ``passes``, the
-            pass's direction: +1 forward, -1 backward for every joint) or ``positive``. ``None``
-            (the default): ``motion`` with ``passes``, else ``random``.
-        positions: an explicit list of positions, ``((phi1_deg, phi2_deg, ...), ...)``, measured
-            in its order (one angle per joint of the table).
+        approach: ``random`` (each axis from a random side), ``motion`` (the side the move came
+            from, unchanged when the axis did not move; with ``passes``, +1 forward and -1
+            backward for every joint) or ``positive``; ``None``: ``motion`` with ``passes``,
+            else ``random``.
+        positions: a list of positions ``((phi1_deg, phi2_deg, ...), ...)``, one angle per
+            joint, measured in its order.
         positions_time_s: the time of each listed position (default: ``dwell_s`` apart); not
             with ``repeats`` or ``passes``.
         positions_dirs: per joint, the approach direction (+1/-1) of each listed position, or
-            ``None`` for a joint the list does not give (the ``approach`` rule then applies);
-            not with ``passes``.
+            ``None`` (the ``approach`` rule applies); not with ``passes``.
         positions_source: where the list came from (a file name), for the comment header.
-        sweep: joints swept one after the other, e.g. ``("phi1", "phi2")``: phi1 over its grid
-            with the others held at their start angle, then phi2 likewise.
-        random_positions: N > 0: N positions drawn uniformly over [start, start + 360) of every
-            joint (seeded; rounded to 1e-6 deg).
+        sweep: joints swept one after the other (``("phi1", "phi2")``: phi1 over its grid with
+            the others held at their start, then phi2).
+        random_positions: N > 0: N positions uniform over [start, start + 360) of every joint
+            (seeded; rounded to 1e-6 deg).
         passes: K > 0: the positions forward then backward, K times (2K traversals).
     """
 
@@ -239,8 +238,8 @@ class Schedule:
     def _check_sweep(self) -> None:
         joints = [str(j) for j in self.sweep]
         for j in joints:
-            if j not in ("phi1", "phi2", "phi3"):
-                raise InputError(f"sweep: unknown axis '{j}', expected phi1, phi2 or phi3")
+            if not re.fullmatch(r"phi[1-9][0-9]*", j):
+                raise InputError(f"sweep: unknown axis '{j}', expected phiK (phi1, phi2, ...)")
         if len(set(joints)) != len(joints):
             raise InputError(f"sweep: an axis is swept twice in {','.join(joints)}")
 
@@ -264,10 +263,7 @@ class Schedule:
         if self.sweep:
             return sum(turn_grid_count(steps[int(j[3:]) - 1][1]) for j in self.sweep
                        if int(j[3:]) <= n_joints)  # fmt: skip
-        out = 1
-        for _, step in steps:
-            out *= turn_grid_count(step)
-        return int(out)
+        return math.prod(turn_grid_count(step) for _, step in steps)
 
     def count(self, n_joints: int = 2) -> int:
         """Number of measurements on a table with ``n_joints`` joints."""
@@ -389,8 +385,6 @@ def read_positions(path: str | Path, joint_names: Sequence[str] | None = None) -
     Raises:
         InputError: naming the file, row and column of the first problem.
     """
-    from ..calibration.positions import angle_columns, check_commanded_angles
-
     path = Path(path)
     names = tuple(joint_names) if joint_names else ("", "")
     header, header_row = read_header(path)
@@ -398,21 +392,12 @@ def read_positions(path: str | Path, joint_names: Sequence[str] | None = None) -
     dir_columns = tuple(f"dir{k}" for k in range(1, len(names) + 1))
     table = read_csv_table(path, columns, ("time_s", *dir_columns), min_rows=1)
     check_commanded_angles(table, columns)
+    check_times_and_directions(table, dir_columns)
     if table.has("time_s"):
-        table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
-        table.refuse(
-            "time_s", table["time_s"] > MAX_TIME_S,
-            f"time since the start of the run must be at most {MAX_TIME_S:g} s",
-        )  # fmt: skip
         refuse_repeated_rows(
             table, (*columns, *dir_columns, "time_s"),
             "a measurement listed twice (same position, directions and time_s)",
         )  # fmt: skip
-    for column in dir_columns:
-        if table.has(column):
-            table.refuse(
-                column, np.abs(table[column]) != 1, "an approach direction must be +1 or -1"
-            )
     check_count(len(table[columns[0]]), MAX_SIMULATED_ROWS, "listed positions", ROW_BYTES)
     return {
         "positions": tuple(zip(*(table[c].tolist() for c in columns), strict=True)),
@@ -476,7 +461,8 @@ class SimulatedMeasurements:
             "schedule: " + self.schedule.describe(self.data.n_joints),
         ]
         if hide_truth:
-            return "\n".join([*lines, "errors and hidden effects: not recorded (--hide-truth)"])
+            hidden = f"errors and hidden effects: not recorded ({argument('hide_truth')})"
+            return "\n".join([*lines, hidden])
         return "\n".join(
             [*lines, f"errors (arcsec): {errors}", f"hidden effects: {effects or 'none'}"]
         )
@@ -521,34 +507,109 @@ def simulate_measurements(
     """Simulate a measurement run.
 
     Args:
-        errors: turntable errors (default none): the table's error vector (rad, m) in its
-            ``parameter_names`` order (the paper's ``TurntableErrors`` on the paper's table).
-        effects: ``{effect name: {parameter name: value in user units}}`` (parameters not given
-            are zero; units are the effect's, e.g. arcsec, arcsec/g, arcsec/h).
+        errors: the table's error vector (rad, m) in its ``parameter_names`` order (the paper's
+            ``TurntableErrors`` on the paper's table); default none.
+        effects: ``{effect: {parameter: value in the effect's user unit}}`` (arcsec, arcsec/g,
+            arcsec/h; parameters not given are zero).
         schedule: positions, order, time and approach directions (default: 30-degree grid).
-        noise_arcsec: 1-sigma Gaussian noise on each angle (in ``[MIN_SIGMA_ARCSEC,
-            MAX_NOISE_ARCSEC]``: the file must read back); three numbers give the noise of
-            ``dpsi, dtheta, dgamma`` separately (written as ``sigma_<angle>_arcsec``).
-        noise_spread: F >= 1: each row's sigma is ``noise_arcsec`` times a factor drawn
-            log-uniform in [1/F, F] (seeded, after the noise), and the row's noise has that sigma;
-            every sigma stays within the noise range. 1 (the default): even noise.
-        seed: seed of every random choice (order, directions, noise): a whole number
-            0 <= seed < 2**63.
-
-        not_measured: angles left empty at every position (``dgamma`` for a pointing run or an
-            autocollimator's two tilts). Without ``dgamma`` a row measures the direction of the
-            payload's x axis, and its ``dpsi`` is that direction's own component (``-dR[2,0]``,
-            docs/measurements.md section 1), as a real run of that kind measures it.
-
-    Every effect needs at least one parameter, each within +-18000 (the small-error limit
-    ``MAX_ANGULAR_ERROR_DEG`` in arcsec) in its user unit; the run may last at most
-    ``MAX_TIME_S`` and the simulated angles must stay within what a measurement file may hold
-    (``MAX_MEASURED_ANGLE_ARCSEC``), or :class:`InputError` says which.
+        noise_arcsec: 1-sigma Gaussian noise of each angle, in ``[MIN_SIGMA_ARCSEC,
+            MAX_NOISE_ARCSEC]`` (the file must read back); three numbers: one per angle
+            (written as ``sigma_<angle>_arcsec``).
+        seed: seed of every random choice (order, directions, noise), 0 <= seed < 2**63.
         turntable: the table (a ``GenericTable``; ``None``: the paper's).
         catalogue: effects besides the table's catalogue that ``effects`` may name (the user's).
+        noise_spread: F >= 1: each row's sigma is ``noise_arcsec`` times a factor drawn
+            log-uniform in [1/F, F] (seeded, after the noise), within the noise range; 1: even.
+        not_measured: angles left empty at every position (``dgamma`` for a pointing run or an
+            autocollimator's two tilts). Without ``dgamma`` a row's ``dpsi`` is the payload x
+            axis' own component (``-dR[2,0]``, docs/measurements.md section 1), as such a run
+            measures it.
+
+    Raises:
+        InputError: an effect without parameters or beyond +-18000 (``MAX_ANGULAR_ERROR_DEG`` in
+            arcsec) in its user unit; a run longer than ``MAX_TIME_S``; angles beyond what a
+            measurement file may hold (``MAX_MEASURED_ANGLE_ARCSEC``).
     """
-    limit = MAX_MEASURED_ANGLE_ARCSEC
-    effect_limit = MAX_ANGULAR_ERROR_DEG * 3600.0  # an effect is a small error
+    noise = _checked_noise(noise_arcsec, noise_spread)
+    seed = check_seed(seed)
+    source = paper_table() if turntable is None else getattr(turntable, "table", turntable)
+    table = measured_table(source)
+    n_joints = table.n_joints
+    if isinstance(errors, TurntableErrors):
+        errors = errors.as_array()
+    vector = np.zeros(len(source.parameter_names)) if errors is None else np.asarray(errors, float)
+    values = {
+        n: v for n, v in zip(source.parameter_names, vector, strict=True) if n in table.base_names
+    }
+    schedule = schedule or Schedule()
+    effects = _checked_effects(effects)
+    rng = np.random.default_rng(seed)
+    variables, blank = _positions(schedule, rng, n_joints, not_measured)
+    effect_objects = [resolve_effect(name, table, catalogue) for name in effects]
+    effects = {e.name: effects[name] for e, name in zip(effect_objects, effects, strict=True)}
+    model = OrientationModel(variables, effect_objects, table)
+    values.update(_effect_values(effect_objects, effects, variables))
+    truth = model.predict(model.parameter_vector(values))
+    measured, sigma_rad = _noisy(truth, noise, noise_spread, rng)
+    measured[:, blank] = np.nan
+    _refuse_beyond_a_file(measured)
+    data = OrientationMeasurements(
+        joint_rad=variables.joint_rad,
+        angles_rad=measured,
+        sigma_rad=sigma_rad,
+        time_s=variables.time_s,
+        dirs=variables.dirs,
+        source=f"simulated (seed {seed})",
+        joint_names=() if table.paper else table.joint_names,
+    )
+    return SimulatedMeasurements(
+        data=data,
+        errors=source.to_user_units(vector),
+        effects=effects,
+        noise_arcsec=float(noise[0]) if noise.size == 1 else tuple(float(v) for v in noise),
+        seed=int(seed),
+        schedule=schedule,
+        truth_rad=truth,
+        noise_spread=float(noise_spread),
+    )
+
+
+def _positions(schedule: Schedule, rng, n_joints: int, not_measured) -> tuple:
+    """The positions ``schedule`` measures (with their times and approach directions) and the
+    indices of the angles ``not_measured``."""
+    check_count(schedule.count(n_joints), MAX_SIMULATED_ROWS, "rows of simulated measurements",
+                ROW_BYTES)  # fmt: skip
+    angles_deg = schedule.positions_deg(rng, n_joints)
+    n = angles_deg[0].size
+    if schedule.duration_s(n_joints) > MAX_TIME_S:
+        raise InputError(
+            f"dwell_s {schedule.dwell_s:g}: the run of {n} measurements would last "
+            f"{schedule.duration_s(n_joints):.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
+        )
+    blank = [ANGLE_NAMES.index(a) for a in _angle_names(not_measured)]
+    variables = PositionVariables(
+        np.stack(angles_deg, axis=1) / DEG_PER_RAD,
+        time_s=schedule.times_s(n),
+        dirs=tuple(schedule.directions(a, rng, k) for k, a in enumerate(angles_deg, start=1)),
+        boresight_only=np.full(n, 2 in blank and 0 not in blank),
+    )
+    return variables, blank
+
+
+def _refuse_beyond_a_file(measured: np.ndarray) -> None:
+    """Refuse simulated angles (rad) beyond what a measurement file may hold."""
+    largest = float(np.nanmax(np.abs(measured))) * ARCSEC_PER_RAD
+    if not largest <= MAX_MEASURED_ANGLE_ARCSEC:
+        raise InputError(
+            f"the simulated orientation errors reach {largest:g} arcsec, beyond the "
+            f"+-{MAX_MEASURED_ANGLE_ARCSEC:g} arcsec a measurement may have "
+            "(docs/measurements.md); give smaller errors, effect parameters or noise"
+        )
+
+
+def _checked_noise(noise_arcsec, noise_spread: float) -> np.ndarray:
+    """``noise_arcsec`` as an array of one or three sigmas, arcsec, each in [MIN_SIGMA_ARCSEC,
+    MAX_NOISE_ARCSEC] however ``noise_spread`` spreads it."""
     noise = np.atleast_1d(np.asarray(noise_arcsec, dtype=float))
     if noise.size not in (1, 3):
         raise InputError(f"noise_arcsec takes one number or three, got {noise.size}")
@@ -570,21 +631,13 @@ def simulate_measurements(
             f"noise_spread {noise_spread:g}: the sigmas would leave [{MIN_SIGMA_ARCSEC:g}, "
             f"{MAX_NOISE_ARCSEC:g}] arcsec (noise_arcsec / spread .. noise_arcsec * spread)"
         )
-    seed = check_seed(seed)
-    source = paper_table() if turntable is None else getattr(turntable, "table", turntable)
-    table = measured_table(source)
-    n_joints = table.n_joints
-    if isinstance(errors, TurntableErrors):
-        errors = errors.as_array()
-    vector = np.zeros(len(source.parameter_names)) if errors is None else errors
-    vector = np.asarray(vector, dtype=float)
-    errors = source.to_user_units(vector)
-    base_values = {
-        n: v for n, v in zip(source.parameter_names, vector, strict=True) if n in table.base_names
-    }
-    schedule = schedule or Schedule()
-    check_count(schedule.count(n_joints), MAX_SIMULATED_ROWS, "rows of simulated measurements",
-                ROW_BYTES)  # fmt: skip
+    return noise
+
+
+def _checked_effects(effects) -> dict[str, dict]:
+    """``{effect: {parameter: value}}`` checked: at least one parameter each, every value a
+    number within the small-error limit (in its user unit)."""
+    limit = MAX_ANGULAR_ERROR_DEG * 3600.0  # an effect is a small error
     effects = {name: dict(params) for name, params in (effects or {}).items()}
     for name, params in effects.items():
         if not params:
@@ -597,30 +650,17 @@ def simulate_measurements(
                 number = float(value)
             except (TypeError, ValueError):
                 number = math.nan
-            if not abs(number) <= effect_limit:
+            if not abs(number) <= limit:
                 raise InputError(
                     f"effect '{name}', parameter '{pname}' = {value!r}: must be a number within "
-                    f"+-{effect_limit:g} (in its user unit: arcsec, arcsec/g or arcsec/h)"
+                    f"+-{limit:g} (in its user unit: arcsec, arcsec/g or arcsec/h)"
                 )
-    rng = np.random.default_rng(seed)
-    angles_deg = schedule.positions_deg(rng, n_joints)
-    n = angles_deg[0].size
-    if schedule.duration_s(n_joints) > MAX_TIME_S:
-        raise InputError(
-            f"dwell_s {schedule.dwell_s:g}: the run of {n} measurements would last "
-            f"{schedule.duration_s(n_joints):.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
-        )
-    blank = [ANGLE_NAMES.index(a) for a in _angle_names(not_measured)]
-    variables = PositionVariables(
-        np.stack(angles_deg, axis=1) / DEG_PER_RAD,
-        time_s=schedule.times_s(n),
-        dirs=tuple(schedule.directions(a, rng, k) for k, a in enumerate(angles_deg, start=1)),
-        boresight_only=np.full(n, 2 in blank and 0 not in blank),
-    )
-    effect_objects = [resolve_effect(name, table, catalogue) for name in effects]
-    effects = {e.name: effects[name] for e, name in zip(effect_objects, effects, strict=True)}
-    model = OrientationModel(variables, effect_objects, table)
-    values = dict(base_values)
+    return effects
+
+
+def _effect_values(effect_objects, effects, variables) -> dict[str, float]:
+    """``{"<effect>.<parameter>": value}`` in internal units of the given parameters."""
+    values = {}
     for effect in effect_objects:
         specs = {s.name: s for s in effect.parameters(variables)}
         for pname, value in effects[effect.name].items():
@@ -630,45 +670,22 @@ def simulate_measurements(
                     f"its parameters: {', '.join(specs)}"
                 )
             values[f"{effect.name}.{pname}"] = float(value) * specs[pname].per_user_unit
-    truth = model.predict(model.parameter_vector(values))
+    return values
+
+
+def _noisy(truth: np.ndarray, noise: np.ndarray, noise_spread: float, rng) -> tuple:
+    """``truth`` (n, 3) rad plus Gaussian noise of ``noise`` arcsec (one sigma, or one per
+    angle; spread log-uniformly over the rows by ``noise_spread``), and the sigma of each row,
+    rad: (n,) for one sigma, else (n, 3)."""
+    n = truth.shape[0]
     if noise.size == 1 and noise_spread == 1:
         sigma_rad = float(noise[0]) / ARCSEC_PER_RAD
-        measured = truth + rng.normal(0.0, sigma_rad, truth.shape)
-        sigma_rad = np.full(n, sigma_rad)
-    else:
-        unit = rng.standard_normal(truth.shape)
-        factor = np.ones((n, 1))
-        if noise_spread != 1:
-            factor = np.exp(rng.uniform(-1.0, 1.0, (n, 1)) * math.log(noise_spread))
-        sigma_rad = factor * noise[None, :] / ARCSEC_PER_RAD  # (n, 1) or (n, 3)
-        measured = truth + unit * sigma_rad
-        sigma_rad = np.broadcast_to(sigma_rad, (n, noise.size)).copy()
-        if noise.size == 1:
-            sigma_rad = sigma_rad[:, 0]
-    measured[:, blank] = np.nan
-    largest = float(np.nanmax(np.abs(measured))) * ARCSEC_PER_RAD
-    if not largest <= limit:
-        raise InputError(
-            f"the simulated orientation errors reach {largest:g} arcsec, beyond the +-{limit:g} "
-            "arcsec a measurement may have (docs/measurements.md); give smaller errors, effect "
-            "parameters or noise"
-        )
-    data = OrientationMeasurements(
-        joint_rad=variables.joint_rad,
-        angles_rad=measured,
-        sigma_rad=sigma_rad,
-        time_s=variables.time_s,
-        dirs=variables.dirs,
-        source=f"simulated (seed {seed})",
-        joint_names=() if table.paper else table.joint_names,
-    )
-    return SimulatedMeasurements(
-        data=data,
-        errors=errors,
-        effects=effects,
-        noise_arcsec=float(noise[0]) if noise.size == 1 else tuple(float(v) for v in noise),
-        seed=int(seed),
-        schedule=schedule,
-        truth_rad=truth,
-        noise_spread=float(noise_spread),
-    )
+        return truth + rng.normal(0.0, sigma_rad, truth.shape), np.full(n, sigma_rad)
+    unit = rng.standard_normal(truth.shape)
+    factor = np.ones((n, 1))
+    if noise_spread != 1:
+        factor = np.exp(rng.uniform(-1.0, 1.0, (n, 1)) * math.log(noise_spread))
+    sigma_rad = factor * noise[None, :] / ARCSEC_PER_RAD  # (n, 1) or (n, 3)
+    measured = truth + unit * sigma_rad
+    sigma_rad = np.broadcast_to(sigma_rad, (n, noise.size)).copy()
+    return measured, sigma_rad[:, 0] if noise.size == 1 else sigma_rad

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.chain import ROTATION, ErrorChain, compose_rotation
+from ..model.paper_table import resolve_table
 
 __all__ = ["JointErrors", "MeasuredTable", "measured_table"]
 
@@ -123,8 +124,6 @@ def measured_table(turntable=None) -> MeasuredTable:
     """The :class:`MeasuredTable` of ``turntable``: ``None`` (the bundled paper table), a
     :class:`~turntable_pin.model.generic_table.GenericTable` (in its layout's names: the paper's
     on the paper's table) or a :class:`MeasuredTable` (returned as it is)."""
-    from ..model.paper_table import resolve_table
-
     if isinstance(turntable, MeasuredTable):
         return turntable
     table = resolve_table(turntable)

@@ -1,58 +1,53 @@
 """TPOINT pointing runs in: a telescope mount's star-pointing run as an orientation-measurement CSV.
 
-A telescope mount is a two-axis table. A TPOINT run file records, per star, where the star is
-(the *observed* position) and where the encoders say the mount pointed (the *raw* position). This
-module reads such a file (:func:`read_tpoint`, a frozen :class:`TpointRun`) and converts it
-(:func:`convert_tpoint`) into rows of the measurement CSV of ``docs/measurements.md`` for the
-bundled mount URDFs, ``models/altaz_mount.urdf`` and ``models/german_equatorial_mount.urdf``.
+A telescope mount is a two-axis table. A TPOINT run records, per star, where the star is (the
+*observed* position) and where the encoders say the mount pointed (the *raw* position).
+:func:`read_tpoint` reads it (a :class:`TpointRun`), :func:`convert_tpoint` makes the rows of the
+measurement CSV (``docs/measurements.md``) for the bundled ``models/altaz_mount.urdf`` and
+``models/german_equatorial_mount.urdf``.
 
-Units: angles in the file and in the CSV's ``phi1_deg, phi2_deg`` are degrees (sexagesimal in the
-equatorial records: hours or degrees, minutes, seconds); the measured angles ``dpsi_arcsec,
-dtheta_arcsec`` are arc seconds; temperature degrees Celsius, pressure millibar (hPa), height
-metres, humidity a fraction 0..1. Inside, angles are radians.
+Units: degrees in the file (sexagesimal h/d m s in equatorial records) and in ``phi1_deg,
+phi2_deg``; arcsec in ``dpsi_arcsec, dtheta_arcsec``; temperature C, pressure mbar (hPa), height
+m, humidity 0..1; radians inside.
 
-The file (what is read; anything else is refused with the file and line named):
+The file (anything else is refused naming file and line):
 
-- ``!`` starts a comment line; blank lines are skipped; a line ``END`` ends the data.
-- The first other line is the caption (free text).
-- Option lines ``: NAME`` (or ``:NAME``): ``ALTAZ`` (an alt-az mount), ``EQUAT`` (an equatorial
-  mount), ``NODA`` and ``ALLSKY`` (recorded, no effect on the conversion). ``J2000`` (mean places)
-  is refused: the conversion does no precession, nutation or aberration. Any other option is
-  refused as unknown.
-- The run-parameter line: latitude ``+-d m s``, then optionally the date ``y m d``, temperature
-  (C), pressure (mbar), height (m), relative humidity (0..1), wavelength (micron), lapse rate
-  (K/m); 3, or 6 to 12 numbers.
-- Alt-az data lines: ``az_obs el_obs az_raw el_raw`` in decimal degrees (TPOINT's "format 4", the
-  layout of the bundled MMT run and of pytelpoint's reader). The azimuth is TPOINT's (South = 0,
-  East = 90) unless ``azimuth_origin``/``azimuth_direction`` say otherwise.
-- Equatorial data lines: ``RA h m s, Dec +-d m s, raw RA h m s, raw Dec +-d m s, sidereal time
-  h m`` (14 numbers; the layout TPOINT exporters such as ACP's ModelToTpoint and RTS2's
-  rts2-tpm write). Hour angles are ``LST - RA`` (positive West), for the star and the raw reading
-  alike; the star places are taken as apparent places of date.
+- ``!`` starts a comment; blank lines are skipped; ``END`` ends the data. The first other line is
+  the caption.
+- Options ``: NAME`` (or ``:NAME``): ``ALTAZ``, ``EQUAT`` (the mount), ``NODA``, ``ALLSKY``
+  (recorded only). ``J2000`` (mean places) is refused: no precession, nutation or aberration is
+  done. Any other option is unknown.
+- The run parameters: latitude ``+-d m s``, then optionally the date ``y m d``, temperature,
+  pressure, height, humidity, wavelength (micron), lapse rate (K/m); 3, or 6 to 12 numbers.
+- Alt-az data: ``az_obs el_obs az_raw el_raw``, decimal degrees (TPOINT's "format 4", as in the
+  bundled MMT run and pytelpoint); TPOINT's azimuth (South = 0, East = 90) unless
+  ``azimuth_origin``/``azimuth_direction`` say otherwise.
+- Equatorial data: ``RA h m s, Dec +-d m s, raw RA h m s, raw Dec +-d m s, sidereal time h m``
+  (14 numbers, as ACP's ModelToTpoint and RTS2's rts2-tpm write). Hour angles are ``LST - RA``
+  (positive West), star and raw alike; star places are taken as apparent places of date.
 
-The conversion (the project's definition, docs/model.md): ``dR = Rd(raw)^T Rt``, with ``Rd`` the
-URDF's nominal chain and ``Rt`` the orientation that points at the star, taken as ``Rd(observed)``
-with the observed angles on the encoders' side of the pier (:func:`encoder_side`: on the far
-side of a German-equatorial pier ``(H + 180 deg, +-180 deg - dec)``). A pointing run measures the
-boresight's direction, not the tube's roll about it, so the rows hold the boresight's own
-components, exact whatever the roll: ``dtheta = dR[1,0]`` (across the second axis' circle) and
-``dpsi = -dR[2,0]``, which is ``dR[0,2]`` of ``dR`` without its twist about the boresight (its
-swing); ``dgamma`` (the roll) is not measured and left empty, and the fit compares such rows with
-the model's swing likewise (``docs/measurements.md``, section 1).
+The conversion (docs/model.md): ``dR = Rd(raw)^T Rt``, ``Rd`` the URDF's nominal chain and ``Rt =
+Rd(observed)`` with the observed angles on the encoders' side of the pier (:func:`encoder_side`;
+on the far side of a German-equatorial pier ``(H + 180 deg, +-180 deg - dec)``). A pointing run
+measures the boresight's direction, not the roll about it, so the rows hold the boresight's own
+components, exact whatever the roll: ``dtheta = dR[1,0]`` and ``dpsi = -dR[2,0]`` (``dR[0,2]`` of
+``dR``'s swing); ``dgamma`` is left empty, and the fit compares such rows with the model's swing
+likewise (``docs/measurements.md``, section 1).
 
-Refraction: with ``refraction="apply"`` the observed position is lifted towards the zenith by the
-Saemundsson refraction at the run's temperature and pressure before ``Rd(observed)`` is formed;
-``"none"`` uses the positions as given. The default follows the file: ``none`` for alt-az runs
-(their observed az/el are where the star is seen, refraction included, as in the bundled MMT
-run and pytelpoint), ``apply`` for equatorial runs (their star places are catalogue places, which
-TPOINT refracts with the run parameters).
+Refraction: ``refraction="apply"`` lifts the observed position towards the zenith by Saemundsson's
+refraction at the run's temperature and pressure before ``Rd(observed)`` is formed; ``"none"``
+uses the positions as given. The default follows the file: ``none`` for alt-az runs (their
+observed az/el are where the star is seen, refraction included, as in the MMT run and
+pytelpoint), ``apply`` for equatorial runs (catalogue places, which TPOINT refracts).
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 import tempfile
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -61,8 +56,12 @@ import numpy as np
 from ..core.csv_table import first_repeated_row
 from ..core.exceptions import InputError
 from ..core.files import read_text_file, write_text_atomic
+from ..core.resources import models_dir
 from ..core.sizes import MAX_TPOINT_FILE_BYTES, MAX_TPOINT_OBSERVATIONS
 from ..core.units import ARCSEC_PER_RAD
+from ..core.words import argument
+from ..model.chain import compose_rotation
+from ..model.generic_table import GenericTable
 from .data import MAX_MEASURED_ANGLE_ARCSEC
 
 __all__ = [
@@ -111,6 +110,13 @@ _RECORD_LAYOUT = {
 _RUN_FIELDS = (
     "temperature_c", "pressure_mbar", "height_m", "humidity", "wavelength_um", "lapse_rate_k_per_m",
 )  # fmt: skip
+_RUN_RANGES = {
+    "temperature_c": (-100.0, 60.0),
+    "pressure_mbar": (0.0, 1200.0),
+    "height_m": (-500.0, 10000.0),
+    "humidity": (0.0, 1.0),
+}
+"""Physical ranges of the run parameters (beyond them, refraction would be meaningless)."""
 _NUMBER = re.compile(r"^[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?$")
 _ORIGIN_NOTE = re.compile(r"\b(north|south)\s*=\s*0\b", re.I)
 _DIRECTION_NOTE = re.compile(r"\b(east|west)\s*=\s*90\b", re.I)
@@ -121,19 +127,16 @@ class TpointRun:
     """A TPOINT run as read (angles in degrees, in the table's conventions).
 
     Attributes:
-        path: the file.
-        caption: its caption line.
+        path, caption: the file and its caption line.
         options: the option names in file order (``ALTAZ``, ``NODA``, ...).
-        mount: :data:`ALTAZ` or :data:`EQUATORIAL`.
-        mount_line: the line of the option naming the mount (``None`` if given by the caller).
-        latitude_deg: the site latitude of the run-parameter line (deg, North positive).
-        latitude_text: the latitude as written (``+31 41 19.6``).
-        run_parameters: ``date`` (y, m, d) and the present fields of the run-parameter line:
-            ``temperature_c`` (C), ``pressure_mbar`` (mbar), ``height_m`` (m), ``humidity``
-            (0..1), ``wavelength_um`` (micron), ``lapse_rate_k_per_m`` (K/m).
-        observed_deg: (N, 2) observed first and second angle: alt-az: azimuth (South = 0, East =
-            90) and elevation; equatorial: hour angle (positive West) and declination (deg).
-        raw_deg: (N, 2) the raw (encoder) angles in the same convention (deg).
+        mount: :data:`ALTAZ` or :data:`EQUATORIAL`; mount_line: the line of the option naming it
+            (``None`` if given by the caller).
+        latitude_deg: the site latitude (deg, North positive); latitude_text: as written.
+        run_parameters: ``date`` (y, m, d) and the fields given of ``temperature_c`` (C),
+            ``pressure_mbar``, ``height_m``, ``humidity`` (0..1), ``wavelength_um``,
+            ``lapse_rate_k_per_m``.
+        observed_deg, raw_deg: (N, 2) the star's and the encoders' angles (deg): azimuth (South
+            = 0, East = 90) and elevation, or hour angle (positive West) and declination.
         lines: (N,) line number of each star's record (1 = first line of the file).
         azimuth_origin, azimuth_direction: the file's azimuth convention (alt-az), converted.
     """
@@ -160,19 +163,17 @@ class TpointRun:
 
 @dataclass(frozen=True)
 class TpointConversion:
-    """A run converted to measurement rows (see the module docstring for the definitions).
+    """A run converted to measurement rows (definitions: the module docstring).
 
     Attributes:
         run: the :class:`TpointRun`.
-        phi_deg: (N, 2) the raw (commanded) joint angles written as ``phi1_deg, phi2_deg`` (deg).
-        dpsi_arcsec, dtheta_arcsec: (N,) the measured orientation error angles (arcsec).
-        refraction: ``apply`` or ``none``: what was done.
-        refraction_arcsec: (N,) the refraction added to each observed elevation (arcsec; zeros
-            for ``none``).
+        phi_deg: (N, 2) the raw (commanded) joint angles, ``phi1_deg, phi2_deg``.
+        dpsi_arcsec, dtheta_arcsec: (N,) the measured orientation error angles.
+        refraction: ``apply`` or ``none``; refraction_arcsec: (N,) what was added to each
+            observed elevation (zeros for ``none``).
         latitude_deg: the latitude of the URDF's polar axis (equatorial; the file's for alt-az).
-        urdf_name: the bundled URDF the rows belong to.
-        urdf_text: that URDF (for an equatorial run: tilted to ``latitude_deg``).
-        urdf_written: where that URDF was written, if it was (named in the comments).
+        urdf_name, urdf_text: the bundled URDF the rows belong to and its text (an equatorial
+            run's tilted to ``latitude_deg``); urdf_written: where it was written, if it was.
     """
 
     run: TpointRun
@@ -206,7 +207,8 @@ class TpointConversion:
         out = [
             f"imported by turntable-pin import-tpoint from {Path(run.path).name} (TPOINT run)",
             f"caption: {run.caption}",
-            f"mount: {run.mount}, table {table}" + (f"; read with --urdf {urdf}" if urdf else ""),
+            f"mount: {run.mount}, table {table}"
+            + (f"; read with {argument('turntable')} {urdf}" if urdf else ""),
             "options: " + (" ".join(run.options) or "none"),
             "run parameters: " + ", ".join(params),
         ]
@@ -266,18 +268,11 @@ def _num(value: float) -> str:
 
 
 def _ranges(lines) -> str:
-    """``21-100, 104`` for the sorted runs of consecutive numbers in ``lines``."""
-    out, start, prev = [], None, None
-    for n in lines:
-        if start is None:
-            start = prev = n
-        elif n == prev + 1:
-            prev = n
-        else:
-            out.append(f"{start}-{prev}" if prev != start else f"{start}")
-            start = prev = n
-    if start is not None:
-        out.append(f"{start}-{prev}" if prev != start else f"{start}")
+    """``21-100, 104`` for the runs of consecutive numbers in the increasing ``lines``."""
+    out = []
+    for _, run in itertools.groupby(enumerate(lines), lambda pair: pair[1] - pair[0]):
+        first, *rest = (n for _, n in run)
+        out.append(f"{first}-{rest[-1]}" if rest else f"{first}")
     return ", ".join(out)
 
 
@@ -293,17 +288,17 @@ def _numbers(tokens: list[str], path: Path, line: int, what: str) -> list[float]
 def _sexagesimal(tokens: list[str], path: Path, line: int, what: str, limit: float) -> float:
     """``+-d m s`` (or ``h m s``) as a decimal number, sign from the first token's text."""
     d, m, s = _numbers(tokens, path, line, what)
+    written = " ".join(tokens)
     if not (d == int(d) and 0 <= m < 60 and 0 <= s < 60):
         raise InputError(
-            f"{what} '{' '.join(tokens)}': expected whole degrees (hours), minutes < 60 and "
-            "seconds < 60",
+            f"{what} '{written}': expected whole degrees (hours), minutes < 60 and seconds < 60",
             path=path,
             line=line,
         )
     value = abs(d) + m / 60.0 + s / 3600.0
     value = -value if tokens[0].startswith("-") else value
     if abs(value) > limit:
-        raise InputError(f"{what} '{' '.join(tokens)}' is beyond +-{limit:g}", path=path, line=line)
+        raise InputError(f"{what} '{written}' is beyond +-{limit:g}", path=path, line=line)
     return value
 
 
@@ -347,213 +342,223 @@ def read_tpoint(
             f"{'|'.join(AZIMUTH_ORIGINS)} and direction {'|'.join(AZIMUTH_DIRECTIONS)}"
         )
     text = read_text_file(path, "TPOINT", encoding="utf-8-sig", max_bytes=MAX_TPOINT_FILE_BYTES)
+    return _Reader(path, mount, azimuth_origin, azimuth_direction).read(text)
 
-    caption = None
-    options: list[str] = []
-    file_mount, mount_line = None, None
-    run_line = None
-    latitude = latitude_text = None
-    params: dict = {}
-    observed, raw, lines = [], [], []
-    notes = []  # (line, text) of the comment lines, for the azimuth convention check
-    for number, raw_line in enumerate(text.splitlines(), start=1):
-        line = raw_line.strip()
-        if not line:
-            continue
-        if line.startswith("!"):
-            notes.append((number, line))
-            continue
-        if caption is None:
-            caption = line
-            continue
-        if line.upper() == "END":
-            break
-        if line.startswith(":"):
-            name = line[1:].strip().split()[0].upper() if line[1:].strip() else ""
-            if run_line is not None:
-                raise InputError(
-                    f"option line '{line}' after the run-parameter line (line {run_line}): "
-                    "options come between the caption and the run parameters",
-                    path=path,
-                    line=number,
+
+@dataclass
+class _Reader:
+    """What has been read of one TPOINT file so far (:func:`read_tpoint`)."""
+
+    path: Path
+    mount: str | None  # the caller's
+    azimuth_origin: str
+    azimuth_direction: str
+    caption: str | None = None
+    options: list[str] = field(default_factory=list)
+    file_mount: str | None = None
+    mount_line: int | None = None
+    run_line: int | None = None
+    latitude: float = 0.0
+    latitude_text: str = ""
+    params: dict = field(default_factory=dict)
+    observed: list = field(default_factory=list)
+    raw: list = field(default_factory=list)
+    lines: list[int] = field(default_factory=list)
+    notes: list = field(default_factory=list)  # (line, text) of the comments, for the azimuth
+
+    def fail(self, message: str, line: int | None = None) -> InputError:
+        """The error ``message`` about the file, at ``line``."""
+        return InputError(message, path=self.path, line=line)
+
+    @property
+    def kind(self) -> str | None:
+        """The mount: the file's, else the caller's."""
+        return self.file_mount or self.mount
+
+    def read(self, text: str) -> TpointRun:
+        """The run the file's ``text`` holds."""
+        for number, raw_line in enumerate(text.splitlines(), start=1):
+            line = raw_line.strip()
+            if not line:
+                continue
+            if line.startswith("!"):
+                self.notes.append((number, line))
+            elif self.caption is None:
+                self.caption = line
+            elif line.upper() == "END":
+                break
+            elif line.startswith(":"):
+                self.option(line, number)
+            elif self.run_line is None:
+                self.run_parameters(line.split(), number)
+            else:
+                self.record(line.split(), number)
+        return self.run()
+
+    def option(self, line: str, number: int) -> None:
+        """An option line ``: NAME``."""
+        name = line[1:].strip().split()[0].upper() if line[1:].strip() else ""
+        if self.run_line is not None:
+            raise self.fail(
+                f"option line '{line}' after the run-parameter line (line {self.run_line}): "
+                "options come between the caption and the run parameters",
+                number,
+            )
+        if name not in KNOWN_OPTIONS:
+            known = ", ".join(f": {o}" for o in KNOWN_OPTIONS)
+            raise self.fail(f"unknown option line '{line}': this importer knows {known}", number)
+        if name == "J2000":
+            raise self.fail(
+                "': J2000' (mean J2000 star places) is not supported: the importer does no "
+                "precession, nutation or aberration; give apparent places of date",
+                number,
+            )
+        if name in _OPTION_MOUNT:
+            if self.file_mount is not None and _OPTION_MOUNT[name] != self.file_mount:
+                raise self.fail(
+                    f"'{line}' contradicts the mount option on line {self.mount_line}", number
                 )
-            if name not in KNOWN_OPTIONS:
-                raise InputError(
-                    f"unknown option line '{line}': this importer knows "
-                    + ", ".join(f": {o}" for o in KNOWN_OPTIONS),
-                    path=path,
-                    line=number,
+            self.file_mount, self.mount_line = _OPTION_MOUNT[name], number
+            if self.mount is not None and self.mount != self.file_mount:
+                raise self.fail(
+                    f"the file states an {self.file_mount} mount ('{line}'), but "
+                    f"{argument('mount')} {self.mount} was given",
+                    number,
                 )
-            if name == "J2000":
-                raise InputError(
-                    "': J2000' (mean J2000 star places) is not supported: the importer does no "
-                    "precession, nutation or aberration; give apparent places of date",
-                    path=path,
-                    line=number,
+        self.options.append(name)
+
+    def run_parameters(self, tokens: list[str], number: int) -> None:
+        """The run-parameter line: latitude, then the date and the other fields if given."""
+        if self.kind is None:
+            raise self.fail(
+                "the file states no mount (no ': ALTAZ' or ': EQUAT' option line before the run "
+                f"parameters); give {argument('mount')} altaz|equatorial",
+                number,
+            )
+        if len(tokens) == _RECORD_NUMBERS[self.kind] or len(tokens) not in (3, *range(6, 13)):
+            raise self.fail(
+                "expected the run-parameter line (latitude d m s [year month day temperature_C "
+                "pressure_mbar height_m humidity ...]: 3 or 6 to 12 numbers), got "
+                f"{len(tokens)} fields: the run-parameter line is missing",
+                number,
+            )
+        self.latitude = _sexagesimal(tokens[:3], self.path, number, "latitude", 90.0)
+        self.latitude_text = " ".join(tokens[:3])
+        rest = _numbers(tokens[3:], self.path, number, "run parameter")
+        if rest:
+            y, mo, d = rest[:3]
+            if not (y == int(y) and mo == int(mo) and d == int(d) and 1 <= mo <= 12
+                    and 1 <= d <= 31):  # fmt: skip
+                raise self.fail(f"date '{' '.join(tokens[3:6])}': expected year month day", number)
+            self.params["date"] = (int(y), int(mo), int(d))
+            self.params.update(zip(_RUN_FIELDS, rest[3:], strict=False))
+        for key, (low, high) in _RUN_RANGES.items():
+            value = self.params.get(key)
+            if value is not None and not low <= value <= high:
+                raise self.fail(
+                    f"run parameter {key} = {value:g} is outside [{low:g}, {high:g}]", number
                 )
-            if name in _OPTION_MOUNT:
-                if file_mount is not None and _OPTION_MOUNT[name] != file_mount:
-                    raise InputError(
-                        f"'{line}' contradicts the mount option on line {mount_line}",
-                        path=path,
-                        line=number,
-                    )
-                file_mount, mount_line = _OPTION_MOUNT[name], number
-                if mount is not None and mount != file_mount:
-                    raise InputError(
-                        f"the file states an {file_mount} mount ('{line}'), but --mount "
-                        f"{mount} was given",
-                        path=path,
-                        line=number,
-                    )
-            options.append(name)
-            continue
-        tokens = line.split()
-        if run_line is None:
-            kind = file_mount or mount
-            if kind is None:
-                raise InputError(
-                    "the file states no mount (no ': ALTAZ' or ': EQUAT' option line before "
-                    "the run parameters); give --mount altaz|equatorial",
-                    path=path,
-                    line=number,
-                )
-            if len(tokens) == _RECORD_NUMBERS[kind] or len(tokens) not in (3, *range(6, 13)):
-                raise InputError(
-                    f"expected the run-parameter line (latitude d m s [year month day "
-                    f"temperature_C pressure_mbar height_m humidity ...]: 3 or 6 to 12 numbers), "
-                    f"got {len(tokens)} fields: the run-parameter line is missing",
-                    path=path,
-                    line=number,
-                )
-            latitude = _sexagesimal(tokens[:3], path, number, "latitude", 90.0)
-            latitude_text = " ".join(tokens[:3])
-            rest = _numbers(tokens[3:], path, number, "run parameter")
-            if rest:
-                y, mo, d = rest[:3]
-                if not (y == int(y) and mo == int(mo) and d == int(d) and 1 <= mo <= 12
-                        and 1 <= d <= 31):  # fmt: skip
-                    raise InputError(
-                        f"date '{' '.join(tokens[3:6])}': expected year month day",
-                        path=path,
-                        line=number,
-                    )
-                params["date"] = (int(y), int(mo), int(d))
-                params.update(zip(_RUN_FIELDS, rest[3:], strict=False))
-            _check_run_parameters(params, path, number)
-            run_line = number
-            continue
-        kind = file_mount or mount
-        expected = _RECORD_NUMBERS[kind]
-        if len(lines) >= MAX_TPOINT_OBSERVATIONS:
-            raise InputError(
+        self.run_line = number
+
+    def record(self, tokens: list[str], number: int) -> None:
+        """A data line: one star's observed and raw position."""
+        expected = _RECORD_NUMBERS[self.kind]
+        if len(self.lines) >= MAX_TPOINT_OBSERVATIONS:
+            raise self.fail(
                 f"more than {MAX_TPOINT_OBSERVATIONS:,} observations; a TPOINT run is read up to "
                 f"{MAX_TPOINT_OBSERVATIONS:,} (as many as a diagnosis takes rows)",
-                path=path,
-                line=number,
+                number,
             )
         if len(tokens) != expected:
-            raise InputError(
-                f"expected {expected} numbers ({_RECORD_LAYOUT[kind]}), got {len(tokens)} fields",
-                path=path,
-                line=number,
+            raise self.fail(
+                f"expected {expected} numbers ({_RECORD_LAYOUT[self.kind]}), got {len(tokens)} "
+                "fields",
+                number,
             )
-        values = _numbers(tokens, path, number, "data")
-        if kind == ALTAZ:
-            az_o, el_o, az_r, el_r = values
-            for label, el in (("observed", el_o), ("raw", el_r)):
-                if not -90.0 <= el <= 90.0:
-                    raise InputError(
-                        f"{label} elevation {el:g} deg is outside [-90, 90]", path=path, line=number
-                    )
-            for label, az in (("observed", az_o), ("raw", az_r)):
-                if abs(az) > 720.0:
-                    raise InputError(
-                        f"{label} azimuth {az:g} deg is beyond +-720 deg", path=path, line=number
-                    )
-            observed.append((_azimuth_to_tpoint(az_o, azimuth_origin, azimuth_direction), el_o))
-            raw.append((_azimuth_to_tpoint(az_r, azimuth_origin, azimuth_direction), el_r))
+        values = _numbers(tokens, self.path, number, "data")
+        if self.kind == ALTAZ:
+            observed, raw = self._altaz(values, number)
         else:
-            ra = _sexagesimal(tokens[0:3], path, number, "RA", 24.0)
-            dec = _sexagesimal(tokens[3:6], path, number, "Dec", 90.0)
-            ra_raw = _sexagesimal(tokens[6:9], path, number, "raw RA", 24.0)
-            dec_raw = _sexagesimal(tokens[9:12], path, number, "raw Dec", 180.0)
-            h, m = values[12:14]
-            if not (h == int(h) and 0 <= h < 24 and 0 <= m < 60):
-                raise InputError(
-                    f"sidereal time '{tokens[12]} {tokens[13]}': expected hours < 24 and "
-                    "minutes < 60",
-                    path=path,
-                    line=number,
-                )
-            lst = h + m / 60.0
-            observed.append((15.0 * (lst - ra), dec))
-            raw.append((15.0 * (lst - ra_raw), dec_raw))
-        lines.append(number)
-    if caption is None:
-        raise InputError("no caption line, no run-parameter line and no data lines", path=path)
-    if run_line is None:
-        raise InputError(
-            "no run-parameter line (latitude d m s [date temperature pressure ...]) after the "
-            "caption and options",
-            path=path,
-        )
-    if not lines:
-        raise InputError(f"no data lines after the run-parameter line (line {run_line})", path=path)
-    kind = file_mount or mount
-    if kind == ALTAZ:
-        _check_azimuth_notes(notes, azimuth_origin, azimuth_direction, path)
-    return TpointRun(
-        path=str(path),
-        caption=caption,
-        options=tuple(options),
-        mount=kind,
-        mount_line=mount_line,
-        latitude_deg=float(latitude),
-        latitude_text=latitude_text,
-        run_parameters=params,
-        observed_deg=np.array(observed, dtype=float),
-        raw_deg=np.array(raw, dtype=float),
-        lines=tuple(lines),
-        azimuth_origin=azimuth_origin,
-        azimuth_direction=azimuth_direction,
-    )
+            observed, raw = self._equatorial(tokens, values, number)
+        self.observed.append(observed)
+        self.raw.append(raw)
+        self.lines.append(number)
 
+    def _altaz(self, values: list[float], number: int) -> tuple:
+        """The observed and raw (azimuth, elevation) of an alt-az record, TPOINT's azimuth."""
+        az_o, el_o, az_r, el_r = values
+        for label, el in (("observed", el_o), ("raw", el_r)):
+            if not -90.0 <= el <= 90.0:
+                raise self.fail(f"{label} elevation {el:g} deg is outside [-90, 90]", number)
+        for label, az in (("observed", az_o), ("raw", az_r)):
+            if abs(az) > 720.0:
+                raise self.fail(f"{label} azimuth {az:g} deg is beyond +-720 deg", number)
+        o, d = self.azimuth_origin, self.azimuth_direction
+        return (_azimuth_to_tpoint(az_o, o, d), el_o), (_azimuth_to_tpoint(az_r, o, d), el_r)
 
-def _check_run_parameters(params: dict, path: Path, line: int) -> None:
-    """Refuse run parameters outside physical ranges (refraction would be meaningless)."""
-    ranges = {
-        "temperature_c": (-100.0, 60.0),
-        "pressure_mbar": (0.0, 1200.0),
-        "height_m": (-500.0, 10000.0),
-        "humidity": (0.0, 1.0),
-    }
-    for key, (low, high) in ranges.items():
-        if key in params and not low <= params[key] <= high:
-            raise InputError(
-                f"run parameter {key} = {params[key]:g} is outside [{low:g}, {high:g}]",
-                path=path,
-                line=line,
+    def _equatorial(self, tokens: list[str], values: list[float], number: int) -> tuple:
+        """The observed and raw (hour angle, declination) of an equatorial record."""
+        path = self.path
+        ra = _sexagesimal(tokens[0:3], path, number, "RA", 24.0)
+        dec = _sexagesimal(tokens[3:6], path, number, "Dec", 90.0)
+        ra_raw = _sexagesimal(tokens[6:9], path, number, "raw RA", 24.0)
+        dec_raw = _sexagesimal(tokens[9:12], path, number, "raw Dec", 180.0)
+        h, m = values[12:14]
+        if not (h == int(h) and 0 <= h < 24 and 0 <= m < 60):
+            raise self.fail(
+                f"sidereal time '{tokens[12]} {tokens[13]}': expected hours < 24 and minutes < 60",
+                number,
             )
+        lst = h + m / 60.0
+        return (15.0 * (lst - ra), dec), (15.0 * (lst - ra_raw), dec_raw)
 
+    def run(self) -> TpointRun:
+        """The run read, once the file is through: refused without a caption, run parameters or
+        data, or when a comment states another azimuth convention than the one taken."""
+        if self.caption is None:
+            raise self.fail("no caption line, no run-parameter line and no data lines")
+        if self.run_line is None:
+            raise self.fail(
+                "no run-parameter line (latitude d m s [date temperature pressure ...]) after the "
+                "caption and options"
+            )
+        if not self.lines:
+            raise self.fail(f"no data lines after the run-parameter line (line {self.run_line})")
+        if self.kind == ALTAZ:
+            self._check_azimuth_notes()
+        return TpointRun(
+            path=str(self.path),
+            caption=self.caption,
+            options=tuple(self.options),
+            mount=self.kind,
+            mount_line=self.mount_line,
+            latitude_deg=float(self.latitude),
+            latitude_text=self.latitude_text,
+            run_parameters=self.params,
+            observed_deg=np.array(self.observed, dtype=float),
+            raw_deg=np.array(self.raw, dtype=float),
+            lines=tuple(self.lines),
+            azimuth_origin=self.azimuth_origin,
+            azimuth_direction=self.azimuth_direction,
+        )
 
-def _check_azimuth_notes(notes, origin: str, direction: str, path: Path) -> None:
-    """Refuse an azimuth convention that a comment of the file contradicts."""
-    checks = (
-        (_ORIGIN_NOTE, origin, "the azimuth origin is", "origin"),
-        (_DIRECTION_NOTE, direction, "azimuth 90 is", "direction"),
-    )
-    for number, text in notes:
-        for pattern, taken, what, option in checks:
-            found = pattern.search(text)
-            if found and found.group(1).lower() != taken:
-                raise InputError(
-                    f"the file's comment states '{found.group(0)}', but {what} taken as "
-                    f"{taken} (--azimuth-{option}); give --azimuth-{option} "
-                    f"{found.group(1).lower()} or correct the comment",
-                    path=path,
-                    line=number,
-                )
+    def _check_azimuth_notes(self) -> None:
+        """Refuse an azimuth convention that a comment of the file contradicts."""
+        checks = (
+            (_ORIGIN_NOTE, self.azimuth_origin, "the azimuth origin is", "origin"),
+            (_DIRECTION_NOTE, self.azimuth_direction, "azimuth 90 is", "direction"),
+        )
+        for number, text in self.notes:
+            for pattern, taken, what, option in checks:
+                found = pattern.search(text)
+                if found and found.group(1).lower() != taken:
+                    flag = argument(f"azimuth_{option}")
+                    raise self.fail(
+                        f"the file's comment states '{found.group(0)}', but {what} taken as "
+                        f"{taken} ({flag}); give {flag} {found.group(1).lower()} or correct the "
+                        "comment",
+                        number,
+                    )
 
 
 # --- the mount URDFs --------------------------------------------------------------------------
@@ -561,10 +566,6 @@ def mount_urdf_text(mount: str, latitude_deg: float | None = None, note: str = "
     """The bundled URDF of ``mount``; for :data:`EQUATORIAL` with the ``hour_angle`` joint's
     origin ``rpy`` set to ``(0, latitude - 90 deg, 0)`` (an XML edit; comments kept, a note added).
     """
-    import xml.etree.ElementTree as ET
-
-    from ..core.resources import models_dir
-
     source = models_dir() / MOUNT_URDFS[mount]
     text = source.read_text(encoding="utf-8")
     if mount != EQUATORIAL:
@@ -606,8 +607,6 @@ def saemundsson_refraction_arcsec(elevation_deg, temperature_c: float, pressure_
 
 def _boresight(placements, q_rad) -> np.ndarray:
     """The payload's x axis in the base frame at joint angles ``q_rad`` (2, ...) -> (..., 3)."""
-    from ..model.chain import compose_rotation
-
     return compose_rotation(placements, list(q_rad))[..., :, 0]
 
 
@@ -627,8 +626,7 @@ def _angles_pointing_at(placements, target: np.ndarray, start_rad: np.ndarray) -
     for _ in range(20):
         f = _boresight(placements, q)
         jac = np.stack(
-            [(_boresight(placements, q + step * e[:, None]) - f) / step for e in np.eye(2)],
-            axis=-1,
+            [(_boresight(placements, q + step * e[:, None]) - f) / step for e in np.eye(2)], axis=-1
         )  # (N, 3, 2)
         dq = np.einsum("nij,nj->ni", np.linalg.pinv(jac), target - f).T
         q = q + dq
@@ -641,13 +639,11 @@ def _angles_pointing_at(placements, target: np.ndarray, start_rad: np.ndarray) -
 def refuse_repeated_positions(run: TpointRun) -> None:
     """Refuse two records of ``run`` at the same raw position, naming both lines of the file.
 
-    The rows of the measurement CSV are the raw positions (``phi1_deg, phi2_deg``), and its
-    reader refuses two rows at one position (to 1e-9 deg) unless they differ in ``time_s`` or
-    approach direction (:func:`~turntable_pin.core.csv_table.refuse_repeated_rows`), which a
-    TPOINT run does not record: the rule is applied here, with the same comparison, so that the
-    import never writes a file that ``fit`` and ``diagnose`` refuse. A copied line (the same star
-    at the same raw position) and two pointings that read the same encoder position are told
-    apart in the message.
+    The CSV's rows are the raw positions, and its reader refuses two at one position unless they
+    differ in ``time_s`` or approach direction (:func:`~.core.csv_table.refuse_repeated_rows`),
+    which a TPOINT run does not record: the same rule here keeps the import from writing a file
+    ``fit`` and ``diagnose`` refuse. The message tells a copied line (the same star) from two
+    pointings that read the same encoder position.
     """
     found = first_repeated_row(list(run.raw_deg.T), run.n_stars)
     if found is None:
@@ -716,9 +712,6 @@ def convert_tpoint(
             measurement file may hold (``MAX_MEASURED_ANGLE_ARCSEC``: not a pointing error),
             naming the line.
     """
-    from ..model.chain import compose_rotation
-    from ..model.generic_table import GenericTable
-
     refuse_repeated_positions(run)
     if refraction is None:
         refraction = "none" if run.mount == ALTAZ else "apply"
@@ -740,28 +733,52 @@ def convert_tpoint(
     obs = np.radians(encoder_side(run)).T
     refr = np.zeros(run.n_stars)
     if refraction == "apply":
-        p = run.run_parameters
-        if "temperature_c" not in p or "pressure_mbar" not in p:
-            raise InputError(
-                "--refraction apply needs the temperature and pressure of the run-parameter "
-                "line, which gives none; use --refraction none or complete the line",
-                path=run.path,
-            )
-        v = _boresight(placements, obs)
-        elevation = np.degrees(np.arcsin(np.clip(v[:, 2], -1.0, 1.0)))
-        low = np.flatnonzero(elevation < 0.0)
-        if low.size:
-            raise InputError(
-                f"observed elevation {elevation[low[0]]:.3f} deg is below the horizon: refraction "
-                "is not defined there",
-                path=run.path,
-                line=run.lines[low[0]],
-            )
-        refr = saemundsson_refraction_arcsec(elevation, p["temperature_c"], p["pressure_mbar"])
-        obs = _angles_pointing_at(placements, _lift(v, refr / ARCSEC_PER_RAD), obs)
+        obs, refr = _refracted(run, placements, obs)
     d_r = np.swapaxes(compose_rotation(placements, list(raw)), -1, -2) @ compose_rotation(
         placements, list(obs)
     )
+    _refuse_far_apart(run, d_r)
+    return TpointConversion(
+        run=run,
+        phi_deg=run.raw_deg.copy(),
+        dpsi_arcsec=-d_r[:, 2, 0] * ARCSEC_PER_RAD,
+        dtheta_arcsec=d_r[:, 1, 0] * ARCSEC_PER_RAD,
+        refraction=refraction,
+        refraction_arcsec=refr,
+        latitude_deg=latitude,
+        urdf_name=MOUNT_URDFS[run.mount],
+        urdf_text=urdf_text,
+    )
+
+
+def _refracted(run: TpointRun, placements, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The observed joint angles ``obs`` (2, N) lifted by the refraction at the run's temperature
+    and pressure, and that refraction (N,) arcsec."""
+    p = run.run_parameters
+    if "temperature_c" not in p or "pressure_mbar" not in p:
+        flag = argument("refraction")
+        raise InputError(
+            f"{flag} apply needs the temperature and pressure of the run-parameter line, which "
+            f"gives none; use {flag} none or complete the line",
+            path=run.path,
+        )
+    v = _boresight(placements, obs)
+    elevation = np.degrees(np.arcsin(np.clip(v[:, 2], -1.0, 1.0)))
+    low = np.flatnonzero(elevation < 0.0)
+    if low.size:
+        raise InputError(
+            f"observed elevation {elevation[low[0]]:.3f} deg is below the horizon: refraction "
+            "is not defined there",
+            path=run.path,
+            line=run.lines[low[0]],
+        )
+    refr = saemundsson_refraction_arcsec(elevation, p["temperature_c"], p["pressure_mbar"])
+    return _angles_pointing_at(placements, _lift(v, refr / ARCSEC_PER_RAD), obs), refr
+
+
+def _refuse_far_apart(run: TpointRun, d_r: np.ndarray) -> None:
+    """Refuse the first star whose observed and raw positions (``d_r`` (N, 3, 3) between them)
+    are farther apart on the sky than a measurement file may hold: not a pointing error."""
     separation = np.degrees(np.arccos(np.clip(d_r[:, 0, 0], -1.0, 1.0))) * 3600.0
     far = np.flatnonzero(separation > MAX_MEASURED_ANGLE_ARCSEC)
     if far.size:
@@ -775,14 +792,3 @@ def convert_tpoint(
             path=run.path,
             line=run.lines[i],
         )
-    return TpointConversion(
-        run=run,
-        phi_deg=run.raw_deg.copy(),
-        dpsi_arcsec=-d_r[:, 2, 0] * ARCSEC_PER_RAD,
-        dtheta_arcsec=d_r[:, 1, 0] * ARCSEC_PER_RAD,
-        refraction=refraction,
-        refraction_arcsec=refr,
-        latitude_deg=latitude,
-        urdf_name=MOUNT_URDFS[run.mount],
-        urdf_text=urdf_text,
-    )

@@ -9,19 +9,36 @@
   loads them, only when called.
 - An **inline term** (``dphi_z2~h3(phi2)``) is an effect of one term named by its text.
 
-:func:`resolve_effects` turns the items of ``fit --effects`` (catalogue names, effect files and
-inline terms) into effects; :func:`load_catalogue` reads the files of ``--catalogue``. Every
+:func:`resolve_effects` turns the items of a fit's ``effects`` (catalogue names, effect files and
+inline terms) into effects; :func:`load_catalogue` reads the ``catalogue`` files. Every
 problem is an :class:`InputError` of one line naming the file, the line or key, and what is wrong.
 """
 
 from __future__ import annotations
 
+import importlib.metadata
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
+import numpy as np
+
 from ..core.exceptions import InputError
-from .effects.base import Effect
+from ..core.files import read_yaml_lines
+from ..core.user_code import call_user, class_file, import_module_file, is_user_code
+from ..core.words import argument
+from .catalogue import catalogue, resolve_effect
+from .effect_terms import (
+    MAX_HARMONIC_ORDER,
+    MAX_POLYNOMIAL_DEGREE,
+    EffectTerm,
+    parse_orders,
+    parse_term,
+)
+from .effects.base import Effect, PositionVariables
+from .effects.contract import check_effect_on_probe, check_story, checked_parameters
+from .effects.declared import DeclaredEffect
+from .table import measured_table
 
 __all__ = [
     "ENTRY_POINT_GROUP",
@@ -72,11 +89,6 @@ def read_effect_file(path: str | Path, turntable=None) -> Effect:
             more than :data:`MAX_EFFECT_TERMS` terms; one line naming the file, the line and the
             key.
     """
-    from ..core.files import read_yaml_lines
-    from .effect_terms import EffectTerm, parse_term
-    from .effects.declared import DeclaredEffect
-    from .table import measured_table
-
     path = Path(path)
     table = measured_table(turntable)
     doc, lines = read_yaml_lines(path)
@@ -86,6 +98,33 @@ def read_effect_file(path: str | Path, turntable=None) -> Effect:
         line = lines.get(where)
         return InputError(f"{key}: {message}" if key else message, path=path, line=line)
 
+    story = _effect_story(doc, fail)
+    items = doc["terms"]
+    if not isinstance(items, list) or not items:
+        raise fail(("terms",), "expected a list of at least one term")
+    if len(items) > MAX_EFFECT_TERMS:
+        raise fail(("terms",), f"{len(items):,} terms; an effect file holds at most "
+                               f"{MAX_EFFECT_TERMS} (one physical effect; write several files "
+                               "for several effects)")  # fmt: skip
+    terms = []
+    for i, item in enumerate(items):
+        term = _file_term(item, ("terms", i), fail)
+        try:
+            terms.append(parse_term(term, table) if isinstance(term, str) else term.check(table))
+        except InputError as exc:
+            raise fail(("terms", i), exc.detail) from None
+    twice = _repeated(s.name for t in terms for s in t.parameters())
+    if twice:
+        raise fail(("terms",), f"parameter(s) {', '.join(twice)} would be defined twice; give "
+                               "the terms different 'prefix' values (e.g. x_, z_)")  # fmt: skip
+    return DeclaredEffect(story["name"], terms, title=story["title"],
+                          explanation=story["explanation"], confirm=story["confirm"],
+                          source=str(path))  # fmt: skip
+
+
+def _effect_story(doc, fail) -> dict[str, str]:
+    """The ``name, title, explanation, confirm`` of an effect file's ``doc``, its keys checked;
+    ``fail(where, message)`` makes the error."""
     if not isinstance(doc, dict):
         raise fail((), "expected a mapping with the keys name, terms (and title, explanation, "
                        "confirm)")  # fmt: skip
@@ -107,63 +146,43 @@ def read_effect_file(path: str | Path, turntable=None) -> Effect:
     if not _NAME.match(story["name"]):
         raise fail(("name",), f"'{story['name']}': use letters, digits and _ . @ - (no spaces, "
                               "commas or '~'), starting with a letter")  # fmt: skip
-    items = doc["terms"]
-    if not isinstance(items, list) or not items:
-        raise fail(("terms",), "expected a list of at least one term")
-    if len(items) > MAX_EFFECT_TERMS:
-        raise fail(("terms",), f"{len(items):,} terms; an effect file holds at most "
-                               f"{MAX_EFFECT_TERMS} (one physical effect; write several files "
-                               "for several effects)")  # fmt: skip
-    terms = []
-    for i, item in enumerate(items):
-        where = ("terms", i)
-        if isinstance(item, str):
-            try:
-                terms.append(parse_term(item, table))
-            except InputError as exc:
-                raise fail(where, exc.detail) from None
-            continue
-        if not isinstance(item, dict):
-            raise fail(where, "expected a term: a mapping (site, harmonics|polynomial|sign, of) "
-                              "or an inline term such as dphi_z2~h3(phi2)")  # fmt: skip
-        for key in item:
-            if key not in TERM_KEYS:
-                raise fail((*where, key), f"unknown key; the keys of a term: "
-                                          f"{', '.join(TERM_KEYS)}")  # fmt: skip
-        shapes = [k for k in ("harmonics", "polynomial", "sign") if k in item]
-        if "site" not in item or len(shapes) != 1:
-            raise fail(where, "a term needs 'site' and exactly one of harmonics, polynomial, "
-                              "sign")  # fmt: skip
-        shape = shapes[0]
-        for key in ("site", "prefix", *(("sign",) if shape == "sign" else ("of",))):
-            if key in item and not isinstance(item[key], str):
-                raise fail((*where, key), "expected a text")
-        if shape == "sign":
-            if "of" in item:
-                raise fail((*where, "of"), "a sign term names its column in 'sign' (sign: dir1)")
-            variable, orders = item["sign"], ()
-        else:
-            if "of" not in item:
-                raise fail(where, f"a {shape} term needs 'of' (the variable: "
-                                  + ("phi1, phi2, phi1+phi2, ...)" if shape == "harmonics"
-                                     else "a column such as temperature_c)"))  # fmt: skip
-            variable = item["of"]
-            orders = _file_orders(item[shape], shape)
-            if isinstance(orders, str):
-                raise fail((*where, shape), orders)
-        term = EffectTerm(item["site"].strip(), shape, variable.strip(), orders,
-                          item.get("prefix", "").strip())  # fmt: skip
-        try:
-            terms.append(term.check(table))
-        except InputError as exc:
-            raise fail(where, exc.detail) from None
-    twice = _repeated(s.name for t in terms for s in t.parameters())
-    if twice:
-        raise fail(("terms",), f"parameter(s) {', '.join(twice)} would be defined twice; give "
-                               "the terms different 'prefix' values (e.g. x_, z_)")  # fmt: skip
-    return DeclaredEffect(story["name"], terms, title=story["title"],
-                          explanation=story["explanation"], confirm=story["confirm"],
-                          source=str(path))  # fmt: skip
+    return story
+
+
+def _file_term(item, where: tuple, fail) -> EffectTerm | str:
+    """The term ``item`` of an effect file at ``where``: an inline term as given, a mapping of
+    :data:`TERM_KEYS` as an unchecked :class:`EffectTerm`; ``fail(where, message)`` makes the
+    error."""
+    if isinstance(item, str):
+        return item
+    if not isinstance(item, dict):
+        raise fail(where, "expected a term: a mapping (site, harmonics|polynomial|sign, of) "
+                          "or an inline term such as dphi_z2~h3(phi2)")  # fmt: skip
+    for key in item:
+        if key not in TERM_KEYS:
+            raise fail((*where, key), f"unknown key; the keys of a term: {', '.join(TERM_KEYS)}")
+    shapes = [k for k in ("harmonics", "polynomial", "sign") if k in item]
+    if "site" not in item or len(shapes) != 1:
+        raise fail(where, "a term needs 'site' and exactly one of harmonics, polynomial, sign")
+    shape = shapes[0]
+    for key in ("site", "prefix", *(("sign",) if shape == "sign" else ("of",))):
+        if key in item and not isinstance(item[key], str):
+            raise fail((*where, key), "expected a text")
+    if shape == "sign":
+        if "of" in item:
+            raise fail((*where, "of"), "a sign term names its column in 'sign' (sign: dir1)")
+        variable, orders = item["sign"], ()
+    else:
+        if "of" not in item:
+            raise fail(where, f"a {shape} term needs 'of' (the variable: "
+                              + ("phi1, phi2, phi1+phi2, ...)" if shape == "harmonics"
+                                 else "a column such as temperature_c)"))  # fmt: skip
+        variable = item["of"]
+        orders = _file_orders(item[shape], shape)
+        if isinstance(orders, str):
+            raise fail((*where, shape), orders)
+    return EffectTerm(item["site"].strip(), shape, variable.strip(), orders,
+                      item.get("prefix", "").strip())  # fmt: skip
 
 
 def _repeated(names: Iterable[str]) -> list[str]:
@@ -178,8 +197,6 @@ def _repeated(names: Iterable[str]) -> list[str]:
 def _file_orders(value, shape: str) -> tuple[int, ...] | str:
     """The orders of ``harmonics:`` (an order, a list, ``"A..B"``) or the powers of a
     ``polynomial:`` degree; a message when ``value`` is not one."""
-    from .effect_terms import MAX_HARMONIC_ORDER, MAX_POLYNOMIAL_DEGREE, _orders
-
     if shape == "polynomial":
         if isinstance(value, bool) or not isinstance(value, int):
             return f"expected the degree, a whole number 1..{MAX_POLYNOMIAL_DEGREE}"
@@ -190,7 +207,7 @@ def _file_orders(value, shape: str) -> tuple[int, ...] | str:
         return tuple(range(1, value + 1))
     if isinstance(value, str):
         try:
-            return _orders(value.strip(), "orders")
+            return parse_orders(value.strip(), "orders")
         except InputError as exc:
             return exc.detail
     values = value if isinstance(value, list) else [value]
@@ -202,10 +219,6 @@ def _file_orders(value, shape: str) -> tuple[int, ...] | str:
 
 def inline_effect(text: str, turntable=None) -> Effect:
     """The effect of one inline term (``dphi_z2~h3(phi2)``), named by its text."""
-    from .effect_terms import parse_term
-    from .effects.declared import DeclaredEffect
-    from .table import measured_table
-
     term = parse_term(text, measured_table(turntable))
     return DeclaredEffect(term.spec(), [term], source="inline term")
 
@@ -213,8 +226,6 @@ def inline_effect(text: str, turntable=None) -> Effect:
 def _effects_in(objects: Iterable, where: str, base: type = Effect, path=None) -> list:
     """The effects among ``objects``: instances of ``base``, and its subclasses built without
     arguments (the user's code: a failure is reported as theirs, :func:`call_user`)."""
-    from ..core.user_code import call_user
-
     out = []
     for obj in objects:
         if isinstance(obj, type) and issubclass(obj, base) and obj is not base:
@@ -226,24 +237,17 @@ def _effects_in(objects: Iterable, where: str, base: type = Effect, path=None) -
 
 
 def load_effects_module(path: str | Path, base: type = Effect) -> tuple:
-    """The effects a Python file defines: instances of :class:`Effect` (or of ``base``: the
-    run effects of :mod:`turntable_pin.instrument` use
-    :class:`~turntable_pin.instrument.effects.base.RunEffect`), and the subclasses defined in
-    the file (built without arguments), in the order they appear. Each effect's ``source`` is
-    the file.
-
-    The file is code that runs: importing it runs its top level
-    (:func:`~turntable_pin.core.user_code.import_module_file`). The effects are not checked
-    here: :func:`check_user_effects` (orientation effects) and
-    :func:`turntable_pin.instrument.effects.contract.check_user_run_effects` (run effects) do.
+    """The effects a Python file defines, in order: instances of :class:`Effect` (or of ``base``:
+    a run's ``RunEffect``) and the subclasses defined there (built without arguments), each
+    with the file as its ``source``. Importing the file runs its top level
+    (:func:`~turntable_pin.core.user_code.import_module_file`); the effects are checked by
+    :func:`check_user_effects` (orientation) or ``check_user_run_effects`` (runs), not here.
 
     Raises:
         InputError: the file cannot be read or defines no effect.
         UserCodeError: importing it, or building an effect, raised an exception or called
             ``sys.exit`` (the file, the line and the message).
     """
-    from ..core.user_code import import_module_file
-
     path = Path(path)
     if not path.is_file():
         raise InputError("no such Python file", path=path)
@@ -257,8 +261,7 @@ def load_effects_module(path: str | Path, base: type = Effect) -> tuple:
     if not effects:
         where = f"{base.__module__.replace('.base', '')}.{base.__name__}"
         raise InputError(
-            f"defines no effect (expected subclasses of {where} or instances of them)",
-            path=path,
+            f"defines no effect (expected subclasses of {where} or instances of them)", path=path
         )
     for effect in effects:
         _set_source(effect, str(path))
@@ -289,12 +292,8 @@ def installed_effects() -> tuple[Effect, ...]:
         InputError: an entry point that holds no effect.
         UserCodeError: an entry point that fails to load (its code raised).
     """
-    from importlib.metadata import entry_points
-
-    from ..core.user_code import call_user
-
     out: list[Effect] = []
-    for ep in entry_points(group=ENTRY_POINT_GROUP):
+    for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP):
         where = f"entry point '{ep.name}' ({ep.value}) of {ENTRY_POINT_GROUP}"
         obj = call_user(f"{where}: loading it", ep.load)
         objects = obj if isinstance(obj, list | tuple) else [obj]
@@ -311,9 +310,6 @@ def effect_definition(effect) -> str:
     """Where ``effect`` is defined, for messages: ``FILE, line L`` (the ``name`` of an effect
     file), ``FILE (class C)`` (a class of a module or plug-in), ``the inline term T`` or
     ``module.Class`` (the package's own)."""
-    from ..core.user_code import class_file, is_user_code
-    from .effects.declared import DeclaredEffect
-
     source = getattr(effect, "source", "")
     source = source if isinstance(source, str) else ""
     if isinstance(effect, DeclaredEffect):
@@ -322,7 +318,7 @@ def effect_definition(effect) -> str:
             return f"{source}, line {line}" if line else source
         if source == "inline term":
             return f"the inline term {effect.name}"
-        return source or "--effects"
+        return source or argument("effects")
     cls = type(effect)
     if is_user_code(effect):
         return f"{source or class_file(cls) or 'Python'} (class {cls.__qualname__})"
@@ -355,8 +351,6 @@ def check_user_effect_names(
             effect file, file and class of a module's effect).
     """
     if taken is None:
-        from .catalogue import catalogue
-
         taken = {e.name: e for e in catalogue(turntable)}
     seen: dict[str, Effect] = {e.name: e for e in others}
     for effect in effects:
@@ -390,10 +384,6 @@ def check_user_effects(effects: Sequence[Effect], turntable=None) -> tuple[Effec
         UserCodeError: an effect that raises or breaks its contract (one line: file, effect,
             method, what it returned and what was expected).
     """
-    from ..core.user_code import is_user_code
-    from .effects.contract import check_effect_on_probe, check_story
-    from .table import measured_table
-
     table = measured_table(turntable)
     for effect in effects:
         if is_user_code(effect):
@@ -406,7 +396,7 @@ def check_user_effects(effects: Sequence[Effect], turntable=None) -> tuple[Effec
 
 
 def load_catalogue(paths: Sequence[str | Path], turntable=None) -> tuple[Effect, ...]:
-    """The effects of ``--catalogue`` files (``.yaml``/``.yml`` effect files, ``.py`` modules)
+    """The effects of ``catalogue`` files (``.yaml``/``.yml`` effect files, ``.py`` modules)
     followed by the installed ones (:func:`installed_effects`), checked by
     :func:`check_user_effects`."""
     effects: list[Effect] = []
@@ -422,17 +412,17 @@ def load_catalogue(paths: Sequence[str | Path], turntable=None) -> tuple[Effect,
 
 
 def _effect_items(text: str) -> list[str]:
-    """The items of one ``--effects`` text: comma-separated, stripped, empty ones left out."""
+    """The items of one ``effects`` text: comma-separated, stripped, empty ones left out."""
     return [x for x in (x.strip() for x in str(text).split(",")) if x]
 
 
 def _is_effect_file(item: str) -> bool:
-    """Whether an item of ``--effects`` (not an inline term) names an effect file."""
+    """Whether an item of ``effects`` (not an inline term) names an effect file."""
     return "~" not in item and item.lower().endswith(EFFECT_FILE_SUFFIXES)
 
 
 def effect_files_named(text: str) -> tuple[Path, ...]:
-    """The effect files an ``--effects`` text names (the items :func:`resolve_effects` reads as
+    """The effect files an ``effects`` text names (the items :func:`resolve_effects` reads as
     files), for the command line's check that no output is written over an input."""
     return tuple(Path(item) for item in _effect_items(text) if _is_effect_file(item))
 
@@ -440,11 +430,9 @@ def effect_files_named(text: str) -> tuple[Path, ...]:
 def resolve_effects(
     items: Sequence[str], turntable=None, extra: Sequence[Effect] = ()
 ) -> tuple[Effect, ...]:
-    """The effects of ``fit --effects``: each item a comma-separated list of catalogue names
+    """The effects of a fit's ``effects``: each item a comma-separated list of catalogue names
     (or names of ``extra`` or of installed effects), effect files (``.yaml``/``.yml``) and inline
     terms (``SITE~SHAPE(VAR)``); duplicates refused, empty items ignored."""
-    from .catalogue import resolve_effect
-
     out: list[Effect] = []
     installed: tuple[Effect, ...] | None = None
     for text in items:
@@ -470,7 +458,7 @@ def resolve_effects(
                         ) from None
                     effect = found[0]
             if any(e.name == effect.name for e in out):
-                raise InputError(f"effect '{effect.name}' is listed twice in --effects")
+                raise InputError(f"effect '{effect.name}' is listed twice in {argument('effects')}")
             out.append(effect)
     return tuple(out)
 
@@ -478,12 +466,6 @@ def resolve_effects(
 def describe_effects(effects: Sequence[Effect], turntable=None) -> list[dict]:
     """Each effect's story with its parameters (``name, unit, description``) on a data set that
     has every column it needs, and where it comes from (``catalogue`` or its file)."""
-    import numpy as np
-
-    from .effects.base import PositionVariables
-    from .effects.contract import checked_parameters
-    from .table import measured_table
-
     table = measured_table(turntable)
     j = table.n_joints
     columns = {c for e in effects for c in e.required_columns}

@@ -13,10 +13,10 @@ from turntable_pin.measurement.effect_model import OrientationModel
 from turntable_pin.measurement.effects import EFFECT_NAMES, EFFECTS, PositionVariables, get_effect
 from turntable_pin.measurement.effects.base_rotation import BaseRotation
 from turntable_pin.measurement.effects.gravity_compliance import GravityCompliance
-from turntable_pin.measurement.effects.paper_names import PAPER_EFFECTS
 from turntable_pin.measurement.effects.payload_mount import PayloadMount
 from turntable_pin.measurement.effects.thermal_drift import ThermalDrift
 from turntable_pin.measurement.table import measured_table
+from turntable_pin.model.paper_table import PAPER_EFFECTS
 
 PAPER = measured_table()
 OUTER, INNER = PAPER.joints

@@ -2,19 +2,21 @@
 
 Each physical effect is one module holding one :class:`Effect` subclass, for any table; a table's
 catalogue of them is :func:`turntable_pin.measurement.catalogue.catalogue`. :data:`EFFECTS` is the
-paper's table's catalogue by the paper's names (:mod:`.paper_names`). :func:`parse_effect_spec`
-reads the ``NAME:P=V,...`` form the simulator takes.
+paper's table's catalogue by the paper's names (``model.paper_table.PAPER_EFFECTS``);
+:func:`parse_effect_spec` reads the ``NAME:P=V,...`` form the simulator takes.
 """
 
 from __future__ import annotations
 
+# ..catalogue is imported inside _paper_effects: it imports this package (a cycle at import)
 import math
 
 import numpy as np
 
 from ...core.exceptions import InputError
+from ...model.paper_table import PAPER_EFFECTS
 from .base import ChainTerm, Effect, EffectText, ParameterSpec, PositionVariables
-from .paper_names import PAPER_EFFECTS
+from .contract import checked_parameters
 
 EFFECT_NAMES: tuple[str, ...] = tuple(e.name for e in PAPER_EFFECTS)
 """The paper's table's catalogue names, in catalogue order."""
@@ -56,8 +58,6 @@ def parameter_names(effect: Effect) -> tuple[str, ...]:
 
 
 def _every_parameter(effect: Effect):
-    from .contract import checked_parameters
-
     one = np.zeros((1, 3))
     dirs = (one[:, 0] + 1,) * 3
     return checked_parameters(effect, PositionVariables(one, one[:, 0], dirs), "one position")

@@ -1,19 +1,17 @@
 """What a candidate physical effect is: parameters, how it changes the kinematic chain, its story.
 
-An effect changes the exact rotation chain of ``docs/model.md`` in one of three ways, each *linear
-in its parameters* (the angles it adds are ``sum_k weight_k(position) * p_k``):
+An effect changes the exact rotation chain of ``docs/model.md``, *linearly in its parameters* (the
+angles it adds are ``sum_k weight_k(position) * p_k``), through terms:
 
-- ``ChainTerm(site=<error name>, ...)``: adds to one of the eight turntable error angles, per
-  position (encoder harmonics, wobble harmonics, backlash);
-- ``ChainTerm(site="pre", axis=...)``: an extra rotation multiplied *before* ``Rt`` (in the base
-  frame: base tilt);
-- ``ChainTerm(site="post", axis=...)``: an extra rotation multiplied *after* ``Rt`` (in the payload
-  frame: gravity sag, thermal drift, payload mount);
-- ``ChainTerm(site="measured", axis="dpsi"|"dtheta"|"dgamma")``: an angle added to that measured
-  angle itself, after the chain (a term of the instrument's reading, not of the table).
+- ``ChainTerm(site=<error name>, ...)``: added to one of the table's error angles, per position
+  (encoder harmonics, wobble harmonics, backlash);
+- ``ChainTerm(site="pre" | "post", axis=...)``: a rotation *before* ``Rt`` (base frame: base
+  tilt) or *after* it (payload frame: gravity sag, thermal drift, payload mount);
+- ``ChainTerm(site="measured", axis="dpsi"|"dtheta"|"dgamma")``: added to that measured angle
+  itself, after the chain (a term of the instrument's reading, not of the table).
 
-Terms of one site are applied in the order listed. :class:`OrientationModel` turns these terms into
-factors of the chain and differentiates them analytically.
+Terms of one site apply in order; :class:`OrientationModel` makes them factors of the chain and
+differentiates them analytically.
 """
 
 from __future__ import annotations
@@ -187,26 +185,6 @@ class PositionVariables:
             raise InputError(f"these positions have {self.n_joints} joint(s), no joint {k}")
         return self.joint_rad[:, k - 1]
 
-    @property
-    def phi1_rad(self) -> np.ndarray:
-        """The first joint's commanded angle (the paper's outer axis), rad (N,)."""
-        return self.angle(1)
-
-    @property
-    def phi2_rad(self) -> np.ndarray:
-        """The second joint's commanded angle (the paper's inner axis), rad (N,)."""
-        return self.angle(2)
-
-    @property
-    def dir1(self) -> np.ndarray | None:
-        """Approach direction of joint 1, or ``None``."""
-        return self.dirs[0] if self.dirs else None
-
-    @property
-    def dir2(self) -> np.ndarray | None:
-        """Approach direction of joint 2, or ``None``."""
-        return self.dirs[1] if len(self.dirs) > 1 else None
-
     def column(self, name: str) -> np.ndarray | None:
         """The data column ``name``: ``time_s``, ``dirK``, ``phiK`` (rad) or an extra column."""
         if name == "time_s":
@@ -249,12 +227,10 @@ def harmonic_parameters(prefix: str, what: str, angle: str) -> tuple[ParameterSp
 
 
 class Effect(CandidateEffect):
-    """Base class of a candidate physical effect of orientation data (a plug-in of
-    :mod:`turntable_pin.measurement.effects`): the one base of every family's effects
-    (:class:`~turntable_pin.stats.candidate_effect.CandidateEffect`: name, story, required
-    columns, parameters) with how it changes the kinematic chain.
-
-    Subclasses set the class attributes and implement :meth:`parameters` and :meth:`chain_terms`.
+    """Base class of a candidate physical effect of orientation data: a
+    :class:`~turntable_pin.stats.candidate_effect.CandidateEffect` (name, story, required
+    columns, parameters) that changes the kinematic chain. Subclasses set the class attributes
+    and implement :meth:`parameters` and :meth:`chain_terms`.
 
     Args:
         name, text: the name and story a table gives this effect instead of the class's.

@@ -1,7 +1,7 @@
 """The contract of an :class:`~.base.Effect` plug-in, checked once where the user's effect enters.
 
-An effect the user writes (a class of a Python module, an installed plug-in, an object passed from
-Python) must give, for the variables of N positions:
+An effect the user writes (a Python module's class, a plug-in, an object from Python) must give,
+for the variables of N positions:
 
 - its story as text (``name``, ``title``, ``definition``, ``explanation``, ``confirm``) and its
   ``required_columns`` as a tuple of column names;
@@ -12,14 +12,15 @@ Python) must give, for the variables of N positions:
   whose ``weights`` map parameters it declared to a finite number or a finite array of shape
   (N,); every declared parameter weighed by some term.
 
-:func:`check_effect` calls the methods (through :func:`~turntable_pin.core.user_code.call_user`)
-on the data's variables or on a probe (:func:`probe_variables`) and raises a one-line
-:class:`~turntable_pin.core.exceptions.UserCodeError` naming the file, the effect, the method,
-what it returned and what was expected; the package's own effects are not checked.
+:func:`check_effect` calls the methods (:func:`~turntable_pin.core.user_code.call_user`) on the
+data's variables or a probe (:func:`probe_variables`); a one-line ``UserCodeError`` names the
+file, the effect, the method, what it returned and what was expected. The package's own effects
+are not checked.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from collections.abc import Mapping
@@ -27,10 +28,10 @@ from collections.abc import Mapping
 import numpy as np
 
 from ...core.exceptions import UserCodeError
-from ...core.user_code import call_user, class_file
+from ...core.user_code import call_user, class_file, is_user_code
 from ...model.angles import ANGLE_NAMES
 from ...stats.candidate_effect import STORY_TEXTS
-from .base import MEASURED, POST, PRE, ChainTerm, ParameterSpec, PositionVariables
+from .base import MEASURED, POST, PRE, ChainTerm, Effect, ParameterSpec, PositionVariables
 
 __all__ = [
     "PROBE_POSITIONS",
@@ -105,91 +106,74 @@ def check_story(effect, base: type) -> None:
     a tuple of column names or whose family story field (``base.story_fields``: a run effect's
     ``side``) is not one of the values it may take; ``base`` is the family's effect class it must
     derive from (:class:`~turntable_pin.stats.candidate_effect.CandidateEffect`'s subclass)."""
+    fail = functools.partial(contract_error, effect)
     if not isinstance(effect, base):
-        raise contract_error(
-            effect, f"is {described(effect)}; expected an instance of {base.__qualname__}"
-        )
+        raise fail(f"is {described(effect)}; expected an instance of {base.__qualname__}")
     for key in STORY_ATTRIBUTES:
         value = getattr(effect, key, "")
         if not isinstance(value, str):
-            raise contract_error(
-                effect,
-                f"its {key} is {described(value)}; expected a text",
-            )
+            raise fail(f"its {key} is {described(value)}; expected a text")
     columns = getattr(effect, "required_columns", ())
     if isinstance(columns, str):
-        raise contract_error(
-            effect,
+        raise fail(
             f"its required_columns is the text {columns!r}; expected a tuple of "
-            f"column names, ({columns!r},)",
+            f"column names, ({columns!r},)"
         )
     if not isinstance(columns, tuple | list) or not all(
         isinstance(c, str) and c for c in columns
     ):  # fmt: skip
-        raise contract_error(
-            effect,
+        raise fail(
             f"its required_columns is {described(columns)}; expected a tuple of "
-            "column names such as ('time_s',)",
+            "column names such as ('time_s',)"
         )
     for key, values in base.story_fields.items():
         value = getattr(effect, key, None)
         if value not in values:
             expected = " or ".join(f"'{v}'" for v in values)
-            raise contract_error(effect, f"its {key} is {described(value)}; expected {expected}")
+            raise fail(f"its {key} is {described(value)}; expected {expected}")
 
 
 def check_parameters(effect, specs, call: str, on: str) -> tuple[ParameterSpec, ...]:
     """``specs`` (what ``effect``'s ``call`` returned on ``on``) as a tuple of at least one
     :class:`ParameterSpec`, names unique texts, scales finite and > 0; a
     :class:`UserCodeError` otherwise."""
+    fail = functools.partial(contract_error, effect)
     expected = "a tuple of ParameterSpec(name, unit, per_user_unit, description)"
     if not isinstance(specs, tuple | list):
-        raise contract_error(
-            effect, f"{call} returned {described(specs)} on {on}; expected {expected}"
-        )
+        raise fail(f"{call} returned {described(specs)} on {on}; expected {expected}")
     if not specs:
-        raise contract_error(
-            effect,
+        raise fail(
             f"{call} returned no parameter on {on}; expected {expected}, at "
-            "least one (an effect without parameters adds nothing)",
+            "least one (an effect without parameters adds nothing)"
         )
     seen = set()
     for k, spec in enumerate(specs, 1):
         if not isinstance(spec, ParameterSpec):
-            raise contract_error(
-                effect,
-                f"{call} returned {described(spec)} as parameter {k} on {on}; "
-                "expected a ParameterSpec(name, unit, per_user_unit, "
-                "description)",
+            raise fail(
+                f"{call} returned {described(spec)} as parameter {k} on {on}; expected a "
+                "ParameterSpec(name, unit, per_user_unit, description)"
             )
         name = spec.name
         if not isinstance(name, str) or not name.strip() or any(c.isspace() for c in name):
-            raise contract_error(
-                effect,
+            raise fail(
                 f"{call}: parameter {k} is named {described(name)}; expected a "
-                "text without spaces (c1, k, rz)",
+                "text without spaces (c1, k, rz)"
             )
         if name in seen:
-            raise contract_error(
-                effect,
-                f"{call} declares the parameter '{name}' twice",
-            )
+            raise fail(f"{call} declares the parameter '{name}' twice")
         seen.add(name)
         for key in ("unit", "description"):
             if not isinstance(getattr(spec, key), str):
-                raise contract_error(
-                    effect,
+                raise fail(
                     f"{call}: parameter '{name}': its {key} is "
-                    f"{described(getattr(spec, key))}; expected a text",
+                    f"{described(getattr(spec, key))}; expected a text"
                 )
         scale = spec.per_user_unit
         number = isinstance(scale, int | float | np.number) and not isinstance(scale, bool)
         if not number or not math.isfinite(float(scale)) or float(scale) <= 0:
-            raise contract_error(
-                effect,
-                f"{call}: parameter '{name}': per_user_unit is {described(scale)}; "
-                "expected a finite number > 0 (the internal value, rad, of one "
-                "user unit: ARCSEC for arcsec)",
+            raise fail(
+                f"{call}: parameter '{name}': per_user_unit is {described(scale)}; expected a "
+                "finite number > 0 (the internal value, rad, of one user unit: ARCSEC for arcsec)"
             )
     return tuple(specs)
 
@@ -198,8 +182,6 @@ def checked_parameters(effect, variables: PositionVariables, on: str) -> tuple[P
     """``effect.parameters(variables)``; for the user's effect called through
     :func:`~turntable_pin.core.user_code.call_user` and checked (:func:`check_parameters`),
     ``on`` naming the variables in a message."""
-    from ...core.user_code import is_user_code
-
     if not is_user_code(effect):
         return tuple(effect.parameters(variables))
     label = effect_label(effect)
@@ -214,26 +196,24 @@ def _site_words(base_names) -> str:
 
 
 def _check_site(effect, term: ChainTerm, where: str, base_names) -> None:
+    fail = functools.partial(contract_error, effect)
     site, axis = term.site, term.axis
     if site in (PRE, POST):
         if axis not in _ROTATION_AXES:
-            raise contract_error(
-                effect,
-                f"{where}: a '{site}' term turns about axis x, y or z; got {described(axis)}",
+            raise fail(
+                f"{where}: a '{site}' term turns about axis x, y or z; got {described(axis)}"
             )
     elif site == MEASURED:
         if axis not in ANGLE_NAMES:
-            raise contract_error(
-                effect,
+            raise fail(
                 f"{where}: a 'measured' term adds to {', '.join(ANGLE_NAMES)}; "
-                f"got axis {described(axis)}",
+                f"got axis {described(axis)}"
             )
     elif not isinstance(site, str) or site not in base_names:
         hint = f" (ChainTerm('measured', '{site}', ...))" if site in ANGLE_NAMES else ""
-        raise contract_error(
-            effect,
+        raise fail(
             f"{where}: site {described(site)} is not one of this table's; expected "
-            f"{_site_words(base_names)}{hint}",
+            f"{_site_words(base_names)}{hint}"
         )
 
 
@@ -242,10 +222,7 @@ def _check_weight(effect, value, where: str, n: int, on: str) -> None:
     expected = f"a number or an array of shape ({n},), one value per position"
     array = numbers_returned(value)
     if array is None:
-        raise contract_error(
-            effect,
-            f"{where} is {described(value)} on {on}; expected {expected}",
-        )
+        raise contract_error(effect, f"{where} is {described(value)} on {on}; expected {expected}")
     if array.shape not in ((), (n,)):
         raise contract_error(
             effect, f"{where} has shape {array.shape} on {on}; expected {expected}"
@@ -258,53 +235,45 @@ def _check_weight(effect, value, where: str, n: int, on: str) -> None:
         )  # fmt: skip
         count = f" at {int(bad.sum())} of {n} positions" if array.ndim else ""
         raise contract_error(
-            effect,
-            f"{where} is not finite ({kinds}{count}) on {on}; expected finite numbers",
+            effect, f"{where} is not finite ({kinds}{count}) on {on}; expected finite numbers"
         )
 
 
 def _check_terms(effect, terms, specs, n: int, base_names, on: str) -> tuple[ChainTerm, ...]:
+    fail = functools.partial(contract_error, effect)
     call = "chain_terms(variables)"
     expected = "a tuple of ChainTerm(site, axis, weights)"
     if not isinstance(terms, tuple | list):
-        raise contract_error(
-            effect, f"{call} returned {described(terms)} on {on}; expected {expected}"
-        )
+        raise fail(f"{call} returned {described(terms)} on {on}; expected {expected}")
     declared = [s.name for s in specs]
     weighed = set()
     for k, term in enumerate(terms, 1):
         where = f"{call}, term {k}"
         if not isinstance(term, ChainTerm):
-            raise contract_error(
-                effect,
-                f"{where} is {described(term)} on {on}; expected a ChainTerm(site, axis, weights)",
+            raise fail(
+                f"{where} is {described(term)} on {on}; expected a ChainTerm(site, axis, weights)"
             )
         _check_site(effect, term, where, base_names)
         axis = f".{term.axis}" if term.site in (PRE, POST, MEASURED) else ""
         where = f"{where} (site {term.site}{axis})"
         if not isinstance(term.weights, Mapping):
-            raise contract_error(
-                effect,
-                f"{where}: weights is {described(term.weights)}; expected a dict "
-                "{parameter name: number or array of one value per "
-                "position}",
+            raise fail(
+                f"{where}: weights is {described(term.weights)}; expected a dict {{parameter "
+                "name: number or array of one value per position}"
             )
         for name, value in term.weights.items():
             if name not in declared:
-                raise contract_error(
-                    effect,
-                    f"{where}: weight {described(name)} is not a parameter of the "
-                    f"effect; parameters(variables) declares "
-                    f"{', '.join(declared)}",
+                raise fail(
+                    f"{where}: weight {described(name)} is not a parameter of the effect; "
+                    f"parameters(variables) declares {', '.join(declared)}"
                 )
             _check_weight(effect, value, f"{where}: weight '{name}'", n, on)
             weighed.add(name)
     unused = [name for name in declared if name not in weighed]
     if unused:
-        raise contract_error(
-            effect,
+        raise fail(
             f"parameters(variables) declares {', '.join(repr(u) for u in unused)} "
-            f"but no term of chain_terms(variables) weighs it on {on}",
+            f"but no term of chain_terms(variables) weighs it on {on}"
         )
     return tuple(terms)
 
@@ -321,8 +290,6 @@ def check_effect(
         UserCodeError: a method raised, or returned something the contract does not allow: one
             line naming the file, the effect, the method, what it returned and what was expected.
     """
-    from .base import Effect
-
     on = on or f"the data ({variables.n} positions)"
     check_story(effect, Effect)
     path = effect_file(effect)
@@ -355,8 +322,6 @@ def check_effect_on_probe(effect, table, columns=()) -> None:
     """Check the user's ``effect`` (:func:`check_effect`) on :func:`probe_variables` of
     ``table`` (a :class:`~turntable_pin.measurement.table.MeasuredTable`) with its required
     columns and ``columns``."""
-    from .base import Effect
-
     check_story(effect, Effect)
     probe = probe_variables(table.n_joints, (*effect.required_columns, *columns))
     check_effect(effect, probe, table.base_names,

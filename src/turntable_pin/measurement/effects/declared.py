@@ -20,7 +20,7 @@ class DeclaredEffect(Effect):
         name: its name (unique among the effects of a run).
         terms: its terms (``EffectTerm``), already checked against the table.
         title, explanation, confirm: its story (``title`` defaults to the definition).
-        source: where it was declared (an effect file, ``--effects``), for messages.
+        source: where it was declared (an effect file, ``effects``), for messages.
     """
 
     def __init__(

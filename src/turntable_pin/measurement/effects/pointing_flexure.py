@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...core.exceptions import InputError
+from ..pointing_terms import coordinate_offsets, mount_kind, mount_terms
 from .base import ARCSEC, POST, ChainTerm, Effect, ParameterSpec, PositionVariables
 
 __all__ = ["GRAVITY_TERMS", "JOINT_TERMS", "MIN_SINE", "PointingFlexure", "pointing_flexures"]
@@ -74,8 +75,6 @@ class PointingFlexure(Effect):
         if name in GRAVITY_TERMS:
             up = np.asarray(self.rotation(variables.joint_rad))[:, 2, :]  # Rd^T e_z, (N, 3)
             return (ChainTerm(POST, "y", {name: up[:, 2]}), ChainTerm(POST, "z", {name: -up[:, 1]}))
-        from ..pointing_terms import coordinate_offsets
-
         if name in _SINGULAR:
             function, where = _SINGULAR[name]
             if np.any(np.abs(function(variables.joint_rad[:, 1])) < MIN_SINE):
@@ -90,8 +89,6 @@ class PointingFlexure(Effect):
 
 def pointing_flexures(table) -> tuple[PointingFlexure, ...]:
     """The flexure effects of a mount (empty on other tables), in TPOINT's order."""
-    from ..pointing_terms import mount_kind, mount_terms
-
     mount = mount_kind(table)
     if mount is None:
         return ()
