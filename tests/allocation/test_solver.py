@@ -164,7 +164,7 @@ def independent_kkt(sub, model):
     """Multipliers and residual recomputed from the solution alone (dense-grid maximiser)."""
     idx = model.members
     x = sub.solution_rad * ARCMIN_PER_RAD
-    lo, hi = sub.interval_rad
+    lo, hi = sub.domain_rad[-1]
     grid = np.linspace(lo, hi, 200001)
     full = np.zeros(8)
     full[idx] = x
@@ -390,7 +390,7 @@ def test_the_papers_quarter_turns_give_what_the_whole_turns_give(monkeypatch):
     quarter = allocate_tolerances(PAPER_LIMITS, "paper")
     whole = GenericTable(paper_table().urdf_path, layout=replace(PAPER_LAYOUT, domains_deg={}))
     turn = allocate_tolerances(PAPER_LIMITS, "paper", table=whole)
-    assert turn.subproblems["psi"].interval_rad == (0.0, 2 * np.pi)
+    assert turn.subproblems["psi"].domain_rad[-1] == (0.0, 2 * np.pi)
     np.testing.assert_allclose(turn.upper_bounds_rad, quarter.upper_bounds_rad, rtol=1e-12)
 
 

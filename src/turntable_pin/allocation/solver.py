@@ -31,25 +31,21 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
-from pathlib import Path
 
 import numpy as np
 
+from ..calibration.positions import PositionSet
+from ..calibration.requirement import orientation_requirement
 from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.exceptions import InfeasibleError, InputError, ModelError
+from ..core.turn_grid import every_combination
 from ..core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, arcmin_by_name
 from ..model.angles import ANGLE_SYMBOLS
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from ..model.paper_table import PHI2_INTERVALS_DEG, resolve_table
+from . import sensitivity
 from .capability import ManufacturingCapability
-from .sensitivity import (
-    FULL_TURN_RAD,
-    PAPER_FIGURE8_TRIG,
-    Sensitivities,
-    grid_angles_rad,
-    grid_axes_rad,
-    table_sensitivities,
-)
+from .sensitivity import FULL_TURN_RAD, PAPER_FIGURE8_TRIG, Sensitivities, grid_axes_rad
 
 __all__ = [
     "DEFAULT_ACCURACY_DPH",
@@ -63,20 +59,15 @@ __all__ = [
     "AngleRows",
     "OrientationLimits",
     "SubproblemResult",
-    "TableAllocation",
-    "allocate_table_tolerances",
     "allocate_tolerances",
     "allocation_weights",
     "angle_rows",
-    "angular_names",
     "default_orientation_limits",
     "domain_max",
-    "grid_angles_rad",
     "interval_max",
     "minimize_weighted",
     "paper_eq16_limits",
     "solve_subproblem",
-    "table_lower_bounds",
 ]
 
 ORIENTATION_ANGLES = ANGLE_SYMBOLS  # the limit names: psi_rad, theta_rad, gamma_rad
@@ -186,9 +177,6 @@ def default_orientation_limits(
     Raises:
         IdentifiabilityError: the positions cannot calibrate the GyroWheel on this table.
     """
-    from ..calibration.positions import PositionSet
-    from ..calibration.requirement import orientation_requirement
-
     if requirement not in REQUIREMENT_KINDS:
         raise InputError(
             f"unknown requirement '{requirement}'; expected one of {REQUIREMENT_KINDS}"
@@ -246,7 +234,7 @@ class AngleRows:
     @cached_property
     def grid(self) -> tuple[np.ndarray, np.ndarray]:
         """The starting grid: positions (N, joints) and ``|C_k|`` there (N, m)."""
-        mesh = np.stack([m.ravel() for m in np.meshgrid(*self.axes_rad, indexing="ij")], axis=1)
+        mesh = every_combination(self.axes_rad)
         return mesh, np.abs(self.values(mesh))
 
 
@@ -263,8 +251,8 @@ def angle_rows(
     """
     d = len(table.joint_names)
     columns = [table.parameter_names.index(n) for n in table.angular_names]
-    mesh = np.meshgrid(*([np.array(_NODES_RAD)] * d), indexing="ij")
-    coefficients = table.regressor([m.ravel() for m in mesh])[:, :, columns]
+    nodes = every_combination([np.array(_NODES_RAD)] * d)
+    coefficients = table.regressor(list(nodes.T))[:, :, columns]
     coefficients = coefficients.reshape((3,) * d + coefficients.shape[1:])
     for j in range(d):
         coefficients = np.moveaxis(np.tensordot(_TO_COEFFICIENTS, coefficients, ([1], [j])), 0, j)
@@ -544,16 +532,6 @@ class SubproblemResult:
         return float(np.sum(self.weights**2 / (self.solution_rad * ARCMIN_PER_RAD) ** 2))
 
     @property
-    def worst_rad(self) -> float:
-        """The first-order worst case at the solution (:attr:`constraint_rad`)."""
-        return self.constraint_rad
-
-    @property
-    def interval_rad(self) -> tuple[float, float]:
-        """The last joint's interval (the paper's phi2 interval)."""
-        return self.domain_rad[-1]
-
-    @property
     def _words(self) -> tuple[str, ...]:
         """The angle names of the named joints (the joint names where none are given)."""
         names = self.angle_names or self.joint_names
@@ -647,7 +625,7 @@ def allocation_weights(scheme: str, sensitivities: Sensitivities | None = None, 
         raise InputError(f"unknown weights '{scheme}'; choose one of {', '.join(WEIGHT_SCHEMES)}")
     if scheme == "equal":
         return np.ones((3, len(table.angular_names)))
-    sens = sensitivities or table_sensitivities(table)
+    sens = sensitivities or sensitivity.sensitivities(table)
     if scheme == "paper":
         return np.where(np.ptp(sens.matrices, axis=0) > 1e-12, 1.0 / PAPER_FIGURE8_TRIG, 1.0)
     with np.errstate(divide="ignore"):
@@ -793,7 +771,7 @@ def allocate_tolerances(
         capability = ManufacturingCapability.of_table(table)
     if capability.error_names != names:
         raise InputError(f"the lower bounds must be of this table's errors: {', '.join(names)}")
-    sensitivities = sensitivities or table_sensitivities(table, grid_step_deg)
+    sensitivities = sensitivities or sensitivity.sensitivities(table, grid_step_deg=grid_step_deg)
     w = allocation_weights(weights, sensitivities, table)
     rows = angle_rows(table, grid_step_deg)
     subproblems = {}
@@ -816,33 +794,3 @@ def allocate_tolerances(
         upper, limits, weights, w, subproblems, np.array(worst),
         capability=capability, table=table, sensitivities=sensitivities,
     )  # fmt: skip
-
-
-# ---- earlier names (a table given by its URDF) ----------------------------------------------
-TableAllocation = Allocation
-"""Earlier name of :class:`Allocation`."""
-
-
-def allocate_table_tolerances(
-    table, limits, weights="model", lower_bounds_rad=None, grid_step_deg=None
-) -> Allocation:
-    """:func:`allocate_tolerances` of ``table`` with lower bounds (P,) in its angular order."""
-    capability = None
-    if lower_bounds_rad is not None:
-        capability = ManufacturingCapability(lower_bounds_rad, {}, "given", table.angular_names)
-    return allocate_tolerances(
-        limits, weights, capability, table=table, grid_step_deg=grid_step_deg
-    )
-
-
-def angular_names(table) -> tuple[str, ...]:
-    """The table's angular errors (every parameter but the offsets), in parameter order."""
-    return tuple(table.angular_names)
-
-
-def table_lower_bounds(table, path: str | Path | None = None) -> np.ndarray:
-    """Lower bounds (P,) of ``table``'s angular errors from a YAML file in its names, radians
-    (default 0; :meth:`ManufacturingCapability.from_yaml`)."""
-    if path is None:
-        return np.zeros(len(table.angular_names))
-    return ManufacturingCapability.from_yaml(path, table).lower_bounds_rad
