@@ -29,6 +29,8 @@ from ..core.interrupts import (
     run_cleanups,
     signal_name,
 )
+from ..core.words import speaking
+from .words import CLI_WORDS
 
 __all__ = ["COMMANDS", "build_parser", "main"]
 
@@ -146,7 +148,8 @@ def main(argv: list[str] | None = None) -> int:
         from .common import check_outputs  # every output checked before any is written
 
         check_outputs(args)
-        status = int(args.func(args) or 0)
+        with speaking(CLI_WORDS):  # the library's texts name flags and shell commands
+            status = int(args.func(args) or 0)
         if first_signal() is not None:  # an interruption that some library swallowed
             raise Interrupted(first_signal())
         return status
