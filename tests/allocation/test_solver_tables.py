@@ -173,7 +173,7 @@ def test_lower_bounds_in_the_tables_names(tmp_path):
 
 def test_bad_grid_and_weights_are_refused():
     table = GenericTable(MODELS / "three_axis_imu_table.urdf")
-    with pytest.raises(InputError, match="coarser --grid-step-deg"):
+    with pytest.raises(InputError, match="coarser grid_step_deg"):
         check_grid_step(table, 1.0)
     with pytest.raises(InputError, match=r"\[1e-06, 90\] degrees"):
         check_grid_step(table, 0.0)

@@ -29,6 +29,7 @@ from ..core.exceptions import InputError
 from ..core.sizes import MIN_GRID_STEP_DEG, turn_grid_count
 from ..core.turn_grid import every_combination, full_turn_grid_deg
 from ..core.units import DEG_PER_RAD
+from ..core.words import argument
 from ..model.angles import ANGLE_NAMES
 from ..model.paper_table import resolve_table
 
@@ -91,7 +92,7 @@ def _check_count(count: int, step: float, joints: int) -> None:
     if count > MAX_GRID_POINTS:
         raise InputError(
             f"a {step:g}-degree grid over {joints} joints has {count} positions, "
-            f"more than {MAX_GRID_POINTS}; choose a coarser --grid-step-deg"
+            f"more than {MAX_GRID_POINTS}; choose a coarser {argument('grid_step_deg')}"
         )
 
 

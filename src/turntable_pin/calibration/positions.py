@@ -33,6 +33,7 @@ from ..core.exceptions import InputError
 from ..core.sizes import MAX_POSITIONS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
 from ..core.turn_grid import full_turn_grid_deg
 from ..core.units import deg_to_rad, rad_to_deg
+from ..core.words import argument
 from ..model.paper_table import resolve_table
 from .site import DEFAULT_LATITUDE_DEG, MAX_LATITUDE_DEG  # noqa: F401  (re-exported)
 
@@ -361,7 +362,7 @@ def angle_columns(
         joints = ", ".join(n for n in names if n) or "the paper's phi1, phi2"
         raise InputError(
             f"column {beyond[0]} is the angle of a joint this table does not have: it has "
-            f"{len(names)} joint(s) ({joints}); are these data of the table given by --urdf?",
+            f"{len(names)} joint(s) ({joints}); are these data of the table given by {argument('urdf')}?",
             path=path, row=header_row, column=beyond[0],
         )  # fmt: skip
     out = []
