@@ -207,12 +207,6 @@ def _calls():
         # calibration
         "calibration.drift_fit.calibrate_run": lambda c: drift_fit.calibrate_run(
             c.run_path, np.radians(45.0), c.table),
-        "calibration.positions.JointPositions.grid": lambda c: (
-            positions.JointPositions.grid(c.table, 120.0)),
-        "calibration.positions.JointPositions.parse": lambda c: (
-            positions.JointPositions.parse(c.table, "grid:120")),
-        "calibration.positions.JointPositions.from_csv": lambda c: (
-            positions.JointPositions.from_csv(c.table, c.positions_csv)),
         "calibration.positions.PositionSet.__init__": lambda c: positions.PositionSet(
             c.positions.angles_rad, table=c.table),
         "calibration.positions.PositionSet.grid": lambda c: c.positions,

@@ -318,9 +318,9 @@ def test_default_limits_are_the_calibration_layers_requirement():
     assert limits.gamma_rad == requirement.box.gamma_rad
     # the paper's planes on request
     planes = default_orientation_limits(requirement="planes")
-    assert planes.psi_rad == requirement.I_psi_rad
-    assert planes.theta_rad == requirement.I_theta_rad
-    assert planes.gamma_rad == requirement.I_gamma_rad
+    assert planes.psi_rad == requirement.psi_rad
+    assert planes.theta_rad == requirement.theta_rad
+    assert planes.gamma_rad == requirement.gamma_rad
     # a looser calibration accuracy allows a larger orientation error
     assert np.all(default_orientation_limits(0.02).as_array() > limits.as_array())
 

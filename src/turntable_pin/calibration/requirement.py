@@ -52,7 +52,6 @@ from .rate_error import (
 
 __all__ = [
     "ACCURACY_RANGE_DPH",
-    "ANGLE_NAMES",
     "BOX_CRITERION",
     "JACOBIAN_STEP_RAD",
     "MAX_ANGLE_RAD",
@@ -80,7 +79,6 @@ with ``w_m`` (about 0.01 deg for the paper's 0.01 deg/h): at 1 deg/h it is alrea
 the end of the small-angle model's range; at 1e-6 deg/h it is a few thousandths of an arc second,
 below what any turntable or autocollimator resolves."""
 
-ANGLE_NAMES = ANGLE_SYMBOLS  # deprecated alias: the limits are named psi, theta, gamma
 PLANES: dict[str, tuple[str, tuple[int, int]]] = {
     "psi_theta": ("x", (0, 1)),
     "theta_gamma": ("y", (1, 2)),
@@ -418,9 +416,8 @@ class RequirementBox:
 
     def to_dict(self) -> dict:
         """The limits (degrees, arc seconds), the criterion and the worst corner, JSON-ready."""
-        limits = zip(ANGLE_NAMES, self.limits_rad, strict=True)
         out: dict = {}
-        for name, value in limits:
+        for name, value in zip(ANGLE_SYMBOLS, self.limits_rad, strict=True):
             out[f"I_{name}_deg"] = rad_to_deg(value)
             out[f"I_{name}_arcsec"] = rad_to_arcsec(value)
         return {
@@ -542,66 +539,32 @@ class OrientationRequirement:
     gyrowheel: GyroWheelModel = field(repr=False)
     inputs: PositionInputs = field(repr=False)
 
-    def plane_function(self, plane: str) -> PlaneRateError:
-        """The :class:`PlaneRateError` this requirement was computed with."""
-        return PlaneRateError(
-            plane, self.gyrowheel, self.inputs, exact=self.exact, definition=self.definition
-        )
-
     @property
     def limits_rad(self) -> np.ndarray:
         """``[I_psi, I_theta, I_gamma]``, radians."""
         return np.array([self.psi_rad, self.theta_rad, self.gamma_rad])
 
-    # Names of earlier versions (the README's changelog lists them).
-    @property
-    def I_psi_rad(self) -> float:  # noqa: N802
-        """Alias of :attr:`psi_rad`."""
-        return self.psi_rad
-
-    @property
-    def I_theta_rad(self) -> float:  # noqa: N802
-        """Alias of :attr:`theta_rad`."""
-        return self.theta_rad
-
-    @property
-    def I_gamma_rad(self) -> float:  # noqa: N802
-        """Alias of :attr:`gamma_rad`."""
-        return self.gamma_rad
-
     def to_dict(self) -> dict:
         """The limits (degrees, arcmin, arcsec), the set-up and both rectangles, JSON-ready."""
-        out = {
-            f"I_{n}_deg": rad_to_deg(v) for n, v in zip(ANGLE_NAMES, self.limits_rad, strict=True)
+        units = {"deg": rad_to_deg, "arcmin": rad_to_arcmin, "arcsec": rad_to_arcsec}
+        return {
+            **{
+                f"I_{n}_{unit}": convert(v)
+                for unit, convert in units.items()
+                for n, v in zip(ANGLE_SYMBOLS, self.limits_rad, strict=True)
+            },
+            "accuracy_dph": self.accuracy_dph,
+            "positions": self.positions_name,
+            "n_positions": self.n_positions,
+            "latitude_deg": rad_to_deg(self.latitude_rad),
+            "definition": self.definition,
+            "exact_rotation": self.exact,
+            "binding_plane": self.binding_plane,
+            "rectangles": [r.to_dict() for r in self.rectangles],
+            "box_dwx_dph": self.box_dwx_dph,
+            "box_dwy_dph": self.box_dwy_dph,
+            "box": self.box.to_dict(),
         }
-        out.update(
-            {
-                f"I_{n}_arcmin": rad_to_arcmin(v)
-                for n, v in zip(ANGLE_NAMES, self.limits_rad, strict=True)
-            }
-        )
-        out.update(
-            {
-                f"I_{n}_arcsec": rad_to_arcsec(v)
-                for n, v in zip(ANGLE_NAMES, self.limits_rad, strict=True)
-            }
-        )
-        out.update(
-            {
-                "accuracy_dph": self.accuracy_dph,
-                "positions": self.positions_name,
-                "n_positions": self.n_positions,
-                "latitude_deg": rad_to_deg(self.latitude_rad),
-                "definition": self.definition,
-                "exact_rotation": self.exact,
-                "binding_plane": self.binding_plane,
-                "rectangles": [r.to_dict() for r in self.rectangles],
-                "box_dwx_dph": self.box_dwx_dph,
-                "box_dwy_dph": self.box_dwy_dph,
-                "box": self.box.to_dict(),
-            }
-        )
-        return out
 
 
 def check_accuracy_dph(accuracy_dph: float) -> float:
