@@ -43,8 +43,27 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.sizes import check_positions_count
 from ..core.units import ARCSEC_PER_RAD
+from ..core.words import argument
+from ..measurement.catalogue import catalogue
+from ..measurement.fit import fit_orientation
+from ..stats.discrimination import (
+    Direction,
+    choice_margin,
+    detection_power,
+    generalized_chi2_sf,
+    misfit,
+    orthonormal_span,
+    quadratic_form,
+    rss_difference,
+    t_optimal_exchange,
+    traded_off,
+)
+from ..stats.least_squares import tall_r_factor
+from ..stats.model_selection import UNDETERMINED_GAIN_RATIO, acceptance_threshold
 from .identify import _evaluate, _root, _start_information, design_rows
 from .schedule import MeasurementPlan, candidate_visits, plan_measurements
 from .space import DesignSpace
@@ -345,8 +364,6 @@ def _amplitude_vector(model, effect, values: Mapping[str, float]) -> np.ndarray:
 
 def _fitted_amplitude(data, effect, table) -> dict[str, float]:
     """``effect``'s parameters fitted with the base errors on ``data``, user units."""
-    from ..measurement.fit import fit_orientation
-
     where = data.source or "the data"
     try:
         fit = fit_orientation(data, [effect], turntable=table)
@@ -392,8 +409,6 @@ class _Rows:
     def residual(self, x: int) -> np.ndarray:
         """What the base errors and the other effect leave of effect ``x``'s prediction, per
         row (in noise sigmas)."""
-        from ..stats.discrimination import orthonormal_span
-
         signal = self.signal(x)
         basis = orthonormal_span(self.fitted(1 - x))
         return signal - basis @ (basis.T @ signal)
@@ -403,18 +418,6 @@ class _Rows:
         the base and the rival's misfit (chi2), the ranks each adds, whether the data determine
         each one's parameters, and the chances that the diagnosis accepts it, puts it first,
         or takes it on top of the rival and drops the rival."""
-        from ..stats.discrimination import (
-            choice_margin,
-            detection_power,
-            generalized_chi2_sf,
-            misfit,
-            orthonormal_span,
-            quadratic_form,
-            rss_difference,
-            traded_off,
-        )
-        from ..stats.model_selection import UNDETERMINED_GAIN_RATIO, acceptance_threshold
-
         y = 1 - x
         m = self.observations
         first_round = acceptance_threshold(self.candidates)
@@ -498,9 +501,6 @@ def design_separate(
             fit it on; an effect whose prediction no position within the limits sees beyond the
             base errors; more positions than candidates.
     """
-    from ..core.blas_threads import one_blas_thread
-    from ..core.sizes import check_positions_count
-
     n_positions = check_positions_count(n_positions, space.candidates_deg.shape[0])
     with one_blas_thread():  # tall-by-small products: many threads on busy cores only wait
         return _design_separate(
@@ -510,26 +510,66 @@ def design_separate(
 
 def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s, target):
     """:func:`design_separate`, on one BLAS thread."""
-    from ..measurement.catalogue import catalogue
-    from ..stats.discrimination import Direction, misfit, orthonormal_span, t_optimal_exchange
-    from ..stats.least_squares import tall_r_factor
+    problem = _setup(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s)
+    names, settled = problem.names, _settled(problem)
+    if "none" in settled:
+        x = settled.index("none")
+        because = (
+            f"{names[1 - x]} reproduces {names[x]} ({_values(problem.user[x])} "
+            f"{problem.units[x]}) at every position, with no more parameters"
+        )
+        return _inseparable(problem, target, because)
+    directions = problem.directions(settled)
+    found, chosen, plan, new = problem.run_of(directions, n_positions)
+    first = np.unique(plan.position, return_index=True)[1]
+    design = problem.rows_of(new, 3 * plan.n_rows)
+    numbers = [design.numbers(x) for x in range(2)]
+    power = min(h["power"] for h in numbers)
 
-    effects = tuple(space.effects)
-    names = tuple(e.name for e in effects)
-    if len(effects) != 2 or names[0] == names[1]:
-        raise InputError(
-            f"--separate takes two different effects (A,B), got {', '.join(names) or 'none'}"
-        )
-    amplitudes = {k: dict(v) for k, v in (amplitudes or {}).items()}
-    unknown = [k for k in amplitudes if k not in names]
-    if unknown:
-        raise InputError(
-            f"--amplitude names effect '{unknown[0]}', which is not one of {names[0]}, {names[1]}"
-        )
+    def scaled(count: int) -> float:
+        factor = count / n_positions
+        return problem.rows_of(new, round(3 * plan.n_rows * factor), factor).power()
+
+    def designed(count: int) -> float:
+        run = problem.run_of(directions, count)
+        return problem.rows_of(run[3], 3 * run[2].n_rows).power()
+
+    count, count_power, verified = _positions_for(
+        scaled, designed, target, n_positions, power, problem.usable.size
+    )
+    return SeparationDesign(
+        space=space,
+        pair=names,
+        positions_deg=space.candidates_deg[chosen][plan.position[np.sort(first)]],
+        plan=plan,
+        hypotheses=_hypotheses(problem, settled, numbers, new, plan, n_positions),
+        misfit_by_position=_shares(design, new, plan, n_positions),
+        measured_deg=np.zeros((0, space.n_joints))
+        if from_data is None
+        else np.degrees(np.asarray(from_data.joint_rad, dtype=float)),
+        noise_arcsec=float(problem.noise),
+        noise_source=problem.noise_source,
+        amplitude_source=problem.source,
+        n_from=problem.n_from,
+        power=float(power),
+        positions_for_power=count,
+        power_at_positions_for_power=count_power,
+        positions_for_power_designed=verified,
+        power_curve=tuple((c, scaled(c)) for c in _curve_counts(n_positions, count)),
+        target=float(target),
+        catalogue_size=problem.size,
+        n_swaps=found.swaps,
+        n_passes=found.passes,
+    )
+
+
+def _setup(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s) -> _Problem:
+    """The :class:`_Problem` of ``space``'s two effects on its candidates (see
+    :func:`design_separate` for what is refused)."""
+    names, amplitudes = _checked_pair(space, amplitudes)
     start_info, noise, noise_source, n_from, start_s = _start_information(
         space, from_data, noise_arcsec, dwell_s
     )
-    noise_rad = noise / ARCSEC_PER_RAD
     duration_s = (n_positions * space.visits.count - 1) * float(dwell_s)
     try:
         rows, keep, model = design_rows(
@@ -541,14 +581,71 @@ def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dw
     if n_positions > usable.size:
         raise InputError(
             f"{n_positions} positions asked, but only {usable.size} candidates: give more "
-            "--candidates"
+            f"{argument('candidates')}"
         )
-    rows = rows / noise_rad  # (C, k, n) whitened
-    n = model.n_params
-    base = np.arange(len(model.base_names))
-    own = tuple(_columns(model, e) for e in effects)
+    source, vectors, user, units = _amplitudes(model, space, amplitudes, from_data)
+    listed = [e.name for e in catalogue(space.table)]
+    rank = [listed.index(name) if name in listed else len(listed) for name in names]
+    return _Problem(
+        space, rows / (noise / ARCSEC_PER_RAD), usable, model.n_params,
+        np.arange(len(model.base_names)), tuple(_columns(model, e) for e in space.effects),
+        vectors, None if start_info is None else _rows_of_information(start_info),
+        0 if from_data is None else int(from_data.measured.sum()), len(listed),
+        0 if rank[0] <= rank[1] else 1, noise / ARCSEC_PER_RAD, dwell_s, start_s, duration_s,
+        names, user, units, source, noise, noise_source, n_from,
+    )  # fmt: skip
+
+
+def _hypotheses(problem, settled, numbers, new, plan, n_positions) -> tuple[Hypothesis, ...]:
+    """Each effect as the truth: on the design (``numbers``), on the positions measured alone,
+    on the new ones alone and on the grid of the design's size."""
+    measured = alone = [None, None]
+    if problem.fixed is not None:
+        measured = [problem.rows_of(None, 0).numbers(x) for x in range(2)]
+        alone = [problem.rows(new, 3 * plan.n_rows, leader=0).numbers(x) for x in range(2)]
+    grid = _grid_misfits(problem, n_positions)
+    names = problem.names
+    return tuple(
+        Hypothesis(
+            effect=names[x],
+            rival=names[1 - x],
+            amplitude=problem.user[x],
+            unit=problem.units[x],
+            misfit_measured_chi2=None if measured[x] is None else measured[x]["misfit_chi2"],
+            misfit_grid_chi2=None if grid is None else grid[x],
+            settled_by=settled[x],
+            power_measured=None if measured[x] is None else measured[x]["power"],
+            power_new_alone=None if alone[x] is None else alone[x]["power"],
+            **numbers[x],
+        )  # fmt: skip
+        for x in range(2)
+    )
+
+
+def _checked_pair(space, amplitudes) -> tuple[tuple[str, str], dict]:
+    """The two effects' names and the amplitudes given (``{effect: {parameter: value}}``), or
+    :class:`InputError`."""
+    names = tuple(e.name for e in space.effects)
+    if len(names) != 2 or names[0] == names[1]:
+        raise InputError(
+            f"{argument('separate')} takes two different effects (A,B), got "
+            f"{', '.join(names) or 'none'}"
+        )
+    amplitudes = {k: dict(v) for k, v in (amplitudes or {}).items()}
+    unknown = [k for k in amplitudes if k not in names]
+    if unknown:
+        raise InputError(
+            f"{argument('amplitude')} names effect '{unknown[0]}', which is not one of "
+            f"{names[0]}, {names[1]}"
+        )
+    return names, amplitudes
+
+
+def _amplitudes(model, space, amplitudes, from_data):
+    """Each effect's amplitude: where it comes from (``{effect: text}``), its vector (internal
+    units), its values by parameter and its unit(s) (user units)."""
     source, vectors = {}, []
-    for effect in effects:
+    for effect in space.effects:
         if effect.name in amplitudes:
             values, source[effect.name] = amplitudes[effect.name], "given"
         elif from_data is not None:
@@ -556,36 +653,39 @@ def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dw
             source[effect.name] = f"fitted on {from_data.source or 'the data measured'}"
         else:
             raise InputError(
-                f"no amplitude for {effect.name}: give it (--amplitude {effect.name}:P=V,...) "
-                "or the data to fit it on (--from DATA.csv)"
+                f"no amplitude for {effect.name}: give it "
+                f"({argument('amplitude')} {effect.name}:P=V,...) or the data to fit it on "
+                f"({argument('from_data')} DATA.csv)"
             )
         vectors.append(_amplitude_vector(model, effect, values))
+    own = [_columns(model, e) for e in space.effects]
     user = [
         {model.parameter_names[i].split(".", 1)[1]: float(v / model.per_user_unit[i])
          for i, v in zip(own[x], vectors[x], strict=True)}
         for x in range(2)
     ]  # fmt: skip
     units = [", ".join(dict.fromkeys(model.parameter_units[i] for i in own[x])) for x in range(2)]
-    fixed = None if start_info is None else _rows_of_information(start_info)
-    from_rows = 0 if from_data is None else int(from_data.measured.sum())
-    listed = [e.name for e in catalogue(space.table)]
-    size = len(listed)
-    rank = [listed.index(name) if name in listed else size for name in names]
-    leader = 0 if rank[0] <= rank[1] else 1
+    return source, vectors, user, units
 
-    def rows_of(new: np.ndarray | None, observations: int, factor: float = 1.0) -> _Rows:
-        """The rows of a run (its Gram matrix times ``factor``) and of the data measured."""
-        stacked = [new * math.sqrt(factor)] if new is not None else []
-        stacked += [fixed] if fixed is not None else []
-        rows = np.concatenate(stacked)
-        return _Rows(rows, observations + from_rows, base, own, vectors, size, leader)
 
-    # Which directions positions must separate, judged over every candidate at once.
-    every = _Rows(tall_r_factor(rows.reshape(-1, n)), 1, base, own, vectors, size, leader)
+def _settled(problem: _Problem) -> list[str]:
+    """How each direction is settled, judged over every candidate at once: ``misfit`` (positions
+    separate it), ``parsimony`` (the rival reproduces it with more ranks) or ``none``.
+
+    Raises:
+        InputError: an effect whose prediction the base errors explain everywhere.
+    """
+    every = problem.rows(tall_r_factor(problem.all_rows.reshape(-1, problem.n_params)), 1)
+    base, names, user, units = (
+        every.rows[:, problem.base],
+        problem.names,
+        problem.user,
+        problem.units,
+    )
     settled = []
     for x in range(2):
         signal = every.signal(x)
-        alone = misfit(every.rows[:, base], signal)
+        alone = misfit(base, signal)
         if not alone > SAME_RTOL * max(float(signal @ signal), 1e-300):
             raise InputError(
                 f"{names[x]} at its amplitude ({_values(user[x])} {units[x]}) changes nothing "
@@ -596,146 +696,117 @@ def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dw
             settled.append("misfit")
             continue
         ranks = [
-            orthonormal_span(np.hstack([every.rows[:, base], every.rows[:, own[z]]])).shape[1]
+            orthonormal_span(np.hstack([base, every.rows[:, problem.own[z]]])).shape[1]
             for z in (x, 1 - x)
         ]
         settled.append("parsimony" if ranks[0] < ranks[1] else "none")
-    if "none" in settled:
-        x = settled.index("none")
-        because = (
-            f"{names[1 - x]} reproduces {names[x]} ({_values(user[x])} {units[x]}) at every "
-            "position, with no more parameters"
-        )
-        return _inseparable(space, names, noise, noise_source, source, n_from, target, because)
+    return settled
 
-    directions = []
-    for x in range(2):
-        if settled[x] == "misfit":
-            fitted = np.concatenate([base, own[1 - x]])
-            directions.append(
-                Direction(
-                    rows[:, :, fitted],
-                    rows[:, :, own[x]] @ vectors[x],
-                    None if fixed is None else fixed[:, fitted],
-                    None if fixed is None else fixed[:, own[x]] @ vectors[x],
-                )
-            )
 
-    def run_of(count: int):
-        """The ``count`` designed positions (candidate indices), their run and its rows."""
-        found = t_optimal_exchange(directions, count, seed=space.seed)
-        chosen = usable[np.sort(found.chosen)]
-        plan = plan_measurements(
-            space.candidates_deg[chosen], needs_time=space.needs_time,
-            needs_dirs=space.needs_dirs, dwell_s=dwell_s, seed=space.seed, start_s=start_s,
-            visits=space.visits.subset(chosen),
-        )  # fmt: skip
-        jac = _evaluate(space, plan.variables())[0].reshape(-1, n) / noise_rad
-        return found, chosen, plan, jac
-
-    found, chosen, plan, new = run_of(n_positions)
-    positions = space.candidates_deg[chosen]
-    first = np.unique(plan.position, return_index=True)[1]
-    positions = positions[plan.position[np.sort(first)]]  # in the order first measured
-    measured_deg = np.zeros((0, space.n_joints))
-    if from_data is not None:
-        measured_deg = np.degrees(np.asarray(from_data.joint_rad, dtype=float))
-    design = rows_of(new, 3 * plan.n_rows)
-    numbers = [design.numbers(x) for x in range(2)]
-    # Each position's share of each misfit: where the rival cannot follow.
+def _shares(design: _Rows, new: np.ndarray, plan, n_positions: int) -> np.ndarray:
+    """(N, 2) each position's share of each misfit (where the rival cannot follow), in the order
+    the positions are first measured."""
     shares = np.zeros((n_positions, 2))
     order = np.unique(plan.position, return_index=True)[1]
     for x in range(2):
         by_row = np.sum(design.residual(x)[: new.shape[0]].reshape(plan.n_rows, 3) ** 2, axis=1)
         per_position = np.bincount(plan.position, by_row, minlength=n_positions)
         shares[:, x] = per_position[plan.position[np.sort(order)]]
-    measured = alone = [None, None]
-    if fixed is not None:
-        measured = [rows_of(None, 0).numbers(x) for x in range(2)]
-        alone = [_Rows(new, 3 * plan.n_rows, base, own, vectors, size).numbers(x) for x in range(2)]
-    grid = _grid_misfits(space, rows_of, n_positions, start_s, duration_s, noise_rad)
-    power = min(h["power"] for h in numbers)
+    return shares
 
-    def scaled(count: int) -> float:
-        factor = count / n_positions
-        return rows_of(new, round(3 * plan.n_rows * factor), factor).power()
 
-    def designed(count: int) -> float:
-        run = run_of(count)
-        return rows_of(run[3], 3 * run[2].n_rows).power()
+@dataclass(frozen=True)
+class _Problem:
+    """The separation on the candidates: their whitened rows (C, k, n) and the usable ones, the
+    columns of the base errors and of each effect, the amplitudes (internal and user units), the
+    data measured (rows of their information), the catalogue's size and which effect it lists
+    first, and what a run needs (noise, dwell, start time, duration)."""
 
-    count, count_power, verified = _positions_for(
-        scaled, designed, target, n_positions, power, usable.size
-    )
-    curve = tuple((c, scaled(c)) for c in _curve_counts(n_positions, count))
-    hypotheses = tuple(
-        Hypothesis(
-            effect=names[x],
-            rival=names[1 - x],
-            amplitude=user[x],
-            unit=units[x],
-            signal_chi2=numbers[x]["signal_chi2"],
-            misfit_chi2=numbers[x]["misfit_chi2"],
-            misfit_measured_chi2=None if measured[x] is None else measured[x]["misfit_chi2"],
-            misfit_grid_chi2=None if grid is None else grid[x],
-            added_rank=numbers[x]["added_rank"],
-            rival_added_rank=numbers[x]["rival_added_rank"],
-            determined=numbers[x]["determined"],
-            rival_determined=numbers[x]["rival_determined"],
-            settled_by=settled[x],
-            power_detect=numbers[x]["power_detect"],
-            power_first=numbers[x]["power_first"],
-            power_on_top=numbers[x]["power_on_top"],
-            power_choice=numbers[x]["power_choice"],
-            power=numbers[x]["power"],
-            power_measured=None if measured[x] is None else measured[x]["power"],
-            power_new_alone=None if alone[x] is None else alone[x]["power"],
-        )
-        for x in range(2)
-    )
-    return SeparationDesign(
-        space=space,
-        pair=names,
-        positions_deg=positions,
-        plan=plan,
-        hypotheses=hypotheses,
-        misfit_by_position=shares,
-        measured_deg=measured_deg,
-        noise_arcsec=float(noise),
-        noise_source=noise_source,
-        amplitude_source=source,
-        n_from=n_from,
-        power=float(power),
-        positions_for_power=count,
-        power_at_positions_for_power=count_power,
-        positions_for_power_designed=verified,
-        power_curve=curve,
-        target=float(target),
-        catalogue_size=size,
-        n_swaps=found.swaps,
-        n_passes=found.passes,
-    )
+    space: DesignSpace
+    all_rows: np.ndarray
+    usable: np.ndarray
+    n_params: int
+    base: np.ndarray
+    own: tuple[np.ndarray, ...]
+    vectors: list
+    fixed: np.ndarray | None
+    from_rows: int
+    size: int
+    leader: int
+    noise_rad: float
+    dwell_s: float
+    start_s: float
+    duration_s: float
+    names: tuple[str, str]
+    user: list
+    units: list
+    source: dict
+    noise: float
+    noise_source: str
+    n_from: int
+
+    def rows(self, rows: np.ndarray, observations: int, leader: int | None = None) -> _Rows:
+        """:class:`_Rows` of ``rows`` standing for ``observations`` measured angles."""
+        leader = self.leader if leader is None else leader
+        return _Rows(rows, observations, self.base, self.own, self.vectors, self.size, leader)
+
+    def rows_of(self, new: np.ndarray | None, observations: int, factor: float = 1.0) -> _Rows:
+        """The rows of a run (its Gram matrix times ``factor``) and of the data measured."""
+        stacked = [new * math.sqrt(factor)] if new is not None else []
+        stacked += [self.fixed] if self.fixed is not None else []
+        return self.rows(np.concatenate(stacked), observations + self.from_rows)
+
+    def directions(self, settled: list[str]) -> list:
+        """The :class:`~turntable_pin.stats.discrimination.Direction` of each effect the
+        positions must separate (``settled`` ``misfit``)."""
+        rows, fixed, out = self.all_rows, self.fixed, []
+        for x in (x for x in range(2) if settled[x] == "misfit"):
+            fitted = np.concatenate([self.base, self.own[1 - x]])
+            out.append(
+                Direction(
+                    rows[:, :, fitted],
+                    rows[:, :, self.own[x]] @ self.vectors[x],
+                    None if fixed is None else fixed[:, fitted],
+                    None if fixed is None else fixed[:, self.own[x]] @ self.vectors[x],
+                )
+            )
+        return out
+
+    def run_of(self, directions, count: int):
+        """The ``count`` designed positions: the exchange's result, their candidate indices,
+        their run and its whitened rows."""
+        space = self.space
+        found = t_optimal_exchange(directions, count, seed=space.seed)
+        chosen = self.usable[np.sort(found.chosen)]
+        plan = plan_measurements(
+            space.candidates_deg[chosen], needs_time=space.needs_time,
+            needs_dirs=space.needs_dirs, dwell_s=self.dwell_s, seed=space.seed,
+            start_s=self.start_s, visits=space.visits.subset(chosen),
+        )  # fmt: skip
+        jac = _evaluate(space, plan.variables())[0].reshape(-1, self.n_params) / self.noise_rad
+        return found, chosen, plan, jac
 
 
 def _values(amplitude: Mapping[str, float]) -> str:
     return ", ".join(f"{k} = {v:.3g}" for k, v in amplitude.items())
 
 
-def _grid_misfits(space, rows_of, n_positions, start_s, duration_s, noise_rad):
+def _grid_misfits(problem: _Problem, n_positions: int):
     """What each effect's rival leaves of it on the 30-degree grid within the limits, scaled to
     the design's size (with the data measured); ``None`` when no grid position can be used."""
-    from ..stats.discrimination import misfit
-
+    space = problem.space
     visits = candidate_visits(
         space.grid_deg.shape[0], space.n_joints, needs_time=space.needs_time,
         needs_dirs=space.needs_dirs, rng=np.random.default_rng([space.seed, 2]),
     )  # fmt: skip
-    grid_rows, _, _ = design_rows(space, space.grid_deg, visits, start_s, duration_s)
+    grid_rows, _, _ = design_rows(
+        space, space.grid_deg, visits, problem.start_s, problem.duration_s
+    )
     if not grid_rows.shape[0]:
         return None
     n = grid_rows.shape[-1]
     factor = n_positions / grid_rows.shape[0]
-    on_grid = rows_of(grid_rows.reshape(-1, n) / noise_rad, 0, factor)
+    on_grid = problem.rows_of(grid_rows.reshape(-1, n) / problem.noise_rad, 0, factor)
     return [misfit(on_grid.fitted(1 - x), on_grid.signal(x)) for x in range(2)]
 
 
@@ -795,9 +866,10 @@ ROUNDING_ROWS = 1e-7
 (an eigenvalue of 1e-14 of the largest), not directions the data see."""
 
 
-def _inseparable(space, names, noise, noise_source, source, n_from, target, because):
+def _inseparable(problem: _Problem, target, because):
     """The result when no positions within the limits separate the two effects: one line saying
     why, and the independent measurements of their ``confirm`` texts."""
+    space = problem.space
     a, b = space.effects
     limits = "; ".join(r.describe() for r in space.ranges)
     text = (
@@ -807,16 +879,16 @@ def _inseparable(space, names, noise, noise_source, source, n_from, target, beca
     )
     return SeparationDesign(
         space=space,
-        pair=names,
+        pair=problem.names,
         positions_deg=np.zeros((0, space.n_joints)),
         plan=None,
         hypotheses=(),
         misfit_by_position=np.zeros((0, 2)),
         measured_deg=np.zeros((0, space.n_joints)),
-        noise_arcsec=float(noise),
-        noise_source=noise_source,
-        amplitude_source=source,
-        n_from=n_from,
+        noise_arcsec=float(problem.noise),
+        noise_source=problem.noise_source,
+        amplitude_source=problem.source,
+        n_from=problem.n_from,
         power=None,
         positions_for_power=None,
         power_at_positions_for_power=None,
