@@ -10,6 +10,8 @@ __all__ = ["CLI_WORDS"]
 CLI_WORDS = CommandLineWords(
     "turntable-pin",
     {
+        "amplitudes": "--amplitude",
         "from_data": "--from",
+        "n_positions": "-n",
     },
 )

@@ -23,7 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.csv_table import write_csv_table
 from ..core.units import DEG_PER_RAD
+from ..measurement.effects.base import PositionVariables
 
 __all__ = ["MeasurementPlan", "Visits", "candidate_visits", "plan_measurements"]
 
@@ -104,10 +106,12 @@ class MeasurementPlan:
         """Number of measurements M."""
         return int(self.joint_deg.shape[0])
 
+    def first_order(self) -> np.ndarray:
+        """The design's positions (indices) in the order they are first measured."""
+        return self.position[np.sort(np.unique(self.position, return_index=True)[1])]
+
     def variables(self):
         """The rows as :class:`~turntable_pin.measurement.effects.base.PositionVariables`."""
-        from ..measurement.effects.base import PositionVariables
-
         dirs = () if self.dirs is None else tuple(self.dirs.T)
         return PositionVariables(self.joint_deg / DEG_PER_RAD, self.time_s, dirs)
 
@@ -124,8 +128,6 @@ class MeasurementPlan:
 
     def write_csv(self, path: str | Path, comment: str = "") -> Path:
         """Write the plan's CSV atomically (``comment`` lines first, with a ``#``)."""
-        from ..core.csv_table import write_csv_table
-
         return write_csv_table(path, self.columns(), comment=comment)
 
     def to_dict(self) -> dict:

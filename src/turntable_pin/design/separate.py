@@ -46,7 +46,6 @@ import numpy as np
 from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError, InputError
 from ..core.sizes import check_positions_count
-from ..core.units import ARCSEC_PER_RAD
 from ..core.words import argument
 from ..measurement.catalogue import catalogue
 from ..measurement.fit import fit_orientation
@@ -64,7 +63,7 @@ from ..stats.discrimination import (
 )
 from ..stats.least_squares import tall_r_factor
 from ..stats.model_selection import UNDETERMINED_GAIN_RATIO, acceptance_threshold
-from .identify import _evaluate, _root, _start_information, design_rows
+from .identify import _evaluate, _root, candidate_rows, design_rows
 from .schedule import MeasurementPlan, candidate_visits, plan_measurements
 from .space import DesignSpace
 
@@ -521,7 +520,6 @@ def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dw
         return _inseparable(problem, target, because)
     directions = problem.directions(settled)
     found, chosen, plan, new = problem.run_of(directions, n_positions)
-    first = np.unique(plan.position, return_index=True)[1]
     design = problem.rows_of(new, 3 * plan.n_rows)
     numbers = [design.numbers(x) for x in range(2)]
     power = min(h["power"] for h in numbers)
@@ -540,7 +538,7 @@ def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dw
     return SeparationDesign(
         space=space,
         pair=names,
-        positions_deg=space.candidates_deg[chosen][plan.position[np.sort(first)]],
+        positions_deg=space.candidates_deg[chosen][plan.first_order()],
         plan=plan,
         hypotheses=_hypotheses(problem, settled, numbers, new, plan, n_positions),
         misfit_by_position=_shares(design, new, plan, n_positions),
@@ -567,32 +565,17 @@ def _setup(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s) -> 
     """The :class:`_Problem` of ``space``'s two effects on its candidates (see
     :func:`design_separate` for what is refused)."""
     names, amplitudes = _checked_pair(space, amplitudes)
-    start_info, noise, noise_source, n_from, start_s = _start_information(
-        space, from_data, noise_arcsec, dwell_s
-    )
-    duration_s = (n_positions * space.visits.count - 1) * float(dwell_s)
-    try:
-        rows, keep, model = design_rows(
-            space, space.candidates_deg, space.visits, start_s, duration_s
-        )
-    except InputError as exc:
-        raise InputError(f"no candidate position within the limits can be used: {exc}") from None
-    usable = np.flatnonzero(keep)
-    if n_positions > usable.size:
-        raise InputError(
-            f"{n_positions} positions asked, but only {usable.size} candidates: give more "
-            f"{argument('candidates')}"
-        )
+    c = candidate_rows(space, n_positions, from_data, noise_arcsec, dwell_s)
+    model = c.model
     source, vectors, user, units = _amplitudes(model, space, amplitudes, from_data)
     listed = [e.name for e in catalogue(space.table)]
     rank = [listed.index(name) if name in listed else len(listed) for name in names]
     return _Problem(
-        space, rows / (noise / ARCSEC_PER_RAD), usable, model.n_params,
-        np.arange(len(model.base_names)), tuple(_columns(model, e) for e in space.effects),
-        vectors, None if start_info is None else _rows_of_information(start_info),
-        0 if from_data is None else int(from_data.measured.sum()), len(listed),
-        0 if rank[0] <= rank[1] else 1, noise / ARCSEC_PER_RAD, dwell_s, start_s, duration_s,
-        names, user, units, source, noise, noise_source, n_from,
+        space, c.rows, np.flatnonzero(c.keep), model.n_params, np.arange(len(model.base_names)),
+        tuple(_columns(model, e) for e in space.effects), vectors,
+        None if c.information is None else _rows_of_information(c.information), c.from_rows,
+        len(listed), 0 if rank[0] <= rank[1] else 1, c.noise_rad, dwell_s, c.start_s,
+        c.duration_s, names, user, units, source, c.noise, c.noise_source, c.n_from,
     )  # fmt: skip
 
 
@@ -707,11 +690,10 @@ def _shares(design: _Rows, new: np.ndarray, plan, n_positions: int) -> np.ndarra
     """(N, 2) each position's share of each misfit (where the rival cannot follow), in the order
     the positions are first measured."""
     shares = np.zeros((n_positions, 2))
-    order = np.unique(plan.position, return_index=True)[1]
     for x in range(2):
         by_row = np.sum(design.residual(x)[: new.shape[0]].reshape(plan.n_rows, 3) ** 2, axis=1)
         per_position = np.bincount(plan.position, by_row, minlength=n_positions)
-        shares[:, x] = per_position[plan.position[np.sort(order)]]
+        shares[:, x] = per_position[plan.first_order()]
     return shares
 
 
