@@ -53,8 +53,10 @@ from ..calibration.requirement import (
 from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.sizes import check_positions_count
 from ..core.turn_grid import every_combination, full_turn_grid_deg
 from ..core.units import DEG_PER_RAD
+from ..core.words import argument, command
 from ..model.angles import ANGLE_SYMBOLS
 from ..stats.design import d_optimal_design, fedorov_exchange, log_det
 from .schedule import MeasurementPlan, plan_measurements
@@ -137,7 +139,7 @@ def comparison_grid(
     raise InputError(
         f"no evenly spaced grid of {n_positions} positions within the limits calibrates the 14 "
         f"drift coefficients to compare the design with (tried {', '.join(tried)}); choose "
-        "another number of positions (-n), e.g. 24, 36 or 64"
+        f"another number of positions ({argument('n_positions')}), e.g. 24, 36 or 64"
     )
 
 
@@ -350,14 +352,17 @@ class CalibrationDesign:
     def positions(self) -> PositionSet:
         """The chosen positions as a :class:`PositionSet` of the table."""
         return PositionSet(
-            self.positions_deg / DEG_PER_RAD, table=self.space.table, name="design --calibrate"
+            self.positions_deg / DEG_PER_RAD,
+            table=self.space.table,
+            name=str(command("design", calibrate=True)),
         )
 
     def comment(self) -> str:
         """The comment lines of the positions' CSV: what made it, with its seed."""
         return "\n".join(
             [
-                "designed by turntable-pin design --calibrate (loosest orientation requirement)",
+                f"designed by {command('design', calibrate=True)} (loosest orientation "
+                "requirement)",
                 f"table: {self.space.table_name}; accuracy_dph={self.accuracy_dph:g}",
                 f"seed={self.space.seed} candidates={self.space.candidates_deg.shape[0]} "
                 f"n_positions={self.n_positions} min_efficiency={self.min_efficiency:g}",
@@ -460,34 +465,13 @@ def design_calibration(
         InputError: N above the candidates of ``space`` (checked first), N below 7 or no grid
             of N to compare with; a precision floor no design reaches.
     """
-    from ..core.sizes import check_positions_count
-
-    n_positions = check_positions_count(n_positions, space.candidates_deg.shape[0])
-    accuracy_dph = check_accuracy_dph(accuracy_dph)
-    if int(n_positions) < N_COEFFICIENTS:
-        raise InputError(
-            f"-n {n_positions}: a calibration needs at least {N_COEFFICIENTS} positions (seven "
-            "drift coefficients per axis)"
-        )
-    n_positions = int(n_positions)
-    if not (np.isfinite(min_efficiency) and 0 < min_efficiency <= MAX_MIN_EFFICIENCY):
-        raise InputError(
-            f"the precision floor (D-efficiency) must be in (0, {MAX_MIN_EFFICIENCY:g}], "
-            f"got {min_efficiency!r}"
-        )
+    n_positions, accuracy_dph = _checked_request(space, n_positions, accuracy_dph, min_efficiency)
     gyrowheel = gyrowheel if gyrowheel is not None else GyroWheelModel.nominal()
     table = space.table
-    drawn = PositionSet(space.candidates_deg / DEG_PER_RAD, table=table, name="within the limits")
-    require_identifiable(position_inputs(drawn, latitude_rad))
-    reference = comparison_grid(space, n_positions, latitude_rad)
-    others = _without(drawn.angles_rad, reference.angles_rad)
-    candidates = PositionSet(
-        np.concatenate([others, reference.angles_rad]), table=table, name="candidates"
-    )
+    reference, candidates, reference_index = _candidates(space, n_positions, latitude_rad)
     inputs = position_inputs(candidates, latitude_rad)
     features = np.stack([regressor_matrix(a, inputs.specific_force_g) for a in AXES], axis=1)
     sensitivity = np.abs(rate_error_jacobian(gyrowheel, inputs))
-    reference_index = np.arange(len(others), len(candidates))
     reference_log_det = _log_det(features, reference_index)
     floor = reference_log_det + _N_PARAMETERS * np.log(min_efficiency)
     start = reference_index
@@ -508,15 +492,14 @@ def design_calibration(
     if min_efficiency <= 1 and box.volume_rad3 < reference_box.volume_rad3:
         chosen, box = reference_index, reference_box  # the full model's last digits: the grid
     plan = plan_measurements(np.round(candidates.angles_rad[chosen] * DEG_PER_RAD, 9))
-    positions_deg = plan.joint_deg
-    design_set = PositionSet(positions_deg / DEG_PER_RAD, table=table, name="design")
+    design_set = PositionSet(plan.joint_deg / DEG_PER_RAD, table=table, name="design")
     uniform, _ = holding_scale(
         accuracy_dph, gyrowheel, position_inputs(design_set, latitude_rad),
         reference_box.limits_rad,
     )  # fmt: skip
     return CalibrationDesign(
         space=space,
-        positions_deg=positions_deg,
+        positions_deg=plan.joint_deg,
         plan=plan,
         reference=reference,
         accuracy_dph=accuracy_dph,
@@ -534,6 +517,42 @@ def design_calibration(
         steps=steps,
         latitude_rad=float(latitude_rad),
     )
+
+
+def _checked_request(space, n_positions, accuracy_dph, min_efficiency) -> tuple[int, float]:
+    """N (checked against the candidates, at least 7) and ``w_m``, or :class:`InputError`; a
+    precision floor outside (0, :data:`MAX_MIN_EFFICIENCY`] is refused too."""
+    n_positions = check_positions_count(n_positions, space.candidates_deg.shape[0])
+    accuracy_dph = check_accuracy_dph(accuracy_dph)
+    if int(n_positions) < N_COEFFICIENTS:
+        raise InputError(
+            f"{argument('n_positions')} {n_positions}: a calibration needs at least "
+            f"{N_COEFFICIENTS} positions (seven drift coefficients per axis)"
+        )
+    if not (np.isfinite(min_efficiency) and 0 < min_efficiency <= MAX_MIN_EFFICIENCY):
+        raise InputError(
+            f"the precision floor (D-efficiency) must be in (0, {MAX_MIN_EFFICIENCY:g}], "
+            f"got {min_efficiency!r}"
+        )
+    return int(n_positions), accuracy_dph
+
+
+def _candidates(space, n_positions: int, latitude_rad: float):
+    """The reference grid, the candidates (those drawn within the limits that the grid does not
+    hold, then the grid's) and the grid's indices among them.
+
+    Raises:
+        IdentifiabilityError: no position within the limits calibrates.
+    """
+    table = space.table
+    drawn = PositionSet(space.candidates_deg / DEG_PER_RAD, table=table, name="within the limits")
+    require_identifiable(position_inputs(drawn, latitude_rad))
+    reference = comparison_grid(space, n_positions, latitude_rad)
+    others = _without(drawn.angles_rad, reference.angles_rad)
+    candidates = PositionSet(
+        np.concatenate([others, reference.angles_rad]), table=table, name="candidates"
+    )
+    return reference, candidates, np.arange(len(others), len(candidates))
 
 
 def _without(angles_rad: np.ndarray, known_rad: np.ndarray) -> np.ndarray:
