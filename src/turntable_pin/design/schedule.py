@@ -11,9 +11,8 @@ How a position is measured depends on what the effects need to be seen:
   ``dirK = +1`` and once with ``-1`` (per joint, the first side seeded and balanced).
 
 With both, the early visit comes from one side and the late one from the other. The
-:class:`MeasurementPlan` writes the CSV that ``turntable-pin simulate --positions`` reads
-(``phiK_deg``, then ``time_s`` and ``dirK`` when the design needs them: one row per
-measurement).
+:class:`MeasurementPlan` writes the CSV the simulation reads as its positions (``phiK_deg``, then
+``time_s`` and ``dirK`` when the design needs them: one row per measurement).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Positions that tell two effects apart (``design --separate A,B``; issue 19, item 2).
+"""Positions that tell two effects apart (``design(separate='A,B')``; issue 19, item 2).
 
 When the diagnosis says that effect B reproduces effect A on the positions measured, the
 question is which positions would tell them apart, and how many. Each effect is taken at its
@@ -46,7 +46,7 @@ import numpy as np
 from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError, InputError
 from ..core.sizes import check_positions_count
-from ..core.words import argument
+from ..core.words import argument, command
 from ..measurement.catalogue import catalogue
 from ..measurement.fit import fit_orientation
 from ..stats.discrimination import (
@@ -158,7 +158,7 @@ class SeparationDesign:
         measured_deg: the positions already measured (M, J), degrees (empty without).
         noise_arcsec, noise_source: the noise of a measured angle and where it comes from.
         amplitude_source: where each effect's amplitude comes from (``{effect: text}``).
-        n_from: positions already measured (``--from``), 0 without.
+        n_from: positions already measured (``from_data``), 0 without.
         power: the smaller chance of the right name at these positions.
         positions_for_power: the fewest positions with at least :attr:`target` power
             (``None``: not within :data:`MAX_POWER_POSITIONS`); power_at_positions_for_power:
@@ -203,7 +203,7 @@ class SeparationDesign:
         a, b = self.pair
         return "\n".join(
             [
-                f"designed by turntable-pin design --separate {a},{b} (T-optimal)",
+                f"designed by {command('design', separate=f'{a},{b}')} (T-optimal)",
                 f"table: {self.space.table_name}",
                 f"seed={self.space.seed} candidates={self.space.candidates_deg.shape[0]} "
                 f"n_positions={self.n_positions} n_from={self.n_from}",
@@ -321,8 +321,8 @@ class SeparationDesign:
         if self.positions_for_power_designed:
             return (
                 f"{self.target:.0%} needs {count} position{'s' if count > 1 else ''}{besides}: "
-                f"design --separate {a},{b} "
-                f"-n {count} gives {_percent(self.power_at_positions_for_power)}"
+                f"design {argument('separate')} {a},{b} {argument('n_positions')} {count} gives "
+                f"{_percent(self.power_at_positions_for_power)}"
             )
         return (
             f"{self.target:.0%} needs about {count} positions{besides} (this design repeated "
@@ -367,7 +367,9 @@ def _fitted_amplitude(data, effect, table) -> dict[str, float]:
     try:
         fit = fit_orientation(data, [effect], turntable=table)
     except (InputError, IdentifiabilityError) as exc:
-        raise InputError(f"--from {where}: {effect.name} cannot be fitted there ({exc})") from None
+        raise InputError(
+            f"{argument('from_data')} {where}: {effect.name} cannot be fitted there ({exc})"
+        ) from None
     model, params = fit.model, fit.result.params
     return {
         model.parameter_names[i].split(".", 1)[1]: float(params[i] / model.per_user_unit[i])
