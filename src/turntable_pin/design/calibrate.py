@@ -364,9 +364,8 @@ class CalibrationDesign:
                 f"designed by {command('design', calibrate=True)} (loosest orientation "
                 "requirement)",
                 f"table: {self.space.table_name}; accuracy_dph={self.accuracy_dph:g}",
-                f"seed={self.space.seed} candidates={self.space.candidates_deg.shape[0]} "
-                f"n_positions={self.n_positions} min_efficiency={self.min_efficiency:g}",
-                "limits: " + "; ".join(r.describe() for r in self.space.ranges),
+                f"{self.space.seed_text(self.n_positions)} min_efficiency={self.min_efficiency:g}",
+                self.space.limits_text,
                 f"reference: {self.reference.name}; looser by {self.looser_by:.4g}; "
                 f"D-efficiency {self.d_efficiency:.4g}",
             ]
@@ -405,10 +404,10 @@ class CalibrationDesign:
         """The design as text: the boxes and the planes of design and reference, the positions."""
         space, ref = self.space, self.reference.name
         lines = [
-            f"design (calibrate, loosest orientation requirement): {self.n_positions} positions "
-            f"of {space.candidates_deg.shape[0]} candidates (seed {space.seed}) on "
-            f"{space.table_name}, for a rate accuracy of {self.accuracy_dph:g} deg/h",
-            "limits: " + "; ".join(r.describe() for r in space.ranges),
+            f"design (calibrate, loosest orientation requirement): "
+            f"{space.chosen_text(self.n_positions)}, for a rate accuracy of "
+            f"{self.accuracy_dph:g} deg/h",
+            space.limits_text,
             f"reference: {ref} ({len(self.reference)} positions); D-efficiency of the design "
             f"against it {self.d_efficiency:.3f} (floor {self.min_efficiency:g}: the 14 drift "
             "coefficients at least as precisely)",
@@ -432,10 +431,7 @@ class CalibrationDesign:
                 f"  {name[:16]:16s}{values}   (corners: dwx {result.box_dwx_dph:.4g}, "
                 f"dwy {result.box_dwy_dph:.4g} deg/h)"
             )
-        names = ", ".join(f"phi{r.index}" for r in space.ranges)
-        lines.append(f"positions ({names}, deg):")
-        for row in self.positions_deg:
-            lines.append("  " + "  ".join(f"{v:10.4f}" for v in row))
+        lines += space.positions_lines(self.positions_deg)
         return "\n".join(lines)
 
 

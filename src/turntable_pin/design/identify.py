@@ -32,7 +32,7 @@ from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import InputError, TurntablePinError
 from ..core.sizes import check_positions_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
-from ..core.words import argument
+from ..core.words import argument, command
 from ..measurement.effect_model import OrientationModel
 from ..measurement.effects.base import PositionVariables
 from ..measurement.fit import fit_orientation
@@ -103,11 +103,10 @@ class IdentifyDesign:
         effects = ", ".join(self.space.effect_names) or "none"
         return "\n".join(
             [
-                "designed by turntable-pin design (identify: D-optimal)",
+                f"designed by {command('design')} (identify: D-optimal)",
                 f"table: {self.space.table_name}; effects: {effects}",
-                f"seed={self.space.seed} candidates={self.space.candidates_deg.shape[0]} "
-                f"n_positions={self.n_positions} n_from={self.n_from}",
-                "limits: " + "; ".join(r.describe() for r in self.space.ranges),
+                f"{self.space.seed_text(self.n_positions)} n_from={self.n_from}",
+                self.space.limits_text,
                 f"noise_arcsec={self.noise_arcsec:g} ({self.noise_source})",
                 f"run: {self.plan.rule}",
             ]
@@ -141,11 +140,9 @@ class IdentifyDesign:
         space = self.space
         effects = " + ".join(("base", *space.effect_names))
         lines = [
-            f"design (identify, D-optimal): {self.n_positions} positions of "
-            f"{space.candidates_deg.shape[0]} candidates (seed {space.seed}) on "
-            f"{space.table_name}, for {effects}"
+            f"design (identify, D-optimal): {space.chosen_text(self.n_positions)}, for {effects}"
             + (f", after the {self.n_from} positions measured" if self.n_from else ""),
-            "limits: " + "; ".join(r.describe() for r in space.ranges),
+            space.limits_text,
             f"run: {self.plan.n_rows} measurements; {self.plan.rule}",
             f"noise: {self.noise_arcsec:.3g} arcsec per angle ({self.noise_source})",
         ]
@@ -175,10 +172,7 @@ class IdentifyDesign:
             lines.append(
                 "not determined by any position within the limits: " + "; ".join(self.undetermined)
             )
-        names = ", ".join(f"phi{r.index}" for r in space.ranges)
-        lines.append(f"positions ({names}, deg):")
-        for row in self.positions_deg:
-            lines.append("  " + "  ".join(f"{v:10.4f}" for v in row))
+        lines += space.positions_lines(self.positions_deg)
         return "\n".join(lines)
 
 

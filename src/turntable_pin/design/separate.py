@@ -1,38 +1,34 @@
 """Positions that tell two effects apart (``design(separate='A,B')``; issue 19, item 2).
 
-When the diagnosis says that effect B reproduces effect A on the positions measured, the
-question is which positions would tell them apart, and how many. Each effect is taken at its
-amplitude (fitted on the data measured with the base errors, or given): if A is true, fitting
-the base errors and B to what A predicts leaves the noise-free misfit
+When the diagnosis says that effect B reproduces effect A on the positions measured, which
+positions would tell them apart, and how many? Each effect is taken at its amplitude (given, or
+fitted with the base errors on the data measured). If A is true, fitting the base errors and B
+to A's prediction leaves the noise-free misfit
 
     lambda_AB = || (I - P_B) J_A a ||^2 / sigma^2,   P_B the projector on the base and B's columns
 
-over the measured angles of the design (the Jacobian of
-:class:`~turntable_pin.measurement.effect_model.OrientationModel` at zero: the linearised model),
-and ``lambda_BA`` the other way round. The design maximises the smaller of the two (T-optimal,
-Atkinson and Fedorov 1975): a seeded exchange over the candidate positions within the joints'
-limits (:func:`~turntable_pin.stats.discrimination.t_optimal_exchange`), added to the positions
-already measured when there are some.
+over the design's measured angles (J the linearised model: the Jacobian of
+:class:`~turntable_pin.measurement.effect_model.OrientationModel` at zero), and ``lambda_BA`` the
+other way round. The design maximises the smaller of the two (T-optimal, Atkinson and Fedorov
+1975): a seeded exchange over the candidates within the joints' limits
+(:func:`~turntable_pin.stats.discrimination.t_optimal_exchange`), after the positions measured.
 
-The power is the diagnosis' own decision (sigma known): when A is true, A is named when it is
-accepted, ``chi2'(k_A, lambda_A0) > k_A ln m + 6 + 2 ln K`` (a non-central chi-square:
-``lambda_A0`` what the base errors alone leave of A, ``k_A`` the ranks A adds to the base, ``m``
-the measured angles, ``K`` the catalogue's size:
-:func:`~turntable_pin.stats.model_selection.acceptance_threshold`), and then either put before
-B in the first round, ``rss_B - rss_A > (k_A - k_B) ln m`` (a generalised chi-square of the
-noise in the span of both models, :func:`~turntable_pin.stats.discrimination.rss_difference`;
-with A's parameters traded off and B's not, also ``gain_A > 2 gain_B``), or, B first, accepted
-on top of B (the nested test: ``chi2'(k_A|B, lambda_AB)`` above the second round's threshold)
-with B then dropped as not needed beside it. The power of a design is the smaller of the two
-chances (A true, B true); a third catalogued effect that might take the name is not counted.
-The positions needed for the target power are found by scaling the design's misfits to other
-sizes (replicating it is exact) and checked by designing that many positions.
+The power is the diagnosis' own decision (sigma known). With A true, A is named when it is
+accepted, ``chi2'(k_A, lambda_A0) > k_A ln m + 6 + 2 ln K`` (``lambda_A0`` what the base errors
+leave of A, ``k_A`` the ranks A adds, ``m`` the measured angles, ``K`` the catalogue's size:
+:func:`~turntable_pin.stats.model_selection.acceptance_threshold`), and then either put before B
+in the first round, ``rss_B - rss_A > (k_A - k_B) ln m`` (a generalised chi-square of the noise in
+both models' span, :func:`~turntable_pin.stats.discrimination.rss_difference`; A traded off and B
+not: also ``gain_A > 2 gain_B``), or, B first, accepted on top of B (``chi2'(k_A|B, lambda_AB)``
+above the second round's threshold) with B then dropped. A design's power is the smaller of the
+two chances (A true, B true); a third effect that might take the name is not counted. The count
+for the target power scales the design's misfits (replicating it is exact), checked by designing
+that many positions.
 
-When B reproduces A at every candidate position (its misfit is below :data:`SAME_RTOL` of A's
-signal beyond the base errors) and A has no fewer ranks than B, no positions within the limits
-separate them: the result says so, with the independent measurements of the effects' ``confirm``
-texts. When B contains A but has more ranks, a true A is still named by the rule's parsimony
-(B's extra ranks must buy their penalty from the noise alone): that direction is left to it.
+When B reproduces A at every candidate (misfit below :data:`SAME_RTOL` of A's signal beyond the
+base) and A has no fewer ranks than B, no positions separate them: the result says so, with the
+independent measurements of the effects' ``confirm`` texts. When B contains A with more ranks, a
+true A is still named by the rule's parsimony: that direction is left to it.
 """
 
 from __future__ import annotations
@@ -88,31 +84,26 @@ MAX_POWER_POSITIONS = 5000
 
 @dataclass(frozen=True)
 class Hypothesis:
-    """One of the two effects taken as the truth, against the other.
+    """One of the two effects taken as the truth, against the other (chi2 are noise-free).
 
     Attributes:
-        effect: its name; rival: the other effect's.
-        amplitude: its parameters in user units (``{name: value}``); unit: their unit(s).
-        signal_chi2: what the base errors alone leave of its prediction on the design (with the
-            positions measured), a noise-free chi2.
-        misfit_chi2: what the base errors and the rival leave of it there (``lambda``).
-        misfit_measured_chi2: the same on the positions measured alone (``None`` without).
-        misfit_grid_chi2: the same on the 30-degree grid within the limits, scaled to the
-            design's number of positions (with the positions measured).
+        effect, rival: the names.  amplitude: its parameters (user units); unit: their unit(s).
+        signal_chi2: what the base errors leave of its prediction on the design (and the data).
+        misfit_chi2: what the base errors and the rival leave of it there (``lambda``);
+            misfit_measured_chi2: on the positions measured alone (``None`` without);
+            misfit_grid_chi2: on the 30-degree grid within the limits at the design's size.
         added_rank, rival_added_rank: the ranks each adds to the base on the design.
-        determined, rival_determined: whether the design determines each one's parameters by
-            the diagnosis' correlation rule (an undetermined effect is put first only when it
-            explains twice what a determined one does).
+        determined, rival_determined: whether the design determines each one's parameters (the
+            diagnosis' correlation rule: an undetermined effect goes first only when it explains
+            twice what a determined one does).
         settled_by: ``misfit`` (the design separates it) or ``parsimony`` (the rival reproduces
             it everywhere with more ranks: the rule names it for its fewer ranks).
-        power_detect: the chance that it is accepted at all (a non-central chi-square).
-        power_first: the chance that it is put before the rival in the first round.
-        power_on_top: the chance that, the rival first, it is accepted on top of it (a
-            non-central chi-square of ``misfit_chi2``) and the rival then dropped.
-        power_choice: the chance that it ends up named rather than the rival (either way).
-        power: ``power_detect * power_choice``, the chance of its name.
-        power_measured: the same on the positions measured alone (``None`` without).
-        power_new_alone: the same on the new positions alone (``None`` without data measured).
+        power_detect: the chance that it is accepted at all; power_first: that it goes before
+            the rival in the first round; power_on_top: that, the rival first, it is accepted on
+            top and the rival dropped; power_choice: that it is named rather than the rival.
+        power: ``power_detect * power_choice``, the chance of its name; power_measured,
+            power_new_alone: on the positions measured alone, on the new ones alone (``None``
+            without data measured).
     """
 
     effect: str
@@ -146,51 +137,44 @@ class SeparationDesign:
     """The positions that tell two effects apart, or why none do.
 
     Attributes:
-        space: the :class:`~.space.DesignSpace` (table, the two effects, limits, candidates).
-        pair: the two effects' names.
+        space: the :class:`~.space.DesignSpace`.  pair: the two effects' names.
         positions_deg: the chosen positions (N, J), degrees, in the run's first order (empty
-            when no positions separate them).
-        plan: the run that measures them (``None`` when none do).
+            when none separate them); plan: their run (``None`` then).
         hypotheses: each effect as the truth (:class:`Hypothesis`), A then B.
         misfit_by_position: (N, 2) each position's share of the misfit each effect's rival
-            leaves (chi2; zero for a direction left to parsimony), in the order of
-            :attr:`positions_deg`.
-        measured_deg: the positions already measured (M, J), degrees (empty without).
+            leaves (chi2; zero for a direction left to parsimony).
+        measured_deg: the positions already measured (M, J), degrees; n_from: their number.
         noise_arcsec, noise_source: the noise of a measured angle and where it comes from.
         amplitude_source: where each effect's amplitude comes from (``{effect: text}``).
-        n_from: positions already measured (``from_data``), 0 without.
         power: the smaller chance of the right name at these positions.
-        positions_for_power: the fewest positions with at least :attr:`target` power
-            (``None``: not within :data:`MAX_POWER_POSITIONS`); power_at_positions_for_power:
-            their power; positions_for_power_designed: whether that many were designed to check
-            it (else it is this design's misfits scaled).
+        positions_for_power: the fewest positions with :attr:`target` power (``None``: more
+            than :data:`MAX_POWER_POSITIONS`), their power, and whether that many were designed
+            to check it (else this design's misfits scaled).
         power_curve: ``(positions, power)`` of this design scaled to other sizes.
-        target: the power asked for.
-        catalogue_size: K of the acceptance threshold ``-6 - 2 ln K``.
-        n_swaps, n_passes: of the exchange.
+        catalogue_size: K of the acceptance threshold.  n_swaps, n_passes: of the exchange.
         inseparable: why no positions within the limits separate them (one line), or ``None``.
     """
 
     space: DesignSpace = field(repr=False)
     pair: tuple[str, str]
     positions_deg: np.ndarray = field(repr=False)
-    plan: MeasurementPlan | None = field(repr=False)
-    hypotheses: tuple[Hypothesis, ...]
-    misfit_by_position: np.ndarray = field(repr=False)
     measured_deg: np.ndarray = field(repr=False)
     noise_arcsec: float
     noise_source: str
     amplitude_source: dict[str, str]
     n_from: int
-    power: float | None
-    positions_for_power: int | None
-    power_at_positions_for_power: float | None
-    positions_for_power_designed: bool
-    power_curve: tuple[tuple[int, float], ...]
     target: float
-    catalogue_size: int
-    n_swaps: int
-    n_passes: int
+    plan: MeasurementPlan | None = field(default=None, repr=False)
+    hypotheses: tuple[Hypothesis, ...] = ()
+    misfit_by_position: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
+    power: float | None = None
+    positions_for_power: int | None = None
+    power_at_positions_for_power: float | None = None
+    positions_for_power_designed: bool = False
+    power_curve: tuple[tuple[int, float], ...] = ()
+    catalogue_size: int = 0
+    n_swaps: int = 0
+    n_passes: int = 0
     inseparable: str | None = None
 
     @property
@@ -205,9 +189,8 @@ class SeparationDesign:
             [
                 f"designed by {command('design', separate=f'{a},{b}')} (T-optimal)",
                 f"table: {self.space.table_name}",
-                f"seed={self.space.seed} candidates={self.space.candidates_deg.shape[0]} "
-                f"n_positions={self.n_positions} n_from={self.n_from}",
-                "limits: " + "; ".join(r.describe() for r in self.space.ranges),
+                f"{self.space.seed_text(self.n_positions)} n_from={self.n_from}",
+                self.space.limits_text,
                 f"noise_arcsec={self.noise_arcsec:g} ({self.noise_source})",
                 "amplitudes: "
                 + "; ".join(
@@ -253,11 +236,9 @@ class SeparationDesign:
         space = self.space
         a, b = self.pair
         lines = [
-            f"design (separate {a} from {b}, T-optimal): {self.n_positions} positions of "
-            f"{space.candidates_deg.shape[0]} candidates (seed {space.seed}) on "
-            f"{space.table_name}"
+            f"design (separate {a} from {b}, T-optimal): {space.chosen_text(self.n_positions)}"
             + (f", after the {self.n_from} positions measured" if self.n_from else ""),
-            "limits: " + "; ".join(r.describe() for r in space.ranges),
+            space.limits_text,
             f"run: {self.plan.n_rows} measurements; {self.plan.rule}",
             f"noise: {self.noise_arcsec:.3g} arcsec per angle ({self.noise_source})",
         ]
@@ -300,10 +281,7 @@ class SeparationDesign:
                 "measure these positions and diagnose them together with the data measured "
                 "(append their rows): the chances above are for both"
             )
-        names = ", ".join(f"phi{r.index}" for r in space.ranges)
-        lines.append(f"positions ({names}, deg):")
-        for row in self.positions_deg:
-            lines.append("  " + "  ".join(f"{v:10.4f}" for v in row))
+        lines += space.positions_lines(self.positions_deg)
         return "\n".join(lines)
 
     def _count_line(self) -> str:
@@ -865,22 +843,11 @@ def _inseparable(problem: _Problem, target, because):
         space=space,
         pair=problem.names,
         positions_deg=np.zeros((0, space.n_joints)),
-        plan=None,
-        hypotheses=(),
-        misfit_by_position=np.zeros((0, 2)),
         measured_deg=np.zeros((0, space.n_joints)),
         noise_arcsec=float(problem.noise),
         noise_source=problem.noise_source,
         amplitude_source=problem.source,
         n_from=problem.n_from,
-        power=None,
-        positions_for_power=None,
-        power_at_positions_for_power=None,
-        positions_for_power_designed=False,
-        power_curve=(),
         target=float(target),
-        catalogue_size=0,
-        n_swaps=0,
-        n_passes=0,
         inseparable=text,
     )

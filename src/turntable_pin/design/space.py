@@ -260,6 +260,30 @@ class DesignSpace:
         """The names of :attr:`effects`."""
         return tuple(e.name for e in self.effects)
 
+    @property
+    def limits_text(self) -> str:
+        """``limits: `` and each joint's range in words (the designs' reports and comments)."""
+        return "limits: " + "; ".join(r.describe() for r in self.ranges)
+
+    def seed_text(self, n_positions: int) -> str:
+        """The CSV comment's ``seed=.. candidates=.. n_positions=..``."""
+        return (
+            f"seed={self.seed} candidates={self.candidates_deg.shape[0]} n_positions={n_positions}"
+        )
+
+    def chosen_text(self, n_positions: int) -> str:
+        """``N positions of C candidates (seed S) on TABLE`` (the reports' first line)."""
+        return (
+            f"{n_positions} positions of {self.candidates_deg.shape[0]} candidates (seed "
+            f"{self.seed}) on {self.table_name}"
+        )
+
+    def positions_lines(self, positions_deg: np.ndarray) -> list[str]:
+        """The positions in a report: a line naming the angles, then one line each, degrees."""
+        names = ", ".join(f"phi{r.index}" for r in self.ranges)
+        rows = ["  " + "  ".join(f"{v:10.4f}" for v in row) for row in positions_deg]
+        return [f"positions ({names}, deg):", *rows]
+
     def to_dict(self) -> dict:
         """The space as a JSON-ready dict (limits, candidate count, grid size, seed)."""
         return {
