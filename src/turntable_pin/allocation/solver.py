@@ -27,6 +27,7 @@ holds everywhere. One point whose closed form meets it is the optimum (``exact``
 
 from __future__ import annotations
 
+# scipy.optimize is imported inside functions: import turntable_pin stays light
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field

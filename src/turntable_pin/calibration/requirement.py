@@ -33,6 +33,7 @@ meets ``w_m`` exactly. Every point of it meets the accuracy; scaled up by any fa
 
 from __future__ import annotations
 
+# scipy.optimize is imported inside functions: import turntable_pin stays light
 from dataclasses import dataclass, field
 
 import numpy as np
