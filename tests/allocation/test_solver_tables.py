@@ -11,13 +11,13 @@ from conftest import REPO_DIR, write_file
 from turntable_pin.allocation.capability import ManufacturingCapability
 from turntable_pin.allocation.sensitivity import check_grid_step
 from turntable_pin.allocation.solver import (
-    ORIENTATION_ANGLES,
     OrientationLimits,
     allocate_tolerances,
     angle_rows,
 )
 from turntable_pin.core.exceptions import InfeasibleError, InputError
 from turntable_pin.core.units import arcsec_to_rad
+from turntable_pin.model.angles import ANGLE_SYMBOLS
 from turntable_pin.model.generic_table import GenericTable
 
 MODELS = REPO_DIR / "models"
@@ -99,7 +99,7 @@ def test_the_solvers_rows_are_the_regressors(urdf, rng):
     rows = angle_rows(table, 30.0)
     points = rng.uniform(-np.pi, np.pi, (20, len(table.joint_names)))
     exact = table.regressor(list(points.T))
-    for k, name in enumerate(ORIENTATION_ANGLES):
+    for k, name in enumerate(ANGLE_SYMBOLS):
         columns = [table.parameter_names.index(n) for n in rows[name].error_names]
         np.testing.assert_allclose(rows[name].values(points), exact[:, k, columns], atol=1e-14)
         others = [

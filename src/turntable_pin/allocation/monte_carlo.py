@@ -42,11 +42,12 @@ from ..core.sizes import (
 )
 from ..core.turn_grid import full_turn_grid_deg
 from ..core.units import DEG_PER_RAD, arcmin_by_name
+from ..model.angles import ANGLE_SYMBOLS
 from ..model.batch_field import ChainExpansion, joint_dependence, max_abs_on_grid
 from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES
 from ..model.paper_table import resolve_table
 from .sensitivity import MAX_GRID_POINTS, check_grid_step
-from .solver import ORIENTATION_ANGLES, OrientationLimits
+from .solver import OrientationLimits
 
 __all__ = [
     "CHUNK_SIZE",
@@ -253,10 +254,10 @@ class MonteCarloResult:
         return {
             "urdf": self.urdf,
             "payload_frame": self.payload_frame,
-            "max_abs_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.max_abs_rad),
+            "max_abs_arcmin": arcmin_by_name(ANGLE_SYMBOLS, self.max_abs_rad),
             "limits_arcmin": self.limits.to_dict(),
             "all_within": self.all_within,
-            "n_exceeding": dict(zip(ORIENTATION_ANGLES, exceeding, strict=True)),
+            "n_exceeding": dict(zip(ANGLE_SYMBOLS, exceeding, strict=True)),
             "n": self.n,
             "seed": self.seed,
             "sampling": f"magnitude uniform in [lower, upper] bound, random sign{zeros}",

@@ -52,7 +52,6 @@ __all__ = [
     "DEFAULT_ACCURACY_DPH",
     "DEFAULT_POSITIONS",
     "MIN_LIMIT_ARCSEC",
-    "ORIENTATION_ANGLES",
     "PHI2_INTERVALS_RAD",
     "REQUIREMENT_KINDS",
     "WEIGHT_SCHEMES",
@@ -71,8 +70,6 @@ __all__ = [
     "solve_subproblem",
 ]
 
-ORIENTATION_ANGLES = ANGLE_SYMBOLS  # the limit names: psi_rad, theta_rad, gamma_rad
-"""Names of the three orientation angles dpsi, dtheta, dgamma as used in keys and options."""
 PHI2_INTERVALS_RAD: dict[str, tuple[float, float]] = {
     angle: (math.radians(lo), math.radians(hi)) for angle, (lo, hi) in PHI2_INTERVALS_DEG.items()
 }
@@ -110,7 +107,7 @@ class OrientationLimits:
     gamma_rad: float
 
     def __post_init__(self) -> None:
-        for name in ORIENTATION_ANGLES:
+        for name in ANGLE_SYMBOLS:
             value = float(getattr(self, f"{name}_rad"))
             if not math.isfinite(value) or value <= 0.0:
                 raise InputError(f"orientation limit for {name} must be a positive number")
@@ -138,12 +135,12 @@ class OrientationLimits:
         return cls(psi / DEG_PER_RAD, theta / DEG_PER_RAD, gamma / DEG_PER_RAD)
 
     def as_array(self) -> np.ndarray:
-        """(3,) radians in :data:`ORIENTATION_ANGLES` order."""
-        return np.array([getattr(self, f"{n}_rad") for n in ORIENTATION_ANGLES])
+        """(3,) radians in :data:`ANGLE_SYMBOLS` order."""
+        return np.array([getattr(self, f"{n}_rad") for n in ANGLE_SYMBOLS])
 
     def to_dict(self) -> dict[str, float]:
         """``{psi: arcmin, theta: arcmin, gamma: arcmin}``."""
-        return {n: getattr(self, f"{n}_rad") * ARCMIN_PER_RAD for n in ORIENTATION_ANGLES}
+        return {n: getattr(self, f"{n}_rad") * ARCMIN_PER_RAD for n in ANGLE_SYMBOLS}
 
 
 def paper_eq16_limits() -> OrientationLimits:
@@ -260,7 +257,7 @@ def angle_rows(
     probe = np.random.default_rng(0).uniform(-math.pi, math.pi, (16, d))  # generic positions
     exact = table.regressor(list(probe.T))[:, :, columns]
     out = {}
-    for k, name in enumerate(ORIENTATION_ANGLES):
+    for k, name in enumerate(ANGLE_SYMBOLS):
         block = coefficients[..., k, :]
         peak = np.abs(block).reshape(-1, block.shape[-1]).max(axis=0)
         members = np.flatnonzero(peak > 1e-12 * max(float(peak.max()), 1e-300))
@@ -616,7 +613,7 @@ def solve_subproblem(rows: AngleRows, limit_rad: float, weights, lower_bounds_ra
 # ---- weights and the whole allocation ------------------------------------------------------
 def allocation_weights(scheme: str, sensitivities: Sensitivities | None = None, table=None):
     """Weights W (3, P) of ``table``'s angular errors (default the bundled table), rows
-    :data:`ORIENTATION_ANGLES`: ``model``, the inverse of the average sensitivities (Figure 8;
+    :data:`ANGLE_SYMBOLS`: ``model``, the inverse of the average sensitivities (Figure 8;
     default on the table's grid); ``paper``, the inverse of the paper's Figure 8 value 0.6481 for
     every term that varies with the angles and 1 for the constant ones (the paper's rule, on any
     table); ``equal``, 1 everywhere (the "traditional" allocation).
@@ -669,7 +666,7 @@ class Allocation:
     @property
     def J(self) -> dict[str, float]:
         """Objective of each problem at its optimum (1/arcmin^2) and their sum."""
-        out = {name: self.subproblems[name].J for name in ORIENTATION_ANGLES}
+        out = {name: self.subproblems[name].J for name in ANGLE_SYMBOLS}
         return {**out, "total": float(sum(out.values()))}
 
     def errors(self) -> np.ndarray:
@@ -693,13 +690,13 @@ class Allocation:
             "upper_bounds_arcmin": arcmin_by_name(self.error_names, self.upper_bounds_rad),
             "J": self.J,
             "J_unit": "1/arcmin^2 (errors in arc minutes)",
-            "worst_case_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.worst_case_rad),
+            "worst_case_arcmin": arcmin_by_name(ANGLE_SYMBOLS, self.worst_case_rad),
             "limits_arcmin": self.limits.to_dict(),
             "weights": self.weights_scheme,
             "lower_bounds": self.capability.to_dict(),
             "grid_step_deg": self.sensitivities.grid_step_deg,
-            "active_constraints": {n: list(self.subproblems[n].active) for n in ORIENTATION_ANGLES},
-            "subproblems": {n: self.subproblems[n].to_dict() for n in ORIENTATION_ANGLES},
+            "active_constraints": {n: list(self.subproblems[n].active) for n in ANGLE_SYMBOLS},
+            "subproblems": {n: self.subproblems[n].to_dict() for n in ANGLE_SYMBOLS},
             "sensitivities": self.sensitivities.by_angle(),
         }
 
@@ -721,7 +718,7 @@ class Allocation:
             lines.append(f'{n:{width}s}{ub:11.4f}\' = {ub * 60:7.2f}"{lb:12.2f}"')
         lines += ["", "with every error at its final upper bound (the smallest of the three "
                   "sub-problems'):"]  # fmt: skip
-        for k, angle in enumerate(ORIENTATION_ANGLES):
+        for k, angle in enumerate(ANGLE_SYMBOLS):
             limit = self.limits.to_dict()[angle]
             worst = self.worst_case_rad[k] * ARCMIN_PER_RAD
             state = (
@@ -733,7 +730,7 @@ class Allocation:
         lines.append(
             "each angle's own sub-problem (its bounds before the minimum over the angles):"
         )
-        for angle in ORIENTATION_ANGLES:
+        for angle in ANGLE_SYMBOLS:
             sub = self.subproblems[angle]
             lines.append(f"d{angle:6s} J = {sub.J:.6g} /arcmin^2  [{sub.method}, KKT residual "
                          f"{sub.kkt_residual:.1e}]")  # fmt: skip
@@ -776,7 +773,7 @@ def allocate_tolerances(
     w = allocation_weights(weights, sensitivities, table)
     rows = angle_rows(table, grid_step_deg)
     subproblems = {}
-    for k, angle in enumerate(ORIENTATION_ANGLES):
+    for k, angle in enumerate(ANGLE_SYMBOLS):
         idx = [names.index(n) for n in rows[angle].error_names]
         subproblems[angle] = solve_subproblem(
             rows[angle], limits.as_array()[k], w[k, idx], capability.lower_bounds_rad[idx]
@@ -789,7 +786,7 @@ def allocate_tolerances(
     whole = angle_rows(table, grid_step_deg, whole_turns=True)  # Lemma 1: every angle and sign
     worst = [
         domain_max(whole[a], bounded[[names.index(n) for n in whole[a].error_names]])[0]
-        for a in ORIENTATION_ANGLES
+        for a in ANGLE_SYMBOLS
     ]
     return Allocation(
         upper, limits, weights, w, subproblems, np.array(worst),
