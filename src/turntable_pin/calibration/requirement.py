@@ -616,22 +616,20 @@ def orientation_requirement(
     rect_y = largest_rectangle(fy, accuracy_dph)
     psi, theta_x = rect_x.half_widths_rad
     theta_y, gamma = rect_y.half_widths_rad
-    if theta_x <= theta_y:
-        binding, theta = "psi_theta", theta_x
-        gamma = float(
-            fy.largest(
-                1, theta * (1 - _MARGIN), accuracy_dph, rect_y.axis_limits_rad[1] * 1.000001
-            )[0]
-        )
-        theta, gamma = _settle(fy, theta, gamma, accuracy_dph)
+    # The other plane's free side re-extended to the contour at the binding plane's I_theta.
+    binding = "psi_theta" if theta_x <= theta_y else "theta_gamma"
+    other, rect, free = (fy, rect_y, 1) if theta_x <= theta_y else (fx, rect_x, 0)
+    theta = min(theta_x, theta_y)
+    side = other.largest(
+        free, theta * (1 - _MARGIN), accuracy_dph, rect.axis_limits_rad[free] * 1.000001
+    )
+    pair = _settle(
+        other, *((theta, float(side[0])) if free else (float(side[0]), theta)), accuracy_dph
+    )
+    if free:
+        theta, gamma = pair
     else:
-        binding, theta = "theta_gamma", theta_y
-        psi = float(
-            fx.largest(
-                0, theta * (1 - _MARGIN), accuracy_dph, rect_x.axis_limits_rad[0] * 1.000001
-            )[0]
-        )
-        psi, theta = _settle(fx, psi, theta, accuracy_dph)
+        psi, theta = pair
     corners = box_corners([psi, theta, gamma])
     box = rate_errors_at_angles_dph(
         gyrowheel, inputs, corners, exact=exact, definition=definition
