@@ -2,33 +2,30 @@
 item 4: the paper's own question, section 2).
 
 How accurate must a turntable be for a GyroWheel calibration of accuracy ``w_m``? For given
-positions the answer is the requirement box of :mod:`turntable_pin.calibration.requirement`:
-the largest box ``|dpsi| <= I_psi, |dtheta| <= I_theta, |dgamma| <= I_gamma`` (largest volume)
-whose every orientation error keeps the rate errors of eqs. 7-14 within ``w_m``. To first order
-the rate error at a position is ``J(p) (dpsi, dtheta, dgamma)`` (the printed eq. 13: the drift at
-the actual gravity direction minus the drift at the ideal one), so the box is set by the most
-sensitive positions: those where tilting gravity changes the drift most. On the paper's Table 1
-GyroWheel gravity along the payload's z axis bounds dpsi and dgamma (through the 43.2 and 33.2
-deg/h/g terms), and gravity in or near the payload's x-y plane bounds dtheta, by how much
-depending on its azimuth there (15 to 82 deg/h per rad).
+positions the answer is the requirement box of :mod:`turntable_pin.calibration.requirement` (the
+largest box of orientation errors whose every point keeps the rate errors of eqs. 7-14 within
+``w_m``). To first order the rate error at a position is ``J(p) (dpsi, dtheta, dgamma)`` (eq. 13
+as printed: the drift at the actual gravity direction minus that at the ideal one), so the most
+sensitive positions set the box: on the paper's Table 1 GyroWheel, gravity along the payload's z
+axis bounds dpsi and dgamma (the 43.2 and 33.2 deg/h/g terms), gravity in or near its x-y plane
+bounds dtheta (15 to 82 deg/h per rad, by its azimuth there).
 
-The design chooses ``N`` positions within the joints' limits that make the box as large as
-possible, i.e. the loosest orientation requirement for the same ``w_m``, while still calibrating
-the 14 drift coefficients (eqs. 5-6, 7 per axis) at least as precisely as the reference: the
-D-efficiency ``exp((log det M - log det M_ref) / 14)`` (``M`` the information of both axes'
-regressors, :func:`~turntable_pin.calibration.gyrowheel.regressor_matrix`) stays at or above
-``min_efficiency`` (default 1). The precision floor is what makes the question sound: positions
-clustered where gravity changes the drift least would give a loose requirement, but barely
-varying regressors, so the calibration would amplify the measurement noise without bound.
+The design chooses ``N`` positions within the joints' limits with the largest box (the loosest
+requirement for the same ``w_m``) that still calibrate the 14 drift coefficients (eqs. 5-6) at
+least as precisely as the reference: the D-efficiency ``exp((log det M - log det M_ref) / 14)``
+(``M`` both axes' information, :func:`~turntable_pin.calibration.gyrowheel.regressor_matrix`) is
+at least ``min_efficiency`` (default 1). Without that floor, positions clustered where gravity
+changes the drift least would give a loose requirement and a calibration that amplifies the
+noise without bound.
 
 The reference is the evenly spaced grid of ``N`` positions within the limits that calibrates
 (:func:`comparison_grid`: on the paper's table ``grid:90x60`` for 24, ``grid:60`` for 36,
-``grid:45`` for 64); it joins the candidates and is where the search starts, so the design is
-never worse than it. The search is a local one over the candidates (:func:`loosest_positions`):
-a position that bounds the box is exchanged for a candidate inside the box when the precision
-floor still holds and the box grows (or fewer positions bound it); when none can be, a Fedorov
-exchange among the positions inside the box (:func:`~turntable_pin.stats.design.
-fedorov_exchange`) raises the precision to make room; it ends when neither helps.
+``grid:45`` for 64); it joins the candidates and starts the search, so the design is never worse.
+The search (:func:`loosest_positions`) exchanges a position that bounds the box for a candidate
+inside it while the floor holds and the box grows (or fewer positions bound it); when none can,
+a Fedorov exchange among the positions inside the box
+(:func:`~turntable_pin.stats.design.fedorov_exchange`) raises the precision to make room; it
+ends when neither helps.
 """
 
 from __future__ import annotations
@@ -183,25 +180,24 @@ def loosest_positions(
     *,
     max_steps: int = MAX_STEPS,
 ) -> tuple[np.ndarray, tuple[SearchStep, ...]]:
-    """The local search of the module docstring, from the design ``start``.
-
-    Each step exchanges a position that bounds the box for a candidate inside it, the exchange
-    that grows the box most or else leaves the fewest positions bounding it
-    (:func:`_exchange_bounding`), as long as the precision floor holds; when none can, a Fedorov
-    exchange among the positions inside the box raises ``log det`` to make room. (Volume,
-    fewer bounding positions, ``log det``) rises at every step, so the search ends.
+    """The local search of the module docstring, from the design ``start``: the exchange of a
+    bounding position that grows the box most, else leaves the fewest positions bounding it
+    (:func:`_exchange_bounding`), while the floor holds; else a Fedorov exchange among the
+    positions inside the box. (Volume, fewer bounding positions, ``log det``) rises at every
+    step, so the search ends.
 
     Args:
         features: each candidate's regressor rows of the two axes (C, 2, 7).
         sensitivity: each candidate's ``|J|`` (C, 2, 3), deg/h per rad of (dpsi, dtheta,
             dgamma) (:func:`~turntable_pin.calibration.requirement.rate_error_jacobian`).
         start: indices of the starting design (``log det`` at least ``floor_log_det``).
-        floor_log_det: the precision floor, ``log det`` of both axes' information.
+        floor_log_det: the precision floor (``log det`` of both axes' information).
         accuracy_dph: ``w_m``, deg/h.
 
     Returns:
         The chosen indices and the steps taken (never a smaller box, never below the floor).
     """
+
     chosen = np.array(start, dtype=int)
     box = _box(sensitivity, chosen, accuracy_dph)
     current = _log_det(features, chosen)

@@ -41,7 +41,14 @@ from ..stats.least_squares import analyse_identifiability, combination_name, tal
 from .schedule import MeasurementPlan, Visits, candidate_visits, plan_measurements
 from .space import DesignSpace
 
-__all__ = ["CandidateRows", "IdentifyDesign", "candidate_rows", "design_identify", "design_rows"]
+__all__ = [
+    "CandidateRows",
+    "IdentifyDesign",
+    "candidate_rows",
+    "design_identify",
+    "design_rows",
+    "grid_rows",
+]
 
 DEFAULT_NOISE_ARCSEC = 1.0
 """Noise of a measured angle when neither ``noise_arcsec`` nor data say it, arc seconds."""
@@ -237,6 +244,16 @@ def design_rows(
     finite = np.all(np.isfinite(rows), axis=(1, 2))
     keep &= finite
     return rows[keep], keep, model
+
+
+def grid_rows(space: DesignSpace, start_s: float, duration_s: float):
+    """:func:`design_rows` of the 30-degree grid within the limits, measured by the same rules
+    as the candidates (its visits seeded apart from theirs)."""
+    visits = candidate_visits(
+        space.grid_deg.shape[0], space.n_joints, needs_time=space.needs_time,
+        needs_dirs=space.needs_dirs, rng=np.random.default_rng([space.seed, 2]),
+    )  # fmt: skip
+    return design_rows(space, space.grid_deg, visits, start_s, duration_s)
 
 
 def _start_information(space, data, noise_arcsec, dwell_s: float):
@@ -483,12 +500,7 @@ def _grid_information(space, c: CandidateRows, information, n_positions: int, dw
     positions where the effects are defined), as measured and at the design's size (its
     information per position, in a run as long as the design's: a drift rate is known better
     from a longer run, not from better positions), and the grid's number of positions."""
-    grid_visits = candidate_visits(
-        space.grid_deg.shape[0], space.n_joints, needs_time=space.needs_time,
-        needs_dirs=space.needs_dirs, rng=np.random.default_rng([space.seed, 2]),
-    )  # fmt: skip
-    _, grid_keep, _ = design_rows(space, space.grid_deg, grid_visits, c.start_s, c.duration_s)
-    grid = space.grid_deg[grid_keep]
+    grid = space.grid_deg[grid_rows(space, c.start_s, c.duration_s)[1]]
     n_grid, count = max(grid.shape[0], 1), space.visits.count
 
     def grid_information(dwell: float) -> np.ndarray:

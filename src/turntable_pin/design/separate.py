@@ -59,8 +59,8 @@ from ..stats.discrimination import (
 )
 from ..stats.least_squares import tall_r_factor
 from ..stats.model_selection import UNDETERMINED_GAIN_RATIO, acceptance_threshold
-from .identify import _evaluate, _root, candidate_rows, design_rows
-from .schedule import MeasurementPlan, candidate_visits, plan_measurements
+from .identify import _evaluate, _root, candidate_rows, grid_rows
+from .schedule import MeasurementPlan, plan_measurements
 from .space import DesignSpace
 
 __all__ = [
@@ -756,19 +756,11 @@ def _values(amplitude: Mapping[str, float]) -> str:
 def _grid_misfits(problem: _Problem, n_positions: int):
     """What each effect's rival leaves of it on the 30-degree grid within the limits, scaled to
     the design's size (with the data measured); ``None`` when no grid position can be used."""
-    space = problem.space
-    visits = candidate_visits(
-        space.grid_deg.shape[0], space.n_joints, needs_time=space.needs_time,
-        needs_dirs=space.needs_dirs, rng=np.random.default_rng([space.seed, 2]),
-    )  # fmt: skip
-    grid_rows, _, _ = design_rows(
-        space, space.grid_deg, visits, problem.start_s, problem.duration_s
-    )
-    if not grid_rows.shape[0]:
+    rows = grid_rows(problem.space, problem.start_s, problem.duration_s)[0]
+    if not rows.shape[0]:
         return None
-    n = grid_rows.shape[-1]
-    factor = n_positions / grid_rows.shape[0]
-    on_grid = problem.rows_of(grid_rows.reshape(-1, n) / problem.noise_rad, 0, factor)
+    factor = n_positions / rows.shape[0]
+    on_grid = problem.rows_of(rows.reshape(-1, rows.shape[-1]) / problem.noise_rad, 0, factor)
     return [misfit(on_grid.fitted(1 - x), on_grid.signal(x)) for x in range(2)]
 
 
