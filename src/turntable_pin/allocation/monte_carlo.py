@@ -177,18 +177,15 @@ class MonteCarloResult:
 
     Attributes:
         worst_rad: (N, 3) each table's largest |dpsi|, |dtheta|, |dgamma| over the grid, rad.
-        error_names: the angular errors drawn (the order of the bounds).
-        upper_bounds_rad, lower_bounds_rad: (P,) the box sampled.
+        error_names: the angular errors drawn; upper_bounds_rad, lower_bounds_rad: (P,) the box.
         limits: the orientation limits checked against.  n, seed: sample size and seed.
-        joint_names: the joints of the grid, in chain order.
-        grid_steps_deg: each joint's grid step, degrees.
+        joint_names: the grid's joints (chain order); grid_steps_deg: each one's step, degrees.
         evaluated_deg: each joint's angles evaluated, degrees: its grid, or 0 alone when no drawn
-            table's ``dR`` depends on the joint.
-        max_dependence: each joint's largest harmonic in any table's dpsi, dtheta, dgamma.
+            table's ``dR`` depends on it; max_dependence: its largest harmonic in any table.
         elapsed_s: wall time.  workers: processes used.
         zero_names: the errors held at 0 (the lengths: the paper's ``deta``, a table's offsets).
-        urdf, payload_frame: the table, when it was read from a URDF.
-        angle_names: the joints' angles in keys (the table's; default the joint names).
+        urdf, payload_frame: the table's.  angle_names: the joints' angles in keys (default the
+            joint names).
     """
 
     worst_rad: np.ndarray

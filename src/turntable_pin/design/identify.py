@@ -59,23 +59,20 @@ class IdentifyDesign:
     """D-optimal positions and what they will determine.
 
     Attributes:
-        space: the :class:`~.space.DesignSpace` (table, effects, limits, candidates, seed).
+        space: the :class:`~.space.DesignSpace`.  plan: the run that measures the positions.
         positions_deg: the chosen positions (N, J), degrees (in the run's first order).
-        plan: the run that measures them (:class:`~.schedule.MeasurementPlan`).
-        combinations: each determined combination: ``name``, ``unit``, ``coefficients``, the
-            expected standard error of the design (``std``), of the grid as measured (``std_grid``,
-            ``n_grid`` positions) and of the grid scaled to the design's size (``std_grid_same_n``);
-            ``None`` where the grid does not determine it.
+        combinations: each determined combination: ``name``, ``unit``, ``coefficients`` and its
+            expected standard error on the design (``std``), on the grid as measured
+            (``std_grid``) and on the grid at the design's size (``std_grid_same_n``; ``None``
+            where the grid does not determine it).
         undetermined: the combinations no position within the limits determines.
         noise_arcsec, noise_source: the noise of a measured angle and where it comes from.
         n_from: positions already measured (``from_data``), 0 without.
-        log_det, log_det_grid_same_n: ``log det`` of the Fisher information of the determined
-            combinations (in their user units) of the design and of the grid scaled to its size
-            (with the information of the data already measured).
-        d_efficiency: ``exp((log_det - log_det_grid_same_n) / p)``: the design's information per
-            position against the grid's (``None`` when the grid determines not all).
-        n_grid: positions of the grid (those the effects are defined at).
-        greedy_log_det: ``log det`` after the greedy start (same coordinates as ``log_det``).
+        log_det, log_det_grid_same_n: ``log det`` of the information of the determined
+            combinations (user units; with the data measured) on the design and on the grid at
+            its size; d_efficiency: ``exp((log_det - log_det_grid_same_n) / p)`` (``None`` when
+            the grid determines not all).
+        n_grid: positions of the grid.  greedy_log_det: ``log det`` after the greedy start.
         n_exchanges, n_sweeps: of the exchange.
     """
 
