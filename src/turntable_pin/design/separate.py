@@ -147,7 +147,8 @@ class SeparationDesign:
         noise_arcsec, noise_source: the noise of a measured angle and where it comes from.
         amplitude_source: where each effect's amplitude comes from (``{effect: text}``).
         power: the smaller chance of the right name at these positions.
-        positions_for_power: the fewest positions with :attr:`target` power (``None``: more
+        target: the power asked for.  positions_for_power, power_at_positions_for_power,
+            positions_for_power_designed: the fewest positions with that power (``None``: more
             than :data:`MAX_POWER_POSITIONS`), their power, and whether that many were designed
             to check it (else this design's misfits scaled).
         power_curve: ``(positions, power)`` of this design scaled to other sizes.
