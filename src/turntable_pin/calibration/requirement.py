@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.exceptions import InputError
+from ..core.turn_grid import every_combination
 from ..core.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
 from ..model.angles import ANGLE_SYMBOLS
 from .drift_fit import require_identifiable
@@ -295,7 +296,7 @@ size of the requirement itself): under eq. 7 ``dw`` is a quadratic of the angles
 difference is its exact linear part for any step; a step this large keeps rounding far below the
 result (the 90-degree grid's nearly singular ``A'`` solves to about 1e-10)."""
 
-_CORNER_SIGNS = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
+_CORNER_SIGNS = every_combination([np.array([-1, 1])] * 3)
 
 
 def box_corners(limits_rad) -> np.ndarray:
