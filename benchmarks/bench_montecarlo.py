@@ -46,7 +46,7 @@ from turntable_pin.model.batch_field import trig_basis
 from turntable_pin.model.chain import compose_rotation
 from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
 from turntable_pin.model.generic_table import GenericTable
-from turntable_pin.model.turntable import TurntableModel
+from turntable_pin.model.paper_table import paper_table
 
 THREE_AXIS = "three_axis_imu_table.urdf"
 THREE_LIMITS_ARCMIN = (0.6112299121, 0.2660663146, 0.4608392377)  # its `allocate` default
@@ -59,7 +59,7 @@ def _setup(case: str) -> dict:
             OrientationLimits.from_arcmin(1.4801, 1.56, 1.4801), "paper"
         )
         return {
-            "chain": TurntableModel().chain,
+            "chain": paper_table().chain,
             "names": ANGULAR_ERROR_NAMES,
             "upper": allocation.upper_bounds_rad,
             "lower": allocation.capability.lower_bounds_rad,

@@ -23,9 +23,9 @@ import numpy as np  # noqa: E402
 from turntable_pin import (  # noqa: E402
     OrientationErrorField,
     TurntableErrors,
-    TurntableModel,
     YourdfpyTurntable,
 )
+from turntable_pin.model.paper_table import paper_table  # noqa: E402
 
 
 def main() -> None:
@@ -43,11 +43,11 @@ def main() -> None:
         dphi_y1=2.0, dphi_z2=-1.5, dalpha_x1=3.0, dalpha_z1=-2.5,
         dalpha_x2=1.8, dalpha_y2=-2.2, deps_x=4.0, deps_y=-3.0, deta_mm=0.2,
     )  # fmt: skip
-    model = TurntableModel(errors)
+    table, values = paper_table(), errors.as_array()
     phi1, phi2 = rng.uniform(0.0, 2 * np.pi, size=(2, args.pairs))
     print(f"seed {args.seed}, {args.pairs} random angle pairs, one core")
 
-    field = OrientationErrorField.from_model(model)
+    field = OrientationErrorField.from_chain(table.chain, values[None])
     field.angles(phi1[:1000], phi2[:1000])  # warm-up
     batch_times = []
     for _ in range(5):
@@ -56,19 +56,22 @@ def main() -> None:
         batch_times.append(time.perf_counter() - t0)
     t_batch = float(np.median(batch_times))
     t0 = time.perf_counter()
-    field = OrientationErrorField.from_model(model)
+    field = OrientationErrorField.from_chain(table.chain, values[None])
     t_setup = time.perf_counter() - t0
 
     n_pin = min(args.per_call_pairs, args.pairs)
     t0 = time.perf_counter()
     per_call = np.array(
-        [model.orientation_error(a, b).dR for a, b in zip(phi1[:n_pin], phi2[:n_pin], strict=True)]
+        [
+            table.orientation_error(values, (a, b)).dR
+            for a, b in zip(phi1[:n_pin], phi2[:n_pin], strict=True)
+        ]
     )
     t_pin = time.perf_counter() - t0
 
     n_yd = min(args.yourdfpy_pairs, args.pairs)
     with tempfile.TemporaryDirectory() as tmp:
-        other = YourdfpyTurntable(model.write_urdf(os.path.join(tmp, "t.urdf")))
+        other = YourdfpyTurntable(table.write_urdf(values, os.path.join(tmp, "t.urdf")))
         t0 = time.perf_counter()
         yd = np.array(
             [

@@ -29,7 +29,7 @@ def main() -> None:
                 start = time.perf_counter()
                 out = Path(tmp) / f"shot_{i}.png"
                 result = render_snapshot(
-                    scene, math.radians(30), math.radians(45), out, width=width, height=height
+                    scene, (math.radians(30), math.radians(45)), out, width=width, height=height
                 )
                 total_s.append(time.perf_counter() - start)
                 scene_s.append(result.scene_seconds)

@@ -19,7 +19,7 @@ import pinocchio as pin
 from turntable_pin.allocation import solver
 from turntable_pin.model.angles import ANGLE_ENTRIES
 from turntable_pin.model.chain import ROTATION
-from turntable_pin.model.errors import ANGULAR_ERROR_NAMES, TurntableErrors
+from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
 from turntable_pin.model.small_angle import small_angle_matrix
 
 ORIENTATION_ANGLES = ("psi", "theta", "gamma")
@@ -124,13 +124,15 @@ def _slsqp(constraint, basis, w, lower_z):
 
 
 # ---- C of the exact chain, two more ways --------------------------------------------------------
-def _factor_twist(model, name: str) -> tuple[str, np.ndarray]:
+def _factor_twist(table, error_values, name: str) -> tuple[str, np.ndarray]:
     """Link holding error ``name`` and the link placement's right-trivialised variation per unit:
     ``tail^-1 xi tail`` with ``tail`` the factors after it and ``xi`` the factor's unit twist."""
-    chain = model.chain
-    link, index = chain.locate(name)
+    chain = table.chain
+    link, index = next(
+        (link, i) for link in chain.links for i, f in enumerate(link.factors) if f.error == name
+    )
     factor = link.factors[index]
-    values = model.errors.as_array().copy()
+    values = np.array(error_values, dtype=float)
     for earlier in link.factors[: index + 1]:
         values[chain.error_names.index(earlier.error)] = 0.0  # identity factors leave the tail
     tail = chain.error_transforms(values)[link.name]
@@ -142,22 +144,24 @@ def _factor_twist(model, name: str) -> tuple[str, np.ndarray]:
     return link.name, tail_se3.actInv(twist).vector
 
 
-def pinocchio_sensitivity_matrix(model, phi1_rad: float, phi2_rad: float) -> np.ndarray:
-    """``C`` (3, 8) of the exact chain at the errors of ``model`` (a ``TurntableModel``) from
+def pinocchio_sensitivity_matrix(table, error_values, phi1_rad: float, phi2_rad: float):
+    """``C`` (3, 8) of the exact chain of the paper's ``table`` at ``error_values`` from
     Pinocchio's ``computeFrameKinematicRegressor`` (a fixed link's factors are carried to the
     payload frame by the placement between the two)."""
-    pin_model, data = model.pin_model, model.pin_data
-    q = model.joint_vector(phi1_rad, phi2_rad)
+    pin_model = table.pinocchio_model(error_values)
+    data = pin_model.createData()
+    q = table.chain.joint_vector(phi1_rad, phi2_rad)
     pin.forwardKinematics(pin_model, data, q)
     pin.updateFramePlacements(pin_model, data)
-    frame_id = model.payload_frame_id
+    frame_id = pin_model.getFrameId(table.payload_frame)
     regressor = pin.computeFrameKinematicRegressor(pin_model, data, frame_id, pin.LOCAL)
-    dR = model.ideal_pose(phi1_rad, phi2_rad).rotation.T @ data.oMf[frame_id].rotation
+    ideal = table.payload_pose(None, (phi1_rad, phi2_rad))
+    dR = ideal.rotation.T @ data.oMf[frame_id].rotation
     payload = pin_model.frames[frame_id].placement
     out = np.empty((3, len(ANGULAR_ERROR_NAMES)))
     for col, name in enumerate(ANGULAR_ERROR_NAMES):
-        link, twist = _factor_twist(model, name)
-        if model.chain.link(link).is_joint:
+        link, twist = _factor_twist(table, error_values, name)
+        if table.chain.link(link).is_joint:
             block = pin_model.getJointId(link) - 1
             omega = (regressor[:, 6 * block : 6 * block + 6] @ twist)[3:]
         else:
@@ -168,18 +172,16 @@ def pinocchio_sensitivity_matrix(model, phi1_rad: float, phi2_rad: float) -> np.
     return out
 
 
-def sensitivity_matrix_fd(model, phi1_rad: float, phi2_rad: float, step_rad: float = 1e-6):
-    """``C`` (3, 8) by central finite differences of the exact model's orientation error."""
-    base = model.errors.as_array()
+def sensitivity_matrix_fd(table, error_values, phi1_rad, phi2_rad, step_rad: float = 1e-6):
+    """``C`` (3, 8) by central finite differences of the exact chain's orientation error."""
+    base = np.asarray(error_values, dtype=float)
     out = np.empty((3, len(ANGULAR_ERROR_NAMES)))
     for col in range(len(ANGULAR_ERROR_NAMES)):
         sides = []
         for sign in (1.0, -1.0):
             values = base.copy()
             values[col] += sign * step_rad
-            e = model.with_errors(TurntableErrors.from_array(values)).orientation_error(
-                phi1_rad, phi2_rad
-            )
+            e = table.orientation_error(values, (phi1_rad, phi2_rad))
             sides.append(np.array([e.dpsi_rad, e.dtheta_rad, e.dgamma_rad]))
         out[:, col] = (sides[0] - sides[1]) / (2.0 * step_rad)
     return out

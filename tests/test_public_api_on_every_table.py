@@ -303,14 +303,11 @@ def _effect_file(c):
 
 
 NOT_A_TABLE = {
-    # These take the paper's façade object (a TurntableModel, the paper's angles phi1 and phi2),
-    # not a table: scripts of earlier versions; every table has the same through the table's own
-    # calls above (sensitivities(table, axes, error_values=...), OrientationErrorField.from_chain).
+    # These take the paper's angles phi1 and phi2 (a two-joint table under the paper's layout):
+    # every table has the same through the table's own calls above (sensitivities(table, axes,
+    # error_values=...)).
     "allocation.sensitivity.average_sensitivities",
     "allocation.sensitivity.sensitivity_matrix",
-    "model.batch_field.OrientationErrorField.from_model",
-    "model.batch_field.OrientationErrorField.from_error_values",
-    "model.turntable.TurntableModel.placement_chain",
     # A Pinocchio model (not a table), the chain's own constructor, a fit's model.
     "model.chain.ErrorChain.from_pinocchio",
     "model.chain.apply_chain_errors",

@@ -46,8 +46,7 @@ def main(out_dir: Path, fast: bool = False) -> list[Path]:
             )
             render_snapshot(
                 scene,
-                math.radians(30.0),
-                math.radians(45.0),
+                (math.radians(30.0), math.radians(45.0)),
                 shot,
                 width=width,
                 height=height,

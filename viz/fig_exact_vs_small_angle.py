@@ -17,6 +17,7 @@ import numpy as np
 from turntable_pin import OrientationErrorField, TurntableErrors, small_angle_orientation_error
 from turntable_pin.core.resources import models_dir
 from turntable_pin.core.units import ARCSEC_PER_RAD
+from turntable_pin.model.paper_table import paper_table
 
 PHI1_DEG = 30.0
 
@@ -26,7 +27,8 @@ def main(out_dir: Path, fast: bool = False) -> list[Path]:
     phi2_rad = np.radians(np.linspace(0.0, 360.0, 73 if fast else 721))
     scales = np.logspace(0, 3, 7 if fast else 19)
 
-    field = OrientationErrorField.from_error_values(errors.as_array()[None])
+    chain = paper_table().chain
+    field = OrientationErrorField.from_chain(chain, errors.as_array()[None])
     exact = field.angles(np.radians(PHI1_DEG), phi2_rad)[0]  # (N, 3)
     small = small_angle_orientation_error(errors, phi2_rad)  # (N, 3)
     diff_uas = (exact - small) * ARCSEC_PER_RAD * 1e6
@@ -35,7 +37,7 @@ def main(out_dir: Path, fast: bool = False) -> list[Path]:
     grid = np.radians(np.linspace(0.0, 360.0, 25 if fast else 73))
     g1, g2 = (a.ravel() for a in np.meshgrid(grid, grid, indexing="ij"))
     values = scales[:, None] * errors.as_array()[None]
-    exact_all = OrientationErrorField.from_error_values(values).angles(g1, g2)  # (K, N, 3)
+    exact_all = OrientationErrorField.from_chain(chain, values).angles(g1, g2)  # (K, N, 3)
     small_all = small_angle_orientation_error(values[:, None, :], g2[None, :])
     worst_arcsec = np.abs(exact_all - small_all).max(axis=(1, 2)) * ARCSEC_PER_RAD
     largest_error_arcsec = scales * np.abs(errors.angular_array_rad()).max() * ARCSEC_PER_RAD

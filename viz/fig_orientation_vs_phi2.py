@@ -19,23 +19,22 @@ import numpy as np
 from turntable_pin import (
     OrientationErrorField,
     TurntableErrors,
-    TurntableModel,
     small_angle_orientation_error,
 )
 from turntable_pin.core.resources import models_dir
 from turntable_pin.core.units import ARCSEC_PER_RAD
+from turntable_pin.model.paper_table import paper_table
 
 PHI1_DEG = (0.0, 45.0, 90.0)
 
 
 def main(out_dir: Path, fast: bool = False) -> list[Path]:
     errors = TurntableErrors.from_yaml(models_dir() / "examples" / "errors_example.yaml")
-    field = OrientationErrorField.from_model(TurntableModel(errors))
+    field = OrientationErrorField.from_chain(paper_table().chain, errors.as_array()[None])
     phi2_deg = np.linspace(0.0, 360.0, 73 if fast else 721)
     phi2_rad = np.radians(phi2_deg)
     exact = (
-        np.stack([field.angles_on_phi2_grid(np.radians(p), phi2_rad)[0] for p in PHI1_DEG])
-        * ARCSEC_PER_RAD
+        np.stack([field.angles(np.radians(p), phi2_rad)[0].T for p in PHI1_DEG]) * ARCSEC_PER_RAD
     )  # (phi1, 3, M)
     spread_arcsec = np.abs(exact - exact[0]).max()
     small = small_angle_orientation_error(errors, phi2_rad).T * ARCSEC_PER_RAD  # (3, M)

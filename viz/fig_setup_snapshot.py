@@ -24,7 +24,7 @@ def main(out_dir: Path, fast: bool = False) -> list[Path]:
     for phi1_deg, phi2_deg in POSITIONS_DEG[:1] if fast else POSITIONS_DEG:
         out = Path(out_dir) / f"setup_phi1_{phi1_deg:g}_phi2_{phi2_deg:g}.png"
         result = render_snapshot(
-            scene, np.radians(phi1_deg), np.radians(phi2_deg), out, width=width, height=height
+            scene, np.radians([phi1_deg, phi2_deg]), out, width=width, height=height
         )
         print(f"wrote {out} ({result.scene_seconds + result.browser_seconds:.1f} s)")
         written.append(out)

@@ -1,18 +1,12 @@
 """turntable-pin: error analysis, error allocation and measurement diagnosis of two-axis turntables.
 
-The turntable is a URDF whose joint placements carry its errors; Pinocchio computes the payload
-orientation and the orientation error ``dR = Rd^T Rt``. Angles are radians and lengths metres inside
-the package; names carry the unit where it is not radians.
-
-The public API below is what a user scripts with, layer by layer (the CLI uses the same calls):
-the error model (``TurntableErrors``, ``TurntableModel``, ``OrientationErrorField``), the GyroWheel
-calibration layer (``GyroWheelModel``, ``PositionSet``, ``calibrate_run``, ``rate_error``,
-``orientation_requirement``), the allocation layer (``allocate_tolerances``,
-``average_sensitivities``, ``run_monte_carlo``), the measurement layer (``read_measurements``,
-``simulate_measurements``, ``fit_orientation``, ``diagnose_measurements``, ``write_report``) and the
-viewer (``SetupScene``, ``render_snapshot``). Everything else lives in its module.
+The turntable is a URDF whose joint placements carry its errors; Pinocchio computes the orientation
+error ``dR = Rd^T Rt``. Inside, angles are radians and lengths metres; names carry other units.
+Below is the public API a user scripts with, layer by layer (the CLI makes the same calls);
+everything else lives in its module.
 """
 
+from importlib import metadata
 from typing import TYPE_CHECKING
 
 from .core.lazy import lazy_exports
@@ -35,7 +29,7 @@ _EXPORTS = {
     "ManufacturingCapability": "allocation.capability",
     "ModelError": "core.exceptions",
     "MonteCarloResult": "allocation.monte_carlo",
-    "OrientationError": "model.turntable",
+    "OrientationError": "model.generic_table",
     "OrientationErrorField": "model.batch_field",
     "OrientationFit": "measurement.fit",
     "OrientationLimits": "allocation.solver",
@@ -48,7 +42,6 @@ _EXPORTS = {
     "SetupScene": "viewer.scene",
     "SimulatedMeasurements": "measurement.simulation",
     "TurntableErrors": "model.errors",
-    "TurntableModel": "model.turntable",
     "TurntablePinError": "core.exceptions",
     "UserCodeError": "core.exceptions",
     "YourdfpyTurntable": "model.urdf_io",
@@ -83,8 +76,6 @@ __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 def _version() -> str:
     """The installed distribution's version (one version: ``pyproject.toml``'s, read from the
     metadata at run time)."""
-    from importlib import metadata
-
     try:
         return metadata.version("turntable-pin")
     except metadata.PackageNotFoundError:  # a source tree on the path, not installed
@@ -130,8 +121,8 @@ if TYPE_CHECKING:  # names for static checkers; nothing is imported at run time
     from .measurement.simulation import SimulatedMeasurements, simulate_measurements  # noqa: F401
     from .model.batch_field import OrientationErrorField  # noqa: F401
     from .model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES, TurntableErrors  # noqa: F401
+    from .model.generic_table import OrientationError  # noqa: F401
     from .model.small_angle import small_angle_matrix, small_angle_orientation_error  # noqa: F401
-    from .model.turntable import OrientationError, TurntableModel  # noqa: F401
     from .model.urdf_io import YourdfpyTurntable  # noqa: F401
     from .report.allocation_figures import plot_monte_carlo, plot_sensitivities  # noqa: F401
     from .report.html_report import write_report  # noqa: F401

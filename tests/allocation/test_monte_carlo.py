@@ -8,7 +8,7 @@ import pytest
 
 from conftest import REPO_DIR
 from rounding import chain_rounding, error_factors
-from turntable_pin import TurntableErrors, TurntableModel
+from turntable_pin import TurntableErrors
 from turntable_pin.allocation import monte_carlo as mc
 from turntable_pin.allocation.capability import ManufacturingCapability
 from turntable_pin.allocation.monte_carlo import (
@@ -26,6 +26,7 @@ from turntable_pin.model.angles import ANGLE_ENTRIES
 from turntable_pin.model.chain import compose_rotation
 from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
 from turntable_pin.model.generic_table import GenericTable
+from turntable_pin.model.paper_table import paper_table
 from turntable_pin.report.allocation_figures import plot_monte_carlo
 
 
@@ -83,7 +84,7 @@ def test_samples_lie_in_the_box_with_both_signs(allocation):
 
 
 def test_worst_values_match_pinocchio_directly(allocation):
-    """Re-draw the first turntables and evaluate them with TurntableModel on the same grid."""
+    """Re-draw the first turntables and evaluate them with Pinocchio on the same grid."""
     result = run(allocation, n=4, seed=9, grid_step_deg=10.0)
     seq = np.random.SeedSequence(9).spawn(1)[0]
     values = sample_errors(
@@ -91,14 +92,15 @@ def test_worst_values_match_pinocchio_directly(allocation):
         allocation.capability.lower_bounds_rad,
     )  # fmt: skip
     grid = np.radians(np.arange(0.0, 360.0, 10.0))
-    rounding_of_dr = chain_rounding(error_factors(TurntableModel().table))
+    table = paper_table()
+    rounding_of_dr = chain_rounding(error_factors(table))
     for k in range(4):
-        model = TurntableModel(TurntableErrors.from_array(values[k]))
+        errors = TurntableErrors.from_array(values[k]).as_array()
         phi1 = 1.234  # any phi1: it drops out
         angles = np.array(
             [
                 [e.dpsi_rad, e.dtheta_rad, e.dgamma_rad]
-                for e in (model.orientation_error(phi1, p) for p in grid)
+                for e in (table.orientation_error(errors, (phi1, p)) for p in grid)
             ]
         )
         # Both form dR of the chain's 12 rotations (the expansion sums the same products) and read
@@ -252,7 +254,7 @@ def _redraw(chain, names, n, chunk_size, seed, upper, lower) -> np.ndarray:
 def test_paper_tables_over_several_chunks_equal_their_exact_chain(allocation, workers):
     """Every table of three chunks against its chain composed on the full phi1 x phi2 grid:
     the phi2 grid at phi1 = 0 alone gives the same maxima to 1e-12 rad."""
-    chain = TurntableModel().chain
+    chain = paper_table().chain
     upper, lower = allocation.upper_bounds_rad, allocation.capability.lower_bounds_rad
     result = run_chain_monte_carlo(
         chain, ANGULAR_ERROR_NAMES, upper, allocation.limits, 61, 3, grid_steps_deg=(30.0, 5.0),
@@ -299,7 +301,7 @@ def test_the_paper_run_is_the_run_of_the_papers_chain(allocation):
     upper, lower = allocation.upper_bounds_rad, allocation.capability.lower_bounds_rad
     paper = run(allocation, n=300, seed=4, grid_step_deg=2.0)
     chain = run_chain_monte_carlo(
-        TurntableModel().chain, ANGULAR_ERROR_NAMES, upper, allocation.limits, 300, 4,
+        paper_table().chain, ANGULAR_ERROR_NAMES, upper, allocation.limits, 300, 4,
         grid_steps_deg=(10.0, 2.0), lower_bounds_rad=lower, progress=False,
     )  # fmt: skip
     np.testing.assert_array_equal(paper.worst_rad, chain.worst_rad)

@@ -7,7 +7,7 @@ import pytest
 from allocation_reference import pinocchio_sensitivity_matrix, sensitivity_matrix_fd
 from conftest import PAPER_TO_GENERIC, REPO_DIR, random_errors
 from rounding import chain_rounding, error_factors
-from turntable_pin import TurntableErrors, TurntableModel, small_angle_matrix
+from turntable_pin import TurntableErrors, small_angle_matrix
 from turntable_pin.allocation.sensitivity import (
     average_sensitivities,
     sensitivities,
@@ -16,6 +16,7 @@ from turntable_pin.allocation.sensitivity import (
 from turntable_pin.core.turn_grid import every_combination, full_turn_grid_deg
 from turntable_pin.model.angles import ANGLE_ENTRIES
 from turntable_pin.model.generic_table import GenericTable
+from turntable_pin.model.paper_table import paper_table
 from turntable_pin.report.allocation_figures import plot_sensitivities
 
 MODELS = REPO_DIR / "models"
@@ -31,33 +32,35 @@ OTHER_TABLES = [
 def test_analytic_matches_central_differences_at_large_errors(rng):
     # Errors of ~0.5 degree make the second-order terms visible, so agreement is not trivial.
     for _ in range(4):
-        model = TurntableModel(random_errors(rng, scale_arcsec=2000.0))
+        values = random_errors(rng, scale_arcsec=2000.0).as_array()
         phi1, phi2 = rng.uniform(0, 2 * np.pi, 2)
-        analytic = sensitivity_matrix(model, phi1, phi2)
-        fd = sensitivity_matrix_fd(model, phi1, phi2, step_rad=1e-6)
+        analytic = sensitivity_matrix(values, phi1, phi2)
+        fd = sensitivity_matrix_fd(paper_table(), values, phi1, phi2, step_rad=1e-6)
         np.testing.assert_allclose(analytic, fd, atol=1e-9)
         # and it differs from the first-order model by the size of the errors
         assert np.abs(analytic - small_angle_matrix(phi2)).max() > 1e-4
 
 
 def test_analytic_at_zero_errors_is_the_small_angle_matrix(rng):
-    model = TurntableModel()
     # The chain's products against one rotation's sines and cosines: both round absolutely.
-    rounding = chain_rounding(error_factors(model.table)) + chain_rounding(1)
+    rounding = chain_rounding(error_factors(paper_table())) + chain_rounding(1)
     for phi1, phi2 in rng.uniform(0, 2 * np.pi, (5, 2)):
         np.testing.assert_allclose(
-            sensitivity_matrix(model, phi1, phi2), small_angle_matrix(phi2), rtol=0, atol=rounding
-        )
+            sensitivity_matrix(np.zeros(9), phi1, phi2), small_angle_matrix(phi2), rtol=0,
+            atol=rounding,
+        )  # fmt: skip
 
 
 def test_phi1_drops_out_of_the_orientation_error_and_its_sensitivities(rng):
-    model = TurntableModel(random_errors(rng, scale_arcsec=3000.0))
+    table, values = paper_table(), random_errors(rng, scale_arcsec=3000.0).as_array()
     phi2 = 0.83
-    ref = model.orientation_error(0.0, phi2).dR
-    ref_c = sensitivity_matrix(model, 0.0, phi2)
+    ref = table.orientation_error(values, (0.0, phi2)).dR
+    ref_c = sensitivity_matrix(values, 0.0, phi2)
     for phi1 in rng.uniform(0, 2 * np.pi, 5):
-        np.testing.assert_allclose(model.orientation_error(phi1, phi2).dR, ref, atol=1e-15)
-        np.testing.assert_allclose(sensitivity_matrix(model, phi1, phi2), ref_c, atol=1e-14)
+        np.testing.assert_allclose(
+            table.orientation_error(values, (phi1, phi2)).dR, ref, atol=1e-15
+        )
+        np.testing.assert_allclose(sensitivity_matrix(values, phi1, phi2), ref_c, atol=1e-14)
 
 
 def test_uniform_average_is_two_over_pi_and_one():
@@ -94,7 +97,7 @@ def test_paper_values_appear_with_the_exact_chain_at_large_errors():
         "dphi_y1", "dphi_z2", "dalpha_x1", "dalpha_z1", "dalpha_x2", "dalpha_y2", "deps_x",
         "deps_y")})  # fmt: skip
     grid = PAPER_STYLE_GRID_DEG
-    avg = average_sensitivities(TurntableModel(errors), phi1_grid_deg=grid, phi2_grid_deg=grid)
+    avg = average_sensitivities(errors.as_array(), phi1_grid_deg=grid, phi2_grid_deg=grid)
     assert avg.value("dgamma", "dalpha_x1") == pytest.approx(0.6481, abs=3e-4)
     assert avg.value("dpsi", "dalpha_x1") == pytest.approx(0.5372, abs=6e-4)
     assert 1e-3 < avg.value("dpsi", "dalpha_z1") < 1e-2
@@ -111,11 +114,11 @@ def test_analytic_equals_pinocchios_kinematic_regressor_at_large_errors(rng):
     # Pinocchio's computeFrameKinematicRegressor, each error factor moved to its placement's end
     # by an adjoint: an independent construction of the same derivative.
     for _ in range(4):
-        model = TurntableModel(random_errors(rng, scale_arcsec=2000.0))
+        values = random_errors(rng, scale_arcsec=2000.0).as_array()
         phi1, phi2 = rng.uniform(0, 2 * np.pi, 2)
         np.testing.assert_allclose(
-            sensitivity_matrix(model, phi1, phi2),
-            pinocchio_sensitivity_matrix(model, phi1, phi2),
+            sensitivity_matrix(values, phi1, phi2),
+            pinocchio_sensitivity_matrix(paper_table(), values, phi1, phi2),
             atol=1e-14,
         )
 
@@ -144,15 +147,13 @@ def test_sensitivities_equal_central_differences_of_the_exact_chain(urdf, rng):
 def test_the_paper_table_through_the_generic_sensitivities_equals_its_own(rng):
     from turntable_pin.allocation.sensitivity import sensitivity_matrix
     from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
-    from turntable_pin.model.turntable import TurntableModel
 
     mapping = PAPER_TO_GENERIC
     table = GenericTable(MODELS / "turntable.urdf")
     names = table.angular_names
-    model = TurntableModel()
     for phi1, phi2 in rng.uniform(-np.pi, np.pi, (4, 2)):
         generic = table.regressor([np.array([phi1]), np.array([phi2])])[0]
-        paper = sensitivity_matrix(model, phi1, phi2)
+        paper = sensitivity_matrix(np.zeros(9), phi1, phi2)
         for col, paper_name in enumerate(ANGULAR_ERROR_NAMES):
             column = table.parameter_names.index(mapping[paper_name])
             np.testing.assert_allclose(paper[:, col], generic[:, column], atol=1e-12)
@@ -188,7 +189,7 @@ def test_sensitivities_at_errors_equal_central_differences_of_the_exact_chain(ur
 def test_default_grid_holds_a_joint_the_model_does_not_depend_on():
     """The paper's phi1 drops out (its errors turn with it): the default grid is 360 phi2 values
     at phi1 = 0, the averages of Figure 8's first-order values; other tables use every joint."""
-    paper = sensitivities(TurntableModel().table)
+    paper = sensitivities(paper_table())
     assert paper.grid_step_deg == 1.0 and paper.phi1_grid_deg.tolist() == [0.0]
     np.testing.assert_allclose(paper.phi2_grid_deg, full_turn_grid_deg(1.0)[:, 0], rtol=1e-15)
     np.testing.assert_array_equal(paper.values, average_sensitivities(phi1_grid_deg=[0.0]).values)

@@ -14,6 +14,7 @@ from turntable_pin.calibration.rate_error import (
     rate_error,
     rate_errors_dph,
 )
+from turntable_pin.model.paper_table import paper_table
 
 LAT_RAD = np.radians(45.75)
 GYRO = GyroWheelModel.nominal()
@@ -184,7 +185,7 @@ def test_per_position_rotations_from_a_turntable():
     # dtheta = dphi_z2.
     errors = TurntableErrors.from_arcsec(dphi_z2=40.0)
     inputs = INPUTS["grid:30"]
-    field = OrientationErrorField.from_error_values(errors.as_array()[None])
+    field = OrientationErrorField.from_chain(paper_table().chain, errors.as_array()[None])
     rotations = field.rotation(inputs.positions.phi1_rad, inputs.positions.phi2_rad)
     per_position = rate_errors_dph(GYRO, inputs, rotations)
     constant = rate_error(GYRO, inputs, 0.0, errors.dphi_z2, 0.0, exact=True)

@@ -9,10 +9,11 @@ import pinocchio as pin
 import pytest
 
 from conftest import REPO_DIR, cli
-from turntable_pin import TurntableErrors, TurntableModel
+from turntable_pin import TurntableErrors
 from turntable_pin.cli import main
 from turntable_pin.core.units import ARCSEC_PER_RAD, arcsec_to_rad
 from turntable_pin.model.generic_table import GenericTable
+from turntable_pin.model.paper_table import paper_table
 
 
 def test_orientation_json_matches_the_library():
@@ -23,7 +24,7 @@ def test_orientation_json_matches_the_library():
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
     errors = TurntableErrors.from_arcsec(dphi_y1=3, deps_x=-2, deta_mm=0.2)
-    expected = TurntableModel(errors).orientation_error(np.radians(30), np.radians(45))
+    expected = paper_table().orientation_error(errors.as_array(), np.radians([30, 45]))
     for key in ("dR", "dpsi_arcsec", "dtheta_arcsec", "dgamma_arcsec", "payload_origin_mm"):
         assert key in out
     np.testing.assert_allclose(out["dR"], expected.dR, atol=1e-15)
@@ -48,7 +49,7 @@ def test_urdf_command_writes_a_model_pinocchio_reads(tmp_path):
     q = np.array([0.4, 1.1])
     pin.framesForwardKinematics(model, data, q)
     errors = TurntableErrors.from_arcsec(dalpha_x2=5, deps_y=-7)
-    expected = TurntableModel(errors).payload_pose(*q)
+    expected = paper_table().payload_pose(errors.as_array(), q)
     np.testing.assert_allclose(
         data.oMf[model.getFrameId("gyrowheel")].rotation, expected.rotation, atol=1e-12
     )

@@ -8,6 +8,7 @@ from rounding import chain_rounding, error_factors
 from turntable_pin import OrientationErrorField, small_angle_orientation_error
 from turntable_pin.measurement.effect_model import OrientationModel
 from turntable_pin.measurement.effects import EFFECTS, PositionVariables
+from turntable_pin.model.paper_table import paper_table
 
 
 def _grid_variables(seed=0, n=60):
@@ -24,7 +25,8 @@ def test_base_model_equals_the_batch_path(seed):
     rng = np.random.default_rng(seed)
     v = _grid_variables(seed)
     errors = rng.normal(0, 1e-3, 8)  # large: the exact chain, not its small-angle form
-    expected = OrientationErrorField.from_error_values(np.append(errors, 0.0)[None]).angles(
+    values = np.append(errors, 0.0)[None]
+    expected = OrientationErrorField.from_chain(paper_table().chain, values).angles(
         v.phi1_rad, v.phi2_rad
     )[0]
     np.testing.assert_allclose(OrientationModel(v).predict(errors), expected, atol=1e-15)

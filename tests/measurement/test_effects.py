@@ -1,7 +1,7 @@
 """The effect catalogue: names of the spec, complete stories, and chain changes as the spec defines.
 
 Each effect's prediction is checked against an independent construction: Pinocchio forward
-kinematics of a TurntableModel per position (errors replaced as the spec says) and the spec's
+kinematics of the paper's table per position (errors replaced as the spec says) and the spec's
 extra rotation matrices multiplied explicitly.
 """
 
@@ -9,12 +9,13 @@ import numpy as np
 import pytest
 
 import spec_reference as ref
-from turntable_pin import TurntableErrors, TurntableModel
+from turntable_pin import TurntableErrors
 from turntable_pin.core.exceptions import InputError
 from turntable_pin.core.rotations import rot_x, rot_y, rot_z
 from turntable_pin.measurement.effect_model import OrientationModel
 from turntable_pin.measurement.effects import EFFECT_NAMES, EFFECTS, PositionVariables, get_effect
 from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
+from turntable_pin.model.paper_table import paper_table
 
 SPEC_NAMES = (
     "outer_encoder_harmonics", "inner_encoder_harmonics", "outer_wobble_harmonics",
@@ -70,9 +71,9 @@ def _independent(effect, v, base, p, i):
         e["dphi_z2"] += p["b2"] * v.dir2[i] / 2
     elif effect == "payload_mount":
         post = rot_z(p["mz"]) @ rot_y(p["my"]) @ rot_x(p["mx"])
-    model = TurntableModel(TurntableErrors(**e))
-    rt = pre @ model.payload_pose(phi1, phi2).rotation @ post
-    rd = model.ideal_pose(phi1, phi2).rotation
+    table = paper_table()
+    rt = pre @ table.payload_pose(TurntableErrors(**e).as_array(), (phi1, phi2)).rotation @ post
+    rd = table.payload_pose(None, (phi1, phi2)).rotation
     dR = rd.T @ rt
     return np.array([dR[0, 2], dR[1, 0], dR[2, 1]])
 

@@ -13,7 +13,7 @@ from turntable_pin.measurement.fit import fit_orientation
 from turntable_pin.measurement.identified import SPLIT_RULE, write_identified_urdf
 from turntable_pin.measurement.simulation import Schedule, simulate_measurements
 from turntable_pin.model.generic_table import GenericTable
-from turntable_pin.model.turntable import TurntableModel
+from turntable_pin.model.paper_table import paper_table
 
 MODELS = REPO_DIR / "models"
 
@@ -45,9 +45,10 @@ def _payload_rotations(urdf, frame: str, q_rad: np.ndarray) -> np.ndarray:
 )  # fmt: skip
 def test_plain_pinocchio_on_the_written_urdf_reproduces_the_fit(tmp_path, urdf, frame):
     path = MODELS / urdf
-    table = TurntableModel(urdf_path=path) if urdf == "turntable.urdf" else GenericTable(path)
+    paper = urdf == "turntable.urdf"
+    table = paper_table(path) if paper else GenericTable(path)
     rng = np.random.default_rng(3)
-    if isinstance(table, GenericTable):
+    if not paper:
         errors = rng.normal(0, 20, len(table.parameter_names)) / ARCSEC_PER_RAD
         schedule = Schedule(45, 45, 90)
     else:

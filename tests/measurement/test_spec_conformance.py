@@ -29,14 +29,15 @@ from turntable_pin.measurement.effects.base import PositionVariables
 from turntable_pin.measurement.fit import fit_orientation
 from turntable_pin.measurement.simulation import Schedule, simulate_measurements
 from turntable_pin.model.batch_field import OrientationErrorField
-from turntable_pin.model.turntable import TurntableModel
+from turntable_pin.model.generic_table import GenericTable
+from turntable_pin.model.paper_table import paper_table
 
 SEEDS = (3, 11)  # the CLI part takes ~10 s; more seeds were tried by hand
 
 
 @pytest.fixture(scope="module")
-def turntable() -> TurntableModel:
-    return TurntableModel()
+def turntable() -> GenericTable:
+    return paper_table()
 
 
 def _positions(rng, n=60):
@@ -106,11 +107,10 @@ def test_pinocchio_model_and_batch_field_match_reference(turntable):
     errors = dict(zip(ref.ERROR_NAMES, rng.uniform(-0.05, 0.05, 8), strict=True))
     expected = ref.reference_angles(phi1, phi2, errors)
     values = np.array([errors[n] for n in ref.ERROR_NAMES] + [3e-3])  # deta: orientation-free
-    field = OrientationErrorField.from_error_values(values[None], turntable)
+    field = OrientationErrorField.from_chain(turntable.chain, values[None])
     np.testing.assert_allclose(field.angles(phi1, phi2)[0], expected, rtol=0, atol=1e-12)
-    model = TurntableModel(TurntableErrors.from_array(values))
     for i in range(phi1.size):
-        err = model.orientation_error(phi1[i], phi2[i])
+        err = turntable.orientation_error(values, (phi1[i], phi2[i]))
         got = [err.dpsi_rad, err.dtheta_rad, err.dgamma_rad]
         np.testing.assert_allclose(got, expected[i], rtol=0, atol=1e-12)
 

@@ -8,19 +8,25 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import REPO_DIR, random_errors
-from turntable_pin import OrientationErrorField, TurntableModel
+from turntable_pin import OrientationErrorField
 from turntable_pin.model import batch_field
 from turntable_pin.model.angles import ANGLE_ENTRIES
-from turntable_pin.model.batch_field import ChainExpansion, joint_dependence, trig_basis
+from turntable_pin.model.batch_field import (
+    ChainExpansion,
+    joint_dependence,
+    max_abs_on_grid,
+    trig_basis,
+)
+from turntable_pin.model.paper_table import paper_table
 
 
 def test_batch_equals_per_call_pinocchio(rng):
     for scale in (10.0, 3000.0):
-        model = TurntableModel(random_errors(rng, scale_arcsec=scale))
-        field = OrientationErrorField.from_model(model)
+        table, values = paper_table(), random_errors(rng, scale_arcsec=scale).as_array()
+        field = OrientationErrorField.from_chain(table.chain, values[None])
         phi1, phi2 = rng.uniform(-20, 20, size=(2, 500))
         per_call = np.array(
-            [model.orientation_error(a, b).dR for a, b in zip(phi1, phi2, strict=True)]
+            [table.orientation_error(values, (a, b)).dR for a, b in zip(phi1, phi2, strict=True)]
         )
         np.testing.assert_allclose(field.rotation(phi1, phi2)[0], per_call, atol=1e-12, rtol=0)
         angles = field.angles(phi1, phi2)[0]
@@ -30,24 +36,24 @@ def test_batch_equals_per_call_pinocchio(rng):
 def test_many_error_sets_equal_their_own_models(rng):
     sets = [random_errors(rng, scale_arcsec=100.0) for _ in range(6)]
     values = np.array([e.as_array() for e in sets])
-    field = OrientationErrorField.from_error_values(values)
+    table = paper_table()
+    field = OrientationErrorField.from_chain(table.chain, values)
     phi1, phi2 = rng.uniform(-7, 7, size=(2, 40))
     angles = field.angles(phi1, phi2)
     grid = np.linspace(0, 2 * np.pi, 17)
-    on_grid = field.angles_on_phi2_grid(0.7, grid)
-    for k, errors in enumerate(sets):
-        model = TurntableModel(errors)
+    on_grid = field.angles(0.7, grid).transpose(0, 2, 1)
+    for k in range(len(sets)):
         np.testing.assert_allclose(
             field.coefficients[k],
-            OrientationErrorField.from_model(model).coefficients[0],
+            OrientationErrorField.from_chain(table.chain, values[k : k + 1]).coefficients[0],
             atol=1e-15,
         )
         for n in range(phi1.size):
-            r = model.orientation_error(phi1[n], phi2[n])
+            r = table.orientation_error(values[k], (phi1[n], phi2[n]))
             np.testing.assert_allclose(
                 angles[k, n], [r.dpsi_rad, r.dtheta_rad, r.dgamma_rad], atol=1e-12, rtol=0
             )
-        r = model.orientation_error(0.7, grid[5])
+        r = table.orientation_error(values[k], (0.7, grid[5]))
         np.testing.assert_allclose(
             on_grid[k, :, 5], [r.dpsi_rad, r.dtheta_rad, r.dgamma_rad], atol=1e-12
         )
@@ -62,7 +68,9 @@ def test_trig_basis_matches_numpy(rng):
 
 
 def test_broadcast_and_shapes(rng):
-    field = OrientationErrorField.from_model(TurntableModel(random_errors(rng)))
+    field = OrientationErrorField.from_chain(
+        paper_table().chain, random_errors(rng).as_array()[None]
+    )
     out = field.angles(0.3, np.linspace(0, 1, 7))
     assert out.shape == (1, 7, 3)
     with pytest.raises(ValueError):
@@ -160,19 +168,19 @@ def test_largest_angles_over_a_grid_equal_the_exact_chain_at_every_point(
     monkeypatch.setattr(batch_field, "_GRID_BLOCK_BYTES", block_bytes)
     table = tables[name]
     sets = rng.uniform(-2e-3, 2e-3, (5, len(table.parameter_names)))
-    field = OrientationErrorField.from_chain(table.chain, sets)
     steps = (40.0, 45.0, 72.0)[: len(table.joint_names)]
     grids = [np.radians(np.arange(0.0, 360.0, s)) + 0.1 * i for i, s in enumerate(steps)]
     for chosen in (grids, [np.array([0.7]), *grids[1:]]):
         mesh = [m.ravel() for m in np.meshgrid(*chosen, indexing="ij")]
         exact = np.stack([table.rotation_error(values, mesh) for values in sets])
         expected = np.abs(_angle_entries(exact)).max(axis=1)
-        np.testing.assert_allclose(field.max_abs_angles(*chosen), expected, atol=1e-12, rtol=0)
+        largest = max_abs_on_grid(ChainExpansion(table.chain).coefficients(sets), chosen)
+        np.testing.assert_allclose(largest, expected, atol=1e-12, rtol=0)
 
 
 def test_the_paper_tables_outer_angle_drops_out_and_no_generic_joint_does(tables, rng):
     """With the errors of Table 2 dR does not depend on phi1: its harmonics are zero."""
-    paper = TurntableModel().chain
+    paper = paper_table().chain
     values = np.append(rng.uniform(-1e-3, 1e-3, (50, 8)), np.zeros((50, 1)), axis=1)
     dependence = joint_dependence(ChainExpansion(paper).coefficients(values), 2)
     assert dependence[0] < 1e-15

@@ -11,14 +11,14 @@ from hypothesis import strategies as st
 
 from allocation_reference import sensitivity_matrix_fd
 from conftest import random_errors
-from turntable_pin import OrientationErrorField, TurntableErrors, TurntableModel
+from turntable_pin import OrientationErrorField, TurntableErrors
 from turntable_pin.allocation.sensitivity import sensitivity_matrix
 from turntable_pin.core.exceptions import ModelError
 from turntable_pin.measurement.effect_model import OrientationModel
 from turntable_pin.measurement.effects.base import PositionVariables
 from turntable_pin.model.chain import ErrorChain
 from turntable_pin.model.errors import ERROR_NAMES
-from turntable_pin.model.paper_table import PLACEMENT_ERROR_FACTORS
+from turntable_pin.model.paper_table import PLACEMENT_ERROR_FACTORS, paper_table
 
 # A two-axis table whose URDF origins are not the identity: an offset, tilted outer bearing, an
 # inner joint placed off the outer axis, and a payload mount with a rotation and an offset, then a
@@ -91,7 +91,7 @@ def offset_urdf(tmp_path_factory) -> Path:
 
 
 def test_chain_links_follow_the_urdf(offset_urdf):
-    chain = TurntableModel(urdf_path=offset_urdf).chain
+    chain = paper_table(offset_urdf).chain
     assert [link.name for link in chain.links] == [
         "outer_axis", "inner_axis", "payload_mount", "sensor_offset", "gyrowheel",
     ]  # fmt: skip
@@ -120,16 +120,13 @@ def test_every_consumer_of_the_chain_equals_an_independent_numpy_chain(
     path = offset_urdf
     errors = TurntableErrors.from_array([*chi, 0.0])
     expected = independent_dR(errors, phi1, phi2)
-    model = TurntableModel(errors, path)
-    np.testing.assert_allclose(model.orientation_error(phi1, phi2).dR, expected, atol=1e-12)
-    field = OrientationErrorField.from_error_values(errors.as_array()[None], TurntableModel(
-        urdf_path=path))  # fmt: skip
+    table = paper_table(path)
+    dR = table.orientation_error(errors.as_array(), (phi1, phi2)).dR
+    np.testing.assert_allclose(dR, expected, atol=1e-12)
+    field = OrientationErrorField.from_chain(table.chain, errors.as_array()[None])
     np.testing.assert_allclose(field.rotation(phi1, phi2)[0, 0], expected, atol=1e-12)
-    np.testing.assert_allclose(
-        OrientationErrorField.from_model(model).rotation(phi1, phi2)[0, 0], expected, atol=1e-12
-    )
     fit_model = OrientationModel(
-        PositionVariables.of(np.array([phi1]), np.array([phi2])), (), TurntableModel(urdf_path=path)
+        PositionVariables.of(np.array([phi1]), np.array([phi2])), (), table
     )
     np.testing.assert_allclose(
         fit_model.rotation_error(errors.angular_array_rad())[0], expected, atol=1e-12
@@ -137,24 +134,24 @@ def test_every_consumer_of_the_chain_equals_an_independent_numpy_chain(
 
 
 def test_sensitivities_on_the_offset_table_match_finite_differences(offset_urdf, rng):
-    model = TurntableModel(random_errors(rng, 200.0), offset_urdf)
+    table, values = paper_table(offset_urdf), random_errors(rng, 200.0).as_array()
     for phi1, phi2 in rng.uniform(-np.pi, np.pi, size=(4, 2)):
         np.testing.assert_allclose(
-            sensitivity_matrix(model, phi1, phi2),
-            sensitivity_matrix_fd(model, phi1, phi2),
+            sensitivity_matrix(values, phi1, phi2, table),
+            sensitivity_matrix_fd(table, values, phi1, phi2),
             atol=1e-8,
         )
 
 
 def test_written_urdf_reproduces_the_chain_in_plain_pinocchio(offset_urdf, tmp_path, rng):
     errors = random_errors(rng, 50.0)
-    model = TurntableModel(errors, offset_urdf)
-    written = model.write_urdf(tmp_path / "with_errors.urdf")
+    table = paper_table(offset_urdf)
+    written = table.write_urdf(errors.as_array(), tmp_path / "with_errors.urdf")
     plain = pin.buildModelFromUrdf(str(written))
     nominal = pin.buildModelFromUrdf(str(offset_urdf))
     frame = plain.getFrameId("gyrowheel")
     for phi1, phi2 in rng.uniform(-np.pi, np.pi, size=(5, 2)):
-        q = model.joint_vector(phi1, phi2)
+        q = table.chain.joint_vector(phi1, phi2)
         rotations = []
         for m in (plain, nominal):
             data = m.createData()
@@ -166,7 +163,7 @@ def test_written_urdf_reproduces_the_chain_in_plain_pinocchio(offset_urdf, tmp_p
 
 
 def test_error_transforms_of_many_sets_equal_one_by_one(rng):
-    chain = TurntableModel().chain
+    chain = paper_table().chain
     sets = np.stack([random_errors(rng).as_array() for _ in range(5)])
     many = chain.error_transforms(sets)
     for k in range(5):
@@ -176,7 +173,7 @@ def test_error_transforms_of_many_sets_equal_one_by_one(rng):
 
 
 def test_chain_refuses_factors_off_the_chain_and_unknown_frames():
-    nominal = TurntableModel().nominal_pin_model
+    nominal = paper_table().nominal_pin_model
     with pytest.raises(ModelError, match="not on the chain"):
         ErrorChain.from_pinocchio(nominal, "gyrowheel", {"no_joint": ()}, ERROR_NAMES)
     with pytest.raises(ModelError, match="no frame 'nowhere'"):

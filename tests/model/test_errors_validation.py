@@ -74,4 +74,4 @@ def test_valid_files_read_as_before(tmp_path):
     path.write_text("errors:\n  dphi_y1_arcsec: 3.0\n  deta_mm: 0.2\n")
     assert TurntableErrors.from_yaml(path) == TurntableErrors.from_arcsec(dphi_y1=3.0, deta_mm=0.2)
     path.write_text("errors:\n")
-    assert TurntableErrors.from_yaml(path) == TurntableErrors.zero()
+    assert TurntableErrors.from_yaml(path) == TurntableErrors()

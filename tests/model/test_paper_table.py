@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from conftest import REPO_DIR, random_errors
 from spec_reference import Rx, Ry, Rz
-from turntable_pin import TurntableErrors, TurntableModel
+from turntable_pin import TurntableErrors
 from turntable_pin.core.exceptions import ModelError
 from turntable_pin.model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES
 from turntable_pin.model.generic_table import GenericTable
@@ -39,7 +39,6 @@ def test_the_paper_table_is_the_generic_table_under_the_paper_layout():
     assert table.joint_names == ("outer_axis", "inner_axis")
     assert table.label == "paper"
     assert paper_table() is table  # read once per process
-    assert TurntableModel().table is table
 
 
 @settings(max_examples=40, deadline=None)
@@ -51,10 +50,8 @@ def test_pinocchio_numpy_chain_and_table3_agree(phi1, phi2, seed):
     expected = by_hand.T @ _table3_rotation(errors, phi1, phi2)
     pinocchio = table.orientation_error(errors.as_array(), (phi1, phi2)).dR
     numpy_chain = table.rotation_error(errors.as_array(), (phi1, phi2))
-    facade = TurntableModel(errors).orientation_error(phi1, phi2).dR
     np.testing.assert_allclose(pinocchio, expected, atol=1e-12)
     np.testing.assert_allclose(numpy_chain, expected, atol=1e-12)
-    np.testing.assert_array_equal(facade, pinocchio)
 
 
 def test_the_regressor_on_the_paper_table_is_eq_26():
@@ -79,19 +76,6 @@ def test_urdfs_get_the_paper_names_only_with_the_paper_joints():
 def test_a_layout_on_a_urdf_without_its_joints_is_refused_naming_both():
     with pytest.raises(ModelError, match="written for joints outer_axis, inner_axis.*has"):
         GenericTable(MODELS / "three_axis_imu_table.urdf", "imu", layout=PAPER_LAYOUT)
-
-
-def test_the_facade_has_no_state_of_its_own_beyond_the_error_set(tmp_path):
-    errors = TurntableErrors.from_arcsec(dphi_y1=3.0, deps_x=-2.0, deta_mm=0.2)
-    model = TurntableModel(errors)
-    values = errors.as_array()
-    np.testing.assert_array_equal(
-        model.payload_pose(0.3, 1.1).homogeneous,
-        model.table.payload_pose(values, (0.3, 1.1)).homogeneous,
-    )
-    written = model.write_urdf(tmp_path / "t.urdf")
-    again = model.table.write_urdf(values, tmp_path / "u.urdf")
-    assert written.read_text() == again.read_text()
 
 
 def test_yourdfpy_checks_any_table_independently(tmp_path):

@@ -1,4 +1,4 @@
-"""Pinocchio forward kinematics of the error model against independent computations."""
+"""Pinocchio forward kinematics of the paper's table against independent computations."""
 
 import numpy as np
 import pinocchio as pin
@@ -7,7 +7,8 @@ from hypothesis import strategies as st
 
 from conftest import random_errors
 from spec_reference import Rx, Ry, Rz
-from turntable_pin import ANGULAR_ERROR_NAMES, TurntableErrors, TurntableModel, YourdfpyTurntable
+from turntable_pin import ANGULAR_ERROR_NAMES, TurntableErrors, YourdfpyTurntable
+from turntable_pin.model.paper_table import paper_table
 from turntable_pin.model.small_angle import small_angle_matrix, small_angle_orientation_error
 
 
@@ -30,7 +31,7 @@ error = st.floats(-1e-2, 1e-2)
 @given(st.lists(error, min_size=8, max_size=8), st.floats(-1e-3, 1e-3), angle, angle)
 def test_pinocchio_equals_table3_product(chi, deta, phi1, phi2):
     errors = TurntableErrors.from_array([*chi, deta])
-    result = TurntableModel(errors).orientation_error(phi1, phi2)
+    result = paper_table().orientation_error(errors.as_array(), (phi1, phi2))
     np.testing.assert_allclose(result.dR, table3_chain(errors, phi1, phi2), rtol=0, atol=1e-12)
     assert result.dpsi_rad == result.dR[0, 2]
     assert result.dtheta_rad == result.dR[1, 0]
@@ -38,9 +39,9 @@ def test_pinocchio_equals_table3_product(chi, deta, phi1, phi2):
 
 
 def test_zero_errors_give_identity_exactly(rng):
-    model = TurntableModel()
+    table = paper_table()
     for phi1, phi2 in rng.uniform(-10, 10, size=(50, 2)):
-        result = model.orientation_error(phi1, phi2)
+        result = table.orientation_error(np.zeros(9), (phi1, phi2))
         # Rd and Rt come from the same products; with identity placements they agree bit for bit.
         np.testing.assert_array_equal(result.dR @ np.eye(3), result.dR)
         assert np.abs(result.dR - np.eye(3)).max() <= 4 * np.finfo(float).eps
@@ -50,9 +51,10 @@ def test_zero_errors_give_identity_exactly(rng):
 def test_deta_moves_the_origin_and_not_the_orientation(rng):
     base = random_errors(rng)
     shifted = TurntableErrors.from_array(base.as_array() + np.r_[np.zeros(8), 3e-4])
-    a, b = TurntableModel(base), TurntableModel(shifted)
+    table = paper_table()
     for phi1, phi2 in rng.uniform(-4, 4, size=(20, 2)):
-        ra, rb = a.orientation_error(phi1, phi2), b.orientation_error(phi1, phi2)
+        ra = table.orientation_error(base.as_array(), (phi1, phi2))
+        rb = table.orientation_error(shifted.as_array(), (phi1, phi2))
         np.testing.assert_allclose(ra.dR, rb.dR, atol=1e-15)
         moved = np.linalg.norm(rb.payload_origin_m - ra.payload_origin_m)
         assert abs(moved - 3e-4) < 1e-12  # a rigid translation of length 3e-4 m
@@ -60,9 +62,10 @@ def test_deta_moves_the_origin_and_not_the_orientation(rng):
 
 def test_only_deta_moves_the_origin(rng):
     no_deta = TurntableErrors.from_array(np.r_[random_errors(rng).angular_array_rad(), 0.0])
-    model = TurntableModel(no_deta)
+    table = paper_table()
     for phi1, phi2 in rng.uniform(-4, 4, size=(10, 2)):
-        assert np.abs(model.orientation_error(phi1, phi2).payload_origin_m).max() < 1e-15
+        origin = table.orientation_error(no_deta.as_array(), (phi1, phi2)).payload_origin_m
+        assert np.abs(origin).max() < 1e-15
 
 
 def test_small_angle_is_second_order(rng):
@@ -71,10 +74,9 @@ def test_small_angle_is_second_order(rng):
     phis = rng.uniform(-np.pi, np.pi, size=(20, 2))
 
     def gap(e):
-        model = TurntableModel(e)
         out = []
         for phi1, phi2 in phis:
-            r = model.orientation_error(phi1, phi2)
+            r = paper_table().orientation_error(e.as_array(), (phi1, phi2))
             exact = np.array([r.dpsi_rad, r.dtheta_rad, r.dgamma_rad])
             out.append(exact - small_angle_orientation_error(e, phi2))
         return np.array(out)
@@ -90,14 +92,14 @@ def test_small_angle_is_second_order(rng):
 def test_written_urdf_reloads_in_pinocchio_and_yourdfpy(tmp_path, rng):
     for _ in range(3):
         errors = random_errors(rng, scale_arcsec=500.0)
-        model = TurntableModel(errors)
-        path = model.write_urdf(tmp_path / "with_errors.urdf")
+        table = paper_table()
+        path = table.write_urdf(errors.as_array(), tmp_path / "with_errors.urdf")
         plain = pin.buildModelFromUrdf(str(path))
         data = plain.createData()
         frame = plain.getFrameId("gyrowheel")
         other = YourdfpyTurntable(path)
         for phi1, phi2 in rng.uniform(-7, 7, size=(10, 2)):
-            expected = model.orientation_error(phi1, phi2)
+            expected = table.orientation_error(errors.as_array(), (phi1, phi2))
             pin.framesForwardKinematics(plain, data, np.array([phi1, phi2]))
             rd = Ry(phi1) @ Rz(phi2)
             np.testing.assert_allclose(rd.T @ data.oMf[frame].rotation, expected.dR, atol=1e-12)
@@ -117,9 +119,9 @@ def test_write_refuses_to_overwrite_the_nominal(tmp_path):
     copy = tmp_path / "t.urdf"
     shutil.copy(default_urdf_path(), copy)
     before = copy.read_bytes()
-    model = TurntableModel(TurntableErrors.from_arcsec(dphi_y1=1), urdf_path=copy)
+    errors = TurntableErrors.from_arcsec(dphi_y1=1)
     try:
-        model.write_urdf(copy)
+        paper_table(copy).write_urdf(errors.as_array(), copy)
     except InputError as exc:
         assert "refusing to overwrite" in str(exc)
     else:
@@ -133,8 +135,12 @@ def test_central_differences_of_the_exact_chain_give_eq26(rng):
     for phi1, phi2 in rng.uniform(-4, 4, size=(5, 2)):
         columns = []
         for name in ANGULAR_ERROR_NAMES:
-            plus = TurntableModel(TurntableErrors(**{name: h})).orientation_error(phi1, phi2)
-            minus = TurntableModel(TurntableErrors(**{name: -h})).orientation_error(phi1, phi2)
+            plus, minus = (
+                paper_table().orientation_error(
+                    TurntableErrors(**{name: d}).as_array(), (phi1, phi2)
+                )
+                for d in (h, -h)
+            )
             columns.append(
                 [(getattr(plus, a) - getattr(minus, a)) / (2 * h)
                  for a in ("dpsi_rad", "dtheta_rad", "dgamma_rad")]

@@ -17,12 +17,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import REPO_DIR, assert_triads_at, meshcat_transforms, needs_chromium
-from turntable_pin import InputError, TurntableErrors, TurntableModel
+from turntable_pin import InputError, TurntableErrors
 from turntable_pin.core.rotations import rot_x, rot_y, rot_z
 from turntable_pin.core.units import arcsec_to_rad
 from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
 from turntable_pin.model.generic_table import GenericTable
-from turntable_pin.model.paper_table import INNER_JOINT, OUTER_JOINT
+from turntable_pin.model.paper_table import INNER_JOINT, OUTER_JOINT, paper_table
 from turntable_pin.viewer.scene import (
     DEFAULT_DISPLAY_ANGLE_RAD,
     DEFAULT_DISPLAY_OFFSET_M,
@@ -79,7 +79,7 @@ def test_magnification_of_small_deta_and_of_a_perfect_table():
     tiny = TurntableErrors.from_arcsec(deps_x=4.0, deta_mm=0.001)
     k = Exaggeration.for_errors(tiny)
     assert k.length_factor == pytest.approx(k.angle_factor)  # 2.7 mm: shown with the same factor
-    assert Exaggeration.for_errors(TurntableErrors.zero()) == Exaggeration(1.0, 1.0)
+    assert Exaggeration.for_errors(TurntableErrors()) == Exaggeration(1.0, 1.0)
     only_deta = Exaggeration.for_errors(TurntableErrors.from_arcsec(deta_mm=0.2))
     assert only_deta.angle_factor == 1.0
     assert only_deta.length_factor == pytest.approx(DEFAULT_DISPLAY_OFFSET_M / 2e-4)
@@ -139,7 +139,7 @@ def test_payload_visual_rides_on_the_actual_payload_frame():
 
 def test_legend_reports_the_true_error_angles():
     scene = SetupScene(EXAMPLE)
-    truth = TurntableModel(EXAMPLE).orientation_error(0.5, 0.8)
+    truth = paper_table().orientation_error(EXAMPLE.as_array(), (0.5, 0.8))
     text = "\n".join(scene.legend(0.5, 0.8))
     assert f"dpsi = {truth.dpsi_rad * 206264.80624709636:.2f}" in text
     assert "x2700" in text and "x150" in text

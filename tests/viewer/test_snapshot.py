@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import math
-
 import matplotlib
 
 matplotlib.use("Agg")
@@ -43,9 +41,9 @@ def shots(tmp_path_factory):
     out = tmp_path_factory.mktemp("shots")
     scene = SetupScene(EXAMPLE)
     with ProcessWatch() as watch:
-        first = render_snapshot(scene, math.radians(30), math.radians(45), out / "a.png")
-    again = render_snapshot(scene, math.radians(30), math.radians(45), out / "b.png")
-    other = render_snapshot(scene, math.radians(90), math.radians(0), out / "c.png")
+        first = render_snapshot(scene, np.radians([30, 45]), out / "a.png")
+    again = render_snapshot(scene, np.radians([30, 45]), out / "b.png")
+    other = render_snapshot(scene, np.radians([90, 0]), out / "c.png")
     return {"first": first, "again": again, "other": other, "watch": watch}
 
 
@@ -89,7 +87,7 @@ def test_a_failing_browser_leaves_nothing_and_keeps_the_old_file(tmp_path, monke
     out.write_bytes(b"old")
     monkeypatch.setenv(CHROMIUM_ENV, "false")  # a program that exits at once, writing nothing
     with ProcessWatch() as watch, pytest.raises(BrowserError, match="no screenshot"):
-        render_snapshot(SetupScene(EXAMPLE), 0.0, 0.0, out, width=200, height=150)
+        render_snapshot(SetupScene(EXAMPLE), (0.0, 0.0), out, width=200, height=150)
     assert out.read_bytes() == b"old"
     assert len(watch.server_pids) == 1
     assert watch.survivors() == []
@@ -98,9 +96,9 @@ def test_a_failing_browser_leaves_nothing_and_keeps_the_old_file(tmp_path, monke
 def test_snapshot_refuses_bad_sizes_and_names_before_starting_anything(tmp_path):
     scene = SetupScene(EXAMPLE)
     with pytest.raises(InputError, match="width"):
-        render_snapshot(scene, 0.0, 0.0, tmp_path / "a.png", width=10)
+        render_snapshot(scene, (0.0, 0.0), tmp_path / "a.png", width=10)
     with pytest.raises(InputError, match=r"\.png"):
-        render_snapshot(scene, 0.0, 0.0, tmp_path / "a.jpg")
+        render_snapshot(scene, (0.0, 0.0), tmp_path / "a.jpg")
 
 
 def test_decorated_page_hides_the_controls_and_escapes_the_legend():

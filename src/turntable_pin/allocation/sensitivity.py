@@ -219,22 +219,22 @@ def sensitivities(
     )
 
 
-def average_sensitivities(model=None, phi1_grid_deg=None, phi2_grid_deg=None) -> Sensitivities:
-    """:func:`sensitivities` of the paper's table over every (phi1, phi2) pair of the grids, in
-    degrees (default 4 phi1 and 360 phi2 values per turn), at the errors of ``model`` (a
-    :class:`~turntable_pin.model.turntable.TurntableModel`; default none)."""
+def average_sensitivities(
+    error_values=None, phi1_grid_deg=None, phi2_grid_deg=None, *, table=None
+) -> Sensitivities:
+    """:func:`sensitivities` of the paper's table (or ``table``, two joints) over every (phi1,
+    phi2) pair of the grids, in degrees (default 4 phi1 and 360 phi2 values per turn), at
+    ``error_values`` (the table's order, rad and m; default none)."""
     phi1 = full_turn_grid_deg(90.0)[:, 0] if phi1_grid_deg is None else phi1_grid_deg
     phi2 = full_turn_grid_deg(1.0)[:, 0] if phi2_grid_deg is None else phi2_grid_deg
-    phi1, phi2 = np.asarray(phi1, float), np.asarray(phi2, float)
-    table = resolve_table(model)
-    errors = None if model is None else model.errors.as_array()
-    return sensitivities(table, (phi1 / DEG_PER_RAD, phi2 / DEG_PER_RAD), error_values=errors)
+    angles = (np.asarray(phi1, float) / DEG_PER_RAD, np.asarray(phi2, float) / DEG_PER_RAD)
+    return sensitivities(resolve_table(table), angles, error_values=error_values)
 
 
-def sensitivity_matrix(model, phi1_rad: float, phi2_rad: float) -> np.ndarray:
-    """``C`` (3, 8) of the paper's table at (phi1, phi2) and the errors of ``model`` (a
-    :class:`~turntable_pin.model.turntable.TurntableModel`), exact (the table's regressor)."""
-    table = model.table
+def sensitivity_matrix(error_values, phi1_rad: float, phi2_rad: float, table=None) -> np.ndarray:
+    """``C`` (3, 8) of the paper's table (or ``table``, two joints) at (phi1, phi2) and
+    ``error_values`` (the table's order, rad and m), exact (the table's regressor)."""
+    table = resolve_table(table)
     columns = [table.parameter_names.index(n) for n in table.angular_names]
     angles = (np.array([phi1_rad], float), np.array([phi2_rad], float))
-    return table.regressor(angles, model.errors.as_array())[0][:, columns]
+    return table.regressor(angles, np.asarray(error_values, float))[0][:, columns]

@@ -1,14 +1,10 @@
 """The ``turntable-pin`` command line: thin subcommands over the library.
 
-Each subcommand lives in a module of this package with a ``register(subparsers)`` function; adding
-one is a line in :data:`COMMANDS` (its module and one-line help) and the module. Only the module of
-the command being run is imported (``turntable-pin --help`` imports none), so start-up pays for
-nothing but what the command uses. Every :class:`TurntablePinError` becomes a one-line message on
-stderr and exit status 2, never a traceback (unless ``TURNTABLE_PIN_TRACEBACK=1`` asks for one,
-:mod:`..core.user_code`: for an error inside a Python effect module you wrote); SIGINT and
-SIGTERM (:mod:`..core.interrupts`) end every command within a second with status 130 / 143 and a
-one-line message, leaving no helper process (meshcat server, Chromium, pool workers) and no
-temporary folder behind.
+Each subcommand is a module of this package with a ``register(subparsers)`` function and a line
+in :data:`COMMANDS`; only the module of the command being run is imported (``--help`` imports
+none). Every :class:`TurntablePinError` becomes a one-line message on stderr and exit status 2
+(a traceback only with ``TURNTABLE_PIN_TRACEBACK=1``); SIGINT and SIGTERM end every command within
+a second with status 130 / 143 and one line, leaving no helper process and no temporary folder.
 """
 
 from __future__ import annotations
@@ -125,14 +121,10 @@ def _command(argv: list[str]) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the console script; returns the exit status.
-
-    SIGINT and SIGTERM end every command with status 130 / 143 and a one-line message, after every
-    helper process it started is stopped and every temporary folder removed. Called without
-    ``argv`` (the console script) the handlers stay installed to the end of the process and an
-    interrupted command ends the process at once (``os._exit``, after the cleanup); with ``argv``
-    (from Python) the status is returned and the previous handlers are restored.
-    """
+    """Entry point of the console script; returns the exit status. Without ``argv`` (the
+    console script) an interrupted command ends the process at once after its cleanup
+    (``os._exit``); with ``argv`` (from Python) the status is returned and the previous signal
+    handlers restored."""
     console = argv is None
     restore = None
     command = None

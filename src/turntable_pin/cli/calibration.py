@@ -96,7 +96,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     _add_model_options(q)
     q.add_argument("--plots", type=Path, metavar="DIR", help="write Figures 4 and 5 (PNG) here")
     q.set_defaults(func=run_requirement)
+    _register_calibrate(subparsers)
 
+
+def _register_calibrate(subparsers: argparse._SubParsersAction) -> None:
     c = subparsers.add_parser(
         "calibrate",
         description="Least-squares calibration of a run CSV (one angle column per joint: "

@@ -23,6 +23,7 @@ __all__ = [
     "add_table_options",
     "check_outputs",
     "effect_list",
+    "effect_options",
     "effect_spec",
     "FOLDER_OUTPUTS",
     "NamesFiles",
@@ -56,8 +57,7 @@ def finite_float(text: str) -> float:
 
 
 def one_or_each(text: str, parse, names: tuple[str, ...]):
-    """``text`` as one value (``parse`` of it) or one per name, comma-separated (a tuple), for
-    the argparse types of options such as ``--noise-arcsec``; else an argparse error."""
+    """``text`` as one value (``parse`` of it) or one per name, comma-separated (a tuple)."""
     parts = text.split(",")
     if len(parts) == 1:
         return parse(text)
@@ -139,10 +139,8 @@ def seed(text: str) -> int:
 def bounded_float(
     low: float, high: float, unit: str = "", *, low_open: bool = False, why: str = ""
 ):
-    """argparse type factory: a finite float in ``[low, high]`` (``(low, high]`` if ``low_open``).
-
-    ``unit`` and ``why`` (a few words on the range) go into the message of a refused value.
-    """
+    """argparse type: a finite float in ``[low, high]`` (``(low, high]`` if ``low_open``);
+    ``unit`` and ``why`` (a few words on the range) go into the message of a refused value."""
     left = "(" if low_open else "["
     suffix = f" {unit}" if unit else ""
     reason = f" ({why})" if why else ""
@@ -160,11 +158,8 @@ def bounded_float(
 
 
 def one_line_errors(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
-    """Make ``parser`` report a bad argument in one line (no usage block), exit status 2.
-
-    The line names the option, like every other error of the command line; ``--help`` still
-    shows the usage.
-    """
+    """Make ``parser`` report a bad argument in one line naming the option (no usage block;
+    ``--help`` still shows it), exit status 2."""
 
     def error(message: str):
         parser.exit(2, f"{parser.prog}: error: {one_line(message)} (see {parser.prog} --help)\n")
@@ -174,12 +169,10 @@ def one_line_errors(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
 
 
 def input_path(value: str) -> Path:
-    """A file a command reads (an argparse ``type``): the path as given when something is there;
-    else the bundled file of that name, so that an installed package runs its examples from any
-    folder: ``altaz_mount.urdf`` or ``altaz_mount`` (a bundled table),
-    ``measurements_example.csv`` or ``mmt_pointing/k_and_e.dat`` (a bundled example), or a
-    repository path ``models/...``. A name that is neither is returned as given (the command
-    then says it is missing)."""
+    """argparse type of a file a command reads: the path as given when something is there, else
+    the bundled file of that name (``altaz_mount``, ``measurements_example.csv``,
+    ``mmt_pointing/k_and_e.dat``, ``models/...``), so an installed package runs its examples
+    from any folder; else the name as given (the command then says it is missing)."""
     path = Path(value)
     if path.exists():
         return path
@@ -238,10 +231,8 @@ def add_error_options(parser: argparse.ArgumentParser) -> None:
 
 
 def table_from_args(args: argparse.Namespace):
-    """The table of ``--urdf``/``--payload-frame`` (and ``--mount``, where a command takes it): a
-    :class:`~turntable_pin.model.generic_table.GenericTable` in the paper's names (the bundled
-    table, or a URDF with the paper's joints and payload) or in the generic ones (any other).
-    A telescope mount is checked against the documented frames here, before any work."""
+    """The table of ``--urdf``, ``--payload-frame`` and ``--mount`` (:func:`table_of`); a
+    telescope mount is checked against the documented frames here, before any work."""
     from ..model.paper_table import table_of
 
     table = table_of(args.urdf, getattr(args, "payload_frame", None), getattr(args, "mount", None))
@@ -256,10 +247,8 @@ def error_values_from_args(
     table, args: argparse.Namespace, max_angle_deg: float = MAX_ANGULAR_ERROR_DEG
 ) -> np.ndarray:
     """The error vector (rad, m) of ``--errors FILE.yaml`` overridden entry by entry by
-    ``--error NAME=VALUE``, in the names of ``table`` (the paper's nine on the paper's table,
-    ``<joint>.position``, ... on any other): arc seconds and millimetres unless a unit suffix
-    says otherwise, angles up to ``max_angle_deg``, degrees; each name once among the
-    ``--error`` options."""
+    ``--error NAME=VALUE`` (each name once) in ``table``'s names: arcsec and mm unless a unit
+    suffix says otherwise, angles up to ``max_angle_deg``, degrees."""
     values = (
         table.errors_from_yaml(args.errors, max_angle_deg=max_angle_deg)
         if args.errors
@@ -304,8 +293,8 @@ def _jsonable(value):
 
 
 def warn_ignored_columns(args: argparse.Namespace, data, path) -> None:
-    """One warning line on stderr naming the columns of ``path`` that ``data`` (measurements or
-    a calibration run) left out as not numbers, so that no column is dropped without a word."""
+    """One warning line on stderr naming the columns of ``path`` that ``data`` left out as not
+    numbers: no column is dropped without a word."""
     from ..core.csv_table import ignored_columns_words
 
     if data.ignored_columns:
@@ -326,9 +315,8 @@ FOLDER_OUTPUTS: tuple[str, ...] = ("plots",)
 
 
 class NamesFiles(str):
-    """The text of an option that names input files among other words, as an argparse type
-    returns it: the text itself (a ``str``), with ``input_files`` the files it names (``--effects
-    base_tilt,mine.yaml`` names ``mine.yaml``). :func:`refuse_inputs_as_outputs` reads them."""
+    """An option's text (a ``str``) with ``input_files``, the files it names (``--effects
+    base_tilt,mine.yaml`` names ``mine.yaml``), for :func:`refuse_inputs_as_outputs`."""
 
     input_files: tuple[Path, ...] = ()
 
@@ -340,24 +328,39 @@ class NamesFiles(str):
 
 
 def effect_list(text: str) -> NamesFiles:
-    """argparse type of ``--effects A,B`` and ``--separate A,B``: comma-separated catalogue
-    names, inline terms and effect files (``.yaml``/``.yml``, read as inputs)."""
+    """argparse type of ``--effects A,B``, ``--separate A,B``: names, inline terms, effect files."""
     from ..measurement.user_effects import effect_files_named
 
     return NamesFiles.of(text, effect_files_named(text))
 
 
 def effect_spec(text: str) -> NamesFiles:
-    """argparse type of ``NAME:P=V,...`` (``simulate --effect``, ``design --amplitude``):
-    ``NAME`` may be an effect file (read as an input)."""
+    """argparse type of ``NAME:P=V,...``; ``NAME`` may be an effect file (an input)."""
     from ..measurement.user_effects import effect_files_named
 
     return NamesFiles.of(text, effect_files_named(text.partition(":")[0]))
 
 
+def effect_options(texts, option: str, table, user=()) -> dict[str, dict[str, float]]:
+    """``NAME:P=V,...`` options (``option``) as ``{effect: {parameter: value}}``, each effect at
+    most once; names of ``table``'s catalogue, of the effects ``user`` or inline terms."""
+    from ..measurement.effects import parse_effect_spec
+    from ..measurement.user_effects import resolve_effects
+
+    effects: dict[str, dict[str, float]] = {}
+    for text in texts:
+        try:
+            name, params = parse_effect_spec(text, lambda n: resolve_effects([n], table, user)[0])
+        except InputError as exc:
+            raise InputError(f"{option} '{text}': {exc}") from None
+        if name in effects:
+            raise InputError(f"{option} '{text}': effect '{name}' is given twice")
+        effects[name] = params
+    return effects
+
+
 def position_scheme(text: str) -> NamesFiles:
-    """argparse type of ``--positions SCHEME|FILE.csv``: a scheme starts with ``grid``; anything
-    else is a CSV file of positions (read as an input)."""
+    """argparse type of ``--positions SCHEME|FILE.csv`` (a scheme starts with ``grid``)."""
     spec = text.strip()
     return NamesFiles.of(text, () if spec.startswith("grid") else (Path(spec),))
 
@@ -370,8 +373,8 @@ def _same_path(a: Path, b: Path) -> bool:
 
 
 def _input_paths(args: argparse.Namespace) -> list[tuple[str, Path]]:
-    """``(option, path)`` of every input file of the command: every path option that is no
-    output, and every file named inside an option's text (:class:`NamesFiles`)."""
+    """``(option, path)`` of every input file: path options that are no output, and the files
+    named inside an option's text (:class:`NamesFiles`)."""
     inputs: list[tuple[str, Path]] = []
     for dest, value in vars(args).items():
         if dest in OUTPUT_OPTIONS:
@@ -385,14 +388,8 @@ def _input_paths(args: argparse.Namespace) -> list[tuple[str, Path]]:
 
 
 def refuse_inputs_as_outputs(args: argparse.Namespace) -> None:
-    """Refuse a command whose output path is one of its inputs (every other path option, and the
-    files named inside an option's text such as ``--effects A,mine.yaml``), or another of its
-    outputs.
-
-    An output file may not be an input file (nor the same file under another name: links count);
-    a plots folder may not be an input file either; two outputs may not be one file. Raises
-    :class:`InputError` naming both.
-    """
+    """Refuse an output that is one of the command's inputs (a path option, or a file named in
+    an option's text; links count) or another of its outputs: :class:`InputError` naming both."""
     inputs = _input_paths(args)
     for dest in OUTPUT_OPTIONS:
         output = getattr(args, dest, None)
@@ -419,12 +416,9 @@ def refuse_inputs_as_outputs(args: argparse.Namespace) -> None:
 
 
 def check_outputs(args: argparse.Namespace) -> None:
-    """Check every output of the command before it writes any, so that a refused output never
-    comes after another has replaced what was there: no output is an input or another output
-    (:func:`refuse_inputs_as_outputs`), and each can be written
-    (:func:`~turntable_pin.core.files.output_target`: a folder where a file is expected or the
-    reverse, a parent that is a file, a write-protected file, a folder one may not write in, a
-    link to nothing). Raises :class:`InputError` naming the option."""
+    """Check every output before any is written (a refused output never follows one that
+    replaced a file): none is an input or another output, and each can be written
+    (:func:`~turntable_pin.core.files.output_target`). :class:`InputError` names the option."""
     from ..core.files import output_target
 
     refuse_inputs_as_outputs(args)

@@ -1,10 +1,8 @@
 """``design``: which positions to measure next, to identify, to separate two effects, to calibrate.
 
-The common options say the table (``--urdf``), the joints' limits, the effects, the positions
-already measured (``--from``), how many positions to choose and from how many seeded candidates;
-each mode is one function (``_run_identify``, ``_run_separate``, ``_run_calibrate``) that calls
-the library (:mod:`turntable_pin.design`) and renders its one result as text, JSON, a CSV of the
-positions (``-o``: what ``simulate --positions`` and the test crew read) and figures (``--plots``).
+Each mode is one function (``_run_identify``, ``_run_separate``, ``_run_calibrate``,
+``_run_separate_run``) that calls :mod:`turntable_pin.design` and renders its one result as text,
+JSON, a CSV of the positions (``-o``, what ``simulate --positions`` reads) and figures.
 """
 
 from __future__ import annotations
@@ -19,6 +17,7 @@ from .common import (
     add_table_options,
     bounded_float,
     effect_list,
+    effect_options,
     effect_spec,
     input_path,
     latitude_deg,
@@ -38,9 +37,7 @@ DEFAULT_POSITIONS = 24
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``design`` to ``subparsers``."""
-    from ..calibration.site import DEFAULT_LATITUDE_DEG
-    from ..design.calibrate import DEFAULT_MIN_EFFICIENCY, MAX_MIN_EFFICIENCY
-    from ..design.space import DEFAULT_CANDIDATES, GRID_STEP_DEG
+    from ..design.space import GRID_STEP_DEG
 
     p = subparsers.add_parser(
         "design",
@@ -57,6 +54,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     one_line_errors(p)
     add_table_options(p)
     add_mount_option(p)
+    _add_mode_options(p)
+    _add_design_options(p)
+    _add_output_options(p)
+    p.set_defaults(func=run_design)
+
+
+def _add_mode_options(p: argparse.ArgumentParser) -> None:
+    """``--separate``, ``--calibrate`` and their own options."""
+    from ..design.calibrate import DEFAULT_MIN_EFFICIENCY, MAX_MIN_EFFICIENCY
+
     mode = p.add_mutually_exclusive_group()
     mode.add_argument(
         "--separate",
@@ -89,6 +96,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         f"against the grid of the same N (default {DEFAULT_MIN_EFFICIENCY:g}: at least as "
         "precise as the grid)",
     )  # fmt: skip
+
+
+def _add_design_options(p: argparse.ArgumentParser) -> None:
+    """How many positions, from which candidates, after which data, with which effects."""
+    from ..design.space import DEFAULT_CANDIDATES, GRID_STEP_DEG
+
     p.add_argument(
         "-n",
         "--positions-count",
@@ -157,6 +170,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=60.0,
         help="time per measurement, for the time_s column (default 60)",
     )
+
+
+def _add_output_options(p: argparse.ArgumentParser) -> None:
+    """``-o``, ``--run`` (with its latitude), ``--json`` and ``--plots``."""
+    from ..calibration.site import DEFAULT_LATITUDE_DEG
+
     p.add_argument(
         "-o",
         "--output",
@@ -179,7 +198,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )  # fmt: skip
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plots", type=Path, metavar="DIR", help="write the design's figures here")
-    p.set_defaults(func=run_design)
 
 
 def _noise_arcsec(text: str) -> float:
@@ -295,7 +313,6 @@ def _run_separate(args: argparse.Namespace) -> int:
     amplitude (``--amplitude``, else fitted on ``--from``), with the chance of the right name;
     one line (exit 0) when no positions within the limits separate them."""
     from ..design.separate import design_separate
-    from ..measurement.effects import parse_effect_spec
     from ..measurement.user_effects import load_effects_modules, resolve_effects
     from ..report.separation_figures import write_separate_plots
 
@@ -305,21 +322,8 @@ def _run_separate(args: argparse.Namespace) -> int:
         )
     table = table_from_args(args)
     modules = load_effects_modules(args.effects_module, table)
-    names = [n.strip() for n in args.separate.split(",") if n.strip()]
-    if len(names) != 2:
-        raise InputError(f"--separate takes two effects, A,B; got '{args.separate}'")
-    pair = resolve_effects(names, table, modules)
-    amplitudes: dict[str, dict[str, float]] = {}
-    for text in args.amplitude:
-        try:
-            name, values = parse_effect_spec(
-                text, lambda n: resolve_effects([n], table, modules)[0]
-            )
-        except InputError as exc:
-            raise InputError(f"--amplitude '{text}': {exc}") from None
-        if name in amplitudes:
-            raise InputError(f"--amplitude '{text}': effect '{name}' is given twice")
-        amplitudes[name] = values
+    pair = resolve_effects(_pair(args), table, modules)
+    amplitudes = effect_options(args.amplitude, "--amplitude", table, modules)
     space = _space(args, pair)
     result = design_separate(
         space,
@@ -336,6 +340,14 @@ def _run_separate(args: argparse.Namespace) -> int:
             print(result.report())
         return 0
     return _finish(result, args, write_separate_plots)
+
+
+def _pair(args: argparse.Namespace) -> list[str]:
+    """The two effects of ``--separate A,B``."""
+    names = [n.strip() for n in args.separate.split(",") if n.strip()]
+    if len(names) != 2:
+        raise InputError(f"--separate takes two effects, A,B; got '{args.separate}'")
+    return names
 
 
 def _run_calibrate(args: argparse.Namespace) -> int:
@@ -387,9 +399,7 @@ def _run_separate_run(args: argparse.Namespace) -> int:
                 f"design --separate --run: {option} is for orientation measurements; the run "
                 "gives the amplitudes and the noise"
             )
-    names = [n.strip() for n in args.separate.split(",") if n.strip()]
-    if len(names) != 2:
-        raise InputError(f"--separate takes two effects, A,B; got '{args.separate}'")
+    names = _pair(args)
     space = _space(args, effects=())
     count = _positions_count(args, space)
     run = read_run(args.run, deg_to_rad(args.latitude_deg), space.table)

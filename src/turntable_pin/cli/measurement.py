@@ -18,6 +18,7 @@ from .common import (
     add_table_options,
     bounded_float,
     effect_list,
+    effect_options,
     effect_spec,
     error_values_from_args,
     input_path,
@@ -42,6 +43,12 @@ APPROACHES = ("random", "motion", "positive")
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``simulate``, ``fit``, ``diagnose`` and ``report`` to ``subparsers``."""
+    _register_simulate(subparsers)
+    _register_fit(subparsers)
+    _register_diagnose_and_report(subparsers)
+
+
+def _register_simulate(subparsers: argparse._SubParsersAction) -> None:
     s = subparsers.add_parser(
         "simulate",
         description="Simulate a measurement run (the CSV described in docs/measurements.md): "
@@ -62,6 +69,23 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "e.g. inner_encoder_harmonics:c1=3,s2=-2; repeatable",
     )
     _add_catalogue_option(s)
+    _add_schedule_options(s)
+    s.add_argument("--no-sigma", action="store_true", help="leave out the sigma_arcsec column")
+    s.add_argument(
+        "--hide-truth",
+        action="store_true",
+        help="record only seed, noise and schedule, not the errors and effects (blind rehearsal)",
+    )
+    s.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.csv")
+    _add_run_options(s)
+    s.set_defaults(
+        func=run_simulate,
+        orientation_defaults={d: s.get_default(d) for d in ORIENTATION_ONLY_OPTIONS},
+    )
+
+
+def _add_schedule_options(s: argparse.ArgumentParser) -> None:
+    """The noise and position schedule options of ``simulate``."""
     step = bounded_float(
         MIN_GRID_STEP_DEG, 360.0, "deg", why="a finer grid exceeds every size limit"
     )
@@ -116,19 +140,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     s.add_argument("--approach", choices=APPROACHES, default=None,
                    help="random (default), motion (default with --passes) or positive")  # fmt: skip
-    s.add_argument("--no-sigma", action="store_true", help="leave out the sigma_arcsec column")
-    s.add_argument(
-        "--hide-truth",
-        action="store_true",
-        help="record only seed, noise and schedule, not the errors and effects (blind rehearsal)",
-    )
-    s.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.csv")
-    _add_run_options(s)
-    s.set_defaults(
-        func=run_simulate,
-        orientation_defaults={d: s.get_default(d) for d in ORIENTATION_ONLY_OPTIONS},
-    )
 
+
+def _register_fit(subparsers: argparse._SubParsersAction) -> None:
     f = subparsers.add_parser(
         "fit",
         description="Weighted least squares of the base error model plus the chosen effects; "
@@ -161,6 +175,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     f.add_argument("--k-sigma", type=positive_float, default=3.0, help="failing threshold (> 0)")
     f.set_defaults(func=run_fit)
 
+
+def _register_diagnose_and_report(subparsers: argparse._SubParsersAction) -> None:
     d = subparsers.add_parser(
         "diagnose",
         description="Test every catalogued effect against the base fit (BIC, delta <= -6), "
@@ -345,23 +361,6 @@ def _read(args: argparse.Namespace, table=None):
     return data.without_sigma() if args.ignore_sigma else data
 
 
-def _parse_effect_options(texts: list[str], table=None, user=()) -> dict[str, dict[str, float]]:
-    """The ``--effect`` options as ``{effect: {parameter: value}}``; each effect at most once.
-    Names may be the table's catalogue's, of the effects ``user`` or inline terms."""
-    from ..measurement.user_effects import resolve_effects
-
-    effects: dict[str, dict[str, float]] = {}
-    for text in texts:
-        try:
-            name, params = parse_effect_spec(text, lambda n: resolve_effects([n], table, user)[0])
-        except InputError as exc:
-            raise InputError(f"--effect '{text}': {exc}") from None
-        if name in effects:
-            raise InputError(f"--effect '{text}': effect '{name}' is given twice")
-        effects[name] = params
-    return effects
-
-
 def _option(dest: str) -> str:
     return "--" + dest.replace("_", "-")
 
@@ -383,13 +382,8 @@ def run_simulate_run(args: argparse.Namespace) -> int:
     from ..calibration.positions import PositionSet
     from ..calibration.site import DEFAULT_LATITUDE_DEG
     from ..core.units import deg_to_rad
-    from ..instrument.simulate import (
-        SIMULATED_INSTRUMENT_EFFECTS,
-        TemperatureProfile,
-        random_positions,
-        simulate_calibration_run,
-    )
-    from ..measurement.user_effects import inline_effect, load_catalogue, resolve_effects
+    from ..instrument.simulate import TemperatureProfile, random_positions, simulate_calibration_run
+    from ..measurement.user_effects import inline_effect, load_catalogue
 
     # A default given explicitly changes nothing and passes.
     defaults = args.orientation_defaults
@@ -401,28 +395,7 @@ def run_simulate_run(args: argparse.Namespace) -> int:
         )
     table = table_from_args(args)
     user = load_catalogue(args.catalogue, table)
-    table_effects: dict[str, dict[str, float]] = {}
-    instrument: dict[str, dict[str, float]] = {}
-
-    def resolve(name: str):
-        if name.strip() in SIMULATED_INSTRUMENT_EFFECTS:
-            return SIMULATED_INSTRUMENT_EFFECTS[name.strip()]
-        try:
-            return resolve_effects([name], table, user)[0]
-        except InputError as exc:
-            raise InputError(
-                f"{exc.detail}; instrument effects: {', '.join(SIMULATED_INSTRUMENT_EFFECTS)}"
-            ) from None
-
-    for text in args.effect:
-        try:
-            name, params = parse_effect_spec(text, resolve)
-        except InputError as exc:
-            raise InputError(f"--effect '{text}': {exc.detail}") from None
-        into = instrument if name in SIMULATED_INSTRUMENT_EFFECTS else table_effects
-        if name in into:
-            raise InputError(f"--effect '{text}': effect '{name}' is given twice")
-        into[name] = params
+    table_effects, instrument = _run_effects(args.effect, table, user)
     user = (*user, *(inline_effect(name, table) for name in table_effects if "~" in name))
     if args.random_positions:
         positions = random_positions(args.random_positions, table, args.seed)
@@ -453,54 +426,61 @@ def run_simulate_run(args: argparse.Namespace) -> int:
     path = sim.write_csv(args.output, hide_truth=args.hide_truth, with_sigma=not args.no_sigma)
     print(f"wrote {path}: {sim.n_positions} positions, seed {sim.seed}")
     if args.truth is not None:
-        argv = list(getattr(args, "argv", ()))
-        if "--truth" in argv:  # the truth file is no part of what made the data
-            del argv[argv.index("--truth") : argv.index("--truth") + 2]
-        argv = [a for a in argv if not a.startswith("--truth=")]
-        command = "turntable-pin " + shlex.join(argv) if argv else ""
-        truth = sim.write_truth(args.truth, data=Path(path).name, command=command)
+        truth = sim.write_truth(args.truth, data=Path(path).name, command=_command_line(args))
         print(f"wrote {truth}")
     return 0
 
 
+def _run_effects(texts: list[str], table, user) -> tuple[dict, dict]:
+    """The ``--effect`` options of ``simulate --run``: ``(table effects, instrument effects)``,
+    each ``{effect: {parameter: value}}`` with each effect at most once."""
+    from ..instrument.simulate import SIMULATED_INSTRUMENT_EFFECTS
+    from ..measurement.user_effects import resolve_effects
+
+    table_effects: dict[str, dict[str, float]] = {}
+    instrument: dict[str, dict[str, float]] = {}
+
+    def resolve(name: str):
+        if name.strip() in SIMULATED_INSTRUMENT_EFFECTS:
+            return SIMULATED_INSTRUMENT_EFFECTS[name.strip()]
+        try:
+            return resolve_effects([name], table, user)[0]
+        except InputError as exc:
+            raise InputError(
+                f"{exc.detail}; instrument effects: {', '.join(SIMULATED_INSTRUMENT_EFFECTS)}"
+            ) from None
+
+    for text in texts:
+        try:
+            name, params = parse_effect_spec(text, resolve)
+        except InputError as exc:
+            raise InputError(f"--effect '{text}': {exc.detail}") from None
+        into = instrument if name in SIMULATED_INSTRUMENT_EFFECTS else table_effects
+        if name in into:
+            raise InputError(f"--effect '{text}': effect '{name}' is given twice")
+        into[name] = params
+    return table_effects, instrument
+
+
+def _command_line(args: argparse.Namespace) -> str:
+    """The command that made the data, for the truth file (``--truth`` is no part of it)."""
+    argv = list(getattr(args, "argv", ()))
+    if "--truth" in argv:
+        del argv[argv.index("--truth") : argv.index("--truth") + 2]
+    argv = [a for a in argv if not a.startswith("--truth=")]
+    return "turntable-pin " + shlex.join(argv) if argv else ""
+
+
 def _run_simulate_orientation(args: argparse.Namespace) -> int:
-    from ..measurement.simulation import (
-        MAX_NOISE_ARCSEC,
-        Schedule,
-        read_positions,
-        simulate_measurements,
-    )
+    from ..measurement.simulation import MAX_NOISE_ARCSEC, Schedule, simulate_measurements
     from ..measurement.user_effects import inline_effect, load_catalogue
 
     table = table_from_args(args)
     joints = _generic_joints(table)
     user = load_catalogue(args.catalogue, table)
-    effects = _parse_effect_options(args.effect, table, user)
+    effects = effect_options(args.effect, "--effect", table, user)
     user = (*user, *(inline_effect(name, table) for name in effects if "~" in name))
-    design = {}
-    if args.positions is not None:
-        design = read_positions(args.positions, joints)
-        given = [f"dir{k}" for k, d in enumerate(design["positions_dirs"], start=1) if d]
-        for option, value in (("--repeats", args.repeats > 1), ("--passes", args.passes)):
-            if value and design["positions_time_s"] is not None:
-                raise InputError(
-                    f"{option}: {args.positions} gives time_s, so each of its rows is one "
-                    f"measurement; leave out {option} or the time_s column"
-                )
-        if args.passes and given:
-            raise InputError(
-                f"--passes: {args.positions} gives {given[0]}, but the passes set the approach "
-                f"directions (+1 forward, -1 backward); leave out --passes or the {given[0]} column"
-            )
-    elif args.sweep is not None:
-        design = {"sweep": _sweep_axes(args.sweep, table)}
-    elif args.random_positions:
-        design = {"random_positions": args.random_positions}
-    if design and args.order != "grid":
-        raise InputError(
-            "--order random shuffles a grid; --positions, --sweep and --random-positions are "
-            "measured in their own order"
-        )
+    design = _position_design(args, table, joints)
     if args.noise_spread != 1:
         noise = args.noise_arcsec if isinstance(args.noise_arcsec, tuple) else (args.noise_arcsec,)
         top = max(noise) * args.noise_spread
@@ -540,6 +520,38 @@ def _run_simulate_orientation(args: argparse.Namespace) -> int:
     path = sim.write_csv(args.output, with_sigma=not args.no_sigma, hide_truth=args.hide_truth)
     print(f"wrote {path}: {sim.data.n_positions} positions, seed {sim.seed}")
     return 0
+
+
+def _position_design(args: argparse.Namespace, table, joints) -> dict:
+    """The positions of ``--positions``, ``--sweep`` or ``--random-positions`` as
+    :class:`~turntable_pin.measurement.simulation.Schedule` arguments (``{}``: the grid)."""
+    from ..measurement.simulation import read_positions
+
+    design = {}
+    if args.positions is not None:
+        design = read_positions(args.positions, joints)
+        given = [f"dir{k}" for k, d in enumerate(design["positions_dirs"], start=1) if d]
+        for option, value in (("--repeats", args.repeats > 1), ("--passes", args.passes)):
+            if value and design["positions_time_s"] is not None:
+                raise InputError(
+                    f"{option}: {args.positions} gives time_s, so each of its rows is one "
+                    f"measurement; leave out {option} or the time_s column"
+                )
+        if args.passes and given:
+            raise InputError(
+                f"--passes: {args.positions} gives {given[0]}, but the passes set the approach "
+                f"directions (+1 forward, -1 backward); leave out --passes or the {given[0]} column"
+            )
+    elif args.sweep is not None:
+        design = {"sweep": _sweep_axes(args.sweep, table)}
+    elif args.random_positions:
+        design = {"random_positions": args.random_positions}
+    if design and args.order != "grid":
+        raise InputError(
+            "--order random shuffles a grid; --positions, --sweep and --random-positions are "
+            "measured in their own order"
+        )
+    return design
 
 
 def _angle_list(text: str) -> tuple[str, ...]:

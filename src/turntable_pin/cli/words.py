@@ -13,5 +13,6 @@ CLI_WORDS = CommandLineWords(
         "amplitudes": "--amplitude",
         "from_data": "--from",
         "n_positions": "-n",
+        "outliers=False": "--keep-outliers",
     },
 )

@@ -1,12 +1,9 @@
 """Running a computation with one BLAS thread (OpenBLAS as bundled with numpy and scipy).
 
-The fits and searches of a diagnosis multiply tall, thin matrices (300,000 x 12) by small ones
-and factor many small blocks. OpenBLAS splits each such call over its threads; on a machine whose
-cores are busy with other work, the threads wait for each other and a call took 10 to 20 times
-longer than on one thread (measured on two busy cores: a blocked QR 0.10 s instead of 0.014 s).
-:func:`one_blas_thread` sets every loaded OpenBLAS to one thread for the duration of a ``with``
-block and restores the previous counts after it. Elsewhere than Linux, or with another BLAS, it
-does nothing.
+A diagnosis multiplies tall, thin matrices (300,000 x 12) and factors many small blocks; on busy
+cores OpenBLAS's threads wait for each other and a call took 10 to 20 times longer than on one
+thread (a blocked QR 0.10 s instead of 0.014 s on two busy cores). :func:`one_blas_thread` sets
+every loaded OpenBLAS to one thread for a ``with`` block (Linux; elsewhere it does nothing).
 """
 
 from __future__ import annotations

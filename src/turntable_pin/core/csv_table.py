@@ -1,15 +1,14 @@
 """Reading numeric CSV tables with checks that name the file, row and column of every problem.
 
-Rows are counted as a spreadsheet shows them: the header is row 1, the first data row is row 2.
-Nothing is written; a file that fails a check raises :class:`InputError`. A file is read only
-when it is a regular file of at most :data:`~turntable_pin.core.sizes.MAX_TABLE_FILE_BYTES`
-bytes, and only up to :data:`~turntable_pin.core.sizes.MAX_TABLE_ROWS` data rows of at most
-:data:`~turntable_pin.core.sizes.MAX_TABLE_COLUMNS` cells (:func:`read_lines`).
+Rows are counted as a spreadsheet shows them (the header is row 1); a file that fails a check
+raises :class:`InputError`. Only a regular file within the sizes of :mod:`.sizes` is read
+(:func:`read_lines`).
 """
 
 from __future__ import annotations
 
 import csv
+import difflib
 import functools
 import math
 from collections.abc import Sequence
@@ -19,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from .exceptions import InputError
-from .files import check_input_file
+from .files import check_input_file, write_text_atomic
 from .sizes import MAX_TABLE_COLUMNS, MAX_TABLE_FILE_BYTES, MAX_TABLE_ROWS
 
 __all__ = [
@@ -41,14 +40,12 @@ class CsvTable:
     """The numeric columns of a CSV file.
 
     Attributes:
-        path: the file read.
+        path: the file read; header: every column name, in file order.
         columns: ``{name: float array}`` of the required and the present optional columns.
-        header: every column name of the file, in file order (unknown ones are kept, unused).
-        rows: the spreadsheet row number of each data row (2 for the first).
-        extra: with ``extra=True``, the other numeric columns (:func:`read_csv_table`).
-        skipped: with ``extra=True``, the other columns that are not numeric (text or empty
-            throughout): kept out, and named here so that the reader's caller can say so.
-        header_row: the spreadsheet row of the header (1 unless ``#`` lines come before it).
+        rows: the spreadsheet row of each data row; header_row: the header's (1 unless ``#``
+            lines come first).
+        extra, skipped: with ``extra=True``, the other numeric columns and the names of the
+            other, non-numeric ones (text or empty throughout), for the caller to say so.
     """
 
     path: Path
@@ -83,8 +80,6 @@ class CsvTable:
 def closest_column_hint(name: str, header) -> str:
     """`` (is 'X' a misspelling of it?)`` for the header column most like ``name``, or ``""``
     when none is close (difflib's ratio at least 0.6)."""
-    import difflib
-
     close = difflib.get_close_matches(name, [h for h in header if h != name], n=1, cutoff=0.6)
     return f" (is '{close[0]}' a misspelling of it?)" if close else ""
 
@@ -105,17 +100,10 @@ def read_header(path: str | Path) -> tuple[tuple[str, ...], int]:
 
 
 def read_lines(path: str | Path) -> list[tuple[int, str]]:
-    """The lines of the CSV file ``path`` that hold cells (blank and ``#`` lines left out), each
-    with its line number, header first.
-
-    Bounded before and while it reads: a regular file of at most ``MAX_TABLE_FILE_BYTES`` bytes
-    (:func:`~turntable_pin.core.files.check_input_file`), at most ``MAX_TABLE_ROWS`` data rows
-    and at most ``MAX_TABLE_COLUMNS`` cells a row (commas counted), so that no file, however its
-    lines are cut, holds more in memory than the largest table a command takes.
-
-    Raises:
-        InputError: naming the file (and the row where a bound is passed).
-    """
+    """``(line number, line)`` of the lines of ``path`` that hold cells, header first (blank and
+    ``#`` lines left out). Bounded before and while it reads (``MAX_TABLE_FILE_BYTES``,
+    ``MAX_TABLE_ROWS``, ``MAX_TABLE_COLUMNS`` cells a row): no file holds more in memory than the
+    largest table a command takes. :class:`InputError` names the file (and the row)."""
     path = check_input_file(path, "CSV", MAX_TABLE_FILE_BYTES)
     lines: list[tuple[int, str]] = []
     try:
@@ -167,23 +155,18 @@ def read_csv_table(
     blank: Sequence[str] = (),
     extra: bool = False,
 ) -> CsvTable:
-    """Read ``path`` and check that every required column exists and every value is finite.
+    """Read ``path`` (one header line; ``#`` lines before it skipped) and check that every
+    ``required`` column exists and every value read is finite.
 
     Args:
-        path: the CSV file (comma-separated, one header line; ``#`` lines before it are skipped).
-        required: column names that must be present, exactly spelled.
-        optional: column names that are read (and checked) when present.
-        min_rows: fewest data rows accepted.
-        blank: columns whose empty cells are read as NaN ("not measured") instead of refused.
-        extra: also read every other column (into :attr:`CsvTable.extra`) that is numeric: at
-            least half of its filled cells are numbers (see :func:`_other_column`); every cell
-            of such a column must then be a finite number. The others (text or empty
-            throughout) are named in :attr:`CsvTable.skipped`.
+        optional: columns read (and checked) when present; min_rows: fewest data rows.
+        blank: columns whose empty cells are NaN ("not measured") instead of refused.
+        extra: also read every other numeric column (:func:`_other_column`) into
+            :attr:`CsvTable.extra`; the others are named in :attr:`CsvTable.skipped`.
 
     Raises:
-        InputError: unreadable file, missing header, a missing column (with close matches named),
-            a duplicated column, a cell that is empty, not a number, NaN or infinite (in a
-            required, a present optional or, with ``extra``, a numeric other column).
+        InputError: unreadable file, no header, a missing (close matches named) or repeated
+            column, a cell read that is empty, not a number, NaN or infinite.
     """
     path = Path(path)
     lines = read_lines(path)
@@ -197,6 +180,31 @@ def read_csv_table(
         name.strip() for name in (parsed[0] if quoted else next(csv.reader([lines[0][1]])))
     )
     header_line = lines[0][0]
+    _check_header(path, header, required, header_line)
+    wanted = [name for name in (*required, *optional) if name in header]
+    index = {name: header.index(name) for name in wanted}
+    others = [n for n in header if n not in index and n] if extra else []
+    values, other_cells, row_numbers = _read_cells(
+        path, lines, parsed, header, index, others, set(blank)
+    )
+    if len(row_numbers) < min_rows:
+        raise InputError(
+            f"expected at least {min_rows} data row(s), found {len(row_numbers)}", path=path
+        )
+    extra_columns, skipped = _other_columns(path, lines, header, other_cells, row_numbers)
+    return CsvTable(
+        path=path,
+        columns={name: np.asarray(v, dtype=float) for name, v in values.items()},
+        header=header,
+        rows=np.asarray(row_numbers, dtype=int),
+        extra=extra_columns,
+        skipped=tuple(skipped),
+        header_row=header_line,
+    )
+
+
+def _check_header(path: Path, header: tuple[str, ...], required, header_line: int) -> None:
+    """Refuse a column named twice, or a required column missing (close matches named)."""
     seen = set()
     for name in header:
         if name in seen:
@@ -205,47 +213,43 @@ def read_csv_table(
             )
         seen.add(name)
     missing = [name for name in required if name not in header]
-    if missing:
-        hints = []
-        for name in missing:
-            close = [h for h in header if h.lower().replace(" ", "") == name.lower()]
-            close += [h for h in header if h not in close and name.split("_")[0] == h.split("_")[0]]
-            if close:
-                hints.append(f"'{name}' (found {', '.join(repr(c) for c in close)})")
-            else:
-                hints.append(f"'{name}'" + closest_column_hint(name, header))
-        raise InputError(
-            f"missing required column(s) {', '.join(hints)}; the header has {', '.join(header)}",
-            path=path,
-            row=header_line,
-        )
-    wanted = [name for name in (*required, *optional) if name in header]
-    index = {name: header.index(name) for name in wanted}
-    others = [n for n in header if n not in index and n] if extra else []
-    whole = None if quoted else _whole_table([line for _, line in lines[1:]], len(header))
+    if not missing:
+        return
+    hints = []
+    for name in missing:
+        close = [h for h in header if h.lower().replace(" ", "") == name.lower()]
+        close += [h for h in header if h not in close and name.split("_")[0] == h.split("_")[0]]
+        if close:
+            hints.append(f"'{name}' (found {', '.join(repr(c) for c in close)})")
+        else:
+            hints.append(f"'{name}'" + closest_column_hint(name, header))
+    raise InputError(
+        f"missing required column(s) {', '.join(hints)}; the header has {', '.join(header)}",
+        path=path,
+        row=header_line,
+    )
+
+
+def _read_cells(path, lines, parsed, header, index, others, blank_ok):
+    """``(values, other cells, row numbers)``: numpy's parser on a clean unquoted body, else the
+    wanted columns at once, else cell by cell (naming the problem)."""
+    row_numbers = [line_no for line_no, _ in lines[1:]]
+    whole = None if parsed else _whole_table([line for _, line in lines[1:]], len(header))
     if whole is not None and all(np.all(np.isfinite(whole[:, i])) for i in index.values()):
         values = {name: whole[:, i].copy() for name, i in index.items()}
-        row_numbers = [line_no for line_no, _ in lines[1:]]
-        other_cells = {n: whole[:, header.index(n)].copy() for n in others}
-    else:
-        if parsed is None:
-            parsed = list(csv.reader([line for _, line in lines]))
-        data_rows = parsed[1:]
-        fast = _whole_columns(data_rows, len(header), index)
-        if fast is not None:
-            values = fast
-            row_numbers = [line_no for line_no, _ in lines[1:]]
-            other_cells = {
-                n: [cells[header.index(n)].strip() for cells in data_rows] for n in others
-            }
-        else:
-            values, other_cells, row_numbers = _cell_by_cell(
-                path, lines, data_rows, header, index, others, set(blank)
-            )
-    if len(row_numbers) < min_rows:
-        raise InputError(
-            f"expected at least {min_rows} data row(s), found {len(row_numbers)}", path=path
-        )
+        return values, {n: whole[:, header.index(n)].copy() for n in others}, row_numbers
+    if parsed is None:
+        parsed = list(csv.reader([line for _, line in lines]))
+    data_rows = parsed[1:]
+    fast = _whole_columns(data_rows, len(header), index)
+    if fast is None:
+        return _cell_by_cell(path, lines, data_rows, header, index, others, blank_ok)
+    other_cells = {n: [cells[header.index(n)].strip() for cells in data_rows] for n in others}
+    return fast, other_cells, row_numbers
+
+
+def _other_columns(path, lines, header, other_cells, row_numbers) -> tuple[dict, list]:
+    """The numeric other columns (``extra=True``) and the names of the text ones."""
     extra_columns, skipped = {}, []
     for name, cells in other_cells.items():
         if isinstance(cells, np.ndarray) and cells.size and np.all(np.isfinite(cells)):
@@ -259,26 +263,14 @@ def read_csv_table(
             skipped.append(name)
         else:
             extra_columns[name] = numbers
-    return CsvTable(
-        path=path,
-        columns={name: np.asarray(v, dtype=float) for name, v in values.items()},
-        header=header,
-        rows=np.asarray(row_numbers, dtype=int),
-        extra=extra_columns,
-        skipped=tuple(skipped),
-        header_row=header_line,
-    )
+    return extra_columns, skipped
 
 
 def _whole_table(data_lines: list[str], width: int) -> np.ndarray | None:
-    """Every cell of unquoted data lines as floats (rows, ``width``), read by numpy's parser,
-    or ``None`` when any cell is not a number numpy reads or a row is not ``width`` cells wide
-    (the cell-by-cell reading then decides, with Python's ``float`` and its messages).
-
-    numpy's parser accepts no cell that ``float`` refuses and gives the same double for the
-    cells both accept (both round the decimal correctly); it refuses some ``float`` accepts
-    (``1_000``, non-ASCII digits), which then go the slow way.
-    """
+    """Every cell of unquoted data lines as floats (rows, ``width``) by numpy's parser, or
+    ``None`` when a cell is not a number it reads or a row is not ``width`` wide (the cell-by-cell
+    reading then decides). numpy accepts no cell ``float`` refuses and gives the same double (both
+    round correctly); some ``float`` accepts (``1_000``) go the slow way."""
     if not data_lines:
         return None
     try:
@@ -346,16 +338,10 @@ def _cell_by_cell(path, lines, data_rows, header, index, others, blank_ok):
 
 
 def _other_column(path, name: str, cells: Sequence[str], rows: Sequence[int]) -> np.ndarray | None:
-    """A column other than the asked-for ones, as floats when it is numeric, ``None`` when it
-    is text (or empty throughout).
-
-    The rule: a column is numeric when at least half of its filled (non-empty) cells read as
-    numbers (Python's ``float``: ``nan`` and ``inf`` count as numbers here, and are refused
-    below). A numeric column is one the file means as numbers (``temperature_c`` with a cell
-    ``warm`` typed into it) and is then checked as a required one: the first cell that is empty,
-    not a number, NaN or infinite is refused naming file, row and column. A column of text with a
-    few numbers among it (a ``note`` column) stays text, and is left out.
-    """
+    """A column other than the asked-for ones, as floats when it is numeric (at least half of
+    its filled cells read as ``float``: ``temperature_c`` with a cell ``warm``), then checked as
+    a required one (file, row and column of the first bad cell); ``None`` when it is text (a
+    ``note`` column with a few numbers) or empty throughout."""
     numbers: list[float | None] = []
     for text in cells:
         try:
@@ -387,10 +373,9 @@ def ignored_columns_words(names: Sequence[str]) -> str:
 
 
 def missing_columns_words(missing: Sequence[str], ignored: Sequence[str], where: str) -> str:
-    """Why the columns ``missing`` cannot be used, for ``"needs the column(s) <this>"``:
-    ``"a, absent from <where>"`` for those the file lacks, and ``"b, present in <where> but not
-    numbers (text or empty throughout), so ignored"`` for those among ``ignored`` (the file's
-    :attr:`CsvTable.skipped`): a column that is there is never called absent."""
+    """Why the columns ``missing`` cannot be used: ``"a, absent from <where>"``, and ``"b,
+    present in <where> but not numbers (...), so ignored"`` for those among ``ignored`` (the
+    file's :attr:`CsvTable.skipped`): a column that is there is never called absent."""
     absent = [c for c in missing if c not in ignored]
     text = [c for c in missing if c in ignored]
     parts = [f"{', '.join(absent)}, absent from {where}"] if absent else []
@@ -403,11 +388,8 @@ def missing_columns_words(missing: Sequence[str], ignored: Sequence[str], where:
 
 
 def refuse_repeated_rows(table: CsvTable, key_columns: Sequence[str], advice: str) -> None:
-    """Refuse two rows equal in every present column of ``key_columns`` (to 1e-9).
-
-    A copied row counts one measurement twice; the error names the second row, the first one and
-    the columns compared, then ``advice`` (what makes repeats legitimate).
-    """
+    """Refuse two rows equal in every present column of ``key_columns`` (to 1e-9), a measurement
+    counted twice: both rows, the columns, then ``advice`` (what makes repeats legitimate)."""
     present = [c for c in key_columns if table.has(c)]
     found = first_repeated_row([table[c] for c in present], len(table))
     if found is not None:
@@ -420,10 +402,9 @@ def refuse_repeated_rows(table: CsvTable, key_columns: Sequence[str], advice: st
 
 
 def first_repeated_row(columns: Sequence[np.ndarray], n_rows: int) -> tuple[int, int] | None:
-    """The first row equal to an earlier one in every column of ``columns``, each value rounded
-    to 1e-9 as Python's ``round`` does (so ``-0.0`` and ``0.0`` are equal), as the indices
-    ``(earlier, row)``; ``None`` when no row repeats. The rule of :func:`refuse_repeated_rows`,
-    for readers that name their own lines (a TPOINT file's)."""
+    """``(earlier, row)``: the first row equal to an earlier one in every column, values rounded
+    to 1e-9 as ``round`` does (``-0.0 == 0.0``); ``None`` when none repeats. The rule of
+    :func:`refuse_repeated_rows`, for readers that name their own lines (a TPOINT file's)."""
     if columns and n_rows > 1:
         keys = np.stack([_rounded_9(np.asarray(c, dtype=float)) for c in columns], axis=1)
         ordered = keys[np.lexsort(keys.T)]
@@ -440,11 +421,8 @@ def first_repeated_row(columns: Sequence[np.ndarray], n_rows: int) -> tuple[int,
 
 
 def _rounded_9(values: np.ndarray) -> np.ndarray:
-    """``round(v, 9)`` of every value, as Python rounds (the exact decimal, half to even).
-
-    Vectorised (``rint(v 1e9) / 1e9``) when that gives the same numbers: ``v 1e9`` below 2**44
-    (its rounding error under 0.004) and nowhere within 0.01 of a half; else value by value.
-    """
+    """``round(v, 9)`` of every value, as Python rounds: vectorised (``rint(v 1e9) / 1e9``) when
+    that is the same (``v 1e9`` below 2**44 and nowhere within 0.01 of a half), else one by one."""
     scaled = values * 1e9
     fraction = np.abs(scaled - np.floor(scaled) - 0.5)
     if np.all(np.abs(scaled) < 2.0**44) and not np.any(fraction < 0.01):
@@ -456,8 +434,6 @@ def write_csv_table(
     path: str | Path, columns: dict[str, Sequence[float]], *, comment: str = ""
 ) -> Path:
     """Write equal-length columns as a CSV file, atomically; ``comment`` lines get a ``#``."""
-    from .files import write_text_atomic
-
     names = list(columns)
     n = len(next(iter(columns.values()))) if columns else 0
     lines = [f"# {line}" for line in comment.splitlines()] if comment else []

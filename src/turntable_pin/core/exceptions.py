@@ -6,6 +6,7 @@ check every random process shares (:func:`check_seed`) lives here too.
 
 from __future__ import annotations
 
+import numbers
 from pathlib import Path
 
 __all__ = [
@@ -22,14 +23,19 @@ __all__ = [
 
 
 def one_line(text: str) -> str:
-    """``text`` with every unprintable character (newline, carriage return, tab, ...) escaped.
-
-    Messages quote user input (a cell, a key, an option value); escaping keeps each message on one
-    line of the terminal whatever that input holds.
-    """
+    """``text`` with every unprintable character (newline, tab, ...) escaped: a message quoting
+    user input (a cell, a key, an option value) stays on one line of the terminal."""
     if text.isprintable():
         return text
     return "".join(ch if ch.isprintable() else repr(ch)[1:-1] for ch in text)
+
+
+def _located(message: str, path: str | None, **where) -> str:
+    """``message`` after where it happened: ``path, row R, line L, column 'C': message``."""
+    words = {"row": "row {}", "line": "line {}", "column": "column '{}'"}
+    parts = [path] if path is not None else []
+    parts += [words[key].format(value) for key, value in where.items() if value is not None]
+    return f"{', '.join(parts)}: {message}" if parts else message
 
 
 class TurntablePinError(Exception):
@@ -61,27 +67,15 @@ class InputError(TurntablePinError, ValueError):
         self.column = column
         self.line = line
         self.detail = message
-        where = []
-        if self.path is not None:
-            where.append(self.path)
-        if row is not None:
-            where.append(f"row {row}")
-        if line is not None:
-            where.append(f"line {line}")
-        if column is not None:
-            where.append(f"column '{column}'")
-        prefix = ", ".join(where)
-        super().__init__(f"{prefix}: {message}" if prefix else message)
+        super().__init__(_located(message, self.path, row=row, line=line, column=column))
 
 
 class UserCodeError(TurntablePinError):
-    """Code the user brought (a Python effect module, an installed plug-in) raised an exception
-    or broke its contract (a shape, a non-finite value, a parameter name).
+    """Code the user brought (an effect module, a plug-in) raised an exception or broke its
+    contract: file (and line), effect and what went wrong; the exception is the ``__cause__``.
 
-    Not an :class:`InputError`: the fits that skip a candidate they cannot evaluate on the data
-    (``except InputError``) must not hide a broken plug-in as "cannot be fitted". The message
-    names the file (and the line when known), the effect and what went wrong; an exception raised
-    inside the user's code is kept as ``__cause__``, with its traceback.
+    Not an :class:`InputError`: fits that skip a candidate they cannot evaluate (``except
+    InputError``) must not hide a broken plug-in as "cannot be fitted".
     """
 
     def __init__(
@@ -90,10 +84,7 @@ class UserCodeError(TurntablePinError):
         self.path = None if path is None else str(path)
         self.line = line
         self.detail = message
-        where = ", ".join(
-            [*([self.path] if self.path else []), *([f"line {line}"] if line else [])]
-        )
-        super().__init__(f"{where}: {message}" if where else message)
+        super().__init__(_located(message, self.path or None, line=line or None))
 
 
 class ModelError(TurntablePinError):
@@ -113,13 +104,8 @@ SEED_LIMIT = 2**63
 
 
 def check_seed(seed: object, what: str = "seed") -> int:
-    """``seed`` as an int, or :class:`InputError` unless it is a whole number in [0, 2**63).
-
-    Every random process of the package takes its seed through this check (numpy would refuse a
-    negative seed with a traceback and take a float or a huge number without a word).
-    """
-    import numbers
-
+    """``seed`` as an int, or :class:`InputError` unless it is a whole number in [0, 2**63): the
+    check of every random process (numpy would take a float or a huge number without a word)."""
     if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
         raise InputError(f"{what} must be a whole number 0 <= seed < 2**63, got {seed!r}")
     value = int(seed)

@@ -3,6 +3,8 @@ the one check of an input file before it is read (a regular file, within the siz
 have: :func:`check_input_file`), and a YAML reader that refuses a key given twice and a document
 whose aliases expand beyond :data:`~turntable_pin.core.sizes.MAX_YAML_VALUES` values."""
 
+# yaml is imported inside the functions that parse: a command that reads no YAML starts faster
+
 from __future__ import annotations
 
 import functools
@@ -12,6 +14,7 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
+from .exceptions import InputError
 from .sizes import MAX_YAML_FILE_BYTES, MAX_YAML_VALUES
 
 __all__ = [
@@ -27,52 +30,51 @@ __all__ = [
 
 
 def output_target(path: str | Path, *, folder: bool = False) -> Path:
-    """Where an output named ``path`` goes, checked before anything is written: ``path`` itself,
-    or the file a symbolic link at ``path`` points to (the link is kept and its target replaced).
-
-    ``folder``: the output is a folder of files (``--plots DIR``), not one file. Raises
-    :class:`InputError` naming ``path`` (``cannot write the file: ...``) where a plain write would
-    fail or would undo what the user protected:
-
-    - a link to nothing (its target does not exist) or a link that loops;
-    - a folder where a file is expected, a file where a folder is expected, a parent that is a file;
-    - an existing file that is write-protected: for a user, one this user may not write
-      (``os.access``); for root, who may write anything, one without any write permission bit
-      (mode ``0444``): the mode is the owner's say, and root keeps to it;
-    - a folder (the output's, or where it would be made) this user may not write in.
-    """
-    from .exceptions import InputError
-
+    """Where an output ``path`` (a file, or a ``folder`` of files) goes, checked before anything
+    is written: ``path``, or the target of a link there (the link is kept). :class:`InputError`
+    (``cannot write the file: ...``) where a plain write would fail or undo what the user
+    protected: a link to nothing or a loop; a folder for a file or the reverse, a parent that is
+    a file; a write-protected file (for root: one without any write bit, the owner's say); a
+    folder this user may not write in."""
     path = Path(path)
-    kind = "folder" if folder else "file"
+    target, why = _link_target(path)
+    why = why or _why_not_writable(target, folder)
+    if why:
+        raise InputError(f"cannot write the {'folder' if folder else 'file'}: {why}", path=path)
+    return target
 
-    def refuse(why: str):
-        raise InputError(f"cannot write the {kind}: {why}", path=path)
 
-    target = path
-    if path.is_symlink():
-        try:
-            target = path.resolve(strict=True)
-        except FileNotFoundError:
-            refuse(f"it is a link to {os.readlink(path)}, which does not exist")
-        except (RuntimeError, OSError):  # RuntimeError: a loop, before Python 3.13
-            refuse("it is a link that loops")
+def _link_target(path: Path) -> tuple[Path, str | None]:
+    """The file a link at ``path`` points to (``path`` itself when no link), and why it cannot
+    be written (a link to nothing, or a loop) or ``None``."""
+    if not path.is_symlink():
+        return path, None
+    try:
+        return path.resolve(strict=True), None
+    except FileNotFoundError:
+        return path, f"it is a link to {os.readlink(path)}, which does not exist"
+    except (RuntimeError, OSError):  # RuntimeError: a loop, before Python 3.13
+        return path, "it is a link that loops"
+
+
+def _why_not_writable(target: Path, folder: bool) -> str | None:
+    """Why an output at ``target`` cannot be written (see :func:`output_target`), or ``None``."""
     if folder and target.exists() and not target.is_dir():
-        refuse("it is a file, not a folder")
+        return "it is a file, not a folder"
     if not folder and target.is_dir():
-        refuse("it is a folder")
+        return "it is a folder"
     blocking = next((p for p in target.parents if p.exists() and not p.is_dir()), None)
     if blocking is not None:
-        refuse(f"{blocking} is a file, not a folder")
+        return f"{blocking} is a file, not a folder"
     if not folder and target.exists() and _write_protected(target):
         mode = stat.S_IMODE(target.stat().st_mode)
-        refuse(f"permission denied (the file is write-protected, mode {mode:04o})")
+        return f"permission denied (the file is write-protected, mode {mode:04o})"
     where = target if folder and target.is_dir() else target.parent
     while not where.exists() and where != where.parent:
         where = where.parent
     if not _access(where, os.W_OK | os.X_OK):
-        refuse(f"permission denied (cannot write in the folder {where})")
-    return target
+        return f"permission denied (cannot write in the folder {where})"
+    return None
 
 
 def _access(path: Path, mode: int) -> bool:
@@ -89,16 +91,10 @@ def _write_protected(path: Path) -> bool:
 
 
 def write_atomic(path: str | Path, write: Callable[[Path], None]) -> Path:
-    """Call ``write(tmp_path)`` on a temporary file beside ``path``, then rename it into place.
-
-    If ``write`` raises, the temporary file is removed and any existing ``path`` is untouched.
-    ``path`` is checked first (:func:`output_target`: a write-protected file is refused, a link is
-    written through to its target). A file replaced keeps its permission bits (and its owner,
-    where the system allows), as a plain write would; a new file gets the mode a plain ``open()``
-    gives. An operating-system error (a full disk) becomes an :class:`InputError` naming ``path``.
-    """
-    from .exceptions import InputError
-
+    """Call ``write(tmp_path)`` on a temporary file beside ``path`` (checked first,
+    :func:`output_target`), then rename it into place; if ``write`` raises, ``path`` is untouched.
+    A replaced file keeps its mode (and owner, where allowed), a new one gets ``open()``'s; an
+    OS error (a full disk) is an :class:`InputError` naming ``path``."""
     path = Path(path)
     target = output_target(path)
     try:
@@ -161,17 +157,9 @@ def _megabytes(size: int) -> str:
 
 
 def check_input_file(path: str | Path, kind: str, max_bytes: int) -> Path:
-    """``path`` (as a ``Path``) when it is a regular file (links followed) of at most ``max_bytes``
-    bytes; else :class:`InputError` naming it, before anything is read.
-
-    Every reader of an input file starts here. A device (``/dev/zero``), a pipe or a socket may
-    never end and cannot be read twice, and a file beyond the size its kind may have
-    (:mod:`~turntable_pin.core.sizes`) would fill the memory before any check of its contents: both
-    are refused, the size in the message. ``kind`` says what the file should be (``"CSV"``,
-    ``"YAML"``, ...), for the message.
-    """
-    from .exceptions import InputError
-
+    """``path`` when it is a regular file (links followed) of at most ``max_bytes`` bytes, else
+    :class:`InputError` naming it (``kind``: ``"CSV"``, ...), before anything is read: where every
+    reader starts. A device or pipe may never end; a huge file would fill the memory."""
     path = Path(path)
     try:
         info = path.stat()
@@ -193,8 +181,6 @@ def check_input_file(path: str | Path, kind: str, max_bytes: int) -> Path:
 def too_large(path: str | Path, kind: str, max_bytes: int, size: int | None = None):
     """The :class:`InputError` of a ``kind`` file larger than ``max_bytes`` (``size``: its size
     in bytes, when known)."""
-    from .exceptions import InputError
-
     has = f"{_megabytes(size)} ({size:,} bytes)" if size is not None else "larger"
     return InputError(
         f"the file is {has}; a {kind} file is read up to {_megabytes(max_bytes)}", path=path
@@ -204,12 +190,8 @@ def too_large(path: str | Path, kind: str, max_bytes: int, size: int | None = No
 def read_text_file(
     path: str | Path, kind: str, encoding: str = "utf-8", *, max_bytes: int = MAX_YAML_FILE_BYTES
 ) -> str:
-    """The text of the file ``path``, checked first by :func:`check_input_file` (``max_bytes``:
-    the most its kind may have; never more is read); an unreadable or non-UTF-8 file is an
-    ``InputError`` naming it (``kind``: what the file should be, e.g. ``"YAML"``, for the
-    message). Newlines are universal, as with :meth:`Path.read_text`."""
-    from .exceptions import InputError
-
+    """The text of ``path`` (:func:`check_input_file` first; never more than ``max_bytes`` read),
+    universal newlines; an unreadable or non-UTF-8 file is an ``InputError`` naming it."""
     path = check_input_file(path, kind, max_bytes)
     try:
         with path.open(encoding=encoding) as handle:
@@ -224,24 +206,15 @@ def read_text_file(
 
 
 def read_yaml(path: str | Path):
-    """Parse a YAML file; an unreadable file or invalid YAML raises :class:`InputError`.
-
-    A key given twice in one mapping is refused, naming the file and the line of the second one
-    (plain YAML readers keep the last value and silently drop the first). The file may have at most
-    :data:`~turntable_pin.core.sizes.MAX_YAML_FILE_BYTES` bytes and its document at most
-    :data:`~turntable_pin.core.sizes.MAX_YAML_VALUES` values with its aliases expanded: an alias
-    is shared, never copied, but whoever walks the document walks it once per alias.
-    """
+    """Parse a YAML file; an unreadable file, invalid YAML, a key given twice in a mapping
+    (named with its line: plain readers drop the first silently), more than ``MAX_YAML_FILE_BYTES``
+    or ``MAX_YAML_VALUES`` values with aliases expanded raise :class:`InputError`."""
     return _load_yaml(path)[0]
 
 
 def read_yaml_lines(path: str | Path) -> tuple[object, dict[tuple, int]]:
-    """:func:`read_yaml`'s document and ``{key path: line}`` of its mapping keys and list items
-    (1-based lines; a key path is a tuple of keys and list indices, ``("terms", 0, "site")``).
-
-    Both come from one parse. The walk enters no value twice: the keys of a value reached through
-    an alias are listed once, under the path of its anchor.
-    """
+    """:func:`read_yaml`'s document and ``{key path: line}`` of its keys and list items (1-based;
+    a key path is a tuple, ``("terms", 0, "site")``; an alias' keys listed once, at its anchor)."""
     data, node = _load_yaml(path)
     return data, _key_lines(node)
 
@@ -249,8 +222,6 @@ def read_yaml_lines(path: str | Path) -> tuple[object, dict[tuple, int]]:
 def _load_yaml(path: str | Path):
     """The document of the YAML file ``path`` and its composed node (``None`` when empty)."""
     import yaml
-
-    from .exceptions import InputError
 
     path = Path(path)
     text = read_text_file(path, "YAML")
@@ -284,8 +255,6 @@ def _check_values(root, path: Path) -> None:
     one that holds itself (an alias inside its own anchor). Counted on the composed nodes, each
     once (an alias is the very node of its anchor): in time linear in the file."""
     import yaml
-
-    from .exceptions import InputError
 
     sizes: dict[int, int] = {}
     inside: set[int] = set()

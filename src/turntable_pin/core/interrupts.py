@@ -1,9 +1,8 @@
 """SIGINT and SIGTERM as an exception that unwinds cleanly, and cleanups that always run.
 
-The command line calls :func:`install_handlers` first thing: from then on both signals raise
-:class:`Interrupted` (a ``KeyboardInterrupt`` carrying the signal number), so every ``finally``
-and ``with`` block on the way out runs, and ``main()`` maps it to exit status 128 + signal (130,
-143). Three rules keep the cleanup itself from being cut short:
+After :func:`install_handlers` both signals raise :class:`Interrupted` (a ``KeyboardInterrupt``
+with the signal number), so every ``finally`` on the way out runs; ``main()`` exits with 128 +
+signal. Three rules keep the cleanup itself from being cut short:
 
 - a signal arriving while an interruption is already being handled (in an ``except``/``finally``
   or ``__exit__`` run because of a ``KeyboardInterrupt``) is not raised again: the first one is
@@ -19,11 +18,11 @@ its optional imports), so until ``main()`` reports it handled (:func:`interrupti
 signal is sent again every :data:`REDELIVERY_S` seconds and raised wherever it is not already
 being unwound.
 
-Processes forked by a pool call :func:`worker_initializer`: they ignore SIGINT (the parent stops
-them), die on SIGTERM and die with their parent. A forked child that still has our handler when a
-signal arrives takes the default action instead of raising the parent's exception.
+Pool workers call :func:`worker_initializer` (ignore SIGINT, die on SIGTERM and with their
+parent); a forked child that still has our handler takes the signal's default action.
 """
 
+# ctypes is imported inside worker_initializer: only pool workers need it
 from __future__ import annotations
 
 import contextlib

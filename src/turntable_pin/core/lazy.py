@@ -1,7 +1,7 @@
 """Lazy public names (PEP 562): a package lists ``name -> module`` and imports a module on
 first use.
 
-This keeps ``import turntable_pin`` and ``turntable-pin --help`` free of Pinocchio, SciPy and
+This keeps ``import turntable_pin`` and the command line's help free of Pinocchio, SciPy and
 matplotlib; each heavy library is imported by the module that needs it, when that module is used.
 """
 

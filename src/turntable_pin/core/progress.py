@@ -1,7 +1,7 @@
 """A minimal progress reporter for long work (Monte Carlo, sweeps), written to stderr.
 
 It draws a one-line bar when stderr is a terminal and otherwise prints a line at every 10 %, so
-logs of batch runs show progress too. ``enabled=False`` silences it (tests, ``--quiet``).
+logs of batch runs show progress too. ``enabled=False`` silences it.
 """
 
 from __future__ import annotations

@@ -8,15 +8,10 @@ with ``importlib.resources``; ``setup.py`` maps the repository's ``models/`` the
 from __future__ import annotations
 
 import os
+from importlib import resources
 from pathlib import Path
 
-__all__ = [
-    "default_gyrowheel_path",
-    "default_lower_bounds_path",
-    "default_urdf_path",
-    "examples_dir",
-    "models_dir",
-]
+__all__ = ["default_gyrowheel_path", "default_urdf_path", "examples_dir", "models_dir"]
 
 
 def models_dir() -> Path:
@@ -27,8 +22,6 @@ def models_dir() -> Path:
     checkout = Path(__file__).resolve().parents[3] / "models"
     if checkout.is_dir() and (checkout / "turntable.urdf").is_file():
         return checkout
-    from importlib import resources
-
     return Path(str(resources.files("turntable_pin") / "models"))
 
 
@@ -45,8 +38,3 @@ def default_urdf_path() -> Path:
 def default_gyrowheel_path() -> Path:
     """Paper Table 1 drift coefficients, ``models/gyrowheel_nominal.yaml``."""
     return models_dir() / "gyrowheel_nominal.yaml"
-
-
-def default_lower_bounds_path() -> Path:
-    """Manufacturing lower bounds of the allocation, ``models/manufacturing_lower_bounds.yaml``."""
-    return models_dir() / "manufacturing_lower_bounds.yaml"

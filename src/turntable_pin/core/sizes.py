@@ -9,6 +9,7 @@ memory bounded by design.
 from __future__ import annotations
 
 import math
+import numbers
 
 from .exceptions import InputError
 
@@ -57,8 +58,8 @@ MAX_DIAGNOSED_ROWS = 200_000
 """Most measurement rows one diagnosis takes (about 5 KB a row: 1 GB at the limit)."""
 
 DIAGNOSIS_ROW_BYTES = 5_000
-"""Peak memory of a diagnosis per measurement row, bytes. Measured: the whole ``diagnose --json``
-command peaked at 470 MB on 100,000 rows (4.7 KB a row, including about 110 MB of interpreter
+"""Peak memory of a diagnosis per measurement row, bytes. Measured: the whole ``diagnose`` command
+(JSON output) peaked at 470 MB on 100,000 rows (4.7 KB a row, including about 110 MB of interpreter
 and libraries; 3.6 KB a row at the margin between 20,000 and 100,000 rows), with a hidden effect
 found (two rounds of candidate fits). It was 18.7 KB a row before the fits shared one reduced
 Jacobian at zero and stopped keeping their Jacobians (``benchmarks/bench_diagnose_long.py``)."""
@@ -67,8 +68,8 @@ MAX_FITTED_ROWS = 1_000_000
 """Most measurement rows one fit takes (about 3 KB a row)."""
 
 FIT_ROW_BYTES = 3_000
-"""Peak memory of a fit per measurement row, bytes. Measured: ``fit FILE --effects
-inner_encoder_harmonics --json`` peaked at 292 MB on 100,000 rows (2.9 KB a row, including about
+"""Peak memory of a fit per measurement row, bytes. Measured: the ``fit`` command with effect
+inner_encoder_harmonics (JSON output) peaked at 292 MB on 100,000 rows (2.9 KB a row, with about
 110 MB of interpreter and libraries); it was 4.6 KB a row with the dense per-factor gains."""
 
 
@@ -112,11 +113,8 @@ fewer (a value takes at least two characters), so the limit only stops aliases."
 
 
 def turn_grid_count(step_deg: float) -> int:
-    """Number of grid angles ``0, step, ... < 360`` degrees (the grids of the package).
-
-    Raises:
-        InputError: a step that is not a number of at least :data:`MIN_GRID_STEP_DEG`.
-    """
+    """Number of grid angles ``0, step, ... < 360`` degrees; :class:`InputError` for a step that
+    is not a number of at least :data:`MIN_GRID_STEP_DEG`."""
     step = float(step_deg)
     if not (math.isfinite(step) and step >= MIN_GRID_STEP_DEG):
         raise InputError(
@@ -127,17 +125,9 @@ def turn_grid_count(step_deg: float) -> int:
 
 
 def check_count(count: float, limit: int, what: str, bytes_each: float = 0.0) -> int:
-    """Refuse ``count`` items above ``limit``, saying how many and what they would need.
-
-    Args:
-        count: the number of items the run would have (may be a float: a product of counts).
-        limit: the largest number accepted.
-        what: what is counted, for the message (``"positions"``).
-        bytes_each: memory per item, for the message (0: not stated).
-
-    Returns:
-        ``count`` as an int when it is within the limit.
-    """
+    """``count`` (maybe a float: a product of counts) as an int when at most ``limit``, else an
+    :class:`InputError` saying how many ``what`` and the memory (``bytes_each`` per item, 0: not
+    stated) they would need."""
     if not math.isfinite(count) or count > limit:
         need = ""
         if bytes_each and math.isfinite(count):
@@ -150,16 +140,9 @@ def check_count(count: float, limit: int, what: str, bytes_each: float = 0.0) ->
 def check_positions_count(
     n_positions, available: int, name: str = "n_positions", more: str = "more candidates"
 ) -> int:
-    """``n_positions`` as an int when it is a whole number from 1 to ``available``, the candidate
-    positions a design chooses among (each at most once); checked before any work, since a design
-    costs time with every position it chooses.
-
-    Raises:
-        InputError: naming the argument ``name`` (the command line says ``-n``) and how to choose
-            more (``more``: ``"more --candidates"`` on the command line).
-    """
-    import numbers
-
+    """``n_positions`` as an int when a whole number from 1 to ``available`` (the candidates a
+    design chooses among, each once), checked before any work; else :class:`InputError` naming
+    the argument ``name`` and how to choose ``more``."""
     if isinstance(n_positions, bool) or not isinstance(n_positions, numbers.Integral):
         raise InputError(f"{name} must be a whole number of positions, got {n_positions!r}")
     count = int(n_positions)

@@ -1,10 +1,6 @@
 """Positions over whole turns of any number of joints, in degrees: the one full-turn grid and the
-one uniform random draw every layer builds its positions from.
-
-A joint angle here is a number of degrees; a grid axis is ``start, start + step, ... <
-start + 360`` (:func:`~turntable_pin.core.sizes.turn_grid_count` angles), and several axes
-combine into every combination, the first joint varying slowest (``numpy.meshgrid`` with
-``indexing="ij"``).
+one uniform random draw every layer builds its positions from (every combination of the axes,
+the first joint varying slowest).
 """
 
 from __future__ import annotations
@@ -30,19 +26,9 @@ def every_combination(axes: Sequence[np.ndarray]) -> np.ndarray:
 
 def full_turn_grid_deg(*steps_deg: float, starts_deg: Sequence[float] | None = None) -> np.ndarray:
     """The full-turn grid of one or more joints, degrees: joint ``k`` takes ``start_k + i *
-    step_k`` for ``i = 0 .. turn_grid_count(step_k) - 1`` (every angle of ``[start_k, start_k +
-    360)``), every combination, as an (N, J) array (the last joint varying fastest). One joint's
-    axis is ``full_turn_grid_deg(step)[:, 0]``.
-
-    Args:
-        steps_deg: one grid step per joint, degrees (at least ``MIN_GRID_STEP_DEG``).
-        starts_deg: the first angle of each joint, degrees (default: 0 for every joint).
-
-    Raises:
-        InputError: a step below ``MIN_GRID_STEP_DEG`` or not a number (from
-            :func:`~turntable_pin.core.sizes.turn_grid_count`). The caller checks the number of
-            positions against its own limit before building the grid.
-    """
+    step_k`` over ``[start_k, start_k + 360)`` (``starts_deg`` default 0), every combination, an
+    (N, J) array (the last joint fastest). :class:`InputError` for a step below
+    ``MIN_GRID_STEP_DEG``; the caller checks N against its own limit first."""
     starts = (0.0,) * len(steps_deg) if starts_deg is None else tuple(starts_deg)
     if len(starts) != len(steps_deg):
         raise ValueError(f"starts_deg: {len(starts)} starts for {len(steps_deg)} steps")
@@ -56,16 +42,9 @@ def full_turn_grid_deg(*steps_deg: float, starts_deg: Sequence[float] | None = N
 def random_turn_positions_deg(
     rng: np.random.Generator, count: int, n_joints: int, starts_deg: Sequence[float] | None = None
 ) -> np.ndarray:
-    """``count`` positions of ``n_joints`` joints drawn uniformly over each joint's whole turn
-    ``[start, start + 360)`` degrees from ``rng`` (one ``uniform`` draw of shape ``(count,
-    n_joints)``), rounded to 1e-6 deg: a (count, n_joints) array.
-
-    Args:
-        rng: the random stream to draw from.
-        count: number of positions (the caller checks it against its limit).
-        n_joints: number of joints.
-        starts_deg: the start of each joint's turn, degrees (default: 0 for every joint).
-    """
+    """``count`` positions (checked by the caller) of ``n_joints`` joints drawn from ``rng``
+    uniformly over each whole turn ``[start, start + 360)`` degrees (one ``uniform`` draw of shape
+    ``(count, n_joints)``; ``starts_deg`` default 0), rounded to 1e-6 deg."""
     draws = rng.uniform(0.0, 360.0, (int(count), int(n_joints)))
     if starts_deg is not None:
         draws = np.asarray(starts_deg, dtype=float) + draws

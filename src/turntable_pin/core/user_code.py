@@ -1,24 +1,25 @@
 """Code the user brings (a Python effect module, an installed plug-in): imported and called so
 that whatever goes wrong inside it is reported as theirs, in one line.
 
-A Python effect module is code that runs: importing it runs its top level, and the package calls
-its classes' methods. :func:`import_module_file` imports one from its path and :func:`call_user`
-calls a method of it; an exception raised inside (or a ``sys.exit`` there) becomes a
-:class:`~.exceptions.UserCodeError` naming the file, the line in it and the exception's message,
-with the exception kept as its ``__cause__``. ``KeyboardInterrupt`` (Ctrl-C, and the package's
-own interruptions) passes through: an interrupted command still ends as interrupted. With the
-environment variable ``TURNTABLE_PIN_TRACEBACK=1`` the command line prints the full traceback
-before the one line (:data:`TRACEBACK_ENV`).
+:func:`import_module_file` imports an effect module from its path (its top level runs) and
+:func:`call_user` calls a method of it; an exception raised inside (or a ``sys.exit``) becomes a
+:class:`~.exceptions.UserCodeError` naming the file, the line and the message (the exception its
+``__cause__``). ``KeyboardInterrupt`` passes through. :data:`TRACEBACK_ENV` asks the command line
+for the full traceback.
 """
 
 from __future__ import annotations
 
+import importlib.util
+import inspect
 import os
 import sys
 import traceback
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from .exceptions import InputError, UserCodeError
 
@@ -52,8 +53,6 @@ def is_user_code(obj: object) -> bool:
 
 def class_file(cls: type) -> str | None:
     """The file that defines ``cls``, or ``None`` when it is not known (built in the shell)."""
-    import inspect
-
     try:
         return inspect.getsourcefile(cls) or inspect.getfile(cls)
     except (TypeError, OSError):
@@ -88,16 +87,9 @@ def _happened(exc: BaseException) -> str:
 
 
 def call_user(what: str, function: Callable, *args: Any, path: str | Path | None = None) -> Any:
-    """``function(*args)``, a piece of the user's code described by ``what`` (``effect 'x'
-    (class X): chain_terms(variables)``), defined in the file ``path``.
-
-    Raises:
-        UserCodeError: ``function`` raised an exception or called ``sys.exit``: the file, the
-            line of it the exception passed through last, ``what`` and the exception's message
-            (the exception is the error's ``__cause__``). ``KeyboardInterrupt`` passes.
-    """
-    import numpy as np
-
+    """``function(*args)``, the user's code described by ``what`` (``effect 'x' (class X):
+    chain_terms(variables)``) in the file ``path``; an exception or ``sys.exit`` inside it is a
+    :class:`UserCodeError` (the file, the last line of it passed, ``what``, the message)."""
     try:
         # a NaN or inf it computes is reported by the contract's check of what it returned,
         # not as numpy's warnings on stderr
@@ -112,18 +104,9 @@ def call_user(what: str, function: Callable, *args: Any, path: str | Path | None
 
 
 def import_module_file(path: str | Path, module_name: str):
-    """The module of the Python file ``path``, imported (its top level run) as ``module_name``.
-
-    No ``__pycache__`` is written beside the file.
-
-    Raises:
-        InputError: the file cannot be loaded as a Python module.
-        UserCodeError: importing it raised an exception (a syntax error, a missing import...)
-            or called ``sys.exit``: one line naming the file and the line. ``KeyboardInterrupt``
-            passes (the module is forgotten first).
-    """
-    import importlib.util
-
+    """The module of the Python file ``path``, imported as ``module_name`` (no ``__pycache__``
+    beside it). :class:`InputError`: not loadable; :class:`UserCodeError`: importing it raised
+    (a syntax error, a missing import...) or called ``sys.exit``, naming the file and line."""
     path = Path(path)
     spec = importlib.util.spec_from_file_location(module_name, path)
     if spec is None or spec.loader is None:

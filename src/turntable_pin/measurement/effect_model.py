@@ -187,7 +187,7 @@ class OrientationModel:
         variables: the commanded angles (and time, directions) of the positions.
         effects: catalogued effects to include (their required columns must be present).
         turntable: the table (:func:`~turntable_pin.measurement.table.measured_table` reads a
-            ``TurntableModel``, a ``GenericTable`` or ``None``: the bundled paper table).
+            a ``GenericTable`` or ``None``: the bundled paper table).
     """
 
     def __init__(

@@ -225,8 +225,8 @@ def fit_orientation(
         effects: catalogued effects to include.
         noise_variance: for data without sigmas, the unit-weight variance (rad^2) to judge the fit
             with (default: estimated from this fit).
-        turntable: the table (a ``MeasuredTable``, ``TurntableModel`` or ``GenericTable``;
-            default: the bundled paper table).
+        turntable: the table (a ``MeasuredTable`` or ``GenericTable``; default: the bundled
+            paper table).
         zero_point: :func:`orientation_zero_point` of these data with these effects and maybe
             more (fits of many effect sets of one data set share it).
         base_fit: the fit of the base errors alone to these ``data``, when at hand (the start

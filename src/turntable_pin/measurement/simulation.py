@@ -544,7 +544,7 @@ def simulate_measurements(
     ``MAX_ANGULAR_ERROR_DEG`` in arcsec) in its user unit; the run may last at most
     ``MAX_TIME_S`` and the simulated angles must stay within what a measurement file may hold
     (``MAX_MEASURED_ANGLE_ARCSEC``), or :class:`InputError` says which.
-        turntable: the table (``GenericTable``, ``TurntableModel`` or ``None``: the paper's).
+        turntable: the table (a ``GenericTable``; ``None``: the paper's).
         catalogue: effects besides the table's catalogue that ``effects`` may name (the user's).
     """
     limit = MAX_MEASURED_ANGLE_ARCSEC

@@ -48,6 +48,7 @@ class MeasuredTable:
         joints: each joint's errors, from the base.
         descriptions: ``{base error: what it is}``.
         label: how reports name the table (``paper`` or the URDF file).
+        title: how a sentence names the table (``the paper's table``, or the URDF file's name).
         named_effects: the catalogue's effects under the table's own names (its layout's
             :class:`~turntable_pin.model.named_effects.NamedEffect`; none: the generic names).
         urdf_path: the nominal URDF the chain was read from.
@@ -64,6 +65,7 @@ class MeasuredTable:
         descriptions: dict[str, str],
         *,
         label: str,
+        title: str = "",
         named_effects: Sequence = (),
         urdf_path=None,
         telescope_mount: str | None = None,
@@ -76,6 +78,7 @@ class MeasuredTable:
         self.joints = tuple(joints)
         self.descriptions = dict(descriptions)
         self.label = label
+        self.title = title or label
         self.named_effects = tuple(named_effects)
         rotations = [f.error for link in chain.links for f in link.factors if f.kind == ROTATION]
         self.base_names = tuple(n for n in chain.error_names if n in rotations)
@@ -104,7 +107,7 @@ class MeasuredTable:
     @property
     def paper(self) -> bool:
         """Whether the table tells its base errors in the paper's words (its effects carry the
-        paper's names); read by ``report/html_report.py`` alone."""
+        paper's names): its data files name the angles ``phi1_deg, phi2_deg``."""
         return bool(self.named_effects) and self.label == "paper"
 
     def angle_label(self, k: int) -> str:
@@ -119,8 +122,7 @@ _MEASURED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 def measured_table(turntable=None) -> MeasuredTable:
     """The :class:`MeasuredTable` of ``turntable``: ``None`` (the bundled paper table), a
     :class:`~turntable_pin.model.generic_table.GenericTable` (in its layout's names: the paper's
-    on the paper's table), a :class:`~turntable_pin.model.turntable.TurntableModel` (its table)
-    or a :class:`MeasuredTable` (returned as it is)."""
+    on the paper's table) or a :class:`MeasuredTable` (returned as it is)."""
     from ..model.paper_table import resolve_table
 
     if isinstance(turntable, MeasuredTable):
@@ -133,7 +135,7 @@ def measured_table(turntable=None) -> MeasuredTable:
             for k, (name, errors) in enumerate(table.layout.joint_errors.items(), start=1)
         ]
         cached = _MEASURED[table] = MeasuredTable(
-            table.chain, joints, table.descriptions, label=table.label,
+            table.chain, joints, table.descriptions, label=table.label, title=table.title,
             named_effects=table.layout.effects, urdf_path=table.urdf_path,
             telescope_mount=table.telescope_mount, declared_mount=table.declared_mount,
         )  # fmt: skip

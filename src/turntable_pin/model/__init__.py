@@ -9,10 +9,9 @@ from ..core.lazy import lazy_exports
 _EXPORTS = {
     "ANGULAR_ERROR_NAMES": "errors",
     "ERROR_NAMES": "errors",
-    "OrientationError": "turntable",
+    "OrientationError": "generic_table",
     "OrientationErrorField": "batch_field",
     "TurntableErrors": "errors",
-    "TurntableModel": "turntable",
     "YourdfpyTurntable": "urdf_io",
     "small_angle_matrix": "small_angle",
     "small_angle_orientation_error": "small_angle",

@@ -59,11 +59,8 @@ _PRODUCT_TO_SUM[1, 2, 4] = _PRODUCT_TO_SUM[2, 1, 4] = 0.5
 
 
 def _basis_rows(angle_rad: np.ndarray, out: np.ndarray) -> np.ndarray:
-    """Fill ``out`` (5, ...) with ``1, cos a, sin a, cos 2a, sin 2a``.
-
-    cos and sin come from one ``tan(a/2)`` through the rational half-angle formulas (a few ulp
-    of error): one transcendental call instead of two, which is most of the cost of a batch.
-    """
+    """Fill ``out`` (5, ...) with ``1, cos a, sin a, cos 2a, sin 2a``; cos and sin from one
+    ``tan(a/2)`` (half-angle formulas, a few ulp): one transcendental call, not two."""
     t = np.tan(0.5 * angle_rad)
     t2 = t * t
     inv = 1.0 / (1.0 + t2)
@@ -108,16 +105,9 @@ def _rodrigues_terms(axis) -> np.ndarray:
 
 
 class ChainExpansion:
-    """An :class:`~.chain.ErrorChain` prepared for the batch path (see the module docstring).
-
-    Holds the rotation part of the chain only (translations never change ``dR``): per stretch
-    between two joints its constant rotations and its error rotations (error column and
-    Rodrigues terms), the joints' Rodrigues terms, and per row of ``dR`` the operator ``L``
-    made from the nominal coefficients ``D``. Plain arrays: cheap to send to worker processes.
-
-    Args:
-        chain: the error chain (1 to 3 joints).
-    """
+    """An :class:`~.chain.ErrorChain` (1 to 3 joints) prepared for the batch path: its rotations
+    only (translations never change ``dR``) per stretch between joints, the joints' Rodrigues
+    terms, and per row of ``dR`` the operator ``L``. Plain arrays: cheap to send to workers."""
 
     def __init__(self, chain) -> None:
         index = {name: i for i, name in enumerate(chain.error_names)}
@@ -175,14 +165,8 @@ class ChainExpansion:
         return x
 
     def coefficients(self, error_values, entries=ANGLE_ENTRIES) -> np.ndarray:
-        """Coefficients (K, len(entries), 5^J) of the ``dR`` entries ``entries`` for K error sets.
-
-        Args:
-            error_values: (K, E) errors in the chain's ``error_names`` order (rad, m).
-            entries: (row, column) of ``dR`` (default: dpsi, dtheta, dgamma).
-
-        The joint axes of the 5^J coefficients are in chain order, the first joint slowest.
-        """
+        """Coefficients (K, len(entries), 5^J) of the ``dR`` entries ``entries`` (row, column;
+        default dpsi, dtheta, dgamma) for ``error_values`` (K, E), the first joint slowest."""
         values = np.atleast_2d(np.asarray(error_values, dtype=float))
         if values.shape[-1] != self.n_errors:
             raise ValueError(f"expected {self.n_errors} error values, got shape {values.shape}")
@@ -199,13 +183,9 @@ def joint_dependence(coefficients: np.ndarray, n_joints: int) -> np.ndarray:
 
 def max_abs_on_grid(coefficients: np.ndarray, grids_rad) -> np.ndarray:
     """Largest ``|value|`` of each polynomial of ``coefficients`` (K, E, 5^J) over the full grid
-    ``grids_rad`` (one 1-d array of angles per joint, every combination): (K, E).
-
-    The grid is evaluated one joint at a time: a product with the basis of every joint but the
-    first, then one with the first joint's (a fifth of the work of one product with the 5^J x N
-    basis of the whole grid, for three joints), in blocks of sets whose values take about
-    :data:`_GRID_BLOCK_BYTES`. A joint with a single angle is folded into the coefficients first.
-    """
+    ``grids_rad`` (one array per joint, every combination): (K, E). One joint at a time (a fifth
+    of the work of the whole grid's basis, for three joints), in blocks of about
+    :data:`_GRID_BLOCK_BYTES`; a joint with one angle is folded into the coefficients first."""
     k, e = coefficients.shape[:2]
     c = coefficients.reshape((k * e,) + (N_BASIS,) * len(grids_rad))
     grids = [np.asarray(g, dtype=float).ravel() for g in grids_rad]
@@ -234,11 +214,8 @@ def max_abs_on_grid(coefficients: np.ndarray, grids_rad) -> np.ndarray:
 
 
 class OrientationErrorField:
-    """``dR`` of one or many error sets of one table as a function of the joint angles.
-
-    Build it with :meth:`from_chain` (K error sets on an :class:`~.chain.ErrorChain`).
-    ``coefficients`` has shape (K, 3, 3, 5, ..., 5), one 5 per joint in chain order.
-    """
+    """``dR`` of K error sets of one table as a function of the joint angles (build it with
+    :meth:`from_chain`); ``coefficients`` (K, 3, 3, 5, ..., 5), one 5 per joint."""
 
     def __init__(self, coefficients: np.ndarray, n_joints: int = 2) -> None:
         coefficients = np.asarray(coefficients, dtype=float)
@@ -259,30 +236,11 @@ class OrientationErrorField:
 
     @classmethod
     def from_chain(cls, chain, error_values: np.ndarray) -> OrientationErrorField:
-        """The fields of K error sets on any :class:`~.chain.ErrorChain` (1 to 3 joints).
-
-        ``error_values`` has shape (K, E) in ``chain.error_names`` order (rad, m).
-        """
+        """The fields of ``error_values`` (K, E; ``chain.error_names`` order, rad and m)."""
         expansion = ChainExpansion(chain)
         c = expansion.coefficients(error_values, _ALL_ENTRIES)
         shape = (c.shape[0], 3, 3) + (N_BASIS,) * expansion.n_joints
         return cls(c.reshape(shape), n_joints=expansion.n_joints)
-
-    @classmethod
-    def from_model(cls, model) -> OrientationErrorField:
-        """The field of one :class:`~.turntable.TurntableModel` (its chain and error set)."""
-        return cls.from_chain(model.chain, model.errors.as_array()[None])
-
-    @classmethod
-    def from_error_values(cls, error_values: np.ndarray, model=None) -> OrientationErrorField:
-        """The fields of K error sets of the paper's table, ``error_values`` (K, 9) in
-        ``ERROR_NAMES`` order (or (K, 8): ``deta`` 0) on ``model``'s URDF (default bundled)."""
-        from .errors import ERROR_NAMES
-        from .turntable import TurntableModel
-
-        values = np.atleast_2d(np.asarray(error_values, dtype=float))
-        values = np.pad(values, ((0, 0), (0, len(ERROR_NAMES) - values.shape[1])))
-        return cls.from_chain((model or TurntableModel()).chain, values)
 
     # ---- evaluation --------------------------------------------------------------------------
     def _evaluate(self, coefficients: np.ndarray, angles_rad) -> np.ndarray:
@@ -298,10 +256,7 @@ class OrientationErrorField:
         return out.reshape(k, e, angles[0].size)
 
     def rotation(self, *angles_rad) -> np.ndarray:
-        """Full ``dR`` at N joint-angle tuples (chain order; broadcast, flattened): (K, N, 3, 3).
-
-        For the paper's table ``rotation(phi1_rad, phi2_rad)``.
-        """
+        """Full ``dR`` at N joint-angle tuples (chain order; broadcast, flattened): (K, N, 3, 3)."""
         k = self.n_sets
         values = self._evaluate(
             self.coefficients.reshape((k, 9) + (N_BASIS,) * self.n_joints), angles_rad
@@ -309,21 +264,5 @@ class OrientationErrorField:
         return values.transpose(0, 2, 1).reshape(k, -1, 3, 3)
 
     def angles(self, *angles_rad) -> np.ndarray:
-        """``(dpsi, dtheta, dgamma)`` in radians at N joint-angle tuples, shape (K, N, 3).
-
-        One (3K, 5^J) x (5^J, P) product per block of P tuples; see the module docstring.
-        """
+        """``(dpsi, dtheta, dgamma)`` in radians at N joint-angle tuples, shape (K, N, 3)."""
         return self._evaluate(self._angle_coefficients, angles_rad).transpose(0, 2, 1)
-
-    def angles_on_phi2_grid(self, phi1_rad: float, phi2_grid_rad) -> np.ndarray:
-        """``(dpsi, dtheta, dgamma)`` of every error set of a two-joint table on a grid of the
-        second joint at one angle of the first: (K, 3, M)."""
-        return self.angles(float(phi1_rad), np.asarray(phi2_grid_rad, dtype=float)).transpose(
-            0, 2, 1
-        )
-
-    def max_abs_angles(self, *grids_rad) -> np.ndarray:
-        """Largest ``|dpsi|, |dtheta|, |dgamma|`` of each set over the full grid (one array of
-        angles per joint, every combination), radians: (K, 3)."""
-        k = self.n_sets
-        return max_abs_on_grid(self._angle_coefficients.reshape(k, 3, -1), grids_rad)

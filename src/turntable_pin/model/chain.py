@@ -7,14 +7,12 @@ frame) and, for a joint, the joint's own rotation about its axis::
 
     Rt(q) = prod_links  N_link E_link(errors) R_axis(q_link)        (R = I for a fixed link)
 
-Every consumer reads this one object: :class:`~turntable_pin.model.turntable.TurntableModel`
-writes ``N E`` into Pinocchio's placements, the URDF writer into the joint ``<origin>``s,
-:class:`~turntable_pin.model.batch_field.OrientationErrorField` composes it for the trigonometric
-coefficients, the measurement fit composes its rotations factor by factor (with effect terms
-inserted) for exact Jacobians, and the sensitivity layer moves each factor's twist through the
-Pinocchio regressor. Nothing here knows the paper's names: the factor table comes from the caller.
+Every consumer reads this one object (Pinocchio's placements, the URDF writer, the batch field,
+the fit's exact Jacobians, the sensitivities); the factor table, with its names, comes from the
+caller.
 """
 
+# pinocchio is imported inside functions: import turntable_pin stays light
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
@@ -46,13 +44,9 @@ TRANSLATION = "trans"
 
 @dataclass(frozen=True)
 class ErrorFactor:
-    """One elementary motion by an error parameter: ``kind`` about/along ``axis`` by ``error``.
-
-    Attributes:
-        kind: :data:`ROTATION` (radians) or :data:`TRANSLATION` (metres).
-        axis: ``"x"``, ``"y"`` or ``"z"`` of the moving frame, or a unit 3-vector (a tuple) in it.
-        error: the error parameter's name.
-    """
+    """One elementary motion by an error parameter: ``kind`` (:data:`ROTATION`, radians, or
+    :data:`TRANSLATION`, metres) about/along ``axis`` (``"x"``, ``"y"``, ``"z"`` of the moving
+    frame, or a unit 3-vector in it) by the parameter ``error``."""
 
     kind: str
     axis: str | tuple[float, float, float]
@@ -66,19 +60,17 @@ class ErrorFactor:
 
 @dataclass(frozen=True)
 class ChainLink:
-    """One link of the chain: nominal placement, error factors, joint axis (None when fixed).
+    """One link of the chain.
 
     Attributes:
-        name: the joint's name (a revolute joint or a fixed joint folded into a frame), or the
-            payload frame's name for the last link.
-        nominal: 4x4 nominal placement relative to the previous link's frame (read-only).
+        name: the joint's (revolute, or fixed and folded into a frame) or the payload frame's.
+        nominal: 4x4 placement relative to the previous link's frame (read-only).
         factors: the error factors applied after ``nominal``, in order.
-        axis: unit rotation axis of a revolute joint in its own frame; ``None`` for a fixed link.
-        q_index: index of the joint's value in Pinocchio's configuration vector (-1 when fixed).
-        unbounded: a continuous joint: Pinocchio holds ``(cos q, sin q)`` at ``q_index``.
-        limits_rad: ``(lower, upper)`` of a revolute joint whose URDF ``<limit>`` spans less
-            than a full turn, radians; ``None`` for a fixed link, a continuous joint or one
-            that may turn all the way round.
+        axis: unit rotation axis of a revolute joint in its own frame (``None``: fixed).
+        q_index: the joint's index in Pinocchio's q (-1 when fixed); unbounded: a continuous
+            joint (Pinocchio holds ``(cos q, sin q)`` there).
+        limits_rad: ``(lower, upper)`` of a joint whose URDF ``<limit>`` spans less than a full
+            turn, radians; else ``None``.
     """
 
     name: str
@@ -112,12 +104,8 @@ def skew(vector) -> np.ndarray:
 
 
 def joint_axis(model, joint_id: int) -> np.ndarray:
-    """Unit rotation axis of a revolute joint of the Pinocchio ``model``, in the joint frame.
-
-    Read off the joint's motion subspace (its angular part), which every revolute type has --
-    aligned or not, bounded or continuous -- whereas only some expose an ``axis`` attribute
-    (Pinocchio 4's ``JointModelRevoluteUnboundedUnaligned`` has none).
-    """
+    """Unit rotation axis of a revolute joint of the Pinocchio ``model``, in the joint frame,
+    read off its motion subspace (every revolute type has one; not all have an ``axis``)."""
     import pinocchio as pin
 
     joint = model.joints[joint_id]
@@ -169,17 +157,10 @@ def _frame_path(model, frame_id: int) -> list[int]:
 
 
 class ErrorChain:
-    """The serial chain from the base to a payload frame of a Pinocchio model, with error factors.
-
-    Args:
-        links: the links from the base to the payload frame (see :class:`ChainLink`).
-        error_names: the error parameters, in the order of the value arrays the methods take.
-        nq: size of Pinocchio's configuration vector.
-        frame_path: names of the Pinocchio frames after the last joint, down to the payload frame
-            (their placements change with the fixed links' errors).
-
-    Build it with :meth:`from_pinocchio`.
-    """
+    """The serial chain from the base to a payload frame, with error factors (build it with
+    :meth:`from_pinocchio`): ``links`` from the base, ``error_names`` (the order of the value
+    arrays), ``nq`` (Pinocchio's q size), ``frame_path`` (the frames after the last joint, whose
+    placements change with the fixed links' errors)."""
 
     def __init__(
         self,
@@ -207,17 +188,11 @@ class ErrorChain:
         factors: Mapping[str, Sequence[tuple[str, str, str]]],
         error_names: Sequence[str],
     ) -> ErrorChain:
-        """Read the chain ending at ``payload_frame`` off the nominal Pinocchio ``model``.
+        """Read the chain ending at ``payload_frame`` off the nominal Pinocchio ``model``, with
+        ``factors`` ``{joint or fixed-joint name: ((kind, axis, error name), ...)}``.
 
-        Args:
-            model: the nominal ``pinocchio.Model`` (no errors in its placements).
-            payload_frame: name of the payload frame.
-            factors: ``{joint or fixed-joint name: ((kind, axis, error name), ...)}``.
-            error_names: order of the error values.
-
-        Joints are read from the root to the payload frame's parent joint; the fixed joints that
-        Pinocchio folded into frames between that joint and the payload frame become fixed links
-        (their placement relative to the previous one), and the payload frame closes the chain.
+        Joints are read from the root to the payload frame's parent joint; the fixed joints
+        Pinocchio folded into frames after it become fixed links, and the payload frame closes it.
         """
         import pinocchio as pin
 
@@ -288,14 +263,6 @@ class ErrorChain:
                 return link
         raise KeyError(name)
 
-    def locate(self, error: str) -> tuple[ChainLink, int]:
-        """The link holding error ``error`` and the factor's index within the link."""
-        for link in self.links:
-            for index, factor in enumerate(link.factors):
-                if factor.error == error:
-                    return link, index
-        raise KeyError(error)
-
     def joint_vector(self, *angles_rad: float) -> np.ndarray:
         """Pinocchio's configuration vector q for joint angles in chain order, radians."""
         joints = self.joints
@@ -311,15 +278,8 @@ class ErrorChain:
 
     # ---- error transforms ---------------------------------------------------------------------
     def error_transforms(self, error_values: np.ndarray) -> dict[str, np.ndarray]:
-        """Homogeneous 4x4 error transforms of each link with factors, vectorised over sets.
-
-        Args:
-            error_values: shape (..., E), the errors in :attr:`error_names` order (rad, m).
-
-        Returns:
-            ``{link name: array (..., 4, 4)}``: the link's factors multiplied in order. The
-            nominal placement is to be applied before them.
-        """
+        """``{link name: (..., 4, 4)}``: each link's factors multiplied in order (the nominal
+        placement comes before them), for ``error_values`` (..., E) in :attr:`error_names` order."""
         values = np.asarray(error_values, dtype=float)
         if values.shape[-1] != len(self.error_names):
             raise ValueError(
@@ -363,12 +323,9 @@ class ErrorChain:
 
 
 def apply_chain_errors(chain: ErrorChain, nominal, model, error_values: np.ndarray) -> None:
-    """Write ``chain``'s error transforms for ``error_values`` into the placements of ``model``.
-
-    ``model`` is a copy of the Pinocchio model ``nominal`` the chain was read off. Joint
-    placements become ``nominal * E``; the frames Pinocchio folded the fixed joints into (all
-    placed relative to the last joint) are composed again in chain order with their errors.
-    """
+    """Write ``chain``'s error transforms into ``model``, a copy of the Pinocchio model
+    ``nominal`` it was read off: joint placements become ``nominal * E``; the frames of the fixed
+    joints (relative to the last joint) are composed again in chain order with their errors."""
     import pinocchio as pin
 
     def _se3(homogeneous: np.ndarray):
@@ -391,11 +348,8 @@ def apply_chain_errors(chain: ErrorChain, nominal, model, error_values: np.ndarr
 
 
 def compose_rotation(chain: Sequence[tuple[np.ndarray, object]], q_rad: Sequence) -> np.ndarray:
-    """Rotation of a placement chain at joint values ``q_rad`` (broadcast over leading dims).
-
-    ``chain`` is ``[(placement (..., 4, 4), joint axis or None), ...]`` as
-    :meth:`ErrorChain.placements` returns; ``q_rad`` holds one value (or array) per joint.
-    """
+    """Rotation of a placement chain (:meth:`ErrorChain.placements`) at joint values ``q_rad``
+    (one value or array per joint; broadcast over leading dims)."""
     result = None
     qi = 0
     for placement, axis in chain:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
@@ -77,23 +77,17 @@ DEFAULT_LENGTH_UNIT = "mm"
 """Unit of ``deta`` given without a unit suffix."""
 
 MAX_ANGULAR_ERROR_DEG = 5.0
-"""Largest angle the small-error model takes, degrees: a turntable error (user input), an
-orientation error (``rate-error``, a measured ``dpsi/dtheta/dgamma``, a noise sigma) and an
-orientation limit (``allocate``). The model is first order in these angles (eq. 26 drops terms of
-order angle^2, 0.4 % of the angle at 5 degrees); an error of more than a few degrees is a broken
-or misassembled table, not a small error, and a value beyond this is refused as a typo or a unit
-mix-up (degrees written as arc seconds)."""
+"""Largest angle the small-error model takes, degrees: a turntable error, an orientation error
+(rate error, a measured angle, a noise sigma) and an orientation limit. Eq. 26 drops terms of
+order angle^2 (0.4 % at 5 degrees); more is a broken table or a unit mix-up (degrees written as
+arc seconds), refused."""
 MAX_ORIENTATION_ERROR_DEG = 30.0
-"""Largest orientation error the exact chain takes from a measurement run, degrees: a measured
-``dpsi/dtheta/dgamma`` (``measurement.data``) and an angular error of a simulated run. A run is
-fitted by nonlinear least squares on the exact rotation chain, so a constant offset of several
-degrees (a telescope mount not synced, an encoder index off) is an ordinary first fit, not a
-small-angle violation: Gauss-Newton from zero errors converges on runs whose measured angles
-reach 20 deg, with Levenberg-Marquardt's help up to 30 deg, and lands in wrong minima only
-beyond 40 deg (``tests/measurement/test_fit.py``). The measured angles are entries of ``dR``
-(sines: they cannot exceed 1 rad = 57.3 deg, and at 30 deg one reads the angle 5 % off);
-a third of a turn or more is no orientation error of the table but another star, the other
-pier side or a sign convention."""
+"""Largest orientation error the exact chain takes from a measurement run, degrees (a measured
+``dpsi/dtheta/dgamma``, an angular error of a simulated run). The fit is nonlinear on the exact
+chain, so an offset of several degrees (a mount not synced) is an ordinary fit: Gauss-Newton
+converges up to 20 deg, with Levenberg-Marquardt up to 30 deg, and lands in wrong minima beyond
+40 deg (``tests/measurement/test_fit.py``). The angles are entries of ``dR`` (sines: 5 % off at
+30 deg); a third of a turn is another star, the other pier side or a sign convention."""
 MAX_DETA_M = 0.01
 """Largest intersection error ``|deta|``, metres (10 mm): the axes of a bench-top table are
 centimetres apart at worst; more is a unit mix-up (metres written as millimetres)."""
@@ -119,19 +113,11 @@ def parse_error_value(
     length_names: Sequence[str] = ("deta",),
     max_angle_deg: float = MAX_ANGULAR_ERROR_DEG,
 ) -> tuple[str, float]:
-    """Turn one user entry into ``(name, value in rad or m)``.
-
-    ``key`` is an error name, optionally with a unit suffix (``dphi_y1_arcmin``, ``deta_m``).
-    Without a suffix angles are arc seconds and lengths (``deta``) millimetres. ``names`` and
-    ``length_names`` are the table's error names and those of them that are lengths (default:
-    the paper's nine, of which ``deta``). ``max_angle_deg``: the largest angle taken, degrees
-    (:data:`MAX_ANGULAR_ERROR_DEG`, the small-error limit; a simulated measurement run takes
-    :data:`MAX_ORIENTATION_ERROR_DEG`).
-
-    Raises:
-        InputError: unknown name or unit, a value that is not a finite number, an angle beyond
-            ``max_angle_deg`` or a ``deta`` beyond :data:`MAX_DETA_M`.
-    """
+    """One user entry as ``(name, value in rad or m)``: ``key`` is one of ``names`` (the table's;
+    ``length_names`` the lengths), optionally with a unit suffix (``dphi_y1_arcmin``, ``deta_m``;
+    default arcsec and mm). :class:`InputError` for an unknown name or unit, a value not finite,
+    an angle beyond ``max_angle_deg`` (a simulated run takes :data:`MAX_ORIENTATION_ERROR_DEG`)
+    or a length beyond :data:`MAX_DETA_M`."""
     key = key.strip()
     name, unit = key, None
     if key not in names:
@@ -168,11 +154,8 @@ def parse_error_value(
 
 
 def read_error_mapping(path: str | Path) -> Mapping:
-    """The ``name[_unit]: value`` mapping of an errors YAML file (optionally under ``errors:``).
-
-    Raises:
-        InputError: unreadable YAML, a key beside ``errors:``, or not a mapping (naming the file).
-    """
+    """The ``name[_unit]: value`` mapping of an errors YAML file (optionally under ``errors:``);
+    :class:`InputError` for unreadable YAML, a key beside ``errors:`` or not a mapping."""
     path = Path(path)
     data = read_yaml(path)
     if isinstance(data, Mapping) and "errors" in data:
@@ -215,11 +198,6 @@ class TurntableErrors:
 
     # ---- constructors -------------------------------------------------------------------
     @classmethod
-    def zero(cls) -> TurntableErrors:
-        """The perfect turntable."""
-        return cls()
-
-    @classmethod
     def from_array(cls, values: Iterable[float]) -> TurntableErrors:
         """From the nine values in :data:`ERROR_NAMES` order (rad, ``deta`` in m)."""
         values = np.asarray(list(values), dtype=float).ravel()
@@ -252,16 +230,8 @@ class TurntableErrors:
     def from_yaml(
         cls, path: str | Path, *, max_angle_deg: float = MAX_ANGULAR_ERROR_DEG
     ) -> TurntableErrors:
-        """Read a YAML file: a mapping ``name[_unit]: value``, optionally under a key ``errors``
-        (angles up to ``max_angle_deg``, degrees).
-
-        Example::
-
-            errors:
-              dphi_y1_arcsec: 3.0
-              deps_x_arcsec: -2.0
-              deta_mm: 0.2
-        """
+        """Read a YAML file of ``name[_unit]: value`` (``dphi_y1_arcsec: 3.0``, ``deta_mm: 0.2``),
+        optionally under a key ``errors`` (angles up to ``max_angle_deg``, degrees)."""
         path = Path(path)
         data = read_error_mapping(path)
         try:
@@ -283,10 +253,6 @@ class TurntableErrors:
         out = {f"{n}_arcsec": getattr(self, n) * ARCSEC_PER_RAD for n in ANGULAR_ERROR_NAMES}
         out["deta_mm"] = self.deta / M_PER_MM
         return out
-
-    def as_dict(self) -> dict[str, float]:
-        """``{name: value}`` in internal units (rad, m)."""
-        return asdict(self)
 
     def scaled(self, factor: float) -> TurntableErrors:
         """Every component multiplied by ``factor``."""

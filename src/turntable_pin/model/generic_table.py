@@ -3,29 +3,26 @@ joints with free names, axes and nominal origins.
 
 The rule that places the errors (stated once, here):
 
-- every joint ``J`` carries, after its nominal ``<origin>``, rotations about its own axis ``a``
-  (``J.position``, the position error) and about two directions perpendicular to it, ``u`` then
-  ``v`` (``J.tilt_a``, ``J.tilt_b``: the axis' wobble or orthogonality error), then translations
-  along ``u`` and ``v`` (``J.offset_a``, ``J.offset_b``, metres: the axes missing each other);
-- ``u`` is the coordinate axis of the joint frame least aligned with ``a`` (the first of x, y, z
-  on a tie), made perpendicular to ``a``; ``v = a x u``;
-- the payload mount (the first fixed joint after the last revolute one, or the payload frame
-  itself when there is none) carries rotations about its x, y and z axes (``M.rot_x``,
-  ``M.rot_y``, ``M.rot_z``): how the payload sits on the table.
+- every joint ``J`` carries, after its nominal ``<origin>``, rotations about its axis ``a``
+  (``J.position``) and about ``u`` then ``v`` perpendicular to it (``J.tilt_a``, ``J.tilt_b``:
+  wobble or orthogonality), then translations along ``u`` and ``v`` (``J.offset_a``,
+  ``J.offset_b``, metres: the axes missing each other);
+- ``u`` is the joint frame's coordinate axis least aligned with ``a`` (x, y, z first on a tie),
+  made perpendicular to ``a``; ``v = a x u``;
+- the payload mount (the first fixed joint after the last revolute one, else the payload frame)
+  carries rotations about its x, y and z axes (``M.rot_x``, ``M.rot_y``, ``M.rot_z``).
 
 Angles are radians, offsets metres. Which combinations orientation data determine is found
-numerically (:meth:`GenericTable.identifiable`: QR with column pivoting of the orientation
-regressor on generic positions); no combination is hard-coded.
-
-A table may instead bring its own :class:`ErrorLayout` (which error factors sit in which
-placement, in which order, under which names): the paper's table is this class given the URDF
-``models/turntable.urdf`` and the layout of its Table 3 (:data:`~.paper_table.PAPER_LAYOUT`), so
-every layer written for a ``GenericTable`` reproduces the paper when given the paper's table.
+numerically (:meth:`GenericTable.identifiable`); no combination is hard-coded. A table may bring
+its own :class:`ErrorLayout` instead: the paper's table is this class given
+``models/turntable.urdf`` and its Table 3 (:data:`~.paper_table.PAPER_LAYOUT`).
 """
 
+# pinocchio and scipy are imported inside functions: import turntable_pin stays light
 from __future__ import annotations
 
 import math
+import xml.etree.ElementTree as ET
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -35,7 +32,11 @@ import numpy as np
 
 from ..core.exceptions import InputError, ModelError
 from ..core.files import check_input_file
+from ..core.resources import models_dir
+from ..core.rotations import axis_rotation
 from ..core.sizes import MAX_URDF_FILE_BYTES
+from ..core.units import ARCSEC_PER_RAD, M_PER_MM
+from ..core.words import argument
 from .angles import ANGLE_ENTRIES
 from .chain import (
     ROTATION,
@@ -44,8 +45,10 @@ from .chain import (
     apply_chain_errors,
     compose_rotation,
 )
+from .errors import MAX_ANGULAR_ERROR_DEG, parse_error_value, read_error_mapping
 from .mount_declaration import read_mount_declaration, resolve_mount
 from .named_effects import NamedEffect
+from .urdf_io import write_error_urdf
 
 __all__ = [
     "MAX_JOINTS",
@@ -80,8 +83,6 @@ def perpendicular_directions(axis) -> tuple[np.ndarray, np.ndarray]:
 def _check_urdf_text(path: Path):
     """Refuse what Pinocchio would silently accept: mimic joints, prismatic/floating/planar;
     return the parsed ``<robot>`` element."""
-    import xml.etree.ElementTree as ET
-
     try:
         root = ET.parse(path).getroot()
     except ET.ParseError as exc:
@@ -114,20 +115,15 @@ def _payload_frame(model, path: Path, payload_frame: str | None) -> str:
     if len(leaves) != 1:
         raise ModelError(
             f"{path}: the payload frame is ambiguous ({len(leaves)} leaf bodies: "
-            f"{', '.join(leaves)}); name it with --payload-frame"
+            f"{', '.join(leaves)}); name it with {argument('payload_frame')}"
         )
     return leaves[0]
 
 
 @dataclass(frozen=True)
 class ClosedForm:
-    """A table's first-order orientation error written out (the paper's eq. 26).
-
-    Attributes:
-        label: how texts cite it (``eq. 26``).
-        orientation_error_rad: ``(error_values, angles_rad) -> (dpsi, dtheta, dgamma)``, radians:
-            the error vector in the layout's order (rad, m) and one angle per joint (chain order).
-    """
+    """A table's first-order orientation error written out: ``label`` (``eq. 26``) and
+    ``orientation_error_rad(error_values, angles_rad) -> (dpsi, dtheta, dgamma)``, radians."""
 
     label: str
     orientation_error_rad: Callable[[np.ndarray, Sequence[float]], np.ndarray]
@@ -136,32 +132,21 @@ class ClosedForm:
 @dataclass(frozen=True, eq=False)
 class ErrorLayout:
     """Where a table's errors sit and what they are called: the table-specific part as data.
-
-    Every field past ``joint_errors`` is optional: a table without it is named and told by the
-    generic rule (its URDF file, its joint names, the regressor, whole turns, no bounds).
+    The fields past ``joint_errors`` are optional (default: the generic rule).
 
     Attributes:
-        factors: ``{placement (joint or fixed joint): ((kind, axis, error name), ...)}``, the
-            elementary motions after each nominal ``<origin>``, in order (see
-            :class:`~turntable_pin.model.chain.ErrorChain`).
-        names: every error, in the order of error vectors.
-        descriptions: ``{error: what it is}``.
+        factors: ``{placement: ((kind, axis, error name), ...)}``, the motions after each nominal
+            ``<origin>``, in order (:class:`~turntable_pin.model.chain.ErrorChain`).
+        names: every error, in the order of error vectors; descriptions: ``{error: words}``.
         joint_errors: ``{joint: (position error, tilt a, tilt b)}``, from the base.
-        label: how reports name the table (``None``: its URDF file).
-        payload_frame: the payload frame the layout is written for (``None``: any).
-        title: how a sentence names the table (``the paper's table``; ``None``: its URDF file's
-            name).
-        angle_names: the name of each joint's angle in keys and texts, from the base (``phi1``,
-            ``phi2``; empty: the joint names).
-        first_order: the first-order model in closed form (``None``: the regressor at zero
-            errors, :meth:`GenericTable.regressor`).
-        domains_deg: ``{orientation angle (psi, theta, gamma): {joint: (lo, hi)}}``, degrees: the
-            joint angles over which the allocation bounds that angle (the paper's eqs. 31-33;
-            a joint not named, or an angle not given: its whole turn).
-        lower_bounds_file: the file of the bundled models folder holding the table's
-            manufacturing lower bounds (``None``: none bundled).
-        effects: the catalogue's effects under the table's own names
-            (:class:`~turntable_pin.model.named_effects.NamedEffect`).
+        label: how reports name the table; title: how a sentence names it (``the paper's
+            table``); payload_frame: the frame it is written for (``None``: any).
+        angle_names: each joint's angle in keys and texts (``phi1``, ``phi2``; empty: the joints).
+        first_order: the first-order model in closed form (``None``: the regressor).
+        domains_deg: ``{psi|theta|gamma: {joint: (lo, hi)}}``, degrees: where the allocation
+            bounds that angle (eqs. 31-33; otherwise whole turns).
+        lower_bounds_file: the bundled manufacturing lower bounds (``None``: none).
+        effects: the catalogue's effects under the table's names (:class:`NamedEffect`).
     """
 
     factors: Mapping[str, tuple[tuple, ...]]
@@ -229,13 +214,9 @@ def generic_layout(chain: ErrorChain, mount: str) -> ErrorLayout:
 
 @dataclass(frozen=True)
 class OrientationError:
-    """The orientation error of the payload at one position.
-
-    Attributes:
-        dR: ``Rd^T Rt`` (eq. 23), 3x3.
-        dpsi_rad, dtheta_rad, dgamma_rad: ``dR[0,2]``, ``dR[1,0]``, ``dR[2,1]`` (eq. 24), radians.
-        payload_origin_m: payload origin in the base frame, metres (zero for a perfect table).
-    """
+    """The orientation error of the payload at one position: ``dR = Rd^T Rt`` (eq. 23), its
+    angles ``dR[0,2]``, ``dR[1,0]``, ``dR[2,1]`` (eq. 24, radians) and the payload origin in the
+    base frame, metres (zero for a perfect table)."""
 
     dR: np.ndarray
     dpsi_rad: float
@@ -246,15 +227,9 @@ class OrientationError:
 
 @dataclass(frozen=True)
 class Identifiable:
-    """What orientation data determine, found on generic positions.
-
-    Attributes:
-        base: the parameters QR with column pivoting picks as identifiable (one per determined
-            combination), in pivot order.
-        combinations: the determined combinations in words (reduced row-echelon form).
-        undetermined: the flat directions in words.
-        no_effect: parameters that never change the orientation (offsets).
-    """
+    """What orientation data on generic positions determine: ``base`` (the parameters QR with
+    column pivoting picks, one per determined combination), the determined ``combinations`` and
+    ``undetermined`` flat directions in words, ``no_effect`` (parameters that never turn)."""
 
     base: tuple[str, ...]
     combinations: tuple[str, ...]
@@ -263,23 +238,18 @@ class Identifiable:
 
 
 class GenericTable:
-    """The generic error model of a URDF turntable (see the module docstring for the rule).
+    """The error model of a URDF turntable (the module docstring's rule, or ``layout``).
 
     Args:
-        urdf_path: the nominal URDF.
-        payload_frame: the payload frame (default: the only leaf of the chain).
-        layout: where the errors sit and what they are called (default: the module's rule).
-        telescope_mount: what the table is, overriding its URDF: ``"altaz"``, ``"equatorial"``
-            or ``"none"`` (a turntable); ``None`` (default): as the URDF declares
-            (:mod:`.mount_declaration`).
+        urdf_path: the nominal URDF; payload_frame: default the only leaf of the chain.
+        telescope_mount: ``"altaz"``, ``"equatorial"`` or ``"none"``, overriding the URDF's
+            declaration (:mod:`.mount_declaration`; ``None``: as declared).
 
     Attributes:
-        urdf_path, payload_frame, nominal_pin_model: the table as read.
-        declared_mount: the mount kind the URDF declares (``None``: it declares none).
-        telescope_mount: the mount kind the table is (``None``: a turntable).
-        chain: its :class:`ErrorChain` with the generic factors.
-        parameter_names: ``<joint>.position``, ``.tilt_a``, ``.tilt_b``, ``.offset_a``,
-            ``.offset_b`` per joint from the base, then ``<mount>.rot_x``, ``.rot_y``, ``.rot_z``.
+        urdf_path, payload_frame, nominal_pin_model, chain (:class:`ErrorChain`), layout.
+        declared_mount, telescope_mount: what the URDF declares, what the table is.
+        parameter_names: the layout's names (generic: ``<joint>.position``, ``.tilt_a``,
+            ``.tilt_b``, ``.offset_a``, ``.offset_b`` per joint, then ``<mount>.rot_x/y/z``).
     """
 
     def __init__(
@@ -399,9 +369,9 @@ class GenericTable:
         return self.layout.first_order.label if self.layout.first_order else "first order"
 
     def first_order_error_rad(self, error_values, angles_rad: Sequence[float]) -> np.ndarray:
-        """``(dpsi, dtheta, dgamma)`` of the first-order model at one position (chain order,
-        radians), radians: the layout's closed form (exact zeros where its matrix has them), else
-        the regressor at zero errors times the errors (the same numbers to rounding)."""
+        """``(dpsi, dtheta, dgamma)`` of the first-order model at one position, radians: the
+        layout's closed form (exact zeros where it has them), else the regressor times the
+        errors (the same numbers to rounding)."""
         values = np.asarray(error_values, dtype=float)
         angles = [float(a) for a in self._angles(angles_rad)]
         if self.layout.first_order is not None:
@@ -409,9 +379,8 @@ class GenericTable:
         return self.regressor([np.array([a]) for a in angles])[0] @ values
 
     def angle_domains_rad(self, angle: str) -> dict[str, tuple[float, float]]:
-        """``{joint: (lo, hi)}``, radians: the joint angles over which the allocation bounds the
-        orientation angle ``angle`` (psi, theta or gamma), as the layout gives them (the paper's
-        eqs. 31-33); the joints not named turn whole."""
+        """``{joint: (lo, hi)}``, radians: where the allocation bounds ``angle`` (psi, theta,
+        gamma), as the layout gives them; the joints not named turn whole."""
         given = self.layout.domains_deg.get(angle, {})
         return {j: (math.radians(lo), math.radians(hi)) for j, (lo, hi) in given.items()}
 
@@ -420,19 +389,14 @@ class GenericTable:
         """The bundled file of the table's manufacturing lower bounds (``None``: none)."""
         if self.layout.lower_bounds_file is None:
             return None
-        from ..core.resources import models_dir
-
         return models_dir() / self.layout.lower_bounds_file
 
     def errors_from_user_units(
         self, entries: Mapping[str, object], *, max_angle_deg: float | None = None
     ) -> np.ndarray:
-        """The error vector from ``{name[_unit]: value}`` in user units (arcsec and mm by
-        default; ``_arcmin``, ``_deg``, ``_rad``, ``_um``, ``_m`` suffixes), with the ranges of
-        :func:`~turntable_pin.model.errors.parse_error_value` (angles up to ``max_angle_deg``,
-        degrees; default the small-error limit ``MAX_ANGULAR_ERROR_DEG``)."""
-        from .errors import MAX_ANGULAR_ERROR_DEG, parse_error_value
-
+        """The error vector from ``{name[_unit]: value}`` in user units
+        (:func:`~turntable_pin.model.errors.parse_error_value`; angles up to ``max_angle_deg``,
+        degrees, default ``MAX_ANGULAR_ERROR_DEG``)."""
         if max_angle_deg is None:
             max_angle_deg = MAX_ANGULAR_ERROR_DEG
 
@@ -452,11 +416,7 @@ class GenericTable:
     def errors_from_yaml(
         self, path: str | Path, *, max_angle_deg: float | None = None
     ) -> np.ndarray:
-        """The error vector of a YAML file of ``name[_unit]: value`` (optionally under
-        ``errors:``), in this table's names (angles up to ``max_angle_deg``, degrees, as in
-        :meth:`errors_from_user_units`)."""
-        from .errors import read_error_mapping
-
+        """:meth:`errors_from_user_units` of a YAML file (optionally under ``errors:``)."""
         try:
             return self.errors_from_user_units(
                 read_error_mapping(path), max_angle_deg=max_angle_deg
@@ -469,8 +429,6 @@ class GenericTable:
     def to_user_units(self, error_values) -> dict[str, float]:
         """``{name_arcsec: value, ..., <joint>.offset_a_mm: value}``: what
         :meth:`errors_from_user_units` reads."""
-        from ..core.units import ARCSEC_PER_RAD, M_PER_MM
-
         out = {}
         for name, value in zip(self.parameter_names, np.asarray(error_values), strict=True):
             if name in self.length_names:
@@ -480,9 +438,8 @@ class GenericTable:
         return out
 
     def payload_pose(self, error_values, angles_rad: Sequence[float]):
-        """The payload pose in the base frame (a ``pinocchio.SE3``) at joint angles (chain
-        order, radians): Pinocchio forward kinematics of the table with these errors in its
-        placements (``None``: the nominal model, the ideal pose)."""
+        """The payload pose (a ``pinocchio.SE3``, base frame) at joint angles (chain order,
+        radians), these errors in the placements (``None``: the ideal pose)."""
         import pinocchio as pin
 
         key = b"" if error_values is None else np.asarray(error_values, float).tobytes()
@@ -535,16 +492,12 @@ class GenericTable:
 
     def write_urdf(self, error_values, path: str | Path) -> Path:
         """Write the URDF with these errors in its joint ``<origin>``s (for plain Pinocchio)."""
-        from .urdf_io import write_error_urdf
-
         return write_error_urdf(self.urdf_path, self.chain, np.asarray(error_values, float), path)
 
     # ---- what orientation data determine ---------------------------------------------------
     def regressor(self, angles_rad: Sequence, error_values=None) -> np.ndarray:
         """d(dpsi, dtheta, dgamma)/d(errors), (N, 3, P), exact (analytic): at zero errors (the
         first-order model) or, given ``error_values`` (P,), of the exact chain at those errors."""
-        from ..core.rotations import axis_rotation
-
         q = [np.atleast_1d(a) for a in self._angles(angles_rad)]
         n = np.broadcast_shapes(*(a.shape for a in q))[0]
         values = None if error_values is None else np.asarray(error_values, dtype=float)

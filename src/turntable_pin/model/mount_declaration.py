@@ -1,16 +1,14 @@
 """What a table says it is: a telescope mount of a named kind, or (saying nothing) a turntable.
 
-A table is a telescope mount only when it says so; its axes are never read to guess it (a
-turntable whose outer axis is vertical and inner axis horizontal has the axes of an alt-az mount,
-and is not one). Its URDF says it with one element, a child of ``<robot>``, that Pinocchio and
-yourdfpy ignore as they ignore ``<gazebo>``::
+A table is a telescope mount only when it says so, never guessed from its axes (a turntable
+may have an alt-az mount's axes). Its URDF says it with a child of ``<robot>`` that Pinocchio and
+yourdfpy ignore::
 
     <turntable_pin mount="altaz"/>          (or mount="equatorial")
 
-The caller may say it instead, and then overrides the URDF (``GenericTable(...,
-telescope_mount=...)``): a kind, or :data:`NO_MOUNT` for a turntable whatever the URDF declares.
-Whether the chain is that mount in the documented frames is checked where the mount's terms are
-used (:func:`turntable_pin.measurement.pointing_terms.mount_kind`).
+The caller may override it (``GenericTable(..., telescope_mount=...)``: a kind, or
+:data:`NO_MOUNT`). The chain is checked where the mount's terms are used
+(:func:`turntable_pin.measurement.pointing_terms.mount_kind`).
 """
 
 from __future__ import annotations
@@ -52,13 +50,9 @@ def declaration_text(kind: str) -> str:
 
 
 def read_mount_declaration(root, path: str | Path) -> str | None:
-    """The mount kind the URDF at ``path`` (its parsed ``<robot>`` element ``root``) declares, or
-    ``None`` when it declares none.
-
-    Raises:
-        InputError: naming ``path``, for a declaration that is not one child of ``<robot>``
-            with exactly the attribute ``mount`` set to one of :data:`MOUNT_KINDS`.
-    """
+    """The mount kind the URDF at ``path`` (its ``<robot>`` element ``root``) declares, or
+    ``None``; :class:`InputError` for a declaration that is not one child of ``<robot>`` with
+    exactly ``mount`` set to one of :data:`MOUNT_KINDS`."""
     found = list(root.iter(DECLARATION_ELEMENT))
     if not found:
         return None
@@ -75,12 +69,8 @@ def read_mount_declaration(root, path: str | Path) -> str | None:
 
 
 def resolve_mount(declared: str | None, given: str | None) -> str | None:
-    """What a table is: ``given`` (a kind, or :data:`NO_MOUNT` for a turntable) when it is not
-    ``None``, else ``declared`` (its URDF's declaration); ``None`` is a turntable.
-
-    Raises:
-        InputError: ``given`` is none of :data:`MOUNT_KINDS`, :data:`NO_MOUNT` or ``None``.
-    """
+    """What a table is (``None``: a turntable): ``given`` (a kind, or :data:`NO_MOUNT`) unless
+    ``None``, else ``declared`` (its URDF's); :class:`InputError` for any other ``given``."""
     if given is None:
         return declared
     if given not in (*MOUNT_KINDS, NO_MOUNT):

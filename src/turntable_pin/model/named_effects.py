@@ -1,10 +1,6 @@
-"""A table's own names and words for the generic effects, as data a layout carries.
-
-An :class:`~turntable_pin.model.generic_table.ErrorLayout` may name some of the measurement
-layer's generic effects (``encoder_harmonics`` of a joint, ``gravity_sag``, ...) in the table's
-own terms: :class:`NamedEffect` says which generic effect a name is, how its parameters are called
-and, in :class:`EffectText`, how the table tells its story. The measurement layer's catalogue
-builds the effects and gives them these names; nothing here computes.
+"""A table's own names and words for the generic effects, as data a layout carries: which
+generic effect a name is (:class:`NamedEffect`), its parameters' names and its story
+(:class:`EffectText`). The measurement layer's catalogue builds the effects; nothing here computes.
 """
 
 from __future__ import annotations
@@ -37,15 +33,11 @@ class NamedEffect:
     """One generic effect under a table's own name.
 
     Attributes:
-        name: the table's name of it (``outer_encoder_harmonics``).
-        kind: the generic effect (``encoder_harmonics``, ``wobble_harmonics``, ``backlash``,
-            ``gravity_sag``, ``base_tilt``, ``thermal_drift``, ``payload_mount``).
-        joints: the joints it is an effect of (per-joint kinds).
-        labels: its parameters' names and descriptions (empty: the class's own).
-        text: its story where the table tells it otherwise than the class (the definitions of
-            the per-joint effects are the class's own: the same words).
-        axes: ``base_tilt``: the base axes it rotates about.
-        tied: ``gravity_sag``: each parameter as entries of the compliance ``K``.
+        name: the table's name (``outer_encoder_harmonics``); kind: the generic effect
+            (``encoder_harmonics``, ``wobble_harmonics``, ``backlash``, ``gravity_sag``, ...).
+        joints: the joints of a per-joint kind; labels: the parameters' names and words (empty:
+            the class's own); text: its story where the table tells it otherwise.
+        axes: ``base_tilt``'s axes; tied: ``gravity_sag``'s parameters as entries of ``K``.
     """
 
     name: str

@@ -3,15 +3,11 @@ names and words of its Table 2 errors and of its effects, and the name map over 
 table.
 
 The bundled ``models/turntable.urdf`` names its joints ``outer_axis`` (phi1, about y) and
-``inner_axis`` (phi2, about z), the fixed ``payload_mount`` and the payload frame ``gyrowheel``;
-:data:`PLACEMENT_ERROR_FACTORS` says which of the nine errors of Table 2 sit in which placement, in
-which order. :data:`PAPER_LAYOUT` is that table as an
-:class:`~turntable_pin.model.generic_table.ErrorLayout`: its names and texts (``the paper's
-table``, phi1 and phi2), its closed first-order form (eq. 26), the phi2 intervals of its
-allocation (eqs. 31-33), its bundled manufacturing lower bounds and its effects' names
-(:data:`PAPER_EFFECTS`). :func:`paper_table` is the generic
-:class:`~turntable_pin.model.generic_table.GenericTable` of the URDF under this layout, the one
-table class every layer reads; no code elsewhere asks which table it has.
+``inner_axis`` (phi2, about z), the fixed ``payload_mount`` and the payload frame ``gyrowheel``.
+:data:`PAPER_LAYOUT` is the table as an :class:`~.generic_table.ErrorLayout` (Table 3's factors,
+its names and texts, eq. 26, the phi2 intervals of eqs. 31-33, its lower bounds and effects);
+:func:`paper_table` is the :class:`~.generic_table.GenericTable` of the URDF under it: no code
+elsewhere asks which table it has.
 """
 
 from __future__ import annotations
@@ -19,8 +15,10 @@ from __future__ import annotations
 from functools import lru_cache
 from pathlib import Path
 
+from ..core.exceptions import InputError
+from ..core.resources import default_urdf_path
 from .errors import ERROR_DESCRIPTIONS, ERROR_NAMES
-from .generic_table import ClosedForm, ErrorLayout
+from .generic_table import ClosedForm, ErrorLayout, GenericTable
 from .named_effects import EffectText, NamedEffect
 from .small_angle import small_angle_orientation_error
 
@@ -78,9 +76,8 @@ PHI2_INTERVALS_DEG: dict[str, tuple[float, float]] = {
     "theta": (0.0, 360.0),  # eq. 32 has no phi2; the whole turn is the same constraint
     "psi": (270.0, 360.0),  # eq. 33
 }
-"""The paper's Omega_k: the phi2 interval ``(lo, hi)`` of each angle's constraint, degrees: where
-every term of eq. 26 is non-negative, so that the largest first-order error is the paper's
-``f_k(phi2, x)``."""
+"""The paper's Omega_k, degrees: the phi2 interval of each angle's constraint, where every term of
+eq. 26 is non-negative (so the largest first-order error is the paper's ``f_k(phi2, x)``)."""
 
 
 def _eq26(error_values, angles_rad):
@@ -223,20 +220,16 @@ PAPER_LAYOUT = ErrorLayout(
     lower_bounds_file="manufacturing_lower_bounds.yaml",
     effects=PAPER_EFFECTS,
 )  # fmt: skip
-"""The paper's table as a layout over the generic table: Table 3's factors under Table 2's names,
-its angles phi1 and phi2, eq. 26, the phi2 intervals of eqs. 31-33, its bundled lower bounds and
-its effects' names."""
+"""The paper's table as a layout over the generic table (see the module docstring)."""
 
 LAYOUTS: tuple[ErrorLayout, ...] = (PAPER_LAYOUT,)
-"""The bundled layouts: a URDF whose chain one of them is written for (its joints and payload
-frame) is read under it (:func:`table_of`)."""
+"""The bundled layouts: a URDF whose joints and payload frame one of them is written for is read
+under it (:func:`table_of`)."""
 
 
 @lru_cache(maxsize=8)
 def _table_under(urdf: str, layout: ErrorLayout, telescope_mount: str | None = None):
     """The table of a URDF under a bundled layout, read once per file, layout, mount and process."""
-    from .generic_table import GenericTable
-
     return GenericTable(urdf, layout=layout, telescope_mount=telescope_mount)
 
 
@@ -244,9 +237,6 @@ def paper_table(urdf_path: str | Path | None = None, telescope_mount: str | None
     """The paper's table: the :class:`~turntable_pin.model.generic_table.GenericTable` of
     ``urdf_path`` (default the bundled ``models/turntable.urdf``) under :data:`PAPER_LAYOUT`
     (read once per file, ``telescope_mount`` and process)."""
-    from ..core.exceptions import InputError
-    from ..core.resources import default_urdf_path
-
     path = Path(urdf_path) if urdf_path is not None else default_urdf_path()
     if not path.is_file():
         raise InputError("no such URDF file", path=path)
@@ -255,9 +245,8 @@ def paper_table(urdf_path: str | Path | None = None, telescope_mount: str | None
 
 def resolve_table(table=None):
     """The table ``table`` stands for, the one place a default table is chosen: ``None``, the
-    bundled table (:func:`paper_table`); an object holding a table as ``.table`` (a
-    :class:`~turntable_pin.model.turntable.TurntableModel`, a position set), that table; else
-    ``table`` itself."""
+    bundled table (:func:`paper_table`); an object holding a table as ``.table`` (a position
+    set), that table; else ``table`` itself."""
     if table is None:
         return paper_table()
     return getattr(table, "table", table)
@@ -269,12 +258,7 @@ def table_of(
     telescope_mount: str | None = None,
 ):
     """The table of a URDF (default the bundled one) under the first of :data:`LAYOUTS` written
-    for its chain (the paper's for the bundled table, or any URDF with the paper's joints and
-    payload frame), else under the generic rule; ``telescope_mount`` says what it is, overriding
-    its URDF (``None``: as the URDF declares;
-    :class:`~turntable_pin.model.generic_table.GenericTable`)."""
-    from .generic_table import GenericTable
-
+    for its chain, else the generic rule; ``telescope_mount`` overrides the URDF's declaration."""
     table = GenericTable(urdf_path or paper_table().urdf_path, payload_frame,
                          telescope_mount=telescope_mount)  # fmt: skip
     layout = next((x for x in LAYOUTS if x.fits(table.joint_names, table.payload_frame)), None)

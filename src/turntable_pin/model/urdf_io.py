@@ -4,6 +4,7 @@ yourdfpy is also a second, independent forward-kinematics library: :class:`Yourd
 evaluates the same orientation error from a URDF without Pinocchio, for cross-checks.
 """
 
+# yourdfpy is imported inside functions: import turntable_pin stays light
 from __future__ import annotations
 
 import warnings
@@ -13,6 +14,7 @@ import numpy as np
 
 from ..core.exceptions import InputError, ModelError
 from ..core.files import check_input_file, write_atomic
+from ..core.resources import default_urdf_path
 from ..core.sizes import MAX_URDF_FILE_BYTES
 from .chain import ErrorChain
 
@@ -39,14 +41,8 @@ def _load_yourdfpy(path: str | Path):
 def write_error_urdf(
     urdf_path: str | Path, chain: ErrorChain, error_values: np.ndarray, path: str | Path
 ) -> Path:
-    """Write the nominal URDF ``urdf_path`` with ``chain``'s error transforms in its joint origins.
-
-    Args:
-        urdf_path: the nominal URDF (never overwritten).
-        chain: the error chain read off that URDF.
-        error_values: the errors in ``chain.error_names`` order (rad, m).
-        path: the output file, written atomically.
-    """
+    """Write the nominal URDF ``urdf_path`` (never overwritten) to ``path`` (atomically) with the
+    error transforms of ``chain`` (read off it) for ``error_values`` in its joint origins."""
     path, urdf_path = Path(path), Path(urdf_path)
     if path.exists() and path.resolve() == urdf_path.resolve():
         raise InputError("refusing to overwrite the input URDF", path=path)
@@ -60,15 +56,9 @@ def write_error_urdf(
 
 
 class YourdfpyTurntable:
-    """Orientation error of a URDF turntable computed with yourdfpy (independent of Pinocchio).
-
-    Args:
-        urdf_path: the URDF with errors in its placements.
-        nominal_urdf_path: the URDF giving the ideal orientation (default: the bundled nominal
-            file, ``models/turntable.urdf``).
-        joints: the revolute joints from the base (default the paper's ``outer_axis``,
-            ``inner_axis``); payload_frame: the payload frame (default ``gyrowheel``).
-    """
+    """Orientation error of ``urdf_path`` (errors in its placements) against
+    ``nominal_urdf_path`` (default the bundled table) with yourdfpy, independent of Pinocchio;
+    ``joints`` from the base and ``payload_frame`` default to the paper's."""
 
     def __init__(
         self,
@@ -77,8 +67,6 @@ class YourdfpyTurntable:
         joints: tuple[str, ...] = ("outer_axis", "inner_axis"),
         payload_frame: str = "gyrowheel",
     ) -> None:
-        from ..core.resources import default_urdf_path
-
         self.joints, self.payload_frame = tuple(joints), payload_frame
         self.actual = _load_yourdfpy(urdf_path)
         self.nominal = _load_yourdfpy(nominal_urdf_path or default_urdf_path())

@@ -1,4 +1,4 @@
-"""Figures of a design (``turntable-pin design --plots DIR``): where to measure, and how well.
+"""Figures of a design (its plots folder): where to measure, and how well.
 
 - ``design_positions.png``: the chosen positions over the joints' ranges (one panel per pair of
   joints; one joint: its angle against the order of measurement), with the 30-degree grid within
@@ -16,18 +16,25 @@ import numpy as np
 from ..design.identify import IdentifyDesign
 from .figures import pyplot, save_png
 
-__all__ = ["plot_design_positions", "plot_design_standard_errors", "write_identify_plots"]
+__all__ = [
+    "joint_label",
+    "joint_range_deg",
+    "plot_design_positions",
+    "plot_design_standard_errors",
+    "write_identify_plots",
+]
 
 _LABEL_CHARS = 48
 """Longest combination name shown on an axis (longer ones are cut, with an ellipsis)."""
 
 
-def _axis_label(space, k: int) -> str:
+def joint_label(space, k: int) -> str:
+    """The axis label of joint ``k`` of a design space: ``phiK <joint> (deg)``."""
     r = space.ranges[k]
     return f"phi{r.index} {r.joint} (deg)"
 
 
-def _range(space, k: int) -> tuple[float, float]:
+def joint_range_deg(space, k: int) -> tuple[float, float]:
     """Joint k's range with a margin of 3 % (points at the limits stay whole)."""
     r = space.ranges[k]
     low, high = (r.low_deg, r.low_deg + 360.0) if r.full_turn else (r.low_deg, r.high_deg)
@@ -56,8 +63,8 @@ def plot_design_positions(design: IdentifyDesign, path):
         for angle in grid[:, 0]:
             ax.axhline(angle, color="0.85", linewidth=0.8, zorder=0)
         ax.set_xlabel("measurement (order of the run)")
-        ax.set_ylabel(_axis_label(space, 0))
-        ax.set_ylim(*_range(space, 0))
+        ax.set_ylabel(joint_label(space, 0))
+        ax.set_ylim(*joint_range_deg(space, 0))
         ax.legend(fontsize=8, loc="upper right")
     for ax, (a, b) in zip(axes[0], pairs, strict=False):
         for points, marker, colour, label in (
@@ -65,10 +72,10 @@ def plot_design_positions(design: IdentifyDesign, path):
             (chosen, "o", "tab:blue", f"design ({design.n_positions})"),
         ):
             ax.plot(points[:, a], points[:, b], marker, color=colour, markersize=5, label=label)
-        ax.set_xlim(*_range(space, a))
-        ax.set_ylim(*_range(space, b))
-        ax.set_xlabel(_axis_label(space, a))
-        ax.set_ylabel(_axis_label(space, b))
+        ax.set_xlim(*joint_range_deg(space, a))
+        ax.set_ylim(*joint_range_deg(space, b))
+        ax.set_xlabel(joint_label(space, a))
+        ax.set_ylabel(joint_label(space, b))
     effects = " + ".join(("base", *space.effect_names))
     fig.suptitle(
         f"D-optimal positions on {space.table_name}\nfor {effects}\n"

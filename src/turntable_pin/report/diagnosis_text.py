@@ -1,19 +1,16 @@
 """The diagnosis in words: the text rendering of the diagnosis JSON (``Diagnosis.to_dict()``), of
 every family of data (orientation measurements, calibration runs).
 
-The text report, the JSON and the HTML page are three views of one structured result: this module
-reads only the dictionary, never another renderer's output. :func:`verdict_lines` is the verdict
-part, which the HTML report shows in its verdict box; :func:`headline` the one-line verdict both
-reports open with; :func:`family_lines` the parts a family's own data add (a calibration run's
-other side, coefficients and what it tells about the table), each said when the result has it.
-
-A headline effect is a *partial explanation*, not "the missing effect", when the model with
-every accepted effect is still unexplained (it fails the chi2 test, e.g. chi2_reduced 2.7 with
-sigma given, or the structure search still finds a term).
+Text, JSON and HTML are three views of one result: this module reads only the dictionary.
+:func:`headline` is the one-line verdict both reports open with, :func:`verdict_lines` the part
+the HTML shows in its verdict box, :func:`family_lines` what a family's own data add (a run's
+other side, coefficients and table). A headline effect is a *partial explanation* when the model
+with every accepted effect is still unexplained (chi2 test failed, or structure remains).
 """
 
 from __future__ import annotations
 
+from ..core.words import Command, argument, command
 from ..stats.diagnosis_engine import DATA_PLACEHOLDER
 
 __all__ = [
@@ -55,8 +52,11 @@ def _unit(d: dict) -> str:
     return _rms_key(d["base"])[len("rms_") :]
 
 
-def _term_words(term: dict) -> str:
-    return f"{term['term']} ({term['amplitude']:.3g} {term['unit']})"
+def _structure_words(structure: list[dict]) -> str:
+    """The first remaining term (and how many more)."""
+    first = structure[0]
+    more = f" and {len(structure) - 1} more" if len(structure) > 1 else ""
+    return f"{first['term']} ({first['amplitude']:.3g} {first['unit']}){more}"
 
 
 def _still_unexplained(d: dict) -> str:
@@ -64,8 +64,7 @@ def _still_unexplained(d: dict) -> str:
     verdict = d["verdict"]
     structure = verdict["remaining_structure"]
     if structure:
-        more = f" and {len(structure) - 1} more" if len(structure) > 1 else ""
-        return f"structure remains: {_term_words(structure[0])}{more}"
+        return f"structure remains: {_structure_words(structure)}"
     if verdict["fails_fit_test"]:
         return (
             f"the best model still fails the chi2 test (chi2_reduced "
@@ -133,9 +132,8 @@ def _verdict_headline(d: dict) -> str:
     level = f"rms {_number(base[key])} {unit}, chi2_reduced {_number(base['chi2_reduced'])}"
     structure = verdict["remaining_structure"]
     if structure:
-        more = f" and {len(structure) - 1} more" if len(structure) > 1 else ""
         return (
-            f"Unexplained structure: {_term_words(structure[0])}{more} (no catalogued effect) "
+            f"Unexplained structure: {_structure_words(structure)} (no catalogued effect) "
             f"-- {level}"
         )
     if verdict["fails_fit_test"]:
@@ -250,7 +248,7 @@ def _rival_lines(d: dict) -> list[str]:
         lines.append(
             "also significant on top of it: "
             + ", ".join(verdict["also_significant"])
-            + " (--until-explained names every step)"
+            + f" ({argument('until_explained')} names every step)"
         )
     commands = verdict.get("separation_commands", {})
     for name in verdict.get("alternatives", []):
@@ -315,7 +313,7 @@ def _unexplained_lines(d: dict, data: str) -> list[str]:
             effects = [*d.get("best", {}).get("effects", []), *specs]
             lines.append(
                 "  fit with what remains: "
-                + fit_command(data, effects, d.get("refit_command", "fit"))
+                + str(fit_command(data, effects, d.get("refit_command", "fit")))
             )
     else:
         lines.append("unexplained: no (the residuals are consistent with the noise)")
@@ -334,7 +332,7 @@ def _outlier_lines(d: dict) -> list[str]:
     more = f" and {len(outliers) - 10} more" if len(outliers) > 10 else ""
     return [
         f"outliers left out of every fit ({len(outliers)}): {shown}{more}; the rule: "
-        f"{d.get('outlier_rule')}; --keep-outliers keeps them"
+        f"{d.get('outlier_rule')}; {argument('outliers=False')} keeps them"
     ]
 
 
@@ -352,12 +350,9 @@ def _settle(commands: dict, name: str) -> list[str]:
     return [f"    to settle it, design the next positions: {commands[name]}"]
 
 
-def fit_command(data: str, specs: list[str], command: str = "fit") -> str:
-    """The ``turntable-pin fit`` command (``calibrate`` for a run) that adds the inline terms
-    ``specs`` to the model."""
-    import shlex
-
-    return f"turntable-pin {command} {shlex.quote(data)} --effects {shlex.quote(','.join(specs))}"
+def fit_command(data: str, specs: list[str], name: str = "fit") -> Command:
+    """The ``fit`` command (``calibrate`` for a run) that adds the inline terms ``specs``."""
+    return command(name, data, effects=",".join(specs))
 
 
 def other_side_lines(d: dict) -> list[str]:
@@ -383,8 +378,7 @@ def other_side_lines(d: dict) -> list[str]:
     for r in rivals:
         lines.append(f"  {r['effect']} (noise-free misfit chi2 {r['chi2_run']:.2g} here): "
                      f"{r['words']}")  # fmt: skip
-        if r["effect"] in commands:
-            lines.append(f"    to settle it, design the next positions: {commands[r['effect']]}")
+        lines += _settle(commands, r["effect"])
     return lines
 
 

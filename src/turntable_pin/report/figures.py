@@ -4,10 +4,14 @@ Every PNG of the package (allocation, requirement, residual and report figures) 
 :func:`save_png`, at one resolution, written atomically when a path is given.
 """
 
+# matplotlib is imported inside pyplot(): import turntable_pin stays light
 from __future__ import annotations
 
+import io
 from pathlib import Path
 from typing import Any
+
+from ..core.files import write_atomic
 
 __all__ = ["FIGURE_DPI", "pyplot", "save_png"]
 
@@ -26,20 +30,8 @@ def pyplot() -> Any:
 
 
 def save_png(fig: Any, path: str | Path | None = None, *, dpi: int = FIGURE_DPI) -> Any:
-    """Render ``fig`` to PNG and close it.
-
-    Args:
-        fig: a matplotlib figure.
-        path: where to write (atomically); ``None`` returns the PNG bytes instead.
-        dpi: resolution, dots per inch.
-
-    Returns:
-        The path written, or the PNG bytes when ``path`` is ``None``.
-    """
-    import io
-
-    from ..core.files import write_atomic
-
+    """Render the matplotlib ``fig`` to PNG at ``dpi`` and close it: written atomically to
+    ``path`` (returned), or the PNG bytes when ``path`` is ``None``."""
     try:
         if path is None:
             buffer = io.BytesIO()

@@ -1,15 +1,13 @@
 """One self-contained HTML page telling the whole story of a diagnosis, of any family of data.
 
-:func:`diagnosis_html` is the one builder: the one-line verdict first, then the sections the
-family lists in its :class:`~turntable_pin.stats.diagnosis_engine.PageWords` (for a measurement
-file: data, base fit, where it fails with a residual map over both angles, the diagnosis with a
-plot of each term the structure search finds against its variable, the fit with the missing
-effect(s) and the parameters; for a calibration run: base fit, the diagnosis with each effect's
-side, the fit with the effect, the coefficients and the table), each rendered here from the one
-result (``Diagnosis.to_dict()`` and its fits), with every plot embedded once as a base64 PNG (the
-page needs no other file).
+:func:`diagnosis_html` is the one builder: the one-line verdict, then the sections the family
+lists in its :class:`~turntable_pin.stats.diagnosis_engine.PageWords` (data, fits, where it
+fails, the diagnosis, the missing effect and its parameters; a run's coefficients and table),
+each rendered from the one result (``Diagnosis.to_dict()`` and its fits), every plot embedded
+once as a base64 PNG (the page needs no other file).
 """
 
+# matplotlib is imported inside functions: import turntable_pin stays light
 from __future__ import annotations
 
 import base64
@@ -226,13 +224,9 @@ def _base(page: _Page, heading: str) -> list[str]:
         parts = [
             _heading(heading)
             + "<p>"
-            + (
-                "The nine turntable errors of the paper (the intersection error never changes "
-                "the orientation, so eight angles are fitted)."
-                if measured.paper
-                else f"The {len(measured.base_names)} rotation errors of the table "
-                f"{html.escape(measured.label)} (its offsets never change the orientation)."
-            )
+            + f"The {len(measured.base_names)} rotation errors of {html.escape(measured.title)} "
+            f"(its {len(measured.chain.error_names) - len(measured.base_names)} offset error(s) "
+            "never change the orientation)."
             + f" The data determine {page.d['base']['rank']} combinations of them:</p>",
             _combinations(result),
         ]

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..core.files import write_bytes_atomic
 from ..measurement.residuals import ResidualAnalysis, ResidualSet, analyse_residuals
+from ..stats.diagnosis_engine import residual_sets
 from ..stats.structure_search import FoundTerm
 from .figures import pyplot, save_png
 
@@ -38,10 +39,8 @@ DIRECTION_MARKERS = {1.0: ("^", "forward"), -1.0: ("v", "backward")}
 
 
 def direction_of(rs: ResidualSet, variable: str) -> np.ndarray | None:
-    """The approach direction (+1/-1 per position) that goes with an angle variable, or None.
-
-    The angle ``phi<k>_deg`` goes with the column ``dir<k>``; any other variable with none.
-    """
+    """The approach direction (``dir<k>``, +1/-1 per position) of the angle ``phi<k>_deg``, or
+    None."""
     if not variable.startswith("phi") or not variable.endswith("_deg"):
         return None
     value = rs.others.get("dir" + variable[3:-4])
@@ -63,9 +62,8 @@ def measured_counts(sets: Sequence[ResidualSet]) -> np.ndarray:
 def not_measured_note(
     components: Sequence[str], counts, n_positions: int, separator: str = "\n"
 ) -> str:
-    """Words naming the components not measured at every position, one per ``separator`` (a
-    line of a figure's title by default), e.g. ``"dgamma: not measured"`` or ``"dpsi: measured
-    at 40 of 80 positions"``; ``""`` when every component was measured everywhere."""
+    """The components not measured everywhere, one per ``separator``: ``"dgamma: not measured"``,
+    ``"dpsi: measured at 40 of 80 positions"``; ``""`` when none."""
     words = []
     for name, count in zip(components, counts, strict=True):
         if count == 0:
@@ -104,34 +102,7 @@ def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
         sigma = np.nanmedian(np.abs(rs.residuals / np.where(rs.normalised == 0, 1, rs.normalised)))
         for row, (name, _) in enumerate(variables):
             ax = axes[row, col]
-            x = np.arange(rs.residuals.shape[0]) if name == "position" else (
-                rs.angles_deg.get(name, rs.others.get(name))
-            )  # fmt: skip
-            direction = direction_of(rs, name)
-            for i, comp in enumerate(rs.components):
-                if not measured[i]:
-                    continue
-                jitter = 0.0 if name == "position" else (i - 1) * 0.01 * (np.ptp(x) or 1.0)
-                if direction is None:
-                    ax.plot(x + jitter, rs.residuals[:, i], ".", ms=3, color=COLOURS[i],
-                            label=comp)  # fmt: skip
-                    continue
-                for sign, (marker, _) in DIRECTION_MARKERS.items():
-                    pick = direction == sign
-                    ax.plot(x[pick] + jitter, rs.residuals[pick, i], marker, ms=3.5,
-                            color=COLOURS[i], mfc=COLOURS[i] if sign > 0 else "none", mew=0.7,
-                            label=comp if sign > 0 else None)  # fmt: skip
-            if rs.outliers is not None:
-                # Left out of every fit: drawn at their value, or at the edge when beyond it.
-                shown = np.clip(rs.outliers, -0.97 * limit, 0.97 * limit)
-                for i in range(len(rs.components)):
-                    pick = np.isfinite(rs.outliers[:, i])
-                    ax.plot(x[pick], shown[pick, i], "x", ms=6, mew=1.4, color="black",
-                            label="outlier (left out)" if i == 0 else None)  # fmt: skip
-            if direction is not None:
-                ax.text(0.01, 0.02, "filled up-triangles: approached forward (dir +1)\n"
-                        "open down-triangles: backward (dir -1)", transform=ax.transAxes,
-                        fontsize=6.5, color="#555")  # fmt: skip
+            _residual_points(ax, rs, name, measured, limit)
             if np.isfinite(sigma) and sigma > 0:
                 for s in (-k_sigma * sigma, k_sigma * sigma):
                     ax.axhline(s, color="grey", lw=0.7, ls="--")
@@ -147,6 +118,39 @@ def residual_figure(sets: Sequence[ResidualSet], k_sigma: float = 3.0) -> bytes:
                 ax.legend(fontsize=7, loc="upper right", ncol=3)
     fig.tight_layout()
     return save_png(fig)
+
+
+def _residual_points(ax, rs: ResidualSet, name: str, measured, limit: float) -> None:
+    """The residuals of ``rs`` against the variable ``name`` (by approach direction when it has
+    one) and its outliers, on ``ax``."""
+    x = np.arange(rs.residuals.shape[0]) if name == "position" else (
+        rs.angles_deg.get(name, rs.others.get(name))
+    )  # fmt: skip
+    direction = direction_of(rs, name)
+    for i, comp in enumerate(rs.components):
+        if not measured[i]:
+            continue
+        jitter = 0.0 if name == "position" else (i - 1) * 0.01 * (np.ptp(x) or 1.0)
+        if direction is None:
+            ax.plot(x + jitter, rs.residuals[:, i], ".", ms=3, color=COLOURS[i],
+                    label=comp)  # fmt: skip
+            continue
+        for sign, (marker, _) in DIRECTION_MARKERS.items():
+            pick = direction == sign
+            ax.plot(x[pick] + jitter, rs.residuals[pick, i], marker, ms=3.5,
+                    color=COLOURS[i], mfc=COLOURS[i] if sign > 0 else "none", mew=0.7,
+                    label=comp if sign > 0 else None)  # fmt: skip
+    if rs.outliers is not None:
+        # Left out of every fit: drawn at their value, or at the edge when beyond it.
+        shown = np.clip(rs.outliers, -0.97 * limit, 0.97 * limit)
+        for i in range(len(rs.components)):
+            pick = np.isfinite(rs.outliers[:, i])
+            ax.plot(x[pick], shown[pick, i], "x", ms=6, mew=1.4, color="black",
+                    label="outlier (left out)" if i == 0 else None)  # fmt: skip
+    if direction is not None:
+        ax.text(0.01, 0.02, "filled up-triangles: approached forward (dir +1)\n"
+                "open down-triangles: backward (dir -1)", transform=ax.transAxes,
+                fontsize=6.5, color="#555")  # fmt: skip
 
 
 def harmonics_figure(analyses: Sequence[ResidualAnalysis]) -> bytes:
@@ -213,16 +217,10 @@ def map_limit(sets: Sequence[ResidualSet]) -> float:
 
 
 def residual_map_figure(sets: Sequence[ResidualSet], limit: float | None = None) -> bytes | None:
-    """PNG: the residual of each component over the first two angles (maps), or None.
-
-    One row per residual set, one panel per measured component (dpsi, dtheta, dgamma; those no
-    set measured are named above the maps, not drawn), the first angle across, the second up,
-    one square per measured position coloured by its residual (repeats averaged; a hollow grey
-    square where the component was not measured), on one symmetric colour scale (``limit`` in
-    the sets' unit; default: the largest residual, :func:`map_limit`), so structure in both
-    angles at once shows. None when the sets have fewer than two angles (only the first two are
-    mapped: the others are averaged over).
-    """
+    """PNG: the residual of each measured component over the first two angles, one row per set
+    (repeats averaged; hollow grey: not measured there), on one symmetric colour scale
+    (``limit``, default :func:`map_limit`), so structure in both angles shows; None with fewer
+    than two angles."""
     names = list(sets[0].angles_deg)
     if len(names) < 2:
         return None
@@ -269,12 +267,8 @@ def residual_map_figure(sets: Sequence[ResidualSet], limit: float | None = None)
 
 
 def structure_term_figure(term: FoundTerm) -> bytes:
-    """PNG: one found term against its variable: the data that show it, the fit, the noise.
-
-    Points: the partial residual projected at each record onto the direction the term enters the
-    observations along (:meth:`FoundTerm.projection`); line: the fitted term; grey band: +-1 sigma
-    of one point (the noise floor).
-    """
+    """PNG: one found term against its variable: the partial residual projected on the term's
+    direction (:meth:`FoundTerm.projection`), the fitted term, and +-1 sigma of one point."""
     plt = pyplot()
 
     pr = term.projection()
@@ -348,8 +342,6 @@ def write_diagnosis_plots(diagnosis, directory: str | Path) -> list[Path]:
     """The figures of a diagnosis of any family into ``directory``: the residuals before and
     (with a missing effect) after, their harmonics and maps (:func:`write_residual_plots`) and
     each structure term (:func:`write_structure_plots`); returns the paths."""
-    from ..stats.diagnosis_engine import residual_sets
-
     base, best = residual_sets(diagnosis)
     sets = [base, best] if diagnosis.steps else [base]
     return [*write_residual_plots(sets, directory),

@@ -1,5 +1,5 @@
 """Figures of the orientation requirement, as PNG files: Figures 4 and 5 of the paper for an
-:class:`OrientationRequirement`, and the calibration design (``design --calibrate``).
+:class:`OrientationRequirement`, and the calibration design (``design_calibration``).
 
 Figure 4: the rate-sensing errors over the orientation-error angles: the surfaces Gamma1
 (``dwx`` over dpsi, dtheta) and Gamma2 (``dwy`` over dtheta, dgamma) with the plane ``w_m``, and
@@ -10,13 +10,14 @@ the box that holds (every angle at its limit at once).
 planes of both, and the search.
 """
 
+# matplotlib is imported inside functions: import turntable_pin stays light
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
-from ..calibration.positions import PositionSet
+from ..calibration.positions import PositionSet, position_inputs
 from ..calibration.rate_error import rate_errors_at_angles_dph
 from ..calibration.requirement import MAX_ANGLE_RAD, OrientationRequirement
 from ..core.units import deg_to_rad, rad_to_deg
@@ -172,12 +173,10 @@ def write_requirement_figures(result: OrientationRequirement, directory: str | P
     ]
 
 
-# ---- the calibration design (design --calibrate) ----------------------------------------------
+# ---- the calibration design (design_calibration) ----------------------------------------------
 def _gravity_map(positions: PositionSet) -> tuple[np.ndarray, np.ndarray]:
     """Where gravity points in the payload frame at each position: its azimuth
     ``atan2(a_y, a_x)`` (deg) and ``a_z`` (g): an equal-area map of the sphere."""
-    from ..calibration.positions import position_inputs
-
     a = position_inputs(positions, 0.0).specific_force_g
     return np.degrees(np.arctan2(a[:, 1], a[:, 0])), a[:, 2]
 

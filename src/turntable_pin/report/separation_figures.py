@@ -1,4 +1,4 @@
-"""Figures of a separation design (``turntable-pin design --separate A,B --plots DIR``).
+"""Figures of a separation design (:func:`~turntable_pin.design.separate.design_separate`).
 
 - ``separate_positions.png``: the chosen positions over the joints' ranges (one panel per pair of
   joints; one joint: its angle against the order of measurement), each coloured by its share of
@@ -16,17 +16,10 @@ from pathlib import Path
 import numpy as np
 
 from ..design.separate import SeparationDesign
+from .design_figures import joint_label, joint_range_deg
 from .figures import pyplot, save_png
 
 __all__ = ["plot_separation_positions", "plot_separation_power", "write_separate_plots"]
-
-
-def _limits(design: SeparationDesign, k: int) -> tuple[float, float]:
-    """Joint k's range with a margin of 3 % (points at the limits stay whole)."""
-    r = design.space.ranges[k]
-    low, high = (r.low_deg, r.low_deg + 360.0) if r.full_turn else (r.low_deg, r.high_deg)
-    pad = 0.03 * max(high - low, 1.0)
-    return low - pad, high + pad
 
 
 def plot_separation_positions(design: SeparationDesign, path):
@@ -40,7 +33,7 @@ def plot_separation_positions(design: SeparationDesign, path):
         1, max(len(pairs), 1), figsize=(4.8 * max(len(pairs), 1) + 1.2, 4.4), squeeze=False
     )
     share = design.misfit_by_position.sum(axis=1)
-    labels = [f"phi{r.index} {r.joint} (deg)" for r in space.ranges]
+    labels = [joint_label(space, k) for k in range(n_joints)]
     dots = None
     if not pairs:  # one joint: the angle of each position in the order first measured
         ax = axes[0, 0]
@@ -50,7 +43,7 @@ def plot_separation_positions(design: SeparationDesign, path):
                           c=share, cmap="viridis", label="design")  # fmt: skip
         ax.set_xlabel("position (order of the run; 0: measured)")
         ax.set_ylabel(labels[0])
-        ax.set_ylim(*_limits(design, 0))
+        ax.set_ylim(*joint_range_deg(space, 0))
     for ax, (a, b) in zip(axes[0], pairs, strict=False):
         grid, measured, chosen = space.grid_deg, design.measured_deg, design.positions_deg
         ax.plot(grid[:, a], grid[:, b], "+", color="0.8", markersize=4, label="30-degree grid")
@@ -60,8 +53,8 @@ def plot_separation_positions(design: SeparationDesign, path):
         dots = ax.scatter(chosen[:, a], chosen[:, b], c=share, cmap="viridis", s=30,
                           edgecolors="k", linewidths=0.4,
                           label=f"design ({design.n_positions})")  # fmt: skip
-        ax.set_xlim(*_limits(design, a))
-        ax.set_ylim(*_limits(design, b))
+        ax.set_xlim(*joint_range_deg(space, a))
+        ax.set_ylim(*joint_range_deg(space, b))
         ax.set_xlabel(labels[a])
         ax.set_ylabel(labels[b])
     if dots is not None:

@@ -1,13 +1,9 @@
 """Headless Chromium as a tool: render a local HTML page to PNG, or check that its images load.
 
-Every run gets a throw-away profile (``--user-data-dir``) and ``XDG_CONFIG_HOME``/``XDG_CACHE_HOME``
-in a temporary folder (its ``TMPDIR`` too), so the browser writes nothing into the home folder.
-The browser is started in its own process group and the whole group is killed and waited for, and
-the folder removed, before a function returns, even on error, timeout or interruption (SIGINT,
-SIGTERM: see :mod:`turntable_pin.core.interrupts`): no browser process outlives the call.
-
-Chromium is an external program (Debian package ``chromium``), not a Python dependency; without
-it these functions raise :class:`BrowserNotFoundError`, which the CLI turns into exit status 2.
+Every run gets a throw-away profile and XDG/TMPDIR folders in a temporary folder (nothing goes
+into the home folder); its processes are killed and waited for, and the folder removed, before a
+function returns, also on error, timeout or interruption. Chromium (Debian package ``chromium``)
+is an external program; without it these functions raise :class:`BrowserNotFoundError`.
 """
 
 from __future__ import annotations
@@ -189,14 +185,9 @@ def _grown(table: list[ProcessInfo], members: set[int]) -> set[int]:
 
 
 def related_processes(marker: str) -> list[int]:
-    """Live processes belonging to one browser run.
-
-    Chromium calls ``setsid`` (so killing the launcher's process group is not enough) and its
-    crash handler detaches into a session of its own; but every one of them, the launcher
-    included, names the run's temporary folder (``marker``) on its command line, or descends from
-    or shares a session or group with a process that does. Starting from the marker, not from a
-    pid, means a pid reused after the launcher was reaped is never mistaken for ours.
-    """
+    """Live processes of one browser run: those naming its folder (``marker``) on their command
+    line, and their descendants, sessions and groups (Chromium calls ``setsid``). Starting from the
+    marker, not a pid, never mistakes a reused pid for ours."""
     table = [p for p in process_table() if p.alive]
     members = _grown(table, {p.pid for p in table if marker in p.cmdline})
     alive = {p.pid for p in table}
@@ -475,16 +466,9 @@ def check_page_images(
     timeout_s: float = 60.0,
     chromium: str | None = None,
 ) -> ImageLoadReport:
-    """Load a local HTML page in headless Chromium and report whether every ``<img>`` loaded.
-
-    A copy of the page, with a ``<base>`` pointing at the page's folder so relative image paths
-    resolve as in the original, gets a script that records ``complete``/``naturalWidth`` of every
-    image at the window's ``load`` event into the DOM, which ``--dump-dom`` prints. The original
-    page is only read.
-
-    Raises:
-        BrowserError: the page is missing or never finished loading.
-    """
+    """Load a local HTML page in headless Chromium and report whether every ``<img>`` loaded: a
+    copy (with a ``<base>`` at the page's folder) records each image's state at ``load`` into the
+    DOM, which Chromium dumps. :class:`BrowserError` when the page is missing or never loads."""
     page = Path(page).resolve()
     try:
         source = page.read_text(encoding="utf-8")

@@ -9,6 +9,7 @@ whose start was cut short is found in the process table (a child of ours running
 ``meshcat.servers.zmqserver``) and killed.
 """
 
+# meshcat and zmq are imported inside functions: import turntable_pin stays light
 from __future__ import annotations
 
 import contextlib
@@ -75,15 +76,8 @@ def import_meshcat():
 
 
 class MeshcatServer:
-    """Context manager: a running meshcat server and a ``meshcat.Visualizer`` connected to it.
-
-    Example::
-
-        with MeshcatServer() as server:
-            server.visualizer["box"].set_object(...)
-            print(server.url)
-        # the server process is gone here
-    """
+    """Context manager: a running meshcat server and a ``meshcat.Visualizer`` connected to it
+    (``server.visualizer``, ``server.url``); the server process is gone after the block."""
 
     def __init__(self) -> None:
         self.visualizer = None

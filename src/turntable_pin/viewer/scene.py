@@ -1,24 +1,19 @@
 """The 3-D scene of a table (the paper's or any URDF's, 1 to 3 joints), errors magnified, meshcat.
 
-Arc-second errors are invisible at true size, so the scene is built from the errors magnified
-(angles by K, lengths by their own factor, see :class:`Exaggeration`): the table's Pinocchio model
-whose joint placements carry the magnified errors (:meth:`GenericTable.pinocchio_model`), drawn by
-Pinocchio's ``MeshcatVisualizer`` from the URDF's visuals. Default magnification: K makes the
-largest angular error :data:`DEFAULT_DISPLAY_ANGLE_RAD` (3 degrees; 2700 for 4 arcsec); the lengths
-(the paper's ``deta``, a generic table's offsets) get the same factor but no more than shows the
-largest as :data:`DEFAULT_DISPLAY_OFFSET_M` (30 mm, a sixth of the paper table's radius) -- a
-0.2 mm offset times 2700 would put the inner axis half a metre off the table.
+Arc-second errors are invisible at true size, so the scene is the table's Pinocchio model with
+the errors magnified (:class:`Exaggeration`) in its placements, drawn by Pinocchio's
+``MeshcatVisualizer`` from the URDF's visuals. By default K makes the largest angular error
+:data:`DEFAULT_DISPLAY_ANGLE_RAD` (3 degrees; 2700 for 4 arcsec); lengths get the same factor but
+at most :data:`DEFAULT_DISPLAY_OFFSET_M` (30 mm): 0.2 mm times 2700 would put the inner axis half
+a metre off the table.
 
-Besides the machine the scene shows the ideal payload frame ``Rd`` (thin dark triad) and the actual
-one ``Rt`` (red/green/blue triad, x/y/z), and the ideal (dark) and actual (magenta) axis of the last
-joint (the paper's inner axis), so wobble and orthogonality errors (the axis tilts), the
-intersection error (the axis moves) and the mount errors (the triads part) can be told apart.
-
-The paper's table is :func:`~turntable_pin.model.paper_table.paper_table` given to the same class
-(the default). A ``<mesh>`` visual whose file cannot be found is drawn as a 5 cm box
-(:func:`primitive_urdf`); :attr:`SetupScene.warnings` says which, for the command line to print.
+The scene also shows the ideal payload frame ``Rd`` (thin dark triad) and the actual one ``Rt``
+(red/green/blue, x/y/z), and the ideal (dark) and actual (magenta) axis of the last joint, so axis
+tilts, axis offsets and mount errors (the triads part) can be told apart. A ``<mesh>`` whose file
+is missing is drawn as a 5 cm box (:func:`primitive_urdf`), said in :attr:`SetupScene.warnings`.
 """
 
+# pinocchio and meshcat are imported inside functions: import turntable_pin stays light
 from __future__ import annotations
 
 import math
@@ -34,6 +29,7 @@ from ..core.interrupts import temporary_folder
 from ..core.rotations import rot_x, rot_z
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD, M_PER_MM
 from ..model.errors import TurntableErrors
+from ..model.generic_table import perpendicular_directions
 from ..model.paper_table import resolve_table
 
 __all__ = [
@@ -119,10 +115,9 @@ class Exaggeration:
         *,
         table=None,
     ) -> Exaggeration:
-        """The default magnification of ``errors`` (a :class:`TurntableErrors` or the error
-        vector of ``table``, default the paper's; see the module docstring); either factor given
-        is used as is. A perfect table is shown at true size; a table whose only errors are
-        lengths shows the largest as ``display_offset_m``."""
+        """The default magnification of ``errors`` (module docstring); a factor given is used
+        as is. A perfect table is shown at true size; with lengths only, the largest is shown as
+        ``display_offset_m``."""
         table = resolve_table(table)
         values = np.abs(_error_vector(table, errors))
         is_length = _is_length(table)
@@ -163,11 +158,8 @@ def _is_length(table) -> np.ndarray:
 
 @dataclass(frozen=True)
 class ScenePoses:
-    """Base-frame poses (4x4) of the scene's markers at one position of the magnified model.
-
-    The axis poses are the last joint's frame (after its rotation) turned so that their z axis is
-    the joint's axis, along which the rod is drawn (the paper's inner axis: the joint frame).
-    """
+    """Base-frame poses (4x4) of the scene's markers at one position of the magnified model; an
+    axis pose is the last joint's frame turned so that its z axis (the rod) is the joint's axis."""
 
     actual_payload: np.ndarray
     ideal_payload: np.ndarray
@@ -193,8 +185,6 @@ _Y_ONTO = (_rotation(rot_z(-math.pi / 2)), np.eye(4), _rotation(rot_x(math.pi / 
 
 def _z_onto(axis) -> np.ndarray:
     """A 4x4 rotation taking z onto the unit ``axis`` (z itself for the z axis)."""
-    from ..model.generic_table import perpendicular_directions
-
     a = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
     u, _ = perpendicular_directions(a)
     y_onto_axis = _rotation(np.column_stack([u, a, np.cross(u, a)]))
@@ -308,21 +298,16 @@ class SetupScene:
     """A table with magnified errors, ready to be drawn into a meshcat visualizer.
 
     Args:
-        errors: the true errors: a :class:`TurntableErrors` (the paper's table) or the table's
-            error vector (rad, m); default none.
-        table: a :class:`~turntable_pin.model.generic_table.GenericTable` (default: the paper's,
-            :func:`~turntable_pin.model.paper_table.paper_table`).
+        errors: a :class:`TurntableErrors` (the paper's table) or the table's error vector
+            (rad, m); default none.
+        table: a ``GenericTable`` (default: the paper's).
         exaggeration: the magnification (default: :meth:`Exaggeration.for_errors`).
-        camera_target_m, camera_offset_m: where the camera looks (base frame, metres) and its
-            eye's offset from there (default: the whole table from north-east and above).
+        camera_target_m, camera_offset_m: where the camera looks and the eye's offset from there
+            (base frame, metres; default: the whole table from north-east and above).
 
-    The angles of :meth:`poses`, :meth:`legend` and :meth:`set_position` are the joint angles in
-    chain order, radians, one per joint (the paper's table: phi1, phi2).
-
-    Attributes:
-        table, error_values, exaggeration, display_values (the magnified errors);
-        pin_model: the table's Pinocchio model with the magnified errors; visual_model: its
-        visuals; warnings: what the command line should say (missing meshes).
+    Angles (:meth:`poses`, :meth:`legend`, :meth:`set_position`) are joint angles, chain order,
+    radians. Attributes: table, error_values, exaggeration, display_values (magnified),
+    pin_model (with them), visual_model, warnings (missing meshes).
     """
 
     def __init__(
@@ -471,12 +456,9 @@ class SetupScene:
 
     def set_camera(self, target_m=None, offset_m=None) -> None:
         """Aim the camera at ``target_m`` from ``target_m + offset_m`` (base frame, metres;
-        default: the scene's ``camera_target_m``, ``camera_offset_m``).
-
-        pinocchio's ``setCameraPosition`` fails with meshcat 0.3.2; the camera is a node whose
-        transform is the orbit target and whose child's ``position`` is the eye offset, in the
-        viewer's y-up frame: ``[dx, dz, -dy]``.
-        """
+        default the scene's). pinocchio's ``setCameraPosition`` fails with meshcat 0.3.2: the
+        camera node's transform is the target, its child's ``position`` the eye offset in the
+        viewer's y-up frame, ``[dx, dz, -dy]``."""
         target_m = self.camera_target_m if target_m is None else target_m
         dx, dy, dz = self.camera_offset_m if offset_m is None else offset_m
         self._vis["/Cameras/default"].set_transform(_translation(target_m))

@@ -1,11 +1,9 @@
 """A PNG of the setup scene of any table, rendered headless: meshcat's static page in Chromium.
 
-The scene is drawn into a short-lived meshcat server, which hands back a self-contained HTML page
-(``static_html``, about 0.9 MB, works offline); the server is then stopped. The page gets the
-controls panel hidden and a legend, and headless Chromium renders it to PNG
-(:func:`turntable_pin.viewer.browser.screenshot_html`). Neither the server nor the browser nor a
-temporary folder outlives the call, also on error or interruption. The same scene and angles give
-a byte-identical PNG (virtual time).
+A short-lived meshcat server hands back a self-contained HTML page (``static_html``, about
+0.9 MB); with the controls hidden and a legend, headless Chromium renders it to PNG
+(:func:`~turntable_pin.viewer.browser.screenshot_html`). Nothing outlives the call, also on error
+or interruption; the same scene and angles give a byte-identical PNG (virtual time).
 """
 
 from __future__ import annotations
@@ -114,25 +112,18 @@ def _check_size(name: str, value: int) -> int:
 
 def render_snapshot(
     scene: SetupScene,
-    *position_and_output,
+    angles_rad,
+    output: str | Path,
+    *,
     width: int = 800,
     height: int = 600,
     legend: bool = True,
     timeout_s: float = 60.0,
 ) -> SnapshotResult:
-    """Render ``scene`` at a position to a PNG file: ``render_snapshot(scene, phi1_rad,
-    phi2_rad, output)`` or ``render_snapshot(scene, angles_rad, output)`` (the joint angles in
-    chain order, radians, one per joint).
-
-    Raises:
-        MeshcatMissingError: meshcat is not installed.
-        BrowserNotFoundError: no Chromium (names the Debian package ``chromium``).
-        BrowserError: Chromium failed or timed out.
-    """
-    if len(position_and_output) < 2:
-        raise InputError("render_snapshot: give the joint angles and the output file")
-    *position, output = position_and_output
-    angles = tuple(float(a) for a in np.concatenate([np.ravel(a) for a in position]))
+    """Render ``scene`` at the joint angles ``angles_rad`` (chain order, radians) to the PNG file
+    ``output``. Raises :class:`MeshcatMissingError`, :class:`BrowserNotFoundError` (naming the
+    Debian package ``chromium``) or :class:`BrowserError` (Chromium failed or timed out)."""
+    angles = tuple(float(a) for a in np.ravel(angles_rad))
     joints = scene.table.joint_names
     if len(angles) != len(joints):
         raise InputError(
