@@ -37,12 +37,7 @@ from turntable_pin.allocation.monte_carlo import (
     run_chain_monte_carlo,
     sample_errors,
 )
-from turntable_pin.allocation.solver import (
-    OrientationLimits,
-    allocate_table_tolerances,
-    allocate_tolerances,
-    angular_names,
-)
+from turntable_pin.allocation.solver import OrientationLimits, allocate_tolerances
 from turntable_pin.core.blas_threads import one_blas_thread
 from turntable_pin.core.resources import models_dir
 from turntable_pin.core.units import ARCMIN_PER_RAD
@@ -74,12 +69,12 @@ def _setup(case: str) -> dict:
             "phi1_drops": True,
         }
     table = GenericTable(models_dir() / THREE_AXIS)
-    allocation = allocate_table_tolerances(
-        table, OrientationLimits.from_arcmin(*THREE_LIMITS_ARCMIN)
+    allocation = allocate_tolerances(
+        OrientationLimits.from_arcmin(*THREE_LIMITS_ARCMIN), table=table
     )
     return {
         "chain": table.chain,
-        "names": angular_names(table),
+        "names": table.angular_names,
         "upper": allocation.upper_bounds_rad,
         "lower": allocation.lower_bounds_rad,
         "limits": allocation.limits,

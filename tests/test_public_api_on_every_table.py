@@ -185,47 +185,28 @@ def _calls():
             capability.ManufacturingCapability.from_yaml(c.lower_bounds_yaml, c.table)),
         "allocation.monte_carlo.run_monte_carlo": lambda c: monte_carlo.run_monte_carlo(
             c.allocation.upper_bounds_rad, c.limits, 20, 1, table=c.table, **mc_options),
-        "allocation.monte_carlo.run_table_monte_carlo": lambda c: (
-            monte_carlo.run_table_monte_carlo(
-                c.table, c.allocation.upper_bounds_rad, c.limits, 20, 1, **mc_options)),
-        "allocation.monte_carlo.sample_table_errors": lambda c: monte_carlo.sample_table_errors(
-            c.table, np.random.default_rng(0), 5, c.allocation.upper_bounds_rad,
-            c.allocation.lower_bounds_rad),
         "allocation.sensitivity.default_grid_step_deg": lambda c: (
             sensitivity.default_grid_step_deg(c.table)),
-        "allocation.sensitivity.grid_angles_rad": lambda c: sensitivity.grid_angles_rad(
+        "allocation.sensitivity.check_grid_step": lambda c: sensitivity.check_grid_step(
             c.table, 30.0),
         "allocation.sensitivity.grid_axes_rad": lambda c: sensitivity.grid_axes_rad(c.table, 30.0),
         "allocation.sensitivity.sensitivities": lambda c: sensitivity.sensitivities(
             c.table, grid_step_deg=30.0, error_values=c.values),
-        "allocation.sensitivity.table_sensitivities": lambda c: (
-            sensitivity.table_sensitivities(c.table, 30.0)),
         "allocation.solver.Allocation.__init__": lambda c: solver.Allocation(
             c.allocation.upper_bounds_rad, c.limits, "model", c.allocation.weights,
             c.allocation.subproblems, c.allocation.worst_case_rad,
             capability=c.allocation.capability, table=c.table,
             sensitivities=c.allocation.sensitivities),
-        "allocation.solver.allocate_table_tolerances": lambda c: (
-            solver.allocate_table_tolerances(c.table, c.limits, "paper", grid_step_deg=30.0)),
         "allocation.solver.allocate_tolerances": lambda c: c.allocation,
         "allocation.solver.allocation_weights": lambda c: {
             s: solver.allocation_weights(s, c.allocation.sensitivities, c.table)
             for s in solver.WEIGHT_SCHEMES},
         "allocation.solver.angle_rows": lambda c: solver.angle_rows(c.table, 30.0),
-        "allocation.solver.angular_names": lambda c: solver.angular_names(c.table),
-        "allocation.solver.table_lower_bounds": lambda c: solver.table_lower_bounds(
-            c.table, c.lower_bounds_yaml),
         "allocation.solver.default_orientation_limits": lambda c: (
             solver.default_orientation_limits(positions="grid:45", table=c.table)),
         # calibration
         "calibration.drift_fit.calibrate_run": lambda c: drift_fit.calibrate_run(
             c.run_path, np.radians(45.0), c.table),
-        "calibration.positions.JointPositions.grid": lambda c: (
-            positions.JointPositions.grid(c.table, 120.0)),
-        "calibration.positions.JointPositions.parse": lambda c: (
-            positions.JointPositions.parse(c.table, "grid:120")),
-        "calibration.positions.JointPositions.from_csv": lambda c: (
-            positions.JointPositions.from_csv(c.table, c.positions_csv)),
         "calibration.positions.PositionSet.__init__": lambda c: positions.PositionSet(
             c.positions.angles_rad, table=c.table),
         "calibration.positions.PositionSet.grid": lambda c: c.positions,
@@ -332,7 +313,6 @@ NOT_A_TABLE = {
     "model.chain.apply_chain_errors",
     "model.chain.joint_axis",
     # Result objects holding what a call above made (walked through that call's result).
-    "allocation.solver.TableAllocation.__init__",
     "measurement.fit.OrientationFit.__init__",
     "measurement.fit.OrientationFitProblem.__init__",
 }

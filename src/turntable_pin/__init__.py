@@ -13,7 +13,6 @@ from .core.lazy import lazy_exports
 _EXPORTS = {
     "ANGULAR_ERROR_NAMES": "model.errors",
     "Allocation": "allocation.solver",
-    "AverageSensitivities": "allocation.sensitivity",
     "CalibrationResult": "calibration.drift_fit",
     "Diagnosis": "stats.model_selection",
     "EFFECTS": "measurement.effects",
@@ -38,6 +37,7 @@ _EXPORTS = {
     "OrientationRequirement": "calibration.requirement",
     "PositionSet": "calibration.positions",
     "RateErrorResult": "calibration.rate_error",
+    "Sensitivities": "allocation.sensitivity",
     "SetupScene": "viewer.scene",
     "SimulatedMeasurements": "measurement.simulation",
     "TurntableErrors": "model.errors",
@@ -94,7 +94,7 @@ if TYPE_CHECKING:  # names for static checkers; nothing is imported at run time
     from .allocation.capability import ManufacturingCapability  # noqa: F401
     from .allocation.monte_carlo import MonteCarloResult, run_monte_carlo  # noqa: F401
     from .allocation.sensitivity import (  # noqa: F401
-        AverageSensitivities,
+        Sensitivities,
         average_sensitivities,
         sensitivity_matrix,
     )

@@ -14,18 +14,14 @@ from turntable_pin.allocation.capability import ManufacturingCapability
 from turntable_pin.allocation.monte_carlo import (
     run_chain_monte_carlo,
     run_monte_carlo,
-    run_table_monte_carlo,
     sample_errors,
-    sample_table_errors,
 )
 from turntable_pin.allocation.solver import (
     OrientationLimits,
-    allocate_table_tolerances,
     allocate_tolerances,
-    angular_names,
-    grid_angles_rad,
 )
 from turntable_pin.core.exceptions import InputError
+from turntable_pin.core.turn_grid import full_turn_grid_deg
 from turntable_pin.model.angles import ANGLE_ENTRIES
 from turntable_pin.model.chain import compose_rotation
 from turntable_pin.model.errors import ANGULAR_ERROR_NAMES
@@ -172,10 +168,10 @@ LIMITS = OrientationLimits.from_arcmin(0.6, 0.25, 0.45)
 )
 def test_draws_stay_within_their_bounds(urdf, rng):
     table = GenericTable(MODELS / urdf)
-    names = angular_names(table)
+    names = table.angular_names
     upper = rng.uniform(1e-5, 1e-4, len(names))
     lower = upper * rng.uniform(0.0, 0.9, len(names))
-    values = sample_table_errors(table, rng, 4000, upper, lower)
+    values = sample_errors(rng, 4000, upper, lower, table.chain.error_names, names)
     columns = [table.parameter_names.index(n) for n in names]
     drawn = np.abs(values[:, columns])
     assert np.all(drawn >= lower) and np.all(drawn <= upper)
@@ -186,44 +182,46 @@ def test_draws_stay_within_their_bounds(urdf, rng):
 
 def test_each_tables_worst_angles_equal_its_exact_chain():
     table = GenericTable(MODELS / "two_axis_vertical_outer.urdf")
-    allocation = allocate_table_tolerances(table, LIMITS, grid_step_deg=30.0)
-    result = run_table_monte_carlo(
-        table, allocation.upper_bounds_rad, LIMITS, 5, seed=11, grid_step_deg=30.0, progress=False
-    )
+    allocation = allocate_tolerances(LIMITS, table=table, grid_step_deg=30.0)
+    result = run_monte_carlo(
+        allocation.upper_bounds_rad, LIMITS, 5, seed=11, table=table, grid_step_deg=30.0,
+        progress=False,
+    )  # fmt: skip
     # Redraw the same tables (chunk seeds as the run spawns them) and evaluate rotation_error.
     seed_seq = np.random.SeedSequence(11).spawn(1)[0]
-    values = sample_table_errors(
-        table, np.random.default_rng(seed_seq), 5, allocation.upper_bounds_rad, np.zeros(9)
-    )
-    grid = grid_angles_rad(table, 30.0)
+    values = sample_errors(
+        np.random.default_rng(seed_seq), 5, allocation.upper_bounds_rad, np.zeros(9),
+        table.chain.error_names, table.angular_names,
+    )  # fmt: skip
+    grid = list(np.radians(full_turn_grid_deg(30.0, 30.0)).T)
     for k in range(5):
         d_r = table.rotation_error(values[k], grid)  # (N, 3, 3)
         angles = np.stack([d_r[:, i, j] for i, j in ANGLE_ENTRIES], axis=1)
         np.testing.assert_allclose(result.worst_rad[k], np.abs(angles).max(axis=0), atol=1e-15)
     assert result.all_within
     assert np.all(result.max_abs_rad <= allocation.worst_case_rad * (1 + 1e-3))
-    assert set(result.to_dict()["upper_bounds_arcmin"]) == set(angular_names(table))
+    assert set(result.to_dict()["upper_bounds_arcmin"]) == set(table.angular_names)
 
 
 def test_a_run_depends_on_its_seed_only():
     table = GenericTable(MODELS / "single_axis_rate_table.urdf")
-    upper = np.full(len(angular_names(table)), 2e-5)
+    upper = np.full(len(table.angular_names), 2e-5)
     runs = [
-        run_table_monte_carlo(table, upper, LIMITS, 1200, seed=5, workers=w, progress=False)
+        run_monte_carlo(upper, LIMITS, 1200, seed=5, table=table, workers=w, progress=False)
         for w in (1, 2)
     ]
     np.testing.assert_array_equal(runs[0].worst_rad, runs[1].worst_rad)
-    other = run_table_monte_carlo(table, upper, LIMITS, 1200, seed=6, progress=False)
+    other = run_monte_carlo(upper, LIMITS, 1200, seed=6, table=table, progress=False)
     assert not np.array_equal(other.worst_rad, runs[0].worst_rad)
 
 
 def test_bad_bounds_are_refused():
     table = GenericTable(MODELS / "single_axis_rate_table.urdf")
     with pytest.raises(InputError, match="expected 6 upper and lower bounds"):
-        run_table_monte_carlo(table, np.ones(8) * 1e-5, LIMITS, 10, 0, progress=False)
+        run_monte_carlo(np.ones(8) * 1e-5, LIMITS, 10, 0, table=table, progress=False)
     with pytest.raises(InputError, match="between 0 and its upper bound"):
-        run_table_monte_carlo(
-            table, np.full(6, 1e-5), LIMITS, 10, 0, lower_bounds_rad=np.full(6, 2e-5),
+        run_monte_carlo(
+            np.full(6, 1e-5), LIMITS, 10, 0, table=table, lower_bounds_rad=np.full(6, 2e-5),
             progress=False,
         )  # fmt: skip
 
@@ -270,7 +268,7 @@ def test_paper_tables_over_several_chunks_equal_their_exact_chain(allocation, wo
 
 def test_three_axis_tables_over_several_chunks_equal_their_exact_chain():
     table = GenericTable(MODELS / "three_axis_imu_table.urdf")
-    names = angular_names(table)
+    names = table.angular_names
     upper = np.linspace(1e-5, 3e-4, len(names))
     lower = 0.2 * upper
     result = run_chain_monte_carlo(
@@ -288,10 +286,10 @@ def test_three_axis_tables_over_several_chunks_equal_their_exact_chain():
 
 def test_a_three_axis_run_does_not_depend_on_the_number_of_workers():
     table = GenericTable(MODELS / "three_axis_imu_table.urdf")
-    upper = np.full(len(angular_names(table)), 5e-5)
+    upper = np.full(len(table.angular_names), 5e-5)
     runs = [
-        run_table_monte_carlo(
-            table, upper, LIMITS, 1100, seed=2, grid_step_deg=45.0, workers=w, progress=False
+        run_monte_carlo(
+            upper, LIMITS, 1100, seed=2, table=table, grid_step_deg=45.0, workers=w, progress=False
         )
         for w in (1, 2)
     ]
@@ -311,8 +309,8 @@ def test_the_paper_run_is_the_run_of_the_papers_chain(allocation):
     assert paper.to_dict()["urdf"].endswith("turntable.urdf")
     assert chain.to_dict()["grid_step_deg"] == {"outer_axis": 10.0, "inner_axis": 2.0}
     # one schema: the paper's run and a URDF table's have the same keys
-    other = run_table_monte_carlo(
-        GenericTable(MODELS / "single_axis_rate_table.urdf"),
-        np.full(6, 1e-5), LIMITS, 10, 0, progress=False,
+    other = run_monte_carlo(
+        np.full(6, 1e-5), LIMITS, 10, 0, table=GenericTable(MODELS / "single_axis_rate_table.urdf"),
+        progress=False,
     )  # fmt: skip
     assert set(other.to_dict()) == set(paper.to_dict())

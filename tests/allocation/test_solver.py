@@ -20,7 +20,6 @@ from turntable_pin import ANGULAR_ERROR_NAMES, InfeasibleError, InputError
 from turntable_pin.allocation.capability import ManufacturingCapability
 from turntable_pin.allocation.solver import (
     MIN_LIMIT_ARCSEC,
-    ORIENTATION_ANGLES,
     PHI2_INTERVALS_RAD,
     OrientationLimits,
     allocate_tolerances,
@@ -31,6 +30,7 @@ from turntable_pin.allocation.solver import (
     paper_eq16_limits,
 )
 from turntable_pin.core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, arcmin_to_rad, arcsec_to_rad
+from turntable_pin.model.angles import ANGLE_SYMBOLS
 from turntable_pin.model.paper_table import paper_table, table_of
 
 TABLE4_ARCMIN = {
@@ -93,7 +93,7 @@ def test_paper_table_is_a_near_optimal_feasible_point():
     paper = np.array([TABLE4_ARCMIN[n] for n in ANGULAR_ERROR_NAMES])
     ours = allocate_tolerances(PAPER_LIMITS, "paper")
     w = allocation_weights("paper")
-    for k, name in enumerate(ORIENTATION_ANGLES):
+    for k, name in enumerate(ANGLE_SYMBOLS):
         idx = models[name].members
         value, _ = interval_max(*models[name].coefficients(paper), *PHI2_INTERVALS_RAD[name])
         assert value <= PAPER_LIMITS.to_dict()[name] + 1e-12
@@ -164,7 +164,7 @@ def independent_kkt(sub, model):
     """Multipliers and residual recomputed from the solution alone (dense-grid maximiser)."""
     idx = model.members
     x = sub.solution_rad * ARCMIN_PER_RAD
-    lo, hi = sub.interval_rad
+    lo, hi = sub.domain_rad[-1]
     grid = np.linspace(lo, hi, 200001)
     full = np.zeros(8)
     full[idx] = x
@@ -250,7 +250,7 @@ def test_interval_max_equals_dense_brute_force(a, b, c, lo, width):
     assert c + a * math.cos(where) + b * math.sin(where) == pytest.approx(value, abs=1e-12)
 
 
-@pytest.mark.parametrize("angle", ORIENTATION_ANGLES)
+@pytest.mark.parametrize("angle", ANGLE_SYMBOLS)
 def test_worst_case_equals_brute_force_over_angles_and_sign_corners(angle, rng):
     model = linear_angle_models()[angle]
     phi2 = np.linspace(0, 2 * np.pi, 36001)
@@ -303,7 +303,7 @@ def test_model_weights_are_inverse_two_over_pi():
 # ---- limits and reporting --------------------------------------------------------------------
 def test_paper_limits_are_eq16():
     limits = paper_eq16_limits().to_dict()
-    for name in ORIENTATION_ANGLES:
+    for name in ANGLE_SYMBOLS:
         assert limits[name] == pytest.approx(0.027 * 60, rel=1e-12)
 
 
@@ -318,9 +318,9 @@ def test_default_limits_are_the_calibration_layers_requirement():
     assert limits.gamma_rad == requirement.box.gamma_rad
     # the paper's planes on request
     planes = default_orientation_limits(requirement="planes")
-    assert planes.psi_rad == requirement.I_psi_rad
-    assert planes.theta_rad == requirement.I_theta_rad
-    assert planes.gamma_rad == requirement.I_gamma_rad
+    assert planes.psi_rad == requirement.psi_rad
+    assert planes.theta_rad == requirement.theta_rad
+    assert planes.gamma_rad == requirement.gamma_rad
     # a looser calibration accuracy allows a larger orientation error
     assert np.all(default_orientation_limits(0.02).as_array() > limits.as_array())
 
@@ -343,8 +343,8 @@ def test_report_and_dict_name_everything():
     allocation = allocate_tolerances(PAPER_LIMITS, "paper")
     d = allocation.to_dict()
     assert set(d["upper_bounds_arcmin"]) == set(ANGULAR_ERROR_NAMES)
-    assert set(d["worst_case_arcmin"]) == set(ORIENTATION_ANGLES)
-    assert d["J"]["total"] == pytest.approx(sum(d["J"][n] for n in ORIENTATION_ANGLES))
+    assert set(d["worst_case_arcmin"]) == set(ANGLE_SYMBOLS)
+    assert d["J"]["total"] == pytest.approx(sum(d["J"][n] for n in ANGLE_SYMBOLS))
     text = allocation.report()
     assert "dalpha_x2" in text and "active" in text and "KKT" in text
 
@@ -357,7 +357,7 @@ def test_the_solvers_rows_on_the_papers_table_are_eq26():
     models = linear_angle_models()
     rng = np.random.default_rng(3)
     points = rng.uniform(-np.pi, np.pi, (50, 2))
-    for name in ORIENTATION_ANGLES:
+    for name in ANGLE_SYMBOLS:
         idx = models[name].members
         assert rows[name].error_names == tuple(ANGULAR_ERROR_NAMES[i] for i in idx)
         eq26 = models[name].basis_values(points[:, 1])[:, idx]
@@ -390,7 +390,7 @@ def test_the_papers_quarter_turns_give_what_the_whole_turns_give(monkeypatch):
     quarter = allocate_tolerances(PAPER_LIMITS, "paper")
     whole = GenericTable(paper_table().urdf_path, layout=replace(PAPER_LAYOUT, domains_deg={}))
     turn = allocate_tolerances(PAPER_LIMITS, "paper", table=whole)
-    assert turn.subproblems["psi"].interval_rad == (0.0, 2 * np.pi)
+    assert turn.subproblems["psi"].domain_rad[-1] == (0.0, 2 * np.pi)
     np.testing.assert_allclose(turn.upper_bounds_rad, quarter.upper_bounds_rad, rtol=1e-12)
 
 
@@ -398,7 +398,7 @@ def test_the_papers_quarter_turns_give_what_the_whole_turns_give(monkeypatch):
 def test_the_worst_case_is_lemma1s_closed_form(weights):
     allocation = allocate_tolerances(PAPER_LIMITS, weights)
     models = linear_angle_models()
-    for k, name in enumerate(ORIENTATION_ANGLES):
+    for k, name in enumerate(ANGLE_SYMBOLS):
         closed = lemma1_closed_form(models[name], allocation.upper_bounds_rad)
         assert allocation.worst_case_rad[k] == pytest.approx(closed, rel=1e-14)
 

@@ -8,17 +8,16 @@ import pytest
 from scipy.optimize import minimize
 
 from conftest import REPO_DIR, write_file
-from turntable_pin.allocation.sensitivity import grid_angles_rad
+from turntable_pin.allocation.capability import ManufacturingCapability
+from turntable_pin.allocation.sensitivity import check_grid_step
 from turntable_pin.allocation.solver import (
-    ORIENTATION_ANGLES,
     OrientationLimits,
-    allocate_table_tolerances,
+    allocate_tolerances,
     angle_rows,
-    angular_names,
-    table_lower_bounds,
 )
 from turntable_pin.core.exceptions import InfeasibleError, InputError
 from turntable_pin.core.units import arcsec_to_rad
+from turntable_pin.model.angles import ANGLE_SYMBOLS
 from turntable_pin.model.generic_table import GenericTable
 
 MODELS = REPO_DIR / "models"
@@ -41,7 +40,7 @@ def full_grid(table, step_deg: float):
 
 def first_order_worst(table, upper_rad, step_deg: float) -> np.ndarray:
     """``max over a full grid of sum_i |C_ki(q)| UB_i`` per angle, from the regressor (3,)."""
-    columns = [table.parameter_names.index(n) for n in angular_names(table)]
+    columns = [table.parameter_names.index(n) for n in table.angular_names]
     finite = np.where(np.isfinite(upper_rad), upper_rad, 0.0)
     worst = np.zeros(3)
     for grid in full_grid(table, step_deg):
@@ -53,9 +52,9 @@ def first_order_worst(table, upper_rad, step_deg: float) -> np.ndarray:
 @pytest.mark.parametrize("urdf", OTHER_TABLES)
 def test_the_allocation_is_admissible_and_named_by_the_tables_errors(urdf):
     table = GenericTable(MODELS / urdf)
-    allocation = allocate_table_tolerances(table, LIMITS, grid_step_deg=30.0)
-    assert allocation.error_names == angular_names(table)
-    assert set(allocation.to_dict()["upper_bounds_arcmin"]) == set(angular_names(table))
+    allocation = allocate_tolerances(LIMITS, table=table, grid_step_deg=30.0)
+    assert allocation.error_names == table.angular_names
+    assert set(allocation.to_dict()["upper_bounds_arcmin"]) == set(table.angular_names)
     assert np.all(np.isfinite(allocation.upper_bounds_rad))
     assert np.all(allocation.upper_bounds_rad > 0)
     # Independent check of the worst case: every sign corner at every grid position (first order)
@@ -65,7 +64,7 @@ def test_the_allocation_is_admissible_and_named_by_the_tables_errors(urdf):
     assert np.all(allocation.worst_case_rad <= LIMITS.as_array() * (1 + 1e-9))
     # Each angle's own problem reaches its limit (the bounds are as large as allowed).
     for k, sub in enumerate(allocation.subproblems.values()):
-        assert sub.worst_rad == pytest.approx(LIMITS.as_array()[k], rel=1e-6)
+        assert sub.constraint_rad == pytest.approx(LIMITS.as_array()[k], rel=1e-6)
     assert table.urdf_path.name in allocation.report()
 
 
@@ -78,7 +77,7 @@ def test_every_point_of_the_continuous_domain_meets_the_limits(urdf, dense_deg):
     """The constraint is semi-infinite: with the default grids (1, 5, 15 deg) the final bounds
     meet the limits on a much denser grid, and the limits are used up (not conservative)."""
     table = GenericTable(MODELS / urdf)
-    allocation = allocate_table_tolerances(table, LIMITS)
+    allocation = allocate_tolerances(LIMITS, table=table)
     dense = first_order_worst(table, allocation.upper_bounds_rad, dense_deg)
     limits = LIMITS.as_array()
     assert np.all(dense <= limits * (1 + 1e-9))
@@ -100,12 +99,12 @@ def test_the_solvers_rows_are_the_regressors(urdf, rng):
     rows = angle_rows(table, 30.0)
     points = rng.uniform(-np.pi, np.pi, (20, len(table.joint_names)))
     exact = table.regressor(list(points.T))
-    for k, name in enumerate(ORIENTATION_ANGLES):
+    for k, name in enumerate(ANGLE_SYMBOLS):
         columns = [table.parameter_names.index(n) for n in rows[name].error_names]
         np.testing.assert_allclose(rows[name].values(points), exact[:, k, columns], atol=1e-14)
         others = [
             table.parameter_names.index(n)
-            for n in angular_names(table)
+            for n in table.angular_names
             if n not in rows[name].error_names
         ]
         assert np.all(np.abs(exact[:, k, others]) < 1e-12)  # the errors left out do not move it
@@ -118,7 +117,7 @@ def test_each_problem_is_solved_to_its_optimum(urdf, dense_deg):
     """SLSQP on every row of a much denser grid solves a relaxation of the continuous problem: its
     optimum is never above ours and only as far below as the grid spacing allows."""
     table = GenericTable(MODELS / urdf)
-    allocation = allocate_table_tolerances(table, LIMITS, weights="equal", grid_step_deg=45.0)
+    allocation = allocate_tolerances(LIMITS, weights="equal", table=table, grid_step_deg=45.0)
     c = np.concatenate([np.abs(table.regressor(grid)) for grid in full_grid(table, dense_deg)])
     for k, sub in enumerate(allocation.subproblems.values()):
         columns = [table.parameter_names.index(n) for n in sub.error_names]
@@ -149,17 +148,19 @@ def test_lower_bounds_in_the_tables_names(tmp_path):
         "lower_bounds:\n  tilt_axis.tilt_a: 1\n  imu_mount.rot_z_arcmin: 0.01\n",
         "lb.yaml",
     )
-    lower = table_lower_bounds(table, path)
-    names = angular_names(table)
+    capability = ManufacturingCapability.from_yaml(path, table)
+    lower = capability.lower_bounds_rad
+    names = table.angular_names
     assert lower[names.index("tilt_axis.tilt_a")] == pytest.approx(arcsec_to_rad(1.0))
     assert lower[names.index("imu_mount.rot_z")] == pytest.approx(arcsec_to_rad(0.6))
-    allocation = allocate_table_tolerances(table, LIMITS, lower_bounds_rad=lower, grid_step_deg=30)
+    allocation = allocate_tolerances(LIMITS, capability=capability, table=table, grid_step_deg=30)
     assert np.all(allocation.upper_bounds_rad >= lower)
     too_big = write_file(tmp_path, "lower_bounds:\n  tilt_axis.tilt_a_arcmin: 2\n", "big.yaml")
     with pytest.raises(InfeasibleError, match="lower bounds alone"):
-        allocate_table_tolerances(
-            table, LIMITS, lower_bounds_rad=table_lower_bounds(table, too_big), grid_step_deg=30
-        )
+        allocate_tolerances(
+            LIMITS, capability=ManufacturingCapability.from_yaml(too_big, table), table=table,
+            grid_step_deg=30,
+        )  # fmt: skip
     for text, fragment in [
         ("lower_bounds:\n  dphi_y1: 1\n", "unknown error name 'dphi_y1'"),
         ("lower_bounds:\n  tilt_axis.offset_a_mm: 1\n", "not an angular error"),
@@ -167,16 +168,16 @@ def test_lower_bounds_in_the_tables_names(tmp_path):
         ("bounds: {}\n", "lower_bounds"),
     ]:
         with pytest.raises(InputError, match=fragment):
-            table_lower_bounds(table, write_file(tmp_path, text, "bad.yaml"))
+            ManufacturingCapability.from_yaml(write_file(tmp_path, text, "bad.yaml"), table)
 
 
 def test_bad_grid_and_weights_are_refused():
     table = GenericTable(MODELS / "three_axis_imu_table.urdf")
-    with pytest.raises(InputError, match="coarser --grid-step-deg"):
-        grid_angles_rad(table, 1.0)
+    with pytest.raises(InputError, match="coarser grid_step_deg"):
+        check_grid_step(table, 1.0)
     with pytest.raises(InputError, match=r"\[1e-06, 90\] degrees"):
-        grid_angles_rad(table, 0.0)
+        check_grid_step(table, 0.0)
     with pytest.raises(InputError, match="choose one of model, paper, equal"):
-        allocate_table_tolerances(table, LIMITS, weights="figure8")
+        allocate_tolerances(LIMITS, weights="figure8", table=table)
     # the paper's Figure 8 rule is one rule: any table takes it
-    assert allocate_table_tolerances(table, LIMITS, weights="paper").weights_scheme == "paper"
+    assert allocate_tolerances(LIMITS, weights="paper", table=table).weights_scheme == "paper"

@@ -4,14 +4,10 @@ beyond its physical range (absurd outputs used to give nan residuals with exit s
 import pytest
 
 from conftest import EXAMPLES_DIR, cli, write_file
-from turntable_pin.calibration.drift_fit import (
-    MAX_RUN_OUTPUT_DPH,
-    MIN_RUN_SIGMA_DPH,
-    calibrate_run,
-    simulate_run,
-)
+from turntable_pin.calibration.drift_fit import calibrate_run, simulate_run
 from turntable_pin.calibration.gyrowheel import GyroWheelModel
 from turntable_pin.calibration.positions import PositionSet, position_inputs
+from turntable_pin.calibration.run import MAX_RUN_OUTPUT_DPH, MIN_RUN_SIGMA_DPH
 from turntable_pin.core.exceptions import InputError
 
 RUN = (EXAMPLES_DIR / "gyrowheel_run_example.csv").read_text()

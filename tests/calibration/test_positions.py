@@ -17,7 +17,6 @@ from turntable_pin.calibration.drift_fit import calibrate_run, write_simulated_r
 from turntable_pin.calibration.gyrowheel import GyroWheelModel
 from turntable_pin.calibration.positions import (
     EARTH_RATE_DPH,
-    JointPositions,
     PositionSet,
     position_inputs,
 )
@@ -129,13 +128,12 @@ def test_the_paper_grid_is_the_generic_grid_of_the_paper_urdf(spec):
     assert paper.name == generic.name
 
 
-def test_the_earlier_name_joint_positions_takes_the_table_first():
+def test_positions_of_a_given_table_by_spec_grid_and_angles():
     table = GenericTable(REPO_DIR / "models" / "three_axis_imu_table.urdf")
-    a = JointPositions.parse(table, "grid:90x45x120")
-    b = PositionSet.parse("grid:90x45x120", table)
+    a = PositionSet.parse("grid:90x45x120", table)
+    b = PositionSet.grid(90, 45, 120, table=table)
     np.testing.assert_array_equal(a.angles_rad, b.angles_rad)
-    np.testing.assert_array_equal(JointPositions.grid(table, 90, 45, 120).angles_rad, b.angles_rad)
-    assert JointPositions(b.angles_rad, table, "b").table is table
+    assert PositionSet(b.angles_rad, table=table, name="b").table is table
 
 
 # --- any table ----------------------------------------------------------------------------------

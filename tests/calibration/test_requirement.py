@@ -92,13 +92,13 @@ def test_theta_is_shared_from_the_binding_plane(requirement):
     theta_x = requirement.rectangles[0].half_widths_rad[1]
     theta_y = requirement.rectangles[1].half_widths_rad[0]
     # The shared theta may be stepped in once by 2 _MARGIN (where rounding puts its corner out).
-    assert requirement.I_theta_rad == pytest.approx(min(theta_x, theta_y), rel=3 * _MARGIN, abs=0)
+    assert requirement.theta_rad == pytest.approx(min(theta_x, theta_y), rel=3 * _MARGIN, abs=0)
     assert requirement.binding_plane == ("psi_theta" if theta_x <= theta_y else "theta_gamma")
     # the free side of the other plane can only have grown
     if requirement.binding_plane == "psi_theta":
-        assert requirement.I_gamma_rad >= requirement.rectangles[1].half_widths_rad[1] * (1 - 1e-9)
+        assert requirement.gamma_rad >= requirement.rectangles[1].half_widths_rad[1] * (1 - 1e-9)
     else:
-        assert requirement.I_psi_rad >= requirement.rectangles[0].half_widths_rad[0] * (1 - 1e-9)
+        assert requirement.psi_rad >= requirement.rectangles[0].half_widths_rad[0] * (1 - 1e-9)
 
 
 def test_box_corners_are_reported(requirement):
@@ -121,7 +121,7 @@ def test_to_dict_states_the_set_up(requirement):
     for key in ("I_psi_deg", "I_theta_deg", "I_gamma_deg", "positions", "latitude_deg"):
         assert key in d
     assert d["latitude_deg"] == pytest.approx(45.75)
-    assert d["I_psi_deg"] == pytest.approx(np.degrees(requirement.I_psi_rad))
+    assert d["I_psi_deg"] == pytest.approx(np.degrees(requirement.psi_rad))
 
 
 def test_bad_accuracy():

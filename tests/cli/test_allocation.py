@@ -55,8 +55,8 @@ def test_default_limits_are_the_orientation_requirement(capsys):
     )
     _, planes = json_of(capsys, ["allocate", "--json", "--requirement", "planes"])
     assert planes["limits_arcmin"] == pytest.approx(
-        {"psi": req.I_psi_rad * ARCMIN_PER_RAD, "theta": req.I_theta_rad * ARCMIN_PER_RAD,
-         "gamma": req.I_gamma_rad * ARCMIN_PER_RAD}
+        {"psi": req.psi_rad * ARCMIN_PER_RAD, "theta": req.theta_rad * ARCMIN_PER_RAD,
+         "gamma": req.gamma_rad * ARCMIN_PER_RAD}
     )  # fmt: skip
     assert out["weights"] == "model"
     _, looser = json_of(capsys, ["allocate", "--json", "--accuracy-dph", "0.02"])

@@ -10,8 +10,7 @@ import pytest
 from conftest import EXAMPLES_DIR, REPO_DIR, cli, needs_chromium, write_file
 from turntable_pin.allocation.solver import (
     OrientationLimits,
-    allocate_table_tolerances,
-    angular_names,
+    allocate_tolerances,
 )
 from turntable_pin.calibration.drift_fit import simulate_run
 from turntable_pin.calibration.gyrowheel import GyroWheelModel
@@ -101,9 +100,9 @@ def test_tables_that_cannot_calibrate_the_gyrowheel_exit_2(command, urdf, fragme
 def test_allocate_names_the_tables_errors_and_meets_the_limits(urdf):
     out = _json("allocate", "--urdf", urdf, "--limits-arcmin", LIMITS, "--grid-step-deg", "30")
     table = GenericTable(urdf)
-    assert list(out["upper_bounds_arcmin"]) == list(angular_names(table))
-    expected = allocate_table_tolerances(
-        table, OrientationLimits.from_arcmin(0.6, 0.25, 0.45), grid_step_deg=30.0
+    assert list(out["upper_bounds_arcmin"]) == list(table.angular_names)
+    expected = allocate_tolerances(
+        OrientationLimits.from_arcmin(0.6, 0.25, 0.45), table=table, grid_step_deg=30.0
     )
     np.testing.assert_allclose(
         list(out["upper_bounds_arcmin"].values()),
@@ -130,7 +129,7 @@ def test_montecarlo_on_a_table_stays_within_the_limits(urdf):
     out = _json("montecarlo", "--urdf", urdf, "--limits-arcmin", LIMITS, "-n", "300",
                 "--seed", "4", "--grid-step-deg", "45")  # fmt: skip
     assert out["seed"] == 4 and out["all_within"]
-    assert list(out["upper_bounds_arcmin"]) == list(angular_names(GenericTable(urdf)))
+    assert list(out["upper_bounds_arcmin"]) == list(GenericTable(urdf).angular_names)
 
 
 def test_montecarlo_scaled_beyond_the_bounds_exceeds_a_limit():

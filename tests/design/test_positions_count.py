@@ -34,13 +34,11 @@ def test_calibrate_refuses_more_positions_than_candidates_at_once(space, n):
 @pytest.mark.parametrize("design", ["identify", "separate"])
 def test_identify_and_separate_refuse_before_the_rows_are_built(space, design, monkeypatch):
     import turntable_pin.design.identify as identify
-    import turntable_pin.design.separate as separate
 
     def never(*args, **kwargs):
         raise AssertionError("the design's rows were built")
 
-    monkeypatch.setattr(identify, "design_rows", never)
-    monkeypatch.setattr(separate, "design_rows", never)
+    monkeypatch.setattr(identify, "design_rows", never)  # both designs build their rows there
     if design == "identify":
         run = lambda n: design_identify(space, n)  # noqa: E731
     else:

@@ -76,7 +76,7 @@ def test_the_design_separates_what_the_campaign_confounds(separated):
     assert design.misfit_by_position.shape == (24, 2) and np.all(design.misfit_by_position >= 0)
     text = design.report()
     assert "chance that the diagnosis names gravity_sag" in text
-    assert f"design --separate {ENCODER},{SAG} -n {count}" in text
+    assert f"design separate {ENCODER},{SAG} n_positions {count}" in text
     json.dumps(design.to_dict())
 
 

@@ -7,12 +7,7 @@ from ..core.lazy import lazy_exports
 
 _EXPORTS = {
     "Sensitivities": "sensitivity",
-    "TableAllocation": "solver",
-    "allocate_table_tolerances": "solver",
-    "run_table_monte_carlo": "monte_carlo",
-    "table_sensitivities": "sensitivity",
     "Allocation": "solver",
-    "AverageSensitivities": "sensitivity",
     "ManufacturingCapability": "capability",
     "MonteCarloResult": "monte_carlo",
     "run_chain_monte_carlo": "monte_carlo",

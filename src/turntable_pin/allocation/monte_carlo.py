@@ -40,12 +40,14 @@ from ..core.sizes import (
     check_count,
     turn_grid_count,
 )
+from ..core.turn_grid import full_turn_grid_deg
 from ..core.units import DEG_PER_RAD, arcmin_by_name
+from ..model.angles import ANGLE_SYMBOLS
 from ..model.batch_field import ChainExpansion, joint_dependence, max_abs_on_grid
 from ..model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES
 from ..model.paper_table import resolve_table
-from .sensitivity import MAX_GRID_POINTS, default_grid_step_deg, grid_angles_rad
-from .solver import ORIENTATION_ANGLES, OrientationLimits
+from .sensitivity import MAX_GRID_POINTS, check_grid_step
+from .solver import OrientationLimits
 
 __all__ = [
     "CHUNK_SIZE",
@@ -54,9 +56,7 @@ __all__ = [
     "MonteCarloResult",
     "run_chain_monte_carlo",
     "run_monte_carlo",
-    "run_table_monte_carlo",
     "sample_errors",
-    "sample_table_errors",
 ]
 
 CHUNK_SIZE = 2000
@@ -88,11 +88,6 @@ def sample_errors(
     columns = [list(error_names).index(name) for name in drawn_names]
     values[:, columns] = magnitudes * rng.choice(np.array([-1.0, 1.0]), size=(n, upper.size))
     return values
-
-
-def sample_table_errors(table, rng: np.random.Generator, n: int, upper_rad, lower_rad):
-    """:func:`sample_errors` for a :class:`~turntable_pin.model.generic_table.GenericTable`."""
-    return sample_errors(rng, n, upper_rad, lower_rad, table.chain.error_names, table.angular_names)
 
 
 def _run_chunk(task) -> tuple[np.ndarray, np.ndarray]:
@@ -182,18 +177,15 @@ class MonteCarloResult:
 
     Attributes:
         worst_rad: (N, 3) each table's largest |dpsi|, |dtheta|, |dgamma| over the grid, rad.
-        error_names: the angular errors drawn (the order of the bounds).
-        upper_bounds_rad, lower_bounds_rad: (P,) the box sampled.
+        error_names: the angular errors drawn; upper_bounds_rad, lower_bounds_rad: (P,) the box.
         limits: the orientation limits checked against.  n, seed: sample size and seed.
-        joint_names: the joints of the grid, in chain order.
-        grid_steps_deg: each joint's grid step, degrees.
+        joint_names: the grid's joints (chain order); grid_steps_deg: each one's step, degrees.
         evaluated_deg: each joint's angles evaluated, degrees: its grid, or 0 alone when no drawn
-            table's ``dR`` depends on the joint.
-        max_dependence: each joint's largest harmonic in any table's dpsi, dtheta, dgamma.
+            table's ``dR`` depends on it; max_dependence: its largest harmonic in any table.
         elapsed_s: wall time.  workers: processes used.
         zero_names: the errors held at 0 (the lengths: the paper's ``deta``, a table's offsets).
-        urdf, payload_frame: the table, when it was read from a URDF.
-        angle_names: the joints' angles in keys (the table's; default the joint names).
+        urdf, payload_frame: the table's.  angle_names: the joints' angles in keys (default the
+            joint names).
     """
 
     worst_rad: np.ndarray
@@ -259,10 +251,10 @@ class MonteCarloResult:
         return {
             "urdf": self.urdf,
             "payload_frame": self.payload_frame,
-            "max_abs_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.max_abs_rad),
+            "max_abs_arcmin": arcmin_by_name(ANGLE_SYMBOLS, self.max_abs_rad),
             "limits_arcmin": self.limits.to_dict(),
             "all_within": self.all_within,
-            "n_exceeding": dict(zip(ORIENTATION_ANGLES, exceeding, strict=True)),
+            "n_exceeding": dict(zip(ANGLE_SYMBOLS, exceeding, strict=True)),
             "n": self.n,
             "seed": self.seed,
             "sampling": f"magnitude uniform in [lower, upper] bound, random sign{zeros}",
@@ -276,6 +268,35 @@ class MonteCarloResult:
             "evaluations_per_s": self.evaluations / max(self.elapsed_s, 1e-12),
             "workers": self.workers,
         }
+
+
+def _checked_bounds(names, upper_bounds_rad, lower_bounds_rad) -> tuple[np.ndarray, np.ndarray]:
+    """The (P,) upper and lower bounds (lower default 0), or :class:`InputError`."""
+    upper = np.asarray(upper_bounds_rad, dtype=float).reshape(-1)
+    lower = (
+        np.zeros_like(upper) if lower_bounds_rad is None else np.asarray(lower_bounds_rad, float)
+    )
+    if upper.size != len(names) or lower.shape != upper.shape:
+        raise InputError(f"expected {len(names)} upper and lower bounds ({', '.join(names)})")
+    if not np.all(np.isfinite(upper)):
+        raise InputError("every upper bound must be a finite number")
+    if np.any(lower > upper) or np.any(lower < 0.0):
+        raise InputError("every lower bound must be between 0 and its upper bound")
+    return upper, lower
+
+
+def _checked_steps(joint_names, grid_steps_deg) -> tuple[float, ...]:
+    """One grid step per joint in [MIN, 90] degrees, each joint's grid within its limit."""
+    steps = tuple(float(step) for step in grid_steps_deg)
+    if len(steps) != len(joint_names) or not all(MIN_GRID_STEP_DEG <= s <= 90.0 for s in steps):
+        raise InputError(
+            f"expected a grid step in [{MIN_GRID_STEP_DEG:g}, 90] degrees for each of "
+            f"{', '.join(joint_names)}, got {steps}"
+        )
+    for joint, step in zip(joint_names, steps, strict=True):
+        check_count(turn_grid_count(step), MAX_GRID_POINTS,
+                    f"grid angles of {joint} (a {step:g}-degree step)")  # fmt: skip
+    return steps
 
 
 def run_chain_monte_carlo(
@@ -308,35 +329,16 @@ def run_chain_monte_carlo(
             outside ``[0, upper]``, fewer than 1 or too many tables, a bad seed or grid step.
     """
     names = tuple(error_names)
-    upper = np.asarray(upper_bounds_rad, dtype=float).reshape(-1)
-    lower = (
-        np.zeros_like(upper) if lower_bounds_rad is None else np.asarray(lower_bounds_rad, float)
-    )
-    if upper.size != len(names) or lower.shape != upper.shape:
-        raise InputError(f"expected {len(names)} upper and lower bounds ({', '.join(names)})")
-    if not np.all(np.isfinite(upper)):
-        raise InputError("every upper bound must be a finite number")
-    if np.any(lower > upper) or np.any(lower < 0.0):
-        raise InputError("every lower bound must be between 0 and its upper bound")
+    upper, lower = _checked_bounds(names, upper_bounds_rad, lower_bounds_rad)
     if n < 1:
         raise InputError(f"the number of turntables must be at least 1, got {n}")
     check_count(n, MAX_MONTE_CARLO_TURNTABLES, "random turntables", TURNTABLE_BYTES)
     seed = check_seed(seed)
-    steps = tuple(float(step) for step in grid_steps_deg)
-    if len(steps) != len(chain.joint_names) or not all(
-        MIN_GRID_STEP_DEG <= s <= 90.0 for s in steps
-    ):
-        raise InputError(
-            f"expected a grid step in [{MIN_GRID_STEP_DEG:g}, 90] degrees for each of "
-            f"{', '.join(chain.joint_names)}, got {steps}"
-        )
-    for joint, step in zip(chain.joint_names, steps, strict=True):
-        check_count(turn_grid_count(step), MAX_GRID_POINTS,
-                    f"grid angles of {joint} (a {step:g}-degree step)")  # fmt: skip
-    expansion = ChainExpansion(chain)
-    grids = [np.arange(turn_grid_count(step)) * step / DEG_PER_RAD for step in steps]
+    steps = _checked_steps(chain.joint_names, grid_steps_deg)
+    grids = [full_turn_grid_deg(step)[:, 0] / DEG_PER_RAD for step in steps]
     sizes = [chunk_size] * (n // chunk_size) + ([n % chunk_size] if n % chunk_size else [])
     chunk_names = (chain.error_names, names)
+    expansion = ChainExpansion(chain)
     tasks = [
         (s, size, expansion, chunk_names, upper, lower, grids, DEPENDENCE_TOLERANCE)
         for s, size in zip(np.random.SeedSequence(seed).spawn(len(sizes)), sizes, strict=True)
@@ -355,8 +357,8 @@ def run_chain_monte_carlo(
             offset += size
     elapsed = time.perf_counter() - start
     evaluated = tuple(
-        tuple(float(a) for a in np.arange(g.size) * step) if d > DEPENDENCE_TOLERANCE else (0.0,)
-        for g, step, d in zip(grids, steps, dependence, strict=True)
+        tuple(map(float, full_turn_grid_deg(step)[:, 0])) if d > DEPENDENCE_TOLERANCE else (0.0,)
+        for step, d in zip(steps, dependence, strict=True)
     )
     return MonteCarloResult(
         zero_names=tuple(name for name in chain.error_names if name not in names),
@@ -402,8 +404,7 @@ def run_monte_carlo(
         limits, n, seed, workers, progress: as :func:`run_chain_monte_carlo`.
     """
     table = resolve_table(table)
-    step = default_grid_step_deg(table) if grid_step_deg is None else float(grid_step_deg)
-    grid_angles_rad(table, step)  # checks the step and the grid's size
+    step = check_grid_step(table, grid_step_deg)
     result = run_chain_monte_carlo(
         table.chain,
         table.angular_names,
@@ -420,8 +421,3 @@ def run_monte_carlo(
         result, urdf=str(table.urdf_path), payload_frame=table.payload_frame,
         angle_names=tuple(table.angle_names),
     )  # fmt: skip
-
-
-def run_table_monte_carlo(table, upper_bounds_rad, limits, n, seed, **options) -> MonteCarloResult:
-    """:func:`run_monte_carlo` of ``table`` (its earlier name, the table first)."""
-    return run_monte_carlo(upper_bounds_rad, limits, n, seed, table=table, **options)

@@ -12,9 +12,9 @@ joint matters, 5 for two, 15 for three) and a joint it does not depend on -- the
 errors turn with it -- is held at 0. On the paper's table that is 360 phi2 values, and the averages
 are ``2/pi = 0.6366`` for every sin/cos term and 1 for every constant term. The paper's
 ``0.6476 / 0.5365`` are the mean of ``|cos|`` and ``|sin|`` over a 45-degree grid that counts both
-0 and 360 degrees (:func:`paper_style_grid_deg`); its ``0.6481 / 0.5372`` and its small non-zero
-off-model values (0.0053, 0.0059, ...) match that grid applied to the exact chain at errors of
-about 0.1-0.2 degrees (see the README).
+0 and 360 degrees; its ``0.6481 / 0.5372`` and its small non-zero off-model values (0.0053,
+0.0059, ...) match that grid applied to the exact chain at errors of about 0.1-0.2 degrees (see
+the README).
 """
 
 from __future__ import annotations
@@ -27,35 +27,29 @@ import numpy as np
 
 from ..core.exceptions import InputError
 from ..core.sizes import MIN_GRID_STEP_DEG, turn_grid_count
+from ..core.turn_grid import every_combination, full_turn_grid_deg
 from ..core.units import DEG_PER_RAD
+from ..core.words import argument
 from ..model.angles import ANGLE_NAMES
+from ..model.paper_table import resolve_table
 
 __all__ = [
     "DEFAULT_GRID_STEPS_DEG",
     "FULL_TURN_RAD",
     "MAX_GRID_POINTS",
-    "ORIENTATION_ANGLE_NAMES",
     "PAPER_FIGURE8_TRIG",
-    "AverageSensitivities",
     "Sensitivities",
-    "TableSensitivities",
     "average_sensitivities",
+    "check_grid_step",
     "default_grid_step_deg",
-    "grid_angles_rad",
     "grid_axes_rad",
     "moving_joints",
-    "paper_style_grid_deg",
     "sensitivities",
     "sensitivity_matrix",
-    "table_sensitivities",
-    "uniform_grid_deg",
 ]
 
-ORIENTATION_ANGLE_NAMES = ANGLE_NAMES
-"""Alias of :data:`turntable_pin.model.angles.ANGLE_NAMES` (rows of the sensitivities)."""
 PAPER_FIGURE8_TRIG = 0.6481
-"""The paper's Figure 8 value used for every sin/cos term by ``--weights paper``
-(see docs/model.md)."""
+"""The paper's Figure 8 value for every sin/cos term of the ``paper`` weights (docs/model.md)."""
 DEFAULT_GRID_STEPS_DEG: dict[int, float] = {1: 1.0, 2: 5.0, 3: 15.0}
 """Default grid step by the number of joints the first-order model depends on, degrees."""
 MAX_GRID_POINTS = 200_000
@@ -98,8 +92,17 @@ def _check_count(count: int, step: float, joints: int) -> None:
     if count > MAX_GRID_POINTS:
         raise InputError(
             f"a {step:g}-degree grid over {joints} joints has {count} positions, "
-            f"more than {MAX_GRID_POINTS}; choose a coarser --grid-step-deg"
+            f"more than {MAX_GRID_POINTS}; choose a coarser {argument('grid_step_deg')}"
         )
+
+
+def check_grid_step(table, step_deg: float | None = None) -> float:
+    """The grid step (default by table), degrees, refused when it is outside [MIN, 90] degrees or
+    its full-turn grid over every joint has more than :data:`MAX_GRID_POINTS` positions."""
+    step = _step(table, step_deg)
+    joints = len(table.joint_names)
+    _check_count(turn_grid_count(step) ** joints, step, joints)
+    return step
 
 
 def grid_axes_rad(table, step_deg: float | None = None, domain_rad=None) -> tuple[np.ndarray, ...]:
@@ -121,31 +124,10 @@ def grid_axes_rad(table, step_deg: float | None = None, domain_rad=None) -> tupl
     axes = []
     for lo, hi, full, count in kinds:
         if full:
-            axes.append(lo + np.arange(0.0, 360.0 - 1e-9, step) / DEG_PER_RAD)
+            axes.append(lo + full_turn_grid_deg(step)[:, 0] / DEG_PER_RAD)
         else:
             axes.append(np.array([lo]) if count == 1 else np.linspace(lo, hi, count))
     return tuple(axes)
-
-
-def grid_angles_rad(table, step_deg: float | None = None) -> list[np.ndarray]:
-    """A full grid over every joint, ``0, step, ... < 360`` degrees each: one flat array of
-    radians per joint (chain order), every combination."""
-    step = _step(table, step_deg)
-    joints = len(table.joint_names)
-    _check_count(turn_grid_count(step) ** joints, step, joints)  # before the angles are made
-    axis = np.arange(0.0, 360.0 - 1e-9, step) / DEG_PER_RAD
-    mesh = np.meshgrid(*([axis] * len(table.joint_names)), indexing="ij")
-    return [m.ravel() for m in mesh]
-
-
-def uniform_grid_deg(n: int) -> np.ndarray:
-    """``n`` equally spaced angles over one turn, 0 included and 360 excluded, degrees."""
-    return 360.0 * np.arange(n) / n
-
-
-def paper_style_grid_deg(step_deg: float = 45.0) -> np.ndarray:
-    """``0, step, ..., 360`` degrees, both ends counted (reproduces the paper's 0.6476/0.5365)."""
-    return np.arange(0.0, 360.0 + 0.5 * step_deg, step_deg)
 
 
 @dataclass(frozen=True)
@@ -169,11 +151,6 @@ class Sensitivities:
     values: np.ndarray
     grid_step_deg: float | None = None
     error_values: np.ndarray | None = None
-
-    @property
-    def grid_rad(self) -> tuple[np.ndarray, ...]:
-        """The positions: one flat array of radians per joint, every combination of the axes."""
-        return tuple(m.ravel() for m in np.meshgrid(*self.axes_rad, indexing="ij"))
 
     @property
     def phi1_grid_deg(self) -> np.ndarray:
@@ -229,9 +206,8 @@ def sensitivities(
         step = _step(table, grid_step_deg)
         axes_rad = grid_axes_rad(table, step)
     axes = tuple(np.atleast_1d(np.asarray(a, dtype=float)) for a in axes_rad)
-    mesh = [m.ravel() for m in np.meshgrid(*axes, indexing="ij")]
     columns = [table.parameter_names.index(n) for n in table.angular_names]
-    matrices = table.regressor(mesh, error_values)[:, :, columns]
+    matrices = table.regressor(list(every_combination(axes).T), error_values)[:, :, columns]
     return Sensitivities(
         error_names=tuple(table.angular_names),
         joint_names=tuple(table.joint_names),
@@ -243,35 +219,22 @@ def sensitivities(
     )
 
 
-def table_sensitivities(table, grid_step_deg: float | None = None) -> Sensitivities:
-    """:func:`sensitivities` of ``table`` on its default grid at ``grid_step_deg``."""
-    return sensitivities(table, grid_step_deg=grid_step_deg)
-
-
 def average_sensitivities(
     error_values=None, phi1_grid_deg=None, phi2_grid_deg=None, *, table=None
 ) -> Sensitivities:
     """:func:`sensitivities` of the paper's table (or ``table``, two joints) over every (phi1,
     phi2) pair of the grids, in degrees (default 4 phi1 and 360 phi2 values per turn), at
     ``error_values`` (the table's order, rad and m; default none)."""
-    from ..model.paper_table import resolve_table
-
-    phi1 = uniform_grid_deg(4) if phi1_grid_deg is None else np.asarray(phi1_grid_deg, float)
-    phi2 = uniform_grid_deg(360) if phi2_grid_deg is None else np.asarray(phi2_grid_deg, float)
-    angles = (phi1 / DEG_PER_RAD, phi2 / DEG_PER_RAD)
+    phi1 = full_turn_grid_deg(90.0)[:, 0] if phi1_grid_deg is None else phi1_grid_deg
+    phi2 = full_turn_grid_deg(1.0)[:, 0] if phi2_grid_deg is None else phi2_grid_deg
+    angles = (np.asarray(phi1, float) / DEG_PER_RAD, np.asarray(phi2, float) / DEG_PER_RAD)
     return sensitivities(resolve_table(table), angles, error_values=error_values)
 
 
 def sensitivity_matrix(error_values, phi1_rad: float, phi2_rad: float, table=None) -> np.ndarray:
     """``C`` (3, 8) of the paper's table (or ``table``, two joints) at (phi1, phi2) and
     ``error_values`` (the table's order, rad and m), exact (the table's regressor)."""
-    from ..model.paper_table import resolve_table
-
     table = resolve_table(table)
     columns = [table.parameter_names.index(n) for n in table.angular_names]
     angles = (np.array([phi1_rad], float), np.array([phi2_rad], float))
     return table.regressor(angles, np.asarray(error_values, float))[0][:, columns]
-
-
-AverageSensitivities = TableSensitivities = Sensitivities
-"""Earlier names of :class:`Sensitivities` (the paper's and any table's)."""

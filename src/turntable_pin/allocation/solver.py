@@ -27,35 +27,31 @@ holds everywhere. One point whose closed form meets it is the optimum (``exact``
 
 from __future__ import annotations
 
+# scipy.optimize is imported inside functions: import turntable_pin stays light
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
-from pathlib import Path
 
 import numpy as np
 
+from ..calibration.positions import PositionSet
+from ..calibration.requirement import orientation_requirement
 from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.exceptions import InfeasibleError, InputError, ModelError
+from ..core.turn_grid import every_combination
 from ..core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, arcmin_by_name
 from ..model.angles import ANGLE_SYMBOLS
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from ..model.paper_table import PHI2_INTERVALS_DEG, resolve_table
+from . import sensitivity
 from .capability import ManufacturingCapability
-from .sensitivity import (
-    FULL_TURN_RAD,
-    PAPER_FIGURE8_TRIG,
-    Sensitivities,
-    grid_angles_rad,
-    grid_axes_rad,
-    table_sensitivities,
-)
+from .sensitivity import FULL_TURN_RAD, PAPER_FIGURE8_TRIG, Sensitivities, grid_axes_rad
 
 __all__ = [
     "DEFAULT_ACCURACY_DPH",
     "DEFAULT_POSITIONS",
     "MIN_LIMIT_ARCSEC",
-    "ORIENTATION_ANGLES",
     "PHI2_INTERVALS_RAD",
     "REQUIREMENT_KINDS",
     "WEIGHT_SCHEMES",
@@ -63,24 +59,17 @@ __all__ = [
     "AngleRows",
     "OrientationLimits",
     "SubproblemResult",
-    "TableAllocation",
-    "allocate_table_tolerances",
     "allocate_tolerances",
     "allocation_weights",
     "angle_rows",
-    "angular_names",
     "default_orientation_limits",
     "domain_max",
-    "grid_angles_rad",
     "interval_max",
     "minimize_weighted",
     "paper_eq16_limits",
     "solve_subproblem",
-    "table_lower_bounds",
 ]
 
-ORIENTATION_ANGLES = ANGLE_SYMBOLS  # the limit names: psi_rad, theta_rad, gamma_rad
-"""Names of the three orientation angles dpsi, dtheta, dgamma as used in keys and options."""
 PHI2_INTERVALS_RAD: dict[str, tuple[float, float]] = {
     angle: (math.radians(lo), math.radians(hi)) for angle, (lo, hi) in PHI2_INTERVALS_DEG.items()
 }
@@ -118,7 +107,7 @@ class OrientationLimits:
     gamma_rad: float
 
     def __post_init__(self) -> None:
-        for name in ORIENTATION_ANGLES:
+        for name in ANGLE_SYMBOLS:
             value = float(getattr(self, f"{name}_rad"))
             if not math.isfinite(value) or value <= 0.0:
                 raise InputError(f"orientation limit for {name} must be a positive number")
@@ -146,12 +135,12 @@ class OrientationLimits:
         return cls(psi / DEG_PER_RAD, theta / DEG_PER_RAD, gamma / DEG_PER_RAD)
 
     def as_array(self) -> np.ndarray:
-        """(3,) radians in :data:`ORIENTATION_ANGLES` order."""
-        return np.array([getattr(self, f"{n}_rad") for n in ORIENTATION_ANGLES])
+        """(3,) radians in :data:`ANGLE_SYMBOLS` order."""
+        return np.array([getattr(self, f"{n}_rad") for n in ANGLE_SYMBOLS])
 
     def to_dict(self) -> dict[str, float]:
         """``{psi: arcmin, theta: arcmin, gamma: arcmin}``."""
-        return {n: getattr(self, f"{n}_rad") * ARCMIN_PER_RAD for n in ORIENTATION_ANGLES}
+        return {n: getattr(self, f"{n}_rad") * ARCMIN_PER_RAD for n in ANGLE_SYMBOLS}
 
 
 def paper_eq16_limits() -> OrientationLimits:
@@ -186,9 +175,6 @@ def default_orientation_limits(
     Raises:
         IdentifiabilityError: the positions cannot calibrate the GyroWheel on this table.
     """
-    from ..calibration.positions import PositionSet
-    from ..calibration.requirement import orientation_requirement
-
     if requirement not in REQUIREMENT_KINDS:
         raise InputError(
             f"unknown requirement '{requirement}'; expected one of {REQUIREMENT_KINDS}"
@@ -246,7 +232,7 @@ class AngleRows:
     @cached_property
     def grid(self) -> tuple[np.ndarray, np.ndarray]:
         """The starting grid: positions (N, joints) and ``|C_k|`` there (N, m)."""
-        mesh = np.stack([m.ravel() for m in np.meshgrid(*self.axes_rad, indexing="ij")], axis=1)
+        mesh = every_combination(self.axes_rad)
         return mesh, np.abs(self.values(mesh))
 
 
@@ -263,15 +249,15 @@ def angle_rows(
     """
     d = len(table.joint_names)
     columns = [table.parameter_names.index(n) for n in table.angular_names]
-    mesh = np.meshgrid(*([np.array(_NODES_RAD)] * d), indexing="ij")
-    coefficients = table.regressor([m.ravel() for m in mesh])[:, :, columns]
+    nodes = every_combination([np.array(_NODES_RAD)] * d)
+    coefficients = table.regressor(list(nodes.T))[:, :, columns]
     coefficients = coefficients.reshape((3,) * d + coefficients.shape[1:])
     for j in range(d):
         coefficients = np.moveaxis(np.tensordot(_TO_COEFFICIENTS, coefficients, ([1], [j])), 0, j)
     probe = np.random.default_rng(0).uniform(-math.pi, math.pi, (16, d))  # generic positions
     exact = table.regressor(list(probe.T))[:, :, columns]
     out = {}
-    for k, name in enumerate(ORIENTATION_ANGLES):
+    for k, name in enumerate(ANGLE_SYMBOLS):
         block = coefficients[..., k, :]
         peak = np.abs(block).reshape(-1, block.shape[-1]).max(axis=0)
         members = np.flatnonzero(peak > 1e-12 * max(float(peak.max()), 1e-300))
@@ -544,16 +530,6 @@ class SubproblemResult:
         return float(np.sum(self.weights**2 / (self.solution_rad * ARCMIN_PER_RAD) ** 2))
 
     @property
-    def worst_rad(self) -> float:
-        """The first-order worst case at the solution (:attr:`constraint_rad`)."""
-        return self.constraint_rad
-
-    @property
-    def interval_rad(self) -> tuple[float, float]:
-        """The last joint's interval (the paper's phi2 interval)."""
-        return self.domain_rad[-1]
-
-    @property
     def _words(self) -> tuple[str, ...]:
         """The angle names of the named joints (the joint names where none are given)."""
         names = self.angle_names or self.joint_names
@@ -637,7 +613,7 @@ def solve_subproblem(rows: AngleRows, limit_rad: float, weights, lower_bounds_ra
 # ---- weights and the whole allocation ------------------------------------------------------
 def allocation_weights(scheme: str, sensitivities: Sensitivities | None = None, table=None):
     """Weights W (3, P) of ``table``'s angular errors (default the bundled table), rows
-    :data:`ORIENTATION_ANGLES`: ``model``, the inverse of the average sensitivities (Figure 8;
+    :data:`ANGLE_SYMBOLS`: ``model``, the inverse of the average sensitivities (Figure 8;
     default on the table's grid); ``paper``, the inverse of the paper's Figure 8 value 0.6481 for
     every term that varies with the angles and 1 for the constant ones (the paper's rule, on any
     table); ``equal``, 1 everywhere (the "traditional" allocation).
@@ -647,7 +623,7 @@ def allocation_weights(scheme: str, sensitivities: Sensitivities | None = None, 
         raise InputError(f"unknown weights '{scheme}'; choose one of {', '.join(WEIGHT_SCHEMES)}")
     if scheme == "equal":
         return np.ones((3, len(table.angular_names)))
-    sens = sensitivities or table_sensitivities(table)
+    sens = sensitivities or sensitivity.sensitivities(table)
     if scheme == "paper":
         return np.where(np.ptp(sens.matrices, axis=0) > 1e-12, 1.0 / PAPER_FIGURE8_TRIG, 1.0)
     with np.errstate(divide="ignore"):
@@ -690,7 +666,7 @@ class Allocation:
     @property
     def J(self) -> dict[str, float]:
         """Objective of each problem at its optimum (1/arcmin^2) and their sum."""
-        out = {name: self.subproblems[name].J for name in ORIENTATION_ANGLES}
+        out = {name: self.subproblems[name].J for name in ANGLE_SYMBOLS}
         return {**out, "total": float(sum(out.values()))}
 
     def errors(self) -> np.ndarray:
@@ -714,13 +690,13 @@ class Allocation:
             "upper_bounds_arcmin": arcmin_by_name(self.error_names, self.upper_bounds_rad),
             "J": self.J,
             "J_unit": "1/arcmin^2 (errors in arc minutes)",
-            "worst_case_arcmin": arcmin_by_name(ORIENTATION_ANGLES, self.worst_case_rad),
+            "worst_case_arcmin": arcmin_by_name(ANGLE_SYMBOLS, self.worst_case_rad),
             "limits_arcmin": self.limits.to_dict(),
             "weights": self.weights_scheme,
             "lower_bounds": self.capability.to_dict(),
             "grid_step_deg": self.sensitivities.grid_step_deg,
-            "active_constraints": {n: list(self.subproblems[n].active) for n in ORIENTATION_ANGLES},
-            "subproblems": {n: self.subproblems[n].to_dict() for n in ORIENTATION_ANGLES},
+            "active_constraints": {n: list(self.subproblems[n].active) for n in ANGLE_SYMBOLS},
+            "subproblems": {n: self.subproblems[n].to_dict() for n in ANGLE_SYMBOLS},
             "sensitivities": self.sensitivities.by_angle(),
         }
 
@@ -742,7 +718,7 @@ class Allocation:
             lines.append(f'{n:{width}s}{ub:11.4f}\' = {ub * 60:7.2f}"{lb:12.2f}"')
         lines += ["", "with every error at its final upper bound (the smallest of the three "
                   "sub-problems'):"]  # fmt: skip
-        for k, angle in enumerate(ORIENTATION_ANGLES):
+        for k, angle in enumerate(ANGLE_SYMBOLS):
             limit = self.limits.to_dict()[angle]
             worst = self.worst_case_rad[k] * ARCMIN_PER_RAD
             state = (
@@ -754,7 +730,7 @@ class Allocation:
         lines.append(
             "each angle's own sub-problem (its bounds before the minimum over the angles):"
         )
-        for angle in ORIENTATION_ANGLES:
+        for angle in ANGLE_SYMBOLS:
             sub = self.subproblems[angle]
             lines.append(f"d{angle:6s} J = {sub.J:.6g} /arcmin^2  [{sub.method}, KKT residual "
                          f"{sub.kkt_residual:.1e}]")  # fmt: skip
@@ -793,11 +769,11 @@ def allocate_tolerances(
         capability = ManufacturingCapability.of_table(table)
     if capability.error_names != names:
         raise InputError(f"the lower bounds must be of this table's errors: {', '.join(names)}")
-    sensitivities = sensitivities or table_sensitivities(table, grid_step_deg)
+    sensitivities = sensitivities or sensitivity.sensitivities(table, grid_step_deg=grid_step_deg)
     w = allocation_weights(weights, sensitivities, table)
     rows = angle_rows(table, grid_step_deg)
     subproblems = {}
-    for k, angle in enumerate(ORIENTATION_ANGLES):
+    for k, angle in enumerate(ANGLE_SYMBOLS):
         idx = [names.index(n) for n in rows[angle].error_names]
         subproblems[angle] = solve_subproblem(
             rows[angle], limits.as_array()[k], w[k, idx], capability.lower_bounds_rad[idx]
@@ -810,39 +786,9 @@ def allocate_tolerances(
     whole = angle_rows(table, grid_step_deg, whole_turns=True)  # Lemma 1: every angle and sign
     worst = [
         domain_max(whole[a], bounded[[names.index(n) for n in whole[a].error_names]])[0]
-        for a in ORIENTATION_ANGLES
+        for a in ANGLE_SYMBOLS
     ]
     return Allocation(
         upper, limits, weights, w, subproblems, np.array(worst),
         capability=capability, table=table, sensitivities=sensitivities,
     )  # fmt: skip
-
-
-# ---- earlier names (a table given by its URDF) ----------------------------------------------
-TableAllocation = Allocation
-"""Earlier name of :class:`Allocation`."""
-
-
-def allocate_table_tolerances(
-    table, limits, weights="model", lower_bounds_rad=None, grid_step_deg=None
-) -> Allocation:
-    """:func:`allocate_tolerances` of ``table`` with lower bounds (P,) in its angular order."""
-    capability = None
-    if lower_bounds_rad is not None:
-        capability = ManufacturingCapability(lower_bounds_rad, {}, "given", table.angular_names)
-    return allocate_tolerances(
-        limits, weights, capability, table=table, grid_step_deg=grid_step_deg
-    )
-
-
-def angular_names(table) -> tuple[str, ...]:
-    """The table's angular errors (every parameter but the offsets), in parameter order."""
-    return tuple(table.angular_names)
-
-
-def table_lower_bounds(table, path: str | Path | None = None) -> np.ndarray:
-    """Lower bounds (P,) of ``table``'s angular errors from a YAML file in its names, radians
-    (default 0; :meth:`ManufacturingCapability.from_yaml`)."""
-    if path is None:
-        return np.zeros(len(table.angular_names))
-    return ManufacturingCapability.from_yaml(path, table).lower_bounds_rad

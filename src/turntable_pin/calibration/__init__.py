@@ -6,7 +6,6 @@ the orientation requirement (eq. 16: the paper's planes, and the largest box tha
 from ..core.lazy import lazy_exports
 
 _EXPORTS = {
-    "JointPositions": "positions",
     "CalibrationResult": "drift_fit",
     "GyroWheelModel": "gyrowheel",
     "OrientationRequirement": "requirement",

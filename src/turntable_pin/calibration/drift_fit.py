@@ -39,19 +39,12 @@ from .gyrowheel import (
 from .positions import PositionInputs, PositionSet
 from .run import (
     MAX_RUN_OUTPUT_DPH,
-    MIN_RUN_SIGMA_DPH,
-    RUN_OPTIONAL_COLUMNS,
-    RUN_REQUIRED_COLUMNS,
     CalibrationRun,
     read_run,
     refuse_copied_rows,
 )
 
 __all__ = [
-    "MAX_RUN_OUTPUT_DPH",
-    "MIN_RUN_SIGMA_DPH",
-    "RUN_OPTIONAL_COLUMNS",
-    "RUN_REQUIRED_COLUMNS",
     "AxisCalibration",
     "CalibrationResult",
     "calibrate",

@@ -33,13 +33,13 @@ from ..core.exceptions import InputError
 from ..core.sizes import MAX_POSITIONS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
 from ..core.turn_grid import full_turn_grid_deg
 from ..core.units import deg_to_rad, rad_to_deg
+from ..core.words import argument
 from ..model.paper_table import resolve_table
 from .site import DEFAULT_LATITUDE_DEG, MAX_LATITUDE_DEG  # noqa: F401  (re-exported)
 
 __all__ = [
     "DEFAULT_LATITUDE_DEG",
     "EARTH_RATE_DPH",
-    "JointPositions",
     "MAX_COMMANDED_ANGLE_DEG",
     "POSITION_BYTES",
     "PositionInputs",
@@ -281,30 +281,6 @@ class PositionSet:
         return out
 
 
-class JointPositions:
-    """The earlier name of :class:`PositionSet` for a given table, the table first
-    (``JointPositions.parse(table, spec)`` is ``PositionSet.parse(spec, table)``); kept for
-    scripts."""
-
-    def __new__(cls, angles_rad, table, name: str = "") -> PositionSet:  # type: ignore[misc]
-        return PositionSet(angles_rad, table=table, name=name)
-
-    @staticmethod
-    def grid(table, *steps_deg: float) -> PositionSet:
-        """:meth:`PositionSet.grid` of ``table``."""
-        return PositionSet.grid(*steps_deg, table=table)
-
-    @staticmethod
-    def parse(table, spec: str) -> PositionSet:
-        """:meth:`PositionSet.parse` of ``table``."""
-        return PositionSet.parse(spec, table)
-
-    @staticmethod
-    def from_csv(table, path: str | Path) -> PositionSet:
-        """:meth:`PositionSet.from_csv` of ``table``."""
-        return PositionSet.from_csv(path, table)
-
-
 @dataclass(frozen=True)
 class PositionInputs:
     """What the GyroWheel senses at each position of a set, at the ideal orientation.
@@ -361,7 +337,8 @@ def angle_columns(
         joints = ", ".join(n for n in names if n) or "the paper's phi1, phi2"
         raise InputError(
             f"column {beyond[0]} is the angle of a joint this table does not have: it has "
-            f"{len(names)} joint(s) ({joints}); are these data of the table given by --urdf?",
+            f"{len(names)} joint(s) ({joints}); are these data of the table given by "
+            f"{argument('urdf')}?",
             path=path, row=header_row, column=beyond[0],
         )  # fmt: skip
     out = []

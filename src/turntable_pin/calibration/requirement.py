@@ -33,11 +33,13 @@ meets ``w_m`` exactly. Every point of it meets the accuracy; scaled up by any fa
 
 from __future__ import annotations
 
+# scipy.optimize is imported inside functions: import turntable_pin stays light
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..core.exceptions import InputError
+from ..core.turn_grid import every_combination
 from ..core.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
 from ..model.angles import ANGLE_SYMBOLS
 from .drift_fit import require_identifiable
@@ -52,7 +54,6 @@ from .rate_error import (
 
 __all__ = [
     "ACCURACY_RANGE_DPH",
-    "ANGLE_NAMES",
     "BOX_CRITERION",
     "JACOBIAN_STEP_RAD",
     "MAX_ANGLE_RAD",
@@ -80,7 +81,6 @@ with ``w_m`` (about 0.01 deg for the paper's 0.01 deg/h): at 1 deg/h it is alrea
 the end of the small-angle model's range; at 1e-6 deg/h it is a few thousandths of an arc second,
 below what any turntable or autocollimator resolves."""
 
-ANGLE_NAMES = ANGLE_SYMBOLS  # deprecated alias: the limits are named psi, theta, gamma
 PLANES: dict[str, tuple[str, tuple[int, int]]] = {
     "psi_theta": ("x", (0, 1)),
     "theta_gamma": ("y", (1, 2)),
@@ -296,7 +296,7 @@ size of the requirement itself): under eq. 7 ``dw`` is a quadratic of the angles
 difference is its exact linear part for any step; a step this large keeps rounding far below the
 result (the 90-degree grid's nearly singular ``A'`` solves to about 1e-10)."""
 
-_CORNER_SIGNS = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
+_CORNER_SIGNS = every_combination([np.array([-1, 1])] * 3)
 
 
 def box_corners(limits_rad) -> np.ndarray:
@@ -418,9 +418,8 @@ class RequirementBox:
 
     def to_dict(self) -> dict:
         """The limits (degrees, arc seconds), the criterion and the worst corner, JSON-ready."""
-        limits = zip(ANGLE_NAMES, self.limits_rad, strict=True)
         out: dict = {}
-        for name, value in limits:
+        for name, value in zip(ANGLE_SYMBOLS, self.limits_rad, strict=True):
             out[f"I_{name}_deg"] = rad_to_deg(value)
             out[f"I_{name}_arcsec"] = rad_to_arcsec(value)
         return {
@@ -542,66 +541,32 @@ class OrientationRequirement:
     gyrowheel: GyroWheelModel = field(repr=False)
     inputs: PositionInputs = field(repr=False)
 
-    def plane_function(self, plane: str) -> PlaneRateError:
-        """The :class:`PlaneRateError` this requirement was computed with."""
-        return PlaneRateError(
-            plane, self.gyrowheel, self.inputs, exact=self.exact, definition=self.definition
-        )
-
     @property
     def limits_rad(self) -> np.ndarray:
         """``[I_psi, I_theta, I_gamma]``, radians."""
         return np.array([self.psi_rad, self.theta_rad, self.gamma_rad])
 
-    # Names of earlier versions (the README's changelog lists them).
-    @property
-    def I_psi_rad(self) -> float:  # noqa: N802
-        """Alias of :attr:`psi_rad`."""
-        return self.psi_rad
-
-    @property
-    def I_theta_rad(self) -> float:  # noqa: N802
-        """Alias of :attr:`theta_rad`."""
-        return self.theta_rad
-
-    @property
-    def I_gamma_rad(self) -> float:  # noqa: N802
-        """Alias of :attr:`gamma_rad`."""
-        return self.gamma_rad
-
     def to_dict(self) -> dict:
         """The limits (degrees, arcmin, arcsec), the set-up and both rectangles, JSON-ready."""
-        out = {
-            f"I_{n}_deg": rad_to_deg(v) for n, v in zip(ANGLE_NAMES, self.limits_rad, strict=True)
+        units = {"deg": rad_to_deg, "arcmin": rad_to_arcmin, "arcsec": rad_to_arcsec}
+        return {
+            **{
+                f"I_{n}_{unit}": convert(v)
+                for unit, convert in units.items()
+                for n, v in zip(ANGLE_SYMBOLS, self.limits_rad, strict=True)
+            },
+            "accuracy_dph": self.accuracy_dph,
+            "positions": self.positions_name,
+            "n_positions": self.n_positions,
+            "latitude_deg": rad_to_deg(self.latitude_rad),
+            "definition": self.definition,
+            "exact_rotation": self.exact,
+            "binding_plane": self.binding_plane,
+            "rectangles": [r.to_dict() for r in self.rectangles],
+            "box_dwx_dph": self.box_dwx_dph,
+            "box_dwy_dph": self.box_dwy_dph,
+            "box": self.box.to_dict(),
         }
-        out.update(
-            {
-                f"I_{n}_arcmin": rad_to_arcmin(v)
-                for n, v in zip(ANGLE_NAMES, self.limits_rad, strict=True)
-            }
-        )
-        out.update(
-            {
-                f"I_{n}_arcsec": rad_to_arcsec(v)
-                for n, v in zip(ANGLE_NAMES, self.limits_rad, strict=True)
-            }
-        )
-        out.update(
-            {
-                "accuracy_dph": self.accuracy_dph,
-                "positions": self.positions_name,
-                "n_positions": self.n_positions,
-                "latitude_deg": rad_to_deg(self.latitude_rad),
-                "definition": self.definition,
-                "exact_rotation": self.exact,
-                "binding_plane": self.binding_plane,
-                "rectangles": [r.to_dict() for r in self.rectangles],
-                "box_dwx_dph": self.box_dwx_dph,
-                "box_dwy_dph": self.box_dwy_dph,
-                "box": self.box.to_dict(),
-            }
-        )
-        return out
 
 
 def check_accuracy_dph(accuracy_dph: float) -> float:
@@ -652,22 +617,20 @@ def orientation_requirement(
     rect_y = largest_rectangle(fy, accuracy_dph)
     psi, theta_x = rect_x.half_widths_rad
     theta_y, gamma = rect_y.half_widths_rad
-    if theta_x <= theta_y:
-        binding, theta = "psi_theta", theta_x
-        gamma = float(
-            fy.largest(
-                1, theta * (1 - _MARGIN), accuracy_dph, rect_y.axis_limits_rad[1] * 1.000001
-            )[0]
-        )
-        theta, gamma = _settle(fy, theta, gamma, accuracy_dph)
+    # The other plane's free side re-extended to the contour at the binding plane's I_theta.
+    binding = "psi_theta" if theta_x <= theta_y else "theta_gamma"
+    other, rect, free = (fy, rect_y, 1) if theta_x <= theta_y else (fx, rect_x, 0)
+    theta = min(theta_x, theta_y)
+    side = other.largest(
+        free, theta * (1 - _MARGIN), accuracy_dph, rect.axis_limits_rad[free] * 1.000001
+    )
+    pair = _settle(
+        other, *((theta, float(side[0])) if free else (float(side[0]), theta)), accuracy_dph
+    )
+    if free:
+        theta, gamma = pair
     else:
-        binding, theta = "theta_gamma", theta_y
-        psi = float(
-            fx.largest(
-                0, theta * (1 - _MARGIN), accuracy_dph, rect_x.axis_limits_rad[0] * 1.000001
-            )[0]
-        )
-        psi, theta = _settle(fx, psi, theta, accuracy_dph)
+        psi, theta = pair
     corners = box_corners([psi, theta, gamma])
     box = rate_errors_at_angles_dph(
         gyrowheel, inputs, corners, exact=exact, definition=definition

@@ -30,16 +30,14 @@ __all__ = [
     "MIN_RUN_SIGMA_DPH",
     "OUTPUT_COLUMNS",
     "RUN_OPTIONAL_COLUMNS",
-    "RUN_REQUIRED_COLUMNS",
     "CalibrationRun",
     "read_run",
     "refuse_copied_rows",
 ]
 
 OUTPUT_COLUMNS: tuple[str, ...] = ("out_x_dph", "out_y_dph")
-"""The two output columns, x axis then y axis (deg/h)."""
-RUN_REQUIRED_COLUMNS: tuple[str, ...] = OUTPUT_COLUMNS
-"""Columns every calibration run CSV must have besides the angle of each joint (deg/h)."""
+"""The two output columns, x axis then y axis (deg/h): every run has them besides each joint's
+angle."""
 RUN_OPTIONAL_COLUMNS: tuple[str, ...] = ("sigma_dph", "time_s")
 """Columns read when present: 1-sigma output noise (deg/h) and time (s)."""
 MAX_RUN_OUTPUT_DPH = 1e6
@@ -125,7 +123,7 @@ def read_run(path: str | Path, latitude_rad: float, table=None) -> CalibrationRu
     """
     table = resolve_table(table)
     optional = PositionSet.candidate_columns(table) + RUN_OPTIONAL_COLUMNS
-    csv = read_csv_table(path, RUN_REQUIRED_COLUMNS, optional, extra=True)
+    csv = read_csv_table(path, OUTPUT_COLUMNS, optional, extra=True)
     columns = PositionSet.columns_of(csv, table)
     positions = PositionSet.from_csv_table(csv, columns, table, str(path))
     _check_run_values(csv)

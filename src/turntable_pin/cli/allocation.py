@@ -10,7 +10,6 @@ from ..allocation.monte_carlo import run_monte_carlo
 from ..allocation.solver import (
     DEFAULT_ACCURACY_DPH,
     DEFAULT_POSITIONS,
-    ORIENTATION_ANGLES,
     REQUIREMENT_KINDS,
     WEIGHT_SCHEMES,
     Allocation,
@@ -22,6 +21,7 @@ from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.exceptions import InfeasibleError, InputError
 from ..core.sizes import MIN_GRID_STEP_DEG
 from ..core.units import ARCMIN_PER_RAD, DEG_PER_RAD
+from ..model.angles import ANGLE_SYMBOLS
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from .common import (
     accuracy_dph,
@@ -48,12 +48,12 @@ def parse_limits(text: str, unit: str) -> OrientationLimits:
     text = text.strip()
     values: dict[str, float] = {}
     if "=" not in text:
-        values = dict.fromkeys(ORIENTATION_ANGLES, _number(text, option))
+        values = dict.fromkeys(ANGLE_SYMBOLS, _number(text, option))
     else:
         for item in text.split(","):
             key, sep, raw = item.partition("=")
             key = key.strip()
-            if not sep or key not in ORIENTATION_ANGLES:
+            if not sep or key not in ANGLE_SYMBOLS:
                 raise InputError(
                     f"{option} '{text}': expected psi=P,theta=T,gamma=G (or one number), "
                     f"got '{item.strip()}'"
@@ -61,7 +61,7 @@ def parse_limits(text: str, unit: str) -> OrientationLimits:
             if key in values:
                 raise InputError(f"{option}: '{key}' is given twice")
             values[key] = _number(raw, option)
-        missing = [n for n in ORIENTATION_ANGLES if n not in values]
+        missing = [n for n in ANGLE_SYMBOLS if n not in values]
         if missing:
             raise InputError(f"{option}: no limit for {', '.join(missing)}")
     make = OrientationLimits.from_arcmin if unit == "arcmin" else OrientationLimits.from_deg
@@ -282,7 +282,7 @@ def run_montecarlo(args: argparse.Namespace) -> int:
         return 0 if result.all_within else 1
     limits = allocation.limits.to_dict()
     print(title)
-    for k, name in enumerate(ORIENTATION_ANGLES):
+    for k, name in enumerate(ANGLE_SYMBOLS):
         value = result.max_abs_rad[k] * ARCMIN_PER_RAD
         flag = "ok" if value <= limits[name] else "EXCEEDED"
         print(f"  max |d{name}| = {value:.4f}'  limit {limits[name]:.4f}'  {flag}")

@@ -10,9 +10,11 @@ __all__ = ["CLI_WORDS"]
 CLI_WORDS = CommandLineWords(
     "turntable-pin",
     {
+        "amplitudes": "--amplitude",
         "from_data": "--from",
         "n": "-n",
-        "turntable": "--urdf",
+        "n_positions": "-n",
         "outliers=False": "--keep-outliers",
+        "turntable": "--urdf",
     },
 )

@@ -11,8 +11,8 @@ positions of the next measurement run:
 - :mod:`.calibrate`: GyroWheel calibration positions with the loosest orientation requirement
   (the largest box that holds) at the precision of the grid of the same number of positions;
 - :mod:`.schedule`: the order, times and approach directions of the chosen positions (repeats
-  for time-driven effects, both sides for backlash) and the CSV that ``simulate --positions``
-  and the test crew read.
+  for time-driven effects, both sides for backlash) and the CSV that the simulation and the
+  test crew read.
 """
 
 from ..core.lazy import lazy_exports

@@ -2,33 +2,30 @@
 item 4: the paper's own question, section 2).
 
 How accurate must a turntable be for a GyroWheel calibration of accuracy ``w_m``? For given
-positions the answer is the requirement box of :mod:`turntable_pin.calibration.requirement`:
-the largest box ``|dpsi| <= I_psi, |dtheta| <= I_theta, |dgamma| <= I_gamma`` (largest volume)
-whose every orientation error keeps the rate errors of eqs. 7-14 within ``w_m``. To first order
-the rate error at a position is ``J(p) (dpsi, dtheta, dgamma)`` (the printed eq. 13: the drift at
-the actual gravity direction minus the drift at the ideal one), so the box is set by the most
-sensitive positions: those where tilting gravity changes the drift most. On the paper's Table 1
-GyroWheel gravity along the payload's z axis bounds dpsi and dgamma (through the 43.2 and 33.2
-deg/h/g terms), and gravity in or near the payload's x-y plane bounds dtheta, by how much
-depending on its azimuth there (15 to 82 deg/h per rad).
+positions the answer is the requirement box of :mod:`turntable_pin.calibration.requirement` (the
+largest box of orientation errors whose every point keeps the rate errors of eqs. 7-14 within
+``w_m``). To first order the rate error at a position is ``J(p) (dpsi, dtheta, dgamma)`` (eq. 13
+as printed: the drift at the actual gravity direction minus that at the ideal one), so the most
+sensitive positions set the box: on the paper's Table 1 GyroWheel, gravity along the payload's z
+axis bounds dpsi and dgamma (the 43.2 and 33.2 deg/h/g terms), gravity in or near its x-y plane
+bounds dtheta (15 to 82 deg/h per rad, by its azimuth there).
 
-The design chooses ``N`` positions within the joints' limits that make the box as large as
-possible, i.e. the loosest orientation requirement for the same ``w_m``, while still calibrating
-the 14 drift coefficients (eqs. 5-6, 7 per axis) at least as precisely as the reference: the
-D-efficiency ``exp((log det M - log det M_ref) / 14)`` (``M`` the information of both axes'
-regressors, :func:`~turntable_pin.calibration.gyrowheel.regressor_matrix`) stays at or above
-``min_efficiency`` (default 1). The precision floor is what makes the question sound: positions
-clustered where gravity changes the drift least would give a loose requirement, but barely
-varying regressors, so the calibration would amplify the measurement noise without bound.
+The design chooses ``N`` positions within the joints' limits with the largest box (the loosest
+requirement for the same ``w_m``) that still calibrate the 14 drift coefficients (eqs. 5-6) at
+least as precisely as the reference: the D-efficiency ``exp((log det M - log det M_ref) / 14)``
+(``M`` both axes' information, :func:`~turntable_pin.calibration.gyrowheel.regressor_matrix`) is
+at least ``min_efficiency`` (default 1). Without that floor, positions clustered where gravity
+changes the drift least would give a loose requirement and a calibration that amplifies the
+noise without bound.
 
 The reference is the evenly spaced grid of ``N`` positions within the limits that calibrates
 (:func:`comparison_grid`: on the paper's table ``grid:90x60`` for 24, ``grid:60`` for 36,
-``grid:45`` for 64); it joins the candidates and is where the search starts, so the design is
-never worse than it. The search is a local one over the candidates (:func:`loosest_positions`):
-a position that bounds the box is exchanged for a candidate inside the box when the precision
-floor still holds and the box grows (or fewer positions bound it); when none can be, a Fedorov
-exchange among the positions inside the box (:func:`~turntable_pin.stats.design.
-fedorov_exchange`) raises the precision to make room; it ends when neither helps.
+``grid:45`` for 64); it joins the candidates and starts the search, so the design is never worse.
+The search (:func:`loosest_positions`) exchanges a position that bounds the box for a candidate
+inside it while the floor holds and the box grows (or fewer positions bound it); when none can,
+a Fedorov exchange among the positions inside the box
+(:func:`~turntable_pin.stats.design.fedorov_exchange`) raises the precision to make room; it
+ends when neither helps.
 """
 
 from __future__ import annotations
@@ -53,8 +50,10 @@ from ..calibration.requirement import (
 from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.sizes import check_positions_count
 from ..core.turn_grid import every_combination, full_turn_grid_deg
 from ..core.units import DEG_PER_RAD
+from ..core.words import argument, command
 from ..model.angles import ANGLE_SYMBOLS
 from ..stats.design import d_optimal_design, fedorov_exchange, log_det
 from .schedule import MeasurementPlan, plan_measurements
@@ -137,7 +136,7 @@ def comparison_grid(
     raise InputError(
         f"no evenly spaced grid of {n_positions} positions within the limits calibrates the 14 "
         f"drift coefficients to compare the design with (tried {', '.join(tried)}); choose "
-        "another number of positions (-n), e.g. 24, 36 or 64"
+        f"another number of positions ({argument('n_positions')}), e.g. 24, 36 or 64"
     )
 
 
@@ -181,25 +180,24 @@ def loosest_positions(
     *,
     max_steps: int = MAX_STEPS,
 ) -> tuple[np.ndarray, tuple[SearchStep, ...]]:
-    """The local search of the module docstring, from the design ``start``.
-
-    Each step exchanges a position that bounds the box for a candidate inside it, the exchange
-    that grows the box most or else leaves the fewest positions bounding it
-    (:func:`_exchange_bounding`), as long as the precision floor holds; when none can, a Fedorov
-    exchange among the positions inside the box raises ``log det`` to make room. (Volume,
-    fewer bounding positions, ``log det``) rises at every step, so the search ends.
+    """The local search of the module docstring, from the design ``start``: the exchange of a
+    bounding position that grows the box most, else leaves the fewest positions bounding it
+    (:func:`_exchange_bounding`), while the floor holds; else a Fedorov exchange among the
+    positions inside the box. (Volume, fewer bounding positions, ``log det``) rises at every
+    step, so the search ends.
 
     Args:
         features: each candidate's regressor rows of the two axes (C, 2, 7).
         sensitivity: each candidate's ``|J|`` (C, 2, 3), deg/h per rad of (dpsi, dtheta,
             dgamma) (:func:`~turntable_pin.calibration.requirement.rate_error_jacobian`).
         start: indices of the starting design (``log det`` at least ``floor_log_det``).
-        floor_log_det: the precision floor, ``log det`` of both axes' information.
+        floor_log_det: the precision floor (``log det`` of both axes' information).
         accuracy_dph: ``w_m``, deg/h.
 
     Returns:
         The chosen indices and the steps taken (never a smaller box, never below the floor).
     """
+
     chosen = np.array(start, dtype=int)
     box = _box(sensitivity, chosen, accuracy_dph)
     current = _log_det(features, chosen)
@@ -350,18 +348,20 @@ class CalibrationDesign:
     def positions(self) -> PositionSet:
         """The chosen positions as a :class:`PositionSet` of the table."""
         return PositionSet(
-            self.positions_deg / DEG_PER_RAD, table=self.space.table, name="design --calibrate"
+            self.positions_deg / DEG_PER_RAD,
+            table=self.space.table,
+            name=str(command("design", calibrate=True)),
         )
 
     def comment(self) -> str:
         """The comment lines of the positions' CSV: what made it, with its seed."""
         return "\n".join(
             [
-                "designed by turntable-pin design --calibrate (loosest orientation requirement)",
+                f"designed by {command('design', calibrate=True)} (loosest orientation "
+                "requirement)",
                 f"table: {self.space.table_name}; accuracy_dph={self.accuracy_dph:g}",
-                f"seed={self.space.seed} candidates={self.space.candidates_deg.shape[0]} "
-                f"n_positions={self.n_positions} min_efficiency={self.min_efficiency:g}",
-                "limits: " + "; ".join(r.describe() for r in self.space.ranges),
+                f"{self.space.seed_text(self.n_positions)} min_efficiency={self.min_efficiency:g}",
+                self.space.limits_text,
                 f"reference: {self.reference.name}; looser by {self.looser_by:.4g}; "
                 f"D-efficiency {self.d_efficiency:.4g}",
             ]
@@ -400,10 +400,10 @@ class CalibrationDesign:
         """The design as text: the boxes and the planes of design and reference, the positions."""
         space, ref = self.space, self.reference.name
         lines = [
-            f"design (calibrate, loosest orientation requirement): {self.n_positions} positions "
-            f"of {space.candidates_deg.shape[0]} candidates (seed {space.seed}) on "
-            f"{space.table_name}, for a rate accuracy of {self.accuracy_dph:g} deg/h",
-            "limits: " + "; ".join(r.describe() for r in space.ranges),
+            f"design (calibrate, loosest orientation requirement): "
+            f"{space.chosen_text(self.n_positions)}, for a rate accuracy of "
+            f"{self.accuracy_dph:g} deg/h",
+            space.limits_text,
             f"reference: {ref} ({len(self.reference)} positions); D-efficiency of the design "
             f"against it {self.d_efficiency:.3f} (floor {self.min_efficiency:g}: the 14 drift "
             "coefficients at least as precisely)",
@@ -427,10 +427,7 @@ class CalibrationDesign:
                 f"  {name[:16]:16s}{values}   (corners: dwx {result.box_dwx_dph:.4g}, "
                 f"dwy {result.box_dwy_dph:.4g} deg/h)"
             )
-        names = ", ".join(f"phi{r.index}" for r in space.ranges)
-        lines.append(f"positions ({names}, deg):")
-        for row in self.positions_deg:
-            lines.append("  " + "  ".join(f"{v:10.4f}" for v in row))
+        lines += space.positions_lines(self.positions_deg)
         return "\n".join(lines)
 
 
@@ -460,34 +457,13 @@ def design_calibration(
         InputError: N above the candidates of ``space`` (checked first), N below 7 or no grid
             of N to compare with; a precision floor no design reaches.
     """
-    from ..core.sizes import check_positions_count
-
-    n_positions = check_positions_count(n_positions, space.candidates_deg.shape[0])
-    accuracy_dph = check_accuracy_dph(accuracy_dph)
-    if int(n_positions) < N_COEFFICIENTS:
-        raise InputError(
-            f"-n {n_positions}: a calibration needs at least {N_COEFFICIENTS} positions (seven "
-            "drift coefficients per axis)"
-        )
-    n_positions = int(n_positions)
-    if not (np.isfinite(min_efficiency) and 0 < min_efficiency <= MAX_MIN_EFFICIENCY):
-        raise InputError(
-            f"the precision floor (D-efficiency) must be in (0, {MAX_MIN_EFFICIENCY:g}], "
-            f"got {min_efficiency!r}"
-        )
+    n_positions, accuracy_dph = _checked_request(space, n_positions, accuracy_dph, min_efficiency)
     gyrowheel = gyrowheel if gyrowheel is not None else GyroWheelModel.nominal()
     table = space.table
-    drawn = PositionSet(space.candidates_deg / DEG_PER_RAD, table=table, name="within the limits")
-    require_identifiable(position_inputs(drawn, latitude_rad))
-    reference = comparison_grid(space, n_positions, latitude_rad)
-    others = _without(drawn.angles_rad, reference.angles_rad)
-    candidates = PositionSet(
-        np.concatenate([others, reference.angles_rad]), table=table, name="candidates"
-    )
+    reference, candidates, reference_index = _candidates(space, n_positions, latitude_rad)
     inputs = position_inputs(candidates, latitude_rad)
     features = np.stack([regressor_matrix(a, inputs.specific_force_g) for a in AXES], axis=1)
     sensitivity = np.abs(rate_error_jacobian(gyrowheel, inputs))
-    reference_index = np.arange(len(others), len(candidates))
     reference_log_det = _log_det(features, reference_index)
     floor = reference_log_det + _N_PARAMETERS * np.log(min_efficiency)
     start = reference_index
@@ -508,15 +484,14 @@ def design_calibration(
     if min_efficiency <= 1 and box.volume_rad3 < reference_box.volume_rad3:
         chosen, box = reference_index, reference_box  # the full model's last digits: the grid
     plan = plan_measurements(np.round(candidates.angles_rad[chosen] * DEG_PER_RAD, 9))
-    positions_deg = plan.joint_deg
-    design_set = PositionSet(positions_deg / DEG_PER_RAD, table=table, name="design")
+    design_set = PositionSet(plan.joint_deg / DEG_PER_RAD, table=table, name="design")
     uniform, _ = holding_scale(
         accuracy_dph, gyrowheel, position_inputs(design_set, latitude_rad),
         reference_box.limits_rad,
     )  # fmt: skip
     return CalibrationDesign(
         space=space,
-        positions_deg=positions_deg,
+        positions_deg=plan.joint_deg,
         plan=plan,
         reference=reference,
         accuracy_dph=accuracy_dph,
@@ -534,6 +509,42 @@ def design_calibration(
         steps=steps,
         latitude_rad=float(latitude_rad),
     )
+
+
+def _checked_request(space, n_positions, accuracy_dph, min_efficiency) -> tuple[int, float]:
+    """N (checked against the candidates, at least 7) and ``w_m``, or :class:`InputError`; a
+    precision floor outside (0, :data:`MAX_MIN_EFFICIENCY`] is refused too."""
+    n_positions = check_positions_count(n_positions, space.candidates_deg.shape[0])
+    accuracy_dph = check_accuracy_dph(accuracy_dph)
+    if int(n_positions) < N_COEFFICIENTS:
+        raise InputError(
+            f"{argument('n_positions')} {n_positions}: a calibration needs at least "
+            f"{N_COEFFICIENTS} positions (seven drift coefficients per axis)"
+        )
+    if not (np.isfinite(min_efficiency) and 0 < min_efficiency <= MAX_MIN_EFFICIENCY):
+        raise InputError(
+            f"the precision floor (D-efficiency) must be in (0, {MAX_MIN_EFFICIENCY:g}], "
+            f"got {min_efficiency!r}"
+        )
+    return int(n_positions), accuracy_dph
+
+
+def _candidates(space, n_positions: int, latitude_rad: float):
+    """The reference grid, the candidates (those drawn within the limits that the grid does not
+    hold, then the grid's) and the grid's indices among them.
+
+    Raises:
+        IdentifiabilityError: no position within the limits calibrates.
+    """
+    table = space.table
+    drawn = PositionSet(space.candidates_deg / DEG_PER_RAD, table=table, name="within the limits")
+    require_identifiable(position_inputs(drawn, latitude_rad))
+    reference = comparison_grid(space, n_positions, latitude_rad)
+    others = _without(drawn.angles_rad, reference.angles_rad)
+    candidates = PositionSet(
+        np.concatenate([others, reference.angles_rad]), table=table, name="candidates"
+    )
+    return reference, candidates, np.arange(len(others), len(candidates))
 
 
 def _without(angles_rad: np.ndarray, known_rad: np.ndarray) -> np.ndarray:

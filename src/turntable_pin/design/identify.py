@@ -24,15 +24,31 @@ design's number of positions), above 1 when the design does better.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
-from ..core.exceptions import InputError
-from ..core.units import ARCSEC_PER_RAD
+from ..core.blas_threads import one_blas_thread
+from ..core.exceptions import InputError, TurntablePinError
+from ..core.sizes import check_positions_count
+from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
+from ..core.words import argument, command
+from ..measurement.effect_model import OrientationModel
+from ..measurement.effects.base import PositionVariables
+from ..measurement.fit import fit_orientation
+from ..stats.design import d_optimal_design, greedy_design, log_det
+from ..stats.least_squares import analyse_identifiability, combination_name, tall_r_factor
 from .schedule import MeasurementPlan, Visits, candidate_visits, plan_measurements
 from .space import DesignSpace
 
-__all__ = ["IdentifyDesign", "design_identify", "design_rows"]
+__all__ = [
+    "CandidateRows",
+    "IdentifyDesign",
+    "candidate_rows",
+    "design_identify",
+    "design_rows",
+    "grid_rows",
+]
 
 DEFAULT_NOISE_ARCSEC = 1.0
 """Noise of a measured angle when neither ``noise_arcsec`` nor data say it, arc seconds."""
@@ -43,23 +59,20 @@ class IdentifyDesign:
     """D-optimal positions and what they will determine.
 
     Attributes:
-        space: the :class:`~.space.DesignSpace` (table, effects, limits, candidates, seed).
+        space: the :class:`~.space.DesignSpace`.  plan: the run that measures the positions.
         positions_deg: the chosen positions (N, J), degrees (in the run's first order).
-        plan: the run that measures them (:class:`~.schedule.MeasurementPlan`).
-        combinations: each determined combination: ``name``, ``unit``, ``coefficients``, the
-            expected standard error of the design (``std``), of the grid as measured (``std_grid``,
-            ``n_grid`` positions) and of the grid scaled to the design's size (``std_grid_same_n``);
-            ``None`` where the grid does not determine it.
+        combinations: each determined combination: ``name``, ``unit``, ``coefficients`` and its
+            expected standard error on the design (``std``), on the grid as measured
+            (``std_grid``) and on the grid at the design's size (``std_grid_same_n``; ``None``
+            where the grid does not determine it).
         undetermined: the combinations no position within the limits determines.
         noise_arcsec, noise_source: the noise of a measured angle and where it comes from.
-        n_from: positions already measured (``--from``), 0 without.
-        log_det, log_det_grid_same_n: ``log det`` of the Fisher information of the determined
-            combinations (in their user units) of the design and of the grid scaled to its size
-            (with the information of the data already measured).
-        d_efficiency: ``exp((log_det - log_det_grid_same_n) / p)``: the design's information per
-            position against the grid's (``None`` when the grid determines not all).
-        n_grid: positions of the grid (those the effects are defined at).
-        greedy_log_det: ``log det`` after the greedy start (same coordinates as ``log_det``).
+        n_from: positions already measured (``from_data``), 0 without.
+        log_det, log_det_grid_same_n: ``log det`` of the information of the determined
+            combinations (user units; with the data measured) on the design and on the grid at
+            its size; d_efficiency: ``exp((log_det - log_det_grid_same_n) / p)`` (``None`` when
+            the grid determines not all).
+        n_grid: positions of the grid.  greedy_log_det: ``log det`` after the greedy start.
         n_exchanges, n_sweeps: of the exchange.
     """
 
@@ -94,11 +107,10 @@ class IdentifyDesign:
         effects = ", ".join(self.space.effect_names) or "none"
         return "\n".join(
             [
-                "designed by turntable-pin design (identify: D-optimal)",
+                f"designed by {command('design')} (identify: D-optimal)",
                 f"table: {self.space.table_name}; effects: {effects}",
-                f"seed={self.space.seed} candidates={self.space.candidates_deg.shape[0]} "
-                f"n_positions={self.n_positions} n_from={self.n_from}",
-                "limits: " + "; ".join(r.describe() for r in self.space.ranges),
+                f"{self.space.seed_text(self.n_positions)} n_from={self.n_from}",
+                self.space.limits_text,
                 f"noise_arcsec={self.noise_arcsec:g} ({self.noise_source})",
                 f"run: {self.plan.rule}",
             ]
@@ -132,11 +144,9 @@ class IdentifyDesign:
         space = self.space
         effects = " + ".join(("base", *space.effect_names))
         lines = [
-            f"design (identify, D-optimal): {self.n_positions} positions of "
-            f"{space.candidates_deg.shape[0]} candidates (seed {space.seed}) on "
-            f"{space.table_name}, for {effects}"
+            f"design (identify, D-optimal): {space.chosen_text(self.n_positions)}, for {effects}"
             + (f", after the {self.n_from} positions measured" if self.n_from else ""),
-            "limits: " + "; ".join(r.describe() for r in space.ranges),
+            space.limits_text,
             f"run: {self.plan.n_rows} measurements; {self.plan.rule}",
             f"noise: {self.noise_arcsec:.3g} arcsec per angle ({self.noise_source})",
         ]
@@ -166,18 +176,13 @@ class IdentifyDesign:
             lines.append(
                 "not determined by any position within the limits: " + "; ".join(self.undetermined)
             )
-        names = ", ".join(f"phi{r.index}" for r in space.ranges)
-        lines.append(f"positions ({names}, deg):")
-        for row in self.positions_deg:
-            lines.append("  " + "  ".join(f"{v:10.4f}" for v in row))
+        lines += space.positions_lines(self.positions_deg)
         return "\n".join(lines)
 
 
 def _evaluate(space: DesignSpace, variables):
     """The Jacobian (M, 3, n) at zero of the base errors and ``space.effects`` at ``variables``,
     and the model (its parameter names, units)."""
-    from ..measurement.effect_model import OrientationModel
-
     model = OrientationModel(variables, space.effects, space.table)
     return model.jacobian(np.zeros(model.n_params)), model
 
@@ -185,9 +190,6 @@ def _evaluate(space: DesignSpace, variables):
 def _variables(joint_deg: np.ndarray, visits: Visits, start_s: float, duration_s: float):
     """Variables of every position in ``joint_deg`` (C, J) measured as ``visits`` says,
     position-major (C * visits.count rows)."""
-    from ..core.units import DEG_PER_RAD
-    from ..measurement.effects.base import PositionVariables
-
     joints = np.repeat(joint_deg / DEG_PER_RAD, visits.count, axis=0)
     fractions = visits.time_fractions()
     time_s = None if fractions is None else start_s + fractions.reshape(-1) * duration_s
@@ -241,19 +243,27 @@ def design_rows(
     return rows[keep], keep, model
 
 
+def grid_rows(space: DesignSpace, start_s: float, duration_s: float):
+    """:func:`design_rows` of the 30-degree grid within the limits, measured by the same rules
+    as the candidates (its visits seeded apart from theirs)."""
+    visits = candidate_visits(
+        space.grid_deg.shape[0], space.n_joints, needs_time=space.needs_time,
+        needs_dirs=space.needs_dirs, rng=np.random.default_rng([space.seed, 2]),
+    )  # fmt: skip
+    return design_rows(space, space.grid_deg, visits, start_s, duration_s)
+
+
 def _start_information(space, data, noise_arcsec, dwell_s: float):
     """What the data already measured bring: ``(information (n, n) or None, noise of the new
     measurements in arcsec, where it comes from, positions measured, time after them)``."""
     if data is None:
         noise = DEFAULT_NOISE_ARCSEC if noise_arcsec is None else float(noise_arcsec)
         return None, noise, "default" if noise_arcsec is None else "given", 0, 0.0
-    from ..core.exceptions import TurntablePinError
-
     where = data.source or "the data"
     try:
         jac, model = _evaluate(space, data.variables())
     except InputError as exc:
-        raise InputError(f"--from {where}: {exc.detail}") from None
+        raise InputError(f"{argument('from_data')} {where}: {exc.detail}") from None
     mask = data.measured.reshape(-1)
     jac = jac.reshape(-1, model.n_params)[mask]
     known = data.sigma_rad is not None and not data.sigma_relative
@@ -268,13 +278,12 @@ def _start_information(space, data, noise_arcsec, dwell_s: float):
         sigma_rad = np.full(jac.shape[0], float(noise_arcsec) / ARCSEC_PER_RAD)
         noise, source = float(noise_arcsec), "given"
     else:
-        from ..measurement.fit import fit_orientation
-
         try:
             fit = fit_orientation(data, space.effects, turntable=space.table)
         except TurntablePinError as exc:
             raise InputError(
-                f"--from {where}: their noise cannot be fitted ({exc}); give --noise-arcsec"
+                f"{argument('from_data')} {where}: their noise cannot be fitted ({exc}); give "
+                f"{argument('noise_arcsec')}"
             ) from None
         sigma_rad = fit.sigma_angles_rad.reshape(-1)[mask]
         noise = float(np.median(sigma_rad)) * ARCSEC_PER_RAD
@@ -298,8 +307,6 @@ def _invisible_effect(space, model, stacked: np.ndarray) -> str | None:
     """Why one of the effects cannot be identified on the ``stacked`` rows (all the candidates):
     its parameters add no determined combination to the base errors (no position sees it) or
     to the other effects (naming those that explain it); ``None`` when every effect adds one."""
-    from ..stats.least_squares import analyse_identifiability
-
     names = np.array(model.parameter_names)
     owner = {e.name: np.array([n.startswith(f"{e.name}.") for n in names]) for e in space.effects}
 
@@ -317,7 +324,7 @@ def _invisible_effect(space, model, stacked: np.ndarray) -> str | None:
             return (
                 f"effect '{effect.name}' changes nothing that the base errors do not already "
                 "explain at any position within the limits: no position can see it; leave it out "
-                "of --effects or widen the limits"
+                f"of {argument('effects')} or widen the limits"
             )
         culprits = [
             other.name
@@ -337,8 +344,6 @@ def _invisible_effect(space, model, stacked: np.ndarray) -> str | None:
 def _fewest_positions(rows, start, rank) -> int | None:
     """The fewest candidates the greedy design needs to determine ``rank`` combinations (None:
     not even twice ``rank``)."""
-    from ..stats.design import greedy_design, log_det
-
     count = min(rows.shape[0], 2 * rank + 2)
     order = greedy_design(rows, count, start)
     m = np.zeros((rows.shape[2],) * 2) if start is None else np.array(start)
@@ -391,9 +396,6 @@ def design_identify(
             effect that no position within the limits can see; positions that cannot determine
             every combination.
     """
-    from ..core.blas_threads import one_blas_thread
-    from ..core.sizes import check_positions_count
-
     n_positions = check_positions_count(n_positions, space.candidates_deg.shape[0])
     with one_blas_thread():  # tall-by-small products: many threads on busy cores only wait
         return _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s)
@@ -401,62 +403,33 @@ def design_identify(
 
 def _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s) -> IdentifyDesign:
     """:func:`design_identify`, on one BLAS thread."""
-    from ..stats.design import d_optimal_design, log_det
-    from ..stats.least_squares import analyse_identifiability, combination_name, tall_r_factor
-
-    start_int, noise, noise_source, n_from, start_s = _start_information(
-        space, from_data, noise_arcsec, dwell_s
+    c = candidate_rows(space, n_positions, from_data, noise_arcsec, dwell_s)
+    n = c.model.n_params
+    candidate_r = tall_r_factor(c.rows.reshape(-1, n))
+    start_rows = () if c.information is None else (_root(c.information),)
+    ident = analyse_identifiability(
+        np.concatenate([candidate_r, *start_rows]), c.model.parameter_names
     )
-    noise_rad = noise / ARCSEC_PER_RAD
-    count = space.visits.count
-    duration_s = (n_positions * count - 1) * float(dwell_s)
-    try:
-        rows, keep, model = design_rows(
-            space, space.candidates_deg, space.visits, start_s, duration_s
-        )
-    except InputError as exc:
-        raise InputError(f"no candidate position within the limits can be used: {exc}") from None
-    candidates_deg = space.candidates_deg[keep]
-    if n_positions > candidates_deg.shape[0]:
-        raise InputError(
-            f"{n_positions} positions asked, but only {candidates_deg.shape[0]} candidates: give "
-            "more --candidates"
-        )
-    rows = rows / noise_rad
-    names, n = model.parameter_names, model.n_params
-    candidate_r = tall_r_factor(rows.reshape(-1, n))
-    stacked = candidate_r if start_int is None else np.concatenate([candidate_r, _root(start_int)])
-    ident = analyse_identifiability(stacked, names)
     rank = ident.rank
     if rank == 0:
         raise InputError("no position within the limits determines any error of the table")
-    invisible = _invisible_effect(space, model, candidate_r)
+    invisible = _invisible_effect(space, c.model, candidate_r)
     if invisible:
         raise InputError(invisible)
-    angles_per_position = 3 * count
-    from_rows = 0 if from_data is None else int(from_data.measured.sum())
-    if angles_per_position * n_positions + from_rows <= rank:
-        fewest = (rank - from_rows) // angles_per_position + 1
-        raise InputError(
-            f"{n_positions} position{'s give' if n_positions > 1 else ' gives'} "
-            f"{angles_per_position * n_positions} measured angles"
-            + (f" (with the {from_rows} measured)" if from_rows else "")
-            + f", not more than the {rank} combinations to identify: choose at least {fewest} "
-            "positions (-n)"
-        )
+    _check_enough_angles(n_positions, 3 * space.visits.count, c.from_rows, rank)
     # Whitened coordinates z of the determined combinations: parameters = basis @ z.
     basis = ident.basis / ident.singular_values[:rank]
-    x = (rows.reshape(-1, n) @ basis).reshape(rows.shape[0], -1, rank)
-    start = None if start_int is None else basis.T @ start_int @ basis
+    x = (c.rows.reshape(-1, n) @ basis).reshape(c.rows.shape[0], -1, rank)
+    start = None if c.information is None else basis.T @ c.information @ basis
     # The exchange runs from the greedy design and from the grid (its best N, or completed):
     # never worse than the grid.
     first_grid = space.candidates_deg.shape[0] - space.grid_deg.shape[0]
-    grid_start = np.flatnonzero(np.flatnonzero(keep) >= first_grid)
+    grid_start = np.flatnonzero(np.flatnonzero(c.keep) >= first_grid)
     found = d_optimal_design(x, n_positions, start, also_from=[grid_start])
     if not np.isfinite(found.log_det):
         fewest = _fewest_positions(x, start, rank)
         more = (
-            f"the fewest that do: {fewest} (-n {fewest})"
+            f"the fewest that do: {fewest} ({argument('n_positions')} {fewest})"
             if fewest
             else "no number of them does: widen the limits or leave effects out"
         )
@@ -464,61 +437,92 @@ def _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s) -> Id
             f"{n_positions} positions within the limits cannot determine all {rank} "
             f"combinations; {more}"
         )
-    chosen = np.flatnonzero(keep)[np.sort(found.chosen)]
+    chosen = np.flatnonzero(c.keep)[np.sort(found.chosen)]
     positions = space.candidates_deg[chosen]
     plan = plan_measurements(
-        positions,
-        needs_time=space.needs_time,
-        needs_dirs=space.needs_dirs,
-        dwell_s=dwell_s,
-        seed=space.seed,
-        start_s=start_s,
-        visits=space.visits.subset(chosen),
-    )
-    first = np.unique(plan.position, return_index=True)[1]
-    positions = positions[plan.position[np.sort(first)]]  # in the order first measured
+        positions, needs_time=space.needs_time, needs_dirs=space.needs_dirs, dwell_s=dwell_s,
+        seed=space.seed, start_s=c.start_s, visits=space.visits.subset(chosen),
+    )  # fmt: skip
 
     def information(plan_: MeasurementPlan) -> np.ndarray:
-        jac = _evaluate(space, plan_.variables())[0].reshape(-1, n) / noise_rad
-        z = jac @ basis
+        z = _evaluate(space, plan_.variables())[0].reshape(-1, n) / c.noise_rad @ basis
         return z.T @ z
 
-    m_design = information(plan) + (0.0 if start is None else start)
-    # The grid, measured by the same rules (its positions where the effects are defined).
-    grid_visits = candidate_visits(
-        space.grid_deg.shape[0], space.n_joints, needs_time=space.needs_time,
-        needs_dirs=space.needs_dirs, rng=np.random.default_rng([space.seed, 2]),
-    )  # fmt: skip
-    _, grid_keep, _ = design_rows(space, space.grid_deg, grid_visits, start_s, duration_s)
-    grid = space.grid_deg[grid_keep]
-    n_grid = max(grid.shape[0], 1)
+    zero = 0.0 if start is None else start
+    m_design = information(plan) + zero
+    m_grid, m_grid_n, n_grid = _grid_information(space, c, information, n_positions, dwell_s)
+    # Combinations in user units: y = to_user @ z (pivot-scaled rows of the RREF, as fit names).
+    pivots = [int(np.flatnonzero(row)[0]) for row in ident.determined]
+    to_user = (ident.determined / c.model.per_user_unit[pivots][:, None]) @ basis
+    shift = 2.0 * float(np.linalg.slogdet(to_user)[1])
+    ld = log_det(m_design) - shift
+    ld_grid = log_det(m_grid_n + zero) - shift
+    finite_grid = bool(np.isfinite(ld_grid))
+    return IdentifyDesign(
+        space=space,
+        positions_deg=positions[plan.first_order()],
+        plan=plan,
+        combinations=_combinations(
+            ident, c.model, pivots, [m_design, m_grid + zero, m_grid_n + zero], to_user
+        ),
+        undetermined=_undetermined(ident, c.model),
+        noise_arcsec=float(c.noise),
+        noise_source=c.noise_source,
+        n_from=c.n_from,
+        log_det=float(ld),
+        log_det_grid_same_n=float(ld_grid) if finite_grid else None,
+        d_efficiency=float(np.exp((ld - ld_grid) / rank)) if finite_grid else None,
+        n_grid=n_grid,
+        greedy_log_det=float(found.greedy_log_det - shift),
+        n_exchanges=found.n_exchanges,
+        n_sweeps=found.n_sweeps,
+    )
+
+
+def _check_enough_angles(n_positions: int, per_position: int, from_rows: int, rank: int) -> None:
+    """Refuse positions that measure no more angles (with those measured) than ``rank``."""
+    if per_position * n_positions + from_rows <= rank:
+        fewest = (rank - from_rows) // per_position + 1
+        raise InputError(
+            f"{n_positions} position{'s give' if n_positions > 1 else ' gives'} "
+            f"{per_position * n_positions} measured angles"
+            + (f" (with the {from_rows} measured)" if from_rows else "")
+            + f", not more than the {rank} combinations to identify: choose at least {fewest} "
+            f"positions ({argument('n_positions')})"
+        )
+
+
+def _grid_information(space, c: CandidateRows, information, n_positions: int, dwell_s: float):
+    """The information of the 30-degree grid within the limits measured by the same rules (its
+    positions where the effects are defined), as measured and at the design's size (its
+    information per position, in a run as long as the design's: a drift rate is known better
+    from a longer run, not from better positions), and the grid's number of positions."""
+    grid = space.grid_deg[grid_rows(space, c.start_s, c.duration_s)[1]]
+    n_grid, count = max(grid.shape[0], 1), space.visits.count
 
     def grid_information(dwell: float) -> np.ndarray:
         return information(
             plan_measurements(
                 grid, needs_time=space.needs_time, needs_dirs=space.needs_dirs, dwell_s=dwell,
-                seed=space.seed, start_s=start_s,
+                seed=space.seed, start_s=c.start_s,
             )
         )  # fmt: skip
 
-    zero = 0.0 if start is None else start
-    m_grid = grid_information(dwell_s) + zero
-    # The grid at the design's size: its information per position, in a run as long as the
-    # design's (a drift rate is known better from a longer run, not from better positions).
     same_duration = dwell_s * (n_positions * count - 1) / max(n_grid * count - 1, 1)
-    m_grid_n = grid_information(same_duration) * (n_positions / n_grid) + zero
-    # Combinations in user units: y = to_user @ z (pivot-scaled rows of the RREF, as fit names).
-    pivots = [int(np.flatnonzero(row)[0]) for row in ident.determined]
-    scale = model.per_user_unit[pivots]
-    to_user = (ident.determined / scale[:, None]) @ basis
-    shift = 2.0 * float(np.linalg.slogdet(to_user)[1])
-    std = _standard_errors(m_design, to_user)
-    std_grid = _standard_errors(m_grid, to_user)
-    std_grid_n = _standard_errors(m_grid_n, to_user)
-    combinations = []
+    m_grid_n = grid_information(same_duration) * (n_positions / n_grid)
+    return grid_information(dwell_s), m_grid_n, int(grid.shape[0])
+
+
+def _combinations(ident, model, pivots, informations, to_user) -> tuple[dict, ...]:
+    """Each determined combination in user units (``name``, ``unit``, ``coefficients``) with its
+    standard error under the design's, the grid's and the grid's at the design's size
+    ``informations``."""
+    names = model.parameter_names
+    std, std_grid, std_grid_n = (_standard_errors(m, to_user) for m in informations)
+    out = []
     for i, row in enumerate(ident.determined):
-        coeffs = row * model.per_user_unit / scale[i]
-        combinations.append(
+        coeffs = row * model.per_user_unit / model.per_user_unit[pivots[i]]
+        out.append(
             {
                 "name": combination_name(coeffs, names),
                 "unit": model.parameter_units[pivots[i]],
@@ -528,29 +532,62 @@ def _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s) -> Id
                 "std_grid_same_n": std_grid_n[i],
             }
         )
-    undetermined = []
-    for row in ident.undetermined:
-        pivot = int(np.flatnonzero(row)[0])
-        undetermined.append(
-            combination_name(row * model.per_user_unit / model.per_user_unit[pivot], names)
-        )
-    ld = log_det(m_design) - shift
-    ld_grid = log_det(m_grid_n) - shift
-    finite_grid = bool(np.isfinite(ld_grid))
-    return IdentifyDesign(
-        space=space,
-        positions_deg=positions,
-        plan=plan,
-        combinations=tuple(combinations),
-        undetermined=tuple(undetermined),
-        noise_arcsec=float(noise),
-        noise_source=noise_source,
-        n_from=n_from,
-        log_det=float(ld),
-        log_det_grid_same_n=float(ld_grid) if finite_grid else None,
-        d_efficiency=float(np.exp((ld - ld_grid) / rank)) if finite_grid else None,
-        n_grid=int(grid.shape[0]),
-        greedy_log_det=float(found.greedy_log_det - shift),
-        n_exchanges=found.n_exchanges,
-        n_sweeps=found.n_sweeps,
+    return tuple(out)
+
+
+def _undetermined(ident, model) -> tuple[str, ...]:
+    """The combinations no position within the limits determines, in words (pivot-scaled)."""
+    unit = model.per_user_unit
+    return tuple(
+        combination_name(row * unit / unit[int(np.flatnonzero(row)[0])], model.parameter_names)
+        for row in ident.undetermined
     )
+
+
+class CandidateRows(NamedTuple):
+    """The candidates' whitened Jacobian rows (C', 3 * visits, n) and which candidates they are
+    (``keep``, (C,)), the model, and what the data already measured bring
+    (:func:`candidate_rows`)."""
+
+    rows: np.ndarray
+    keep: np.ndarray
+    model: object
+    information: np.ndarray | None
+    noise: float
+    noise_rad: float
+    noise_source: str
+    n_from: int
+    from_rows: int
+    start_s: float
+    duration_s: float
+
+
+def candidate_rows(space, n_positions, from_data, noise_arcsec, dwell_s) -> CandidateRows:
+    """The :class:`CandidateRows` of a design of ``n_positions`` (after ``from_data``).
+
+    Raises:
+        InputError: no candidate where the effects are defined; fewer usable candidates than
+            ``n_positions``; data measured that cannot be used.
+    """
+    information, noise, noise_source, n_from, start_s = _start_information(
+        space, from_data, noise_arcsec, dwell_s
+    )
+    duration_s = (n_positions * space.visits.count - 1) * float(dwell_s)
+    try:
+        rows, keep, model = design_rows(
+            space, space.candidates_deg, space.visits, start_s, duration_s
+        )
+    except InputError as exc:
+        raise InputError(f"no candidate position within the limits can be used: {exc}") from None
+    usable = int(keep.sum())
+    if n_positions > usable:
+        raise InputError(
+            f"{n_positions} positions asked, but only {usable} candidates: give more "
+            f"{argument('candidates')}"
+        )
+    noise_rad = noise / ARCSEC_PER_RAD
+    from_rows = 0 if from_data is None else int(from_data.measured.sum())
+    return CandidateRows(
+        rows / noise_rad, keep, model, information, noise, noise_rad, noise_source, n_from,
+        from_rows, start_s, duration_s,
+    )  # fmt: skip

@@ -11,9 +11,8 @@ How a position is measured depends on what the effects need to be seen:
   ``dirK = +1`` and once with ``-1`` (per joint, the first side seeded and balanced).
 
 With both, the early visit comes from one side and the late one from the other. The
-:class:`MeasurementPlan` writes the CSV that ``turntable-pin simulate --positions`` reads
-(``phiK_deg``, then ``time_s`` and ``dirK`` when the design needs them: one row per
-measurement).
+:class:`MeasurementPlan` writes the CSV the simulation reads as its positions (``phiK_deg``, then
+``time_s`` and ``dirK`` when the design needs them: one row per measurement).
 """
 
 from __future__ import annotations
@@ -23,7 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.csv_table import write_csv_table
 from ..core.units import DEG_PER_RAD
+from ..measurement.effects.base import PositionVariables
 
 __all__ = ["MeasurementPlan", "Visits", "candidate_visits", "plan_measurements"]
 
@@ -104,10 +105,12 @@ class MeasurementPlan:
         """Number of measurements M."""
         return int(self.joint_deg.shape[0])
 
+    def first_order(self) -> np.ndarray:
+        """The design's positions (indices) in the order they are first measured."""
+        return self.position[np.sort(np.unique(self.position, return_index=True)[1])]
+
     def variables(self):
         """The rows as :class:`~turntable_pin.measurement.effects.base.PositionVariables`."""
-        from ..measurement.effects.base import PositionVariables
-
         dirs = () if self.dirs is None else tuple(self.dirs.T)
         return PositionVariables(self.joint_deg / DEG_PER_RAD, self.time_s, dirs)
 
@@ -124,8 +127,6 @@ class MeasurementPlan:
 
     def write_csv(self, path: str | Path, comment: str = "") -> Path:
         """Write the plan's CSV atomically (``comment`` lines first, with a ``#``)."""
-        from ..core.csv_table import write_csv_table
-
         return write_csv_table(path, self.columns(), comment=comment)
 
     def to_dict(self) -> dict:

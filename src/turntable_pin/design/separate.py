@@ -1,38 +1,34 @@
-"""Positions that tell two effects apart (``design --separate A,B``; issue 19, item 2).
+"""Positions that tell two effects apart (``design(separate='A,B')``; issue 19, item 2).
 
-When the diagnosis says that effect B reproduces effect A on the positions measured, the
-question is which positions would tell them apart, and how many. Each effect is taken at its
-amplitude (fitted on the data measured with the base errors, or given): if A is true, fitting
-the base errors and B to what A predicts leaves the noise-free misfit
+When the diagnosis says that effect B reproduces effect A on the positions measured, which
+positions would tell them apart, and how many? Each effect is taken at its amplitude (given, or
+fitted with the base errors on the data measured). If A is true, fitting the base errors and B
+to A's prediction leaves the noise-free misfit
 
     lambda_AB = || (I - P_B) J_A a ||^2 / sigma^2,   P_B the projector on the base and B's columns
 
-over the measured angles of the design (the Jacobian of
-:class:`~turntable_pin.measurement.effect_model.OrientationModel` at zero: the linearised model),
-and ``lambda_BA`` the other way round. The design maximises the smaller of the two (T-optimal,
-Atkinson and Fedorov 1975): a seeded exchange over the candidate positions within the joints'
-limits (:func:`~turntable_pin.stats.discrimination.t_optimal_exchange`), added to the positions
-already measured when there are some.
+over the design's measured angles (J the linearised model: the Jacobian of
+:class:`~turntable_pin.measurement.effect_model.OrientationModel` at zero), and ``lambda_BA`` the
+other way round. The design maximises the smaller of the two (T-optimal, Atkinson and Fedorov
+1975): a seeded exchange over the candidates within the joints' limits
+(:func:`~turntable_pin.stats.discrimination.t_optimal_exchange`), after the positions measured.
 
-The power is the diagnosis' own decision (sigma known): when A is true, A is named when it is
-accepted, ``chi2'(k_A, lambda_A0) > k_A ln m + 6 + 2 ln K`` (a non-central chi-square:
-``lambda_A0`` what the base errors alone leave of A, ``k_A`` the ranks A adds to the base, ``m``
-the measured angles, ``K`` the catalogue's size:
-:func:`~turntable_pin.stats.model_selection.acceptance_threshold`), and then either put before
-B in the first round, ``rss_B - rss_A > (k_A - k_B) ln m`` (a generalised chi-square of the
-noise in the span of both models, :func:`~turntable_pin.stats.discrimination.rss_difference`;
-with A's parameters traded off and B's not, also ``gain_A > 2 gain_B``), or, B first, accepted
-on top of B (the nested test: ``chi2'(k_A|B, lambda_AB)`` above the second round's threshold)
-with B then dropped as not needed beside it. The power of a design is the smaller of the two
-chances (A true, B true); a third catalogued effect that might take the name is not counted.
-The positions needed for the target power are found by scaling the design's misfits to other
-sizes (replicating it is exact) and checked by designing that many positions.
+The power is the diagnosis' own decision (sigma known). With A true, A is named when it is
+accepted, ``chi2'(k_A, lambda_A0) > k_A ln m + 6 + 2 ln K`` (``lambda_A0`` what the base errors
+leave of A, ``k_A`` the ranks A adds, ``m`` the measured angles, ``K`` the catalogue's size:
+:func:`~turntable_pin.stats.model_selection.acceptance_threshold`), and then either put before B
+in the first round, ``rss_B - rss_A > (k_A - k_B) ln m`` (a generalised chi-square of the noise in
+both models' span, :func:`~turntable_pin.stats.discrimination.rss_difference`; A traded off and B
+not: also ``gain_A > 2 gain_B``), or, B first, accepted on top of B (``chi2'(k_A|B, lambda_AB)``
+above the second round's threshold) with B then dropped. A design's power is the smaller of the
+two chances (A true, B true); a third effect that might take the name is not counted. The count
+for the target power scales the design's misfits (replicating it is exact), checked by designing
+that many positions.
 
-When B reproduces A at every candidate position (its misfit is below :data:`SAME_RTOL` of A's
-signal beyond the base errors) and A has no fewer ranks than B, no positions within the limits
-separate them: the result says so, with the independent measurements of the effects' ``confirm``
-texts. When B contains A but has more ranks, a true A is still named by the rule's parsimony
-(B's extra ranks must buy their penalty from the noise alone): that direction is left to it.
+When B reproduces A at every candidate (misfit below :data:`SAME_RTOL` of A's signal beyond the
+base) and A has no fewer ranks than B, no positions separate them: the result says so, with the
+independent measurements of the effects' ``confirm`` texts. When B contains A with more ranks, a
+true A is still named by the rule's parsimony: that direction is left to it.
 """
 
 from __future__ import annotations
@@ -43,10 +39,28 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError, InputError
-from ..core.units import ARCSEC_PER_RAD
-from .identify import _evaluate, _root, _start_information, design_rows
-from .schedule import MeasurementPlan, candidate_visits, plan_measurements
+from ..core.sizes import check_positions_count
+from ..core.words import argument, command
+from ..measurement.catalogue import catalogue
+from ..measurement.fit import fit_orientation
+from ..stats.discrimination import (
+    Direction,
+    choice_margin,
+    detection_power,
+    generalized_chi2_sf,
+    misfit,
+    orthonormal_span,
+    quadratic_form,
+    rss_difference,
+    t_optimal_exchange,
+    traded_off,
+)
+from ..stats.least_squares import tall_r_factor
+from ..stats.model_selection import UNDETERMINED_GAIN_RATIO, acceptance_threshold
+from .identify import _evaluate, _root, candidate_rows, grid_rows
+from .schedule import MeasurementPlan, plan_measurements
 from .space import DesignSpace
 
 __all__ = [
@@ -70,31 +84,26 @@ MAX_POWER_POSITIONS = 5000
 
 @dataclass(frozen=True)
 class Hypothesis:
-    """One of the two effects taken as the truth, against the other.
+    """One of the two effects taken as the truth, against the other (chi2 are noise-free).
 
     Attributes:
-        effect: its name; rival: the other effect's.
-        amplitude: its parameters in user units (``{name: value}``); unit: their unit(s).
-        signal_chi2: what the base errors alone leave of its prediction on the design (with the
-            positions measured), a noise-free chi2.
-        misfit_chi2: what the base errors and the rival leave of it there (``lambda``).
-        misfit_measured_chi2: the same on the positions measured alone (``None`` without).
-        misfit_grid_chi2: the same on the 30-degree grid within the limits, scaled to the
-            design's number of positions (with the positions measured).
+        effect, rival: the names.  amplitude: its parameters (user units); unit: their unit(s).
+        signal_chi2: what the base errors leave of its prediction on the design (and the data).
+        misfit_chi2: what the base errors and the rival leave of it there (``lambda``);
+            misfit_measured_chi2: on the positions measured alone (``None`` without);
+            misfit_grid_chi2: on the 30-degree grid within the limits at the design's size.
         added_rank, rival_added_rank: the ranks each adds to the base on the design.
-        determined, rival_determined: whether the design determines each one's parameters by
-            the diagnosis' correlation rule (an undetermined effect is put first only when it
-            explains twice what a determined one does).
+        determined, rival_determined: whether the design determines each one's parameters (the
+            diagnosis' correlation rule: an undetermined effect goes first only when it explains
+            twice what a determined one does).
         settled_by: ``misfit`` (the design separates it) or ``parsimony`` (the rival reproduces
             it everywhere with more ranks: the rule names it for its fewer ranks).
-        power_detect: the chance that it is accepted at all (a non-central chi-square).
-        power_first: the chance that it is put before the rival in the first round.
-        power_on_top: the chance that, the rival first, it is accepted on top of it (a
-            non-central chi-square of ``misfit_chi2``) and the rival then dropped.
-        power_choice: the chance that it ends up named rather than the rival (either way).
-        power: ``power_detect * power_choice``, the chance of its name.
-        power_measured: the same on the positions measured alone (``None`` without).
-        power_new_alone: the same on the new positions alone (``None`` without data measured).
+        power_detect: the chance that it is accepted at all; power_first: that it goes before
+            the rival in the first round; power_on_top: that, the rival first, it is accepted on
+            top and the rival dropped; power_choice: that it is named rather than the rival.
+        power: ``power_detect * power_choice``, the chance of its name; power_measured,
+            power_new_alone: on the positions measured alone, on the new ones alone (``None``
+            without data measured).
     """
 
     effect: str
@@ -128,51 +137,45 @@ class SeparationDesign:
     """The positions that tell two effects apart, or why none do.
 
     Attributes:
-        space: the :class:`~.space.DesignSpace` (table, the two effects, limits, candidates).
-        pair: the two effects' names.
+        space: the :class:`~.space.DesignSpace`.  pair: the two effects' names.
         positions_deg: the chosen positions (N, J), degrees, in the run's first order (empty
-            when no positions separate them).
-        plan: the run that measures them (``None`` when none do).
+            when none separate them); plan: their run (``None`` then).
         hypotheses: each effect as the truth (:class:`Hypothesis`), A then B.
         misfit_by_position: (N, 2) each position's share of the misfit each effect's rival
-            leaves (chi2; zero for a direction left to parsimony), in the order of
-            :attr:`positions_deg`.
-        measured_deg: the positions already measured (M, J), degrees (empty without).
+            leaves (chi2; zero for a direction left to parsimony).
+        measured_deg: the positions already measured (M, J), degrees; n_from: their number.
         noise_arcsec, noise_source: the noise of a measured angle and where it comes from.
         amplitude_source: where each effect's amplitude comes from (``{effect: text}``).
-        n_from: positions already measured (``--from``), 0 without.
         power: the smaller chance of the right name at these positions.
-        positions_for_power: the fewest positions with at least :attr:`target` power
-            (``None``: not within :data:`MAX_POWER_POSITIONS`); power_at_positions_for_power:
-            their power; positions_for_power_designed: whether that many were designed to check
-            it (else it is this design's misfits scaled).
+        target: the power asked for.  positions_for_power, power_at_positions_for_power,
+            positions_for_power_designed: the fewest positions with that power (``None``: more
+            than :data:`MAX_POWER_POSITIONS`), their power, and whether that many were designed
+            to check it (else this design's misfits scaled).
         power_curve: ``(positions, power)`` of this design scaled to other sizes.
-        target: the power asked for.
-        catalogue_size: K of the acceptance threshold ``-6 - 2 ln K``.
-        n_swaps, n_passes: of the exchange.
+        catalogue_size: K of the acceptance threshold.  n_swaps, n_passes: of the exchange.
         inseparable: why no positions within the limits separate them (one line), or ``None``.
     """
 
     space: DesignSpace = field(repr=False)
     pair: tuple[str, str]
     positions_deg: np.ndarray = field(repr=False)
-    plan: MeasurementPlan | None = field(repr=False)
-    hypotheses: tuple[Hypothesis, ...]
-    misfit_by_position: np.ndarray = field(repr=False)
     measured_deg: np.ndarray = field(repr=False)
     noise_arcsec: float
     noise_source: str
     amplitude_source: dict[str, str]
     n_from: int
-    power: float | None
-    positions_for_power: int | None
-    power_at_positions_for_power: float | None
-    positions_for_power_designed: bool
-    power_curve: tuple[tuple[int, float], ...]
     target: float
-    catalogue_size: int
-    n_swaps: int
-    n_passes: int
+    plan: MeasurementPlan | None = field(default=None, repr=False)
+    hypotheses: tuple[Hypothesis, ...] = ()
+    misfit_by_position: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
+    power: float | None = None
+    positions_for_power: int | None = None
+    power_at_positions_for_power: float | None = None
+    positions_for_power_designed: bool = False
+    power_curve: tuple[tuple[int, float], ...] = ()
+    catalogue_size: int = 0
+    n_swaps: int = 0
+    n_passes: int = 0
     inseparable: str | None = None
 
     @property
@@ -185,11 +188,10 @@ class SeparationDesign:
         a, b = self.pair
         return "\n".join(
             [
-                f"designed by turntable-pin design --separate {a},{b} (T-optimal)",
+                f"designed by {command('design', separate=f'{a},{b}')} (T-optimal)",
                 f"table: {self.space.table_name}",
-                f"seed={self.space.seed} candidates={self.space.candidates_deg.shape[0]} "
-                f"n_positions={self.n_positions} n_from={self.n_from}",
-                "limits: " + "; ".join(r.describe() for r in self.space.ranges),
+                f"{self.space.seed_text(self.n_positions)} n_from={self.n_from}",
+                self.space.limits_text,
                 f"noise_arcsec={self.noise_arcsec:g} ({self.noise_source})",
                 "amplitudes: "
                 + "; ".join(
@@ -235,11 +237,9 @@ class SeparationDesign:
         space = self.space
         a, b = self.pair
         lines = [
-            f"design (separate {a} from {b}, T-optimal): {self.n_positions} positions of "
-            f"{space.candidates_deg.shape[0]} candidates (seed {space.seed}) on "
-            f"{space.table_name}"
+            f"design (separate {a} from {b}, T-optimal): {space.chosen_text(self.n_positions)}"
             + (f", after the {self.n_from} positions measured" if self.n_from else ""),
-            "limits: " + "; ".join(r.describe() for r in space.ranges),
+            space.limits_text,
             f"run: {self.plan.n_rows} measurements; {self.plan.rule}",
             f"noise: {self.noise_arcsec:.3g} arcsec per angle ({self.noise_source})",
         ]
@@ -282,10 +282,7 @@ class SeparationDesign:
                 "measure these positions and diagnose them together with the data measured "
                 "(append their rows): the chances above are for both"
             )
-        names = ", ".join(f"phi{r.index}" for r in space.ranges)
-        lines.append(f"positions ({names}, deg):")
-        for row in self.positions_deg:
-            lines.append("  " + "  ".join(f"{v:10.4f}" for v in row))
+        lines += space.positions_lines(self.positions_deg)
         return "\n".join(lines)
 
     def _count_line(self) -> str:
@@ -303,8 +300,8 @@ class SeparationDesign:
         if self.positions_for_power_designed:
             return (
                 f"{self.target:.0%} needs {count} position{'s' if count > 1 else ''}{besides}: "
-                f"design --separate {a},{b} "
-                f"-n {count} gives {_percent(self.power_at_positions_for_power)}"
+                f"design {argument('separate')} {a},{b} {argument('n_positions')} {count} gives "
+                f"{_percent(self.power_at_positions_for_power)}"
             )
         return (
             f"{self.target:.0%} needs about {count} positions{besides} (this design repeated "
@@ -345,13 +342,13 @@ def _amplitude_vector(model, effect, values: Mapping[str, float]) -> np.ndarray:
 
 def _fitted_amplitude(data, effect, table) -> dict[str, float]:
     """``effect``'s parameters fitted with the base errors on ``data``, user units."""
-    from ..measurement.fit import fit_orientation
-
     where = data.source or "the data"
     try:
         fit = fit_orientation(data, [effect], turntable=table)
     except (InputError, IdentifiabilityError) as exc:
-        raise InputError(f"--from {where}: {effect.name} cannot be fitted there ({exc})") from None
+        raise InputError(
+            f"{argument('from_data')} {where}: {effect.name} cannot be fitted there ({exc})"
+        ) from None
     model, params = fit.model, fit.result.params
     return {
         model.parameter_names[i].split(".", 1)[1]: float(params[i] / model.per_user_unit[i])
@@ -392,8 +389,6 @@ class _Rows:
     def residual(self, x: int) -> np.ndarray:
         """What the base errors and the other effect leave of effect ``x``'s prediction, per
         row (in noise sigmas)."""
-        from ..stats.discrimination import orthonormal_span
-
         signal = self.signal(x)
         basis = orthonormal_span(self.fitted(1 - x))
         return signal - basis @ (basis.T @ signal)
@@ -403,18 +398,6 @@ class _Rows:
         the base and the rival's misfit (chi2), the ranks each adds, whether the data determine
         each one's parameters, and the chances that the diagnosis accepts it, puts it first,
         or takes it on top of the rival and drops the rival."""
-        from ..stats.discrimination import (
-            choice_margin,
-            detection_power,
-            generalized_chi2_sf,
-            misfit,
-            orthonormal_span,
-            quadratic_form,
-            rss_difference,
-            traded_off,
-        )
-        from ..stats.model_selection import UNDETERMINED_GAIN_RATIO, acceptance_threshold
-
         y = 1 - x
         m = self.observations
         first_round = acceptance_threshold(self.candidates)
@@ -498,9 +481,6 @@ def design_separate(
             fit it on; an effect whose prediction no position within the limits sees beyond the
             base errors; more positions than candidates.
     """
-    from ..core.blas_threads import one_blas_thread
-    from ..core.sizes import check_positions_count
-
     n_positions = check_positions_count(n_positions, space.candidates_deg.shape[0])
     with one_blas_thread():  # tall-by-small products: many threads on busy cores only wait
         return _design_separate(
@@ -510,45 +490,126 @@ def design_separate(
 
 def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s, target):
     """:func:`design_separate`, on one BLAS thread."""
-    from ..measurement.catalogue import catalogue
-    from ..stats.discrimination import Direction, misfit, orthonormal_span, t_optimal_exchange
-    from ..stats.least_squares import tall_r_factor
+    problem = _setup(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s)
+    names, settled = problem.names, _settled(problem)
+    if "none" in settled:
+        x = settled.index("none")
+        because = (
+            f"{names[1 - x]} reproduces {names[x]} ({_values(problem.user[x])} "
+            f"{problem.units[x]}) at every position, with no more parameters"
+        )
+        return _inseparable(problem, target, because)
+    directions = problem.directions(settled)
+    found, chosen, plan, new = problem.run_of(directions, n_positions)
+    design = problem.rows_of(new, 3 * plan.n_rows)
+    numbers = [design.numbers(x) for x in range(2)]
+    power = min(h["power"] for h in numbers)
 
-    effects = tuple(space.effects)
-    names = tuple(e.name for e in effects)
-    if len(effects) != 2 or names[0] == names[1]:
+    def scaled(count: int) -> float:
+        factor = count / n_positions
+        return problem.rows_of(new, round(3 * plan.n_rows * factor), factor).power()
+
+    def designed(count: int) -> float:
+        run = problem.run_of(directions, count)
+        return problem.rows_of(run[3], 3 * run[2].n_rows).power()
+
+    count, count_power, verified = _positions_for(
+        scaled, designed, target, n_positions, power, problem.usable.size
+    )
+    return SeparationDesign(
+        space=space,
+        pair=names,
+        positions_deg=space.candidates_deg[chosen][plan.first_order()],
+        plan=plan,
+        hypotheses=_hypotheses(problem, settled, numbers, new, plan, n_positions),
+        misfit_by_position=_shares(design, new, plan, n_positions),
+        measured_deg=np.zeros((0, space.n_joints))
+        if from_data is None
+        else np.degrees(np.asarray(from_data.joint_rad, dtype=float)),
+        noise_arcsec=float(problem.noise),
+        noise_source=problem.noise_source,
+        amplitude_source=problem.source,
+        n_from=problem.n_from,
+        power=float(power),
+        positions_for_power=count,
+        power_at_positions_for_power=count_power,
+        positions_for_power_designed=verified,
+        power_curve=tuple((c, scaled(c)) for c in _curve_counts(n_positions, count)),
+        target=float(target),
+        catalogue_size=problem.size,
+        n_swaps=found.swaps,
+        n_passes=found.passes,
+    )
+
+
+def _setup(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s) -> _Problem:
+    """The :class:`_Problem` of ``space``'s two effects on its candidates (see
+    :func:`design_separate` for what is refused)."""
+    names, amplitudes = _checked_pair(space, amplitudes)
+    c = candidate_rows(space, n_positions, from_data, noise_arcsec, dwell_s)
+    model = c.model
+    source, vectors, user, units = _amplitudes(model, space, amplitudes, from_data)
+    listed = [e.name for e in catalogue(space.table)]
+    rank = [listed.index(name) if name in listed else len(listed) for name in names]
+    return _Problem(
+        space, c.rows, np.flatnonzero(c.keep), model.n_params, np.arange(len(model.base_names)),
+        tuple(_columns(model, e) for e in space.effects), vectors,
+        None if c.information is None else _rows_of_information(c.information), c.from_rows,
+        len(listed), 0 if rank[0] <= rank[1] else 1, c.noise_rad, dwell_s, c.start_s,
+        c.duration_s, names, user, units, source, c.noise, c.noise_source, c.n_from,
+    )  # fmt: skip
+
+
+def _hypotheses(problem, settled, numbers, new, plan, n_positions) -> tuple[Hypothesis, ...]:
+    """Each effect as the truth: on the design (``numbers``), on the positions measured alone,
+    on the new ones alone and on the grid of the design's size."""
+    measured = alone = [None, None]
+    if problem.fixed is not None:
+        measured = [problem.rows_of(None, 0).numbers(x) for x in range(2)]
+        alone = [problem.rows(new, 3 * plan.n_rows, leader=0).numbers(x) for x in range(2)]
+    grid = _grid_misfits(problem, n_positions)
+    names = problem.names
+    return tuple(
+        Hypothesis(
+            effect=names[x],
+            rival=names[1 - x],
+            amplitude=problem.user[x],
+            unit=problem.units[x],
+            misfit_measured_chi2=None if measured[x] is None else measured[x]["misfit_chi2"],
+            misfit_grid_chi2=None if grid is None else grid[x],
+            settled_by=settled[x],
+            power_measured=None if measured[x] is None else measured[x]["power"],
+            power_new_alone=None if alone[x] is None else alone[x]["power"],
+            **numbers[x],
+        )  # fmt: skip
+        for x in range(2)
+    )
+
+
+def _checked_pair(space, amplitudes) -> tuple[tuple[str, str], dict]:
+    """The two effects' names and the amplitudes given (``{effect: {parameter: value}}``), or
+    :class:`InputError`."""
+    names = tuple(e.name for e in space.effects)
+    if len(names) != 2 or names[0] == names[1]:
         raise InputError(
-            f"--separate takes two different effects (A,B), got {', '.join(names) or 'none'}"
+            f"{argument('separate')} takes two different effects (A,B), got "
+            f"{', '.join(names) or 'none'}"
         )
     amplitudes = {k: dict(v) for k, v in (amplitudes or {}).items()}
     unknown = [k for k in amplitudes if k not in names]
     if unknown:
         raise InputError(
-            f"--amplitude names effect '{unknown[0]}', which is not one of {names[0]}, {names[1]}"
+            f"{argument('amplitude')} names effect '{unknown[0]}', which is not one of "
+            f"{names[0]}, {names[1]}"
         )
-    start_info, noise, noise_source, n_from, start_s = _start_information(
-        space, from_data, noise_arcsec, dwell_s
-    )
-    noise_rad = noise / ARCSEC_PER_RAD
-    duration_s = (n_positions * space.visits.count - 1) * float(dwell_s)
-    try:
-        rows, keep, model = design_rows(
-            space, space.candidates_deg, space.visits, start_s, duration_s
-        )
-    except InputError as exc:
-        raise InputError(f"no candidate position within the limits can be used: {exc}") from None
-    usable = np.flatnonzero(keep)
-    if n_positions > usable.size:
-        raise InputError(
-            f"{n_positions} positions asked, but only {usable.size} candidates: give more "
-            "--candidates"
-        )
-    rows = rows / noise_rad  # (C, k, n) whitened
-    n = model.n_params
-    base = np.arange(len(model.base_names))
-    own = tuple(_columns(model, e) for e in effects)
+    return names, amplitudes
+
+
+def _amplitudes(model, space, amplitudes, from_data):
+    """Each effect's amplitude: where it comes from (``{effect: text}``), its vector (internal
+    units), its values by parameter and its unit(s) (user units)."""
     source, vectors = {}, []
-    for effect in effects:
+    for effect in space.effects:
         if effect.name in amplitudes:
             values, source[effect.name] = amplitudes[effect.name], "given"
         elif from_data is not None:
@@ -556,36 +617,39 @@ def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dw
             source[effect.name] = f"fitted on {from_data.source or 'the data measured'}"
         else:
             raise InputError(
-                f"no amplitude for {effect.name}: give it (--amplitude {effect.name}:P=V,...) "
-                "or the data to fit it on (--from DATA.csv)"
+                f"no amplitude for {effect.name}: give it "
+                f"({argument('amplitude')} {effect.name}:P=V,...) or the data to fit it on "
+                f"({argument('from_data')} DATA.csv)"
             )
         vectors.append(_amplitude_vector(model, effect, values))
+    own = [_columns(model, e) for e in space.effects]
     user = [
         {model.parameter_names[i].split(".", 1)[1]: float(v / model.per_user_unit[i])
          for i, v in zip(own[x], vectors[x], strict=True)}
         for x in range(2)
     ]  # fmt: skip
     units = [", ".join(dict.fromkeys(model.parameter_units[i] for i in own[x])) for x in range(2)]
-    fixed = None if start_info is None else _rows_of_information(start_info)
-    from_rows = 0 if from_data is None else int(from_data.measured.sum())
-    listed = [e.name for e in catalogue(space.table)]
-    size = len(listed)
-    rank = [listed.index(name) if name in listed else size for name in names]
-    leader = 0 if rank[0] <= rank[1] else 1
+    return source, vectors, user, units
 
-    def rows_of(new: np.ndarray | None, observations: int, factor: float = 1.0) -> _Rows:
-        """The rows of a run (its Gram matrix times ``factor``) and of the data measured."""
-        stacked = [new * math.sqrt(factor)] if new is not None else []
-        stacked += [fixed] if fixed is not None else []
-        rows = np.concatenate(stacked)
-        return _Rows(rows, observations + from_rows, base, own, vectors, size, leader)
 
-    # Which directions positions must separate, judged over every candidate at once.
-    every = _Rows(tall_r_factor(rows.reshape(-1, n)), 1, base, own, vectors, size, leader)
+def _settled(problem: _Problem) -> list[str]:
+    """How each direction is settled, judged over every candidate at once: ``misfit`` (positions
+    separate it), ``parsimony`` (the rival reproduces it with more ranks) or ``none``.
+
+    Raises:
+        InputError: an effect whose prediction the base errors explain everywhere.
+    """
+    every = problem.rows(tall_r_factor(problem.all_rows.reshape(-1, problem.n_params)), 1)
+    base, names, user, units = (
+        every.rows[:, problem.base],
+        problem.names,
+        problem.user,
+        problem.units,
+    )
     settled = []
     for x in range(2):
         signal = every.signal(x)
-        alone = misfit(every.rows[:, base], signal)
+        alone = misfit(base, signal)
         if not alone > SAME_RTOL * max(float(signal @ signal), 1e-300):
             raise InputError(
                 f"{names[x]} at its amplitude ({_values(user[x])} {units[x]}) changes nothing "
@@ -596,146 +660,108 @@ def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dw
             settled.append("misfit")
             continue
         ranks = [
-            orthonormal_span(np.hstack([every.rows[:, base], every.rows[:, own[z]]])).shape[1]
+            orthonormal_span(np.hstack([base, every.rows[:, problem.own[z]]])).shape[1]
             for z in (x, 1 - x)
         ]
         settled.append("parsimony" if ranks[0] < ranks[1] else "none")
-    if "none" in settled:
-        x = settled.index("none")
-        because = (
-            f"{names[1 - x]} reproduces {names[x]} ({_values(user[x])} {units[x]}) at every "
-            "position, with no more parameters"
-        )
-        return _inseparable(space, names, noise, noise_source, source, n_from, target, because)
+    return settled
 
-    directions = []
-    for x in range(2):
-        if settled[x] == "misfit":
-            fitted = np.concatenate([base, own[1 - x]])
-            directions.append(
-                Direction(
-                    rows[:, :, fitted],
-                    rows[:, :, own[x]] @ vectors[x],
-                    None if fixed is None else fixed[:, fitted],
-                    None if fixed is None else fixed[:, own[x]] @ vectors[x],
-                )
-            )
 
-    def run_of(count: int):
-        """The ``count`` designed positions (candidate indices), their run and its rows."""
-        found = t_optimal_exchange(directions, count, seed=space.seed)
-        chosen = usable[np.sort(found.chosen)]
-        plan = plan_measurements(
-            space.candidates_deg[chosen], needs_time=space.needs_time,
-            needs_dirs=space.needs_dirs, dwell_s=dwell_s, seed=space.seed, start_s=start_s,
-            visits=space.visits.subset(chosen),
-        )  # fmt: skip
-        jac = _evaluate(space, plan.variables())[0].reshape(-1, n) / noise_rad
-        return found, chosen, plan, jac
-
-    found, chosen, plan, new = run_of(n_positions)
-    positions = space.candidates_deg[chosen]
-    first = np.unique(plan.position, return_index=True)[1]
-    positions = positions[plan.position[np.sort(first)]]  # in the order first measured
-    measured_deg = np.zeros((0, space.n_joints))
-    if from_data is not None:
-        measured_deg = np.degrees(np.asarray(from_data.joint_rad, dtype=float))
-    design = rows_of(new, 3 * plan.n_rows)
-    numbers = [design.numbers(x) for x in range(2)]
-    # Each position's share of each misfit: where the rival cannot follow.
+def _shares(design: _Rows, new: np.ndarray, plan, n_positions: int) -> np.ndarray:
+    """(N, 2) each position's share of each misfit (where the rival cannot follow), in the order
+    the positions are first measured."""
     shares = np.zeros((n_positions, 2))
-    order = np.unique(plan.position, return_index=True)[1]
     for x in range(2):
         by_row = np.sum(design.residual(x)[: new.shape[0]].reshape(plan.n_rows, 3) ** 2, axis=1)
         per_position = np.bincount(plan.position, by_row, minlength=n_positions)
-        shares[:, x] = per_position[plan.position[np.sort(order)]]
-    measured = alone = [None, None]
-    if fixed is not None:
-        measured = [rows_of(None, 0).numbers(x) for x in range(2)]
-        alone = [_Rows(new, 3 * plan.n_rows, base, own, vectors, size).numbers(x) for x in range(2)]
-    grid = _grid_misfits(space, rows_of, n_positions, start_s, duration_s, noise_rad)
-    power = min(h["power"] for h in numbers)
+        shares[:, x] = per_position[plan.first_order()]
+    return shares
 
-    def scaled(count: int) -> float:
-        factor = count / n_positions
-        return rows_of(new, round(3 * plan.n_rows * factor), factor).power()
 
-    def designed(count: int) -> float:
-        run = run_of(count)
-        return rows_of(run[3], 3 * run[2].n_rows).power()
+@dataclass(frozen=True)
+class _Problem:
+    """The separation on the candidates: their whitened rows (C, k, n) and the usable ones, the
+    columns of the base errors and of each effect, the amplitudes (internal and user units), the
+    data measured (rows of their information), the catalogue's size and which effect it lists
+    first, and what a run needs (noise, dwell, start time, duration)."""
 
-    count, count_power, verified = _positions_for(
-        scaled, designed, target, n_positions, power, usable.size
-    )
-    curve = tuple((c, scaled(c)) for c in _curve_counts(n_positions, count))
-    hypotheses = tuple(
-        Hypothesis(
-            effect=names[x],
-            rival=names[1 - x],
-            amplitude=user[x],
-            unit=units[x],
-            signal_chi2=numbers[x]["signal_chi2"],
-            misfit_chi2=numbers[x]["misfit_chi2"],
-            misfit_measured_chi2=None if measured[x] is None else measured[x]["misfit_chi2"],
-            misfit_grid_chi2=None if grid is None else grid[x],
-            added_rank=numbers[x]["added_rank"],
-            rival_added_rank=numbers[x]["rival_added_rank"],
-            determined=numbers[x]["determined"],
-            rival_determined=numbers[x]["rival_determined"],
-            settled_by=settled[x],
-            power_detect=numbers[x]["power_detect"],
-            power_first=numbers[x]["power_first"],
-            power_on_top=numbers[x]["power_on_top"],
-            power_choice=numbers[x]["power_choice"],
-            power=numbers[x]["power"],
-            power_measured=None if measured[x] is None else measured[x]["power"],
-            power_new_alone=None if alone[x] is None else alone[x]["power"],
-        )
-        for x in range(2)
-    )
-    return SeparationDesign(
-        space=space,
-        pair=names,
-        positions_deg=positions,
-        plan=plan,
-        hypotheses=hypotheses,
-        misfit_by_position=shares,
-        measured_deg=measured_deg,
-        noise_arcsec=float(noise),
-        noise_source=noise_source,
-        amplitude_source=source,
-        n_from=n_from,
-        power=float(power),
-        positions_for_power=count,
-        power_at_positions_for_power=count_power,
-        positions_for_power_designed=verified,
-        power_curve=curve,
-        target=float(target),
-        catalogue_size=size,
-        n_swaps=found.swaps,
-        n_passes=found.passes,
-    )
+    space: DesignSpace
+    all_rows: np.ndarray
+    usable: np.ndarray
+    n_params: int
+    base: np.ndarray
+    own: tuple[np.ndarray, ...]
+    vectors: list
+    fixed: np.ndarray | None
+    from_rows: int
+    size: int
+    leader: int
+    noise_rad: float
+    dwell_s: float
+    start_s: float
+    duration_s: float
+    names: tuple[str, str]
+    user: list
+    units: list
+    source: dict
+    noise: float
+    noise_source: str
+    n_from: int
+
+    def rows(self, rows: np.ndarray, observations: int, leader: int | None = None) -> _Rows:
+        """:class:`_Rows` of ``rows`` standing for ``observations`` measured angles."""
+        leader = self.leader if leader is None else leader
+        return _Rows(rows, observations, self.base, self.own, self.vectors, self.size, leader)
+
+    def rows_of(self, new: np.ndarray | None, observations: int, factor: float = 1.0) -> _Rows:
+        """The rows of a run (its Gram matrix times ``factor``) and of the data measured."""
+        stacked = [new * math.sqrt(factor)] if new is not None else []
+        stacked += [self.fixed] if self.fixed is not None else []
+        return self.rows(np.concatenate(stacked), observations + self.from_rows)
+
+    def directions(self, settled: list[str]) -> list:
+        """The :class:`~turntable_pin.stats.discrimination.Direction` of each effect the
+        positions must separate (``settled`` ``misfit``)."""
+        rows, fixed, out = self.all_rows, self.fixed, []
+        for x in (x for x in range(2) if settled[x] == "misfit"):
+            fitted = np.concatenate([self.base, self.own[1 - x]])
+            out.append(
+                Direction(
+                    rows[:, :, fitted],
+                    rows[:, :, self.own[x]] @ self.vectors[x],
+                    None if fixed is None else fixed[:, fitted],
+                    None if fixed is None else fixed[:, self.own[x]] @ self.vectors[x],
+                )
+            )
+        return out
+
+    def run_of(self, directions, count: int):
+        """The ``count`` designed positions: the exchange's result, their candidate indices,
+        their run and its whitened rows."""
+        space = self.space
+        found = t_optimal_exchange(directions, count, seed=space.seed)
+        chosen = self.usable[np.sort(found.chosen)]
+        plan = plan_measurements(
+            space.candidates_deg[chosen], needs_time=space.needs_time,
+            needs_dirs=space.needs_dirs, dwell_s=self.dwell_s, seed=space.seed,
+            start_s=self.start_s, visits=space.visits.subset(chosen),
+        )  # fmt: skip
+        jac = _evaluate(space, plan.variables())[0].reshape(-1, self.n_params) / self.noise_rad
+        return found, chosen, plan, jac
 
 
 def _values(amplitude: Mapping[str, float]) -> str:
     return ", ".join(f"{k} = {v:.3g}" for k, v in amplitude.items())
 
 
-def _grid_misfits(space, rows_of, n_positions, start_s, duration_s, noise_rad):
+def _grid_misfits(problem: _Problem, n_positions: int):
     """What each effect's rival leaves of it on the 30-degree grid within the limits, scaled to
     the design's size (with the data measured); ``None`` when no grid position can be used."""
-    from ..stats.discrimination import misfit
-
-    visits = candidate_visits(
-        space.grid_deg.shape[0], space.n_joints, needs_time=space.needs_time,
-        needs_dirs=space.needs_dirs, rng=np.random.default_rng([space.seed, 2]),
-    )  # fmt: skip
-    grid_rows, _, _ = design_rows(space, space.grid_deg, visits, start_s, duration_s)
-    if not grid_rows.shape[0]:
+    rows = grid_rows(problem.space, problem.start_s, problem.duration_s)[0]
+    if not rows.shape[0]:
         return None
-    n = grid_rows.shape[-1]
-    factor = n_positions / grid_rows.shape[0]
-    on_grid = rows_of(grid_rows.reshape(-1, n) / noise_rad, 0, factor)
+    factor = n_positions / rows.shape[0]
+    on_grid = problem.rows_of(rows.reshape(-1, rows.shape[-1]) / problem.noise_rad, 0, factor)
     return [misfit(on_grid.fitted(1 - x), on_grid.signal(x)) for x in range(2)]
 
 
@@ -795,9 +821,10 @@ ROUNDING_ROWS = 1e-7
 (an eigenvalue of 1e-14 of the largest), not directions the data see."""
 
 
-def _inseparable(space, names, noise, noise_source, source, n_from, target, because):
+def _inseparable(problem: _Problem, target, because):
     """The result when no positions within the limits separate the two effects: one line saying
     why, and the independent measurements of their ``confirm`` texts."""
+    space = problem.space
     a, b = space.effects
     limits = "; ".join(r.describe() for r in space.ranges)
     text = (
@@ -807,24 +834,13 @@ def _inseparable(space, names, noise, noise_source, source, n_from, target, beca
     )
     return SeparationDesign(
         space=space,
-        pair=names,
+        pair=problem.names,
         positions_deg=np.zeros((0, space.n_joints)),
-        plan=None,
-        hypotheses=(),
-        misfit_by_position=np.zeros((0, 2)),
         measured_deg=np.zeros((0, space.n_joints)),
-        noise_arcsec=float(noise),
-        noise_source=noise_source,
-        amplitude_source=source,
-        n_from=n_from,
-        power=None,
-        positions_for_power=None,
-        power_at_positions_for_power=None,
-        positions_for_power_designed=False,
-        power_curve=(),
+        noise_arcsec=float(problem.noise),
+        noise_source=problem.noise_source,
+        amplitude_source=problem.source,
+        n_from=problem.n_from,
         target=float(target),
-        catalogue_size=0,
-        n_swaps=0,
-        n_passes=0,
         inseparable=text,
     )

@@ -1,8 +1,8 @@
 """The space a design chooses from: the table, the effects, the joints' limits, the candidates.
 
-Every mode of ``turntable-pin design`` starts here. A joint turns within its URDF ``<limit>``
-(a continuous joint, or one whose limits span a full turn, anywhere in [0, 360) deg), narrowed by
-``--limits-deg`` (``J=LO:HI``: ``J`` the joint's name or ``phiK``); the candidate positions are
+Every design starts here. A joint turns within its URDF ``<limit>`` (a continuous joint, or one
+whose limits span a full turn, anywhere in [0, 360) deg), narrowed by ``limits_deg``
+(``J=LO:HI``: ``J`` the joint's name or ``phiK``); the candidate positions are
 drawn uniformly within the limits (seeded) and joined by the 30-degree grid within them, which
 is also the design every result is compared with. The effects decide what the measurements must
 also record: an effect that needs ``time_s`` makes the run repeat its positions early and late,
@@ -24,6 +24,9 @@ from ..core.exceptions import InputError, check_seed
 from ..core.sizes import check_count
 from ..core.turn_grid import RANDOM_ROUND_DECIMALS, every_combination, full_turn_grid_deg
 from ..core.units import DEG_PER_RAD
+from ..core.words import argument
+from ..measurement.table import measured_table
+from ..model.paper_table import resolve_table
 from .schedule import Visits, candidate_visits
 
 __all__ = [
@@ -58,7 +61,8 @@ class JointRange:
         joint: the joint's name; index: its place from the base (``phiK``).
         low_deg, high_deg: the range; a full-turn joint has ``[low_deg, low_deg + 360)``.
         full_turn: the joint turns all the way round (no limit narrower than a turn).
-        source: ``urdf`` (its ``<limit>``), ``continuous`` (none) or ``--limits-deg``.
+        source: ``urdf`` (its ``<limit>``), ``continuous`` (none) or ``limits_deg`` (its
+            :func:`~turntable_pin.core.words.argument` name: the flag on the command line).
     """
 
     joint: str
@@ -105,7 +109,7 @@ _LIMIT = re.compile(r"^\s*([^=\s]+)\s*=\s*([^:]+):(.+)$")
 
 
 def parse_limits_deg(text: str, joint_names: Sequence[str]) -> dict[int, tuple[float, float]]:
-    """``--limits-deg J=LO:HI,...`` as ``{joint index (1 = phi1): (low, high)}``, degrees.
+    """``limits_deg`` text ``J=LO:HI,...`` as ``{joint index (1 = phi1): (low, high)}``, degrees.
 
     ``J`` is a joint's name or ``phiK``; each joint at most once; ``LO <= HI``.
 
@@ -115,42 +119,41 @@ def parse_limits_deg(text: str, joint_names: Sequence[str]) -> dict[int, tuple[f
     known = {f"phi{k}": k for k in range(1, len(joint_names) + 1)}
     known.update({name: k for k, name in enumerate(joint_names, start=1)})
     out: dict[int, tuple[float, float]] = {}
+    flag = argument("limits_deg")
     for item in filter(None, (x.strip() for x in str(text).split(","))):
         match = _LIMIT.match(item)
         if not match:
-            raise InputError(f"--limits-deg '{item}': expected JOINT=LO:HI, e.g. phi2=0:90")
+            raise InputError(f"{flag} '{item}': expected JOINT=LO:HI, e.g. phi2=0:90")
         name, low_text, high_text = match.groups()
         if name not in known:
             raise InputError(
-                f"--limits-deg '{item}': unknown joint '{name}'; the table's joints: "
+                f"{flag} '{item}': unknown joint '{name}'; the table's joints: "
                 + ", ".join(f"{n} (phi{k})" for k, n in enumerate(joint_names, start=1))
             )
         try:
             low, high = float(low_text), float(high_text)
         except ValueError:
-            raise InputError(f"--limits-deg '{item}': the bounds must be numbers") from None
+            raise InputError(f"{flag} '{item}': the bounds must be numbers") from None
         if not (math.isfinite(low) and math.isfinite(high)):
-            raise InputError(f"--limits-deg '{item}': the bounds must be finite numbers")
+            raise InputError(f"{flag} '{item}': the bounds must be finite numbers")
         if low > high:
             raise InputError(
-                f"--limits-deg '{item}': the lower bound {low:g} is above the upper {high:g}, "
+                f"{flag} '{item}': the lower bound {low:g} is above the upper {high:g}, "
                 "which leaves no position"
             )
         if known[name] in out:
-            raise InputError(f"--limits-deg '{item}': joint {name} is limited twice")
+            raise InputError(f"{flag} '{item}': joint {name} is limited twice")
         out[known[name]] = (low, high)
     return out
 
 
 def joint_ranges(table, limits_deg=None) -> tuple[JointRange, ...]:
-    """Each joint's range: its URDF ``<limit>`` narrowed by ``limits_deg`` (a ``--limits-deg``
-    text or ``{index or name: (low, high)}``); a joint without limits turns a full turn.
+    """Each joint's range: its URDF ``<limit>`` narrowed by ``limits_deg`` (``J=LO:HI,...`` text
+    or ``{index or name: (low, high)}``); a joint without limits turns a full turn.
 
     Raises:
         InputError: limits that leave a joint no position (naming the joint and both ranges).
     """
-    from ..measurement.table import measured_table
-
     measured = measured_table(table)
     names = measured.joint_names
     if isinstance(limits_deg, str):
@@ -178,11 +181,12 @@ def joint_ranges(table, limits_deg=None) -> tuple[JointRange, ...]:
             else:
                 if g_low > high or g_high < low:
                     raise InputError(
-                        f"--limits-deg {name}={g_low:g}:{g_high:g} leaves no position: the URDF "
+                        f"{argument('limits_deg')} {name}={g_low:g}:{g_high:g} leaves no "
+                        "position: the URDF "
                         f"limits {name} to {low:g} .. {high:g} deg"
                     )
                 low, high = max(low, g_low), min(high, g_high)
-            source = "--limits-deg"
+            source = argument("limits_deg")
         out.append(JointRange(name, k, float(low), float(high), bool(full), source))
     return tuple(out)
 
@@ -204,7 +208,7 @@ def _design_columns(effects) -> tuple[bool, bool]:
                 raise InputError(
                     f"effect '{effect.name}' needs the column {column}, which a design cannot "
                     "choose (only positions, their order and time, and approach directions); "
-                    "leave it out of --effects"
+                    f"leave it out of {argument('effects')}"
                 )
     return needs_time, needs_dirs
 
@@ -244,8 +248,6 @@ class DesignSpace:
     @property
     def measured(self):
         """The :class:`~turntable_pin.measurement.table.MeasuredTable` of :attr:`table`."""
-        from ..measurement.table import measured_table
-
         return measured_table(self.table)
 
     @property
@@ -257,6 +259,30 @@ class DesignSpace:
     def effect_names(self) -> tuple[str, ...]:
         """The names of :attr:`effects`."""
         return tuple(e.name for e in self.effects)
+
+    @property
+    def limits_text(self) -> str:
+        """``limits: `` and each joint's range in words (the designs' reports and comments)."""
+        return "limits: " + "; ".join(r.describe() for r in self.ranges)
+
+    def seed_text(self, n_positions: int) -> str:
+        """The CSV comment's ``seed=.. candidates=.. n_positions=..``."""
+        return (
+            f"seed={self.seed} candidates={self.candidates_deg.shape[0]} n_positions={n_positions}"
+        )
+
+    def chosen_text(self, n_positions: int) -> str:
+        """``N positions of C candidates (seed S) on TABLE`` (the reports' first line)."""
+        return (
+            f"{n_positions} positions of {self.candidates_deg.shape[0]} candidates (seed "
+            f"{self.seed}) on {self.table_name}"
+        )
+
+    def positions_lines(self, positions_deg: np.ndarray) -> list[str]:
+        """The positions in a report: a line naming the angles, then one line each, degrees."""
+        names = ", ".join(f"phi{r.index}" for r in self.ranges)
+        rows = ["  " + "  ".join(f"{v:10.4f}" for v in row) for row in positions_deg]
+        return [f"positions ({names}, deg):", *rows]
 
     def to_dict(self) -> dict:
         """The space as a JSON-ready dict (limits, candidate count, grid size, seed)."""
@@ -286,12 +312,10 @@ def design_space(
     Args:
         table: a ``GenericTable`` (default: the paper's table).
         effects: effects (objects, e.g. from ``resolve_effects``) to identify besides the base.
-        limits_deg: ``--limits-deg`` text or ``{joint name or index: (low, high)}``, degrees.
+        limits_deg: ``J=LO:HI,...`` text or ``{joint name or index: (low, high)}``, degrees.
         candidates: how many random candidate positions (the grid joins them).
         seed: seed of the random candidates (0 <= seed < 2**63).
     """
-    from ..model.paper_table import resolve_table
-
     table = resolve_table(table)
     seed = check_seed(seed)
     candidates = int(

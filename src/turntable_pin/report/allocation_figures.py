@@ -4,9 +4,8 @@ from __future__ import annotations
 
 from ..allocation.monte_carlo import MonteCarloResult
 from ..allocation.sensitivity import Sensitivities
-from ..allocation.solver import ORIENTATION_ANGLES
 from ..core.units import ARCMIN_PER_RAD
-from ..model.angles import ANGLE_NAMES
+from ..model.angles import ANGLE_NAMES, ANGLE_SYMBOLS
 from .figures import pyplot, save_png
 
 __all__ = ["plot_monte_carlo", "plot_sensitivities"]
@@ -42,7 +41,7 @@ def plot_monte_carlo(result: MonteCarloResult, path):
     keys = result.angle_names or result.joint_names
     over = ", ".join(k for k in keys if k not in result.held_at_deg) or "the positions"
     step = ", ".join(sorted({f"{s:g}" for s in result.grid_steps_deg}))
-    for k, (ax, name) in enumerate(zip(axes, ORIENTATION_ANGLES, strict=True)):
+    for k, (ax, name) in enumerate(zip(axes, ANGLE_SYMBOLS, strict=True)):
         values = result.worst_rad[:, k] * ARCMIN_PER_RAD
         ax.hist(values, bins=60, color="tab:blue", alpha=0.85)
         ax.axvline(limits[k], color="tab:red", linestyle="--", label=f"limit {limits[k]:.4f}'")
