@@ -15,6 +15,7 @@ CLI_WORDS = CommandLineWords(
         "n": "-n",
         "n_positions": "-n",
         "outliers=False": "--keep-outliers",
+        "temperature_c": "--temperature",
         "turntable": "--urdf",
     },
 )

@@ -533,8 +533,8 @@ def _temperatures(temperature_c, time_s, instrument):
         temperature_c = _column(temperature_c, len(time_s), "temperature_c", -273.15, 1000.0)
     if "temperature_coefficient" in instrument and temperature_c is None:
         raise InputError(
-            "instrument effect 'temperature_coefficient' needs a temperature: give temperature_c "
-            "(--temperature START,RAMP_PER_H,SWING,PERIOD_H)"
+            "instrument effect 'temperature_coefficient' needs a temperature: give "
+            f"{argument('temperature_c')} (a start, a ramp per hour, a swing and its period)"
         )
     return profile, temperature_c
 
