@@ -231,7 +231,7 @@ def _add_run_options(s: argparse.ArgumentParser) -> None:
         "with --run, simulate a GyroWheel calibration run: the outputs out_x_dph, out_y_dph at "
         "each position through the exact chain of the table's errors and effects, with the "
         "instrument effects of --effect (instrument_tilt:mx,my and instrument_heading:mz "
-        "arcsec; bias_drift:x,y deg/h per h; temperature_coefficient:x,y deg/h/degC; "
+        "arcsec; bias_drift:x,y deg/h/h; temperature_coefficient:x,y deg/h/degC; "
         "earth_rate_scale:x,y ppm; "
         "g_squared_terms:x_xz,x_yz,y_xz,y_yz deg/h/g^2); --positions takes a scheme "
         "(grid:STEP, grid:S1xS2; default grid:30) or a CSV of angles",

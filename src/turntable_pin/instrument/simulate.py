@@ -27,33 +27,39 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ..calibration.gyrowheel import AXES, MAX_COEFFICIENT_DPH, GyroWheelModel, regressor_matrix
+from ..calibration.gyrowheel import AXES, GyroWheelModel, regressor_matrix
 from ..calibration.positions import POSITION_BYTES, PositionSet, base_frame_inputs, position_inputs
 from ..calibration.rate_error import orientation_error_rotation
 from ..calibration.run import MAX_RUN_OUTPUT_DPH, MIN_RUN_SIGMA_DPH
-from ..core.csv_table import write_csv_table
 from ..core.exceptions import InputError, check_seed
 from ..core.files import write_text_atomic
 from ..core.sizes import MAX_POSITIONS, MAX_TIME_S, check_count
 from ..core.turn_grid import random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, deg_to_rad, rad_to_deg
 from ..core.words import argument, command
-from ..measurement.catalogue import resolve_effect
 from ..measurement.effect_model import OrientationModel
 from ..measurement.effects.base import PositionVariables
+from ..measurement.simulated import (
+    SimulatedFile,
+    checked_column,
+    checked_noise,
+    checked_values,
+    planted_effects,
+    run_times_s,
+)
 from ..measurement.table import measured_table
 from ..model.angles import ANGLE_ENTRIES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
+from .effects import INSTRUMENT_EFFECTS, RunEffect
+from .effects.base import Sensed
+from .effects.mount import Mount
 
 __all__ = [
     "DEFAULT_DWELL_S",
     "DEFAULT_OUTLIER_SIGMAS",
     "SIMULATED_INSTRUMENT_EFFECTS",
-    "MAX_RUN_TIME_S",
-    "InstrumentEffect",
     "SimulatedRun",
     "TemperatureProfile",
-    "check_instrument_effects",
     "random_positions",
     "simulate_calibration_run",
 ]
@@ -62,77 +68,15 @@ DEFAULT_DWELL_S = 60.0
 """Time per position when no ``time_s`` is given, s."""
 DEFAULT_OUTLIER_SIGMAS = 30.0
 """Size of a gross outlier when ``outlier_dph`` is not given: this many sigma of its channel."""
-MAX_RUN_TIME_S = MAX_TIME_S
-"""Longest simulated run, s (a year): a run file's ``time_s`` is at most that
-(:data:`~turntable_pin.core.sizes.MAX_TIME_S`)."""
-_MOUNT_LIMIT_ARCSEC = MAX_ANGULAR_ERROR_DEG * 3600.0
+SIMULATED_INSTRUMENT_EFFECTS: dict[str, RunEffect] = {c.name: c() for c in INSTRUMENT_EFFECTS}
+"""The instrument effects a simulated run may plant, by name: the run catalogue's, each planting
+what its :meth:`~.effects.base.RunEffect.planted_dph` says (a mount turns what is sensed)."""
 
 
-@dataclass(frozen=True)
-class InstrumentEffect:
-    """One effect of the instrument itself on a simulated run: its ``name``, its
-    ``parameter_names`` (zero when not given), the ``unit`` of all, the ``limit`` of a
-    ``|value|`` in it, and a ``description`` (what it is, how it enters the outputs)."""
-
-    name: str
-    parameter_names: tuple[str, ...]
-    unit: str
-    limit: float
-    description: str
-
-    def parameters(self, variables=None) -> tuple:
-        """The parameters (``name``, ``unit``) as ``parse_effect_spec`` reads them."""
-        return tuple(_Parameter(n, self.unit) for n in self.parameter_names)
-
-
-@dataclass(frozen=True)
-class _Parameter:
-    name: str
-    unit: str
-
-
-SIMULATED_INSTRUMENT_EFFECTS: dict[str, InstrumentEffect] = {
-    e.name: e
-    for e in (
-        InstrumentEffect(
-            "instrument_tilt", ("mx", "my"), "arcsec", _MOUNT_LIMIT_ARCSEC,
-            "the GyroWheel tilted on the payload about payload x and y: with the heading, it "
-            "senses a M and w M, M = exp([m]x), m = (mx, my, mz)",
-        ),
-        InstrumentEffect(
-            "instrument_heading", ("mz",), "arcsec", _MOUNT_LIMIT_ARCSEC,
-            "the GyroWheel turned on the payload about payload z (mz of the same M)",
-        ),
-        InstrumentEffect(
-            "bias_drift", ("x", "y"), "deg/h per h", 1e3,
-            "a bias that drifts linearly in time: out_c += d_c * time_s / 3600",
-        ),
-        InstrumentEffect(
-            "temperature_coefficient", ("x", "y"), "deg/h/degC", 1e3,
-            "a bias that follows the temperature: out_c += k_c * (T - mean(T)) "
-            "(needs temperature_c)",
-        ),
-        InstrumentEffect(
-            "earth_rate_scale", ("x", "y"), "ppm", 1e5,
-            "a scale-factor error on the sensed rate: out_c = (1 + s_c 1e-6) w_c + drift",
-        ),
-        InstrumentEffect(
-            "g_squared_terms", ("x_xz", "x_yz", "y_xz", "y_yz"), "deg/h/g^2",
-            MAX_COEFFICIENT_DPH,
-            "g^2 terms eq. 1 leaves out: out_x += x_xz ax az + x_yz ay az, "
-            "out_y += y_xz ax az + y_yz ay az",
-        ),
-    )
-}  # fmt: skip
-"""The instrument effects a simulated run may hold, by name."""
-
-
-def check_instrument_effects(
-    instrument: Mapping[str, Mapping[str, float]],
-) -> dict[str, dict[str, float]]:
-    """``{effect: {parameter: value}}`` checked against :data:`SIMULATED_INSTRUMENT_EFFECTS`
-    (known names, at least one parameter, finite values within the limit), every parameter
-    filled (zero when not given); InputError otherwise, listing the known names."""
+def _checked_instrument(instrument) -> dict[str, dict[str, float]]:
+    """``{effect: {parameter: value}}`` of :data:`SIMULATED_INSTRUMENT_EFFECTS`, each checked
+    (``checked_values``, within the effect's ``limit``) and every parameter filled (zero when not
+    given); InputError for an unknown name, listing the known ones."""
     out: dict[str, dict[str, float]] = {}
     for name, params in dict(instrument or {}).items():
         effect = SIMULATED_INSTRUMENT_EFFECTS.get(str(name))
@@ -141,28 +85,9 @@ def check_instrument_effects(
                 f"unknown instrument effect '{name}'; instrument effects: "
                 f"{', '.join(SIMULATED_INSTRUMENT_EFFECTS)}"
             )
-        if not isinstance(params, Mapping) or not params:
-            raise InputError(
-                f"instrument effect '{name}' needs at least one of its parameters "
-                f"({', '.join(effect.parameter_names)}, {effect.unit})"
-            )
-        values = dict.fromkeys(effect.parameter_names, 0.0)
-        for pname, value in params.items():
-            if pname not in values:
-                raise InputError(
-                    f"instrument effect '{name}' has no parameter '{pname}'; its parameters: "
-                    f"{', '.join(effect.parameter_names)} ({effect.unit})"
-                )
-            try:
-                number = float(value)
-            except (TypeError, ValueError):
-                number = math.nan
-            if isinstance(value, bool) or not abs(number) <= effect.limit:
-                raise InputError(
-                    f"instrument effect '{name}', parameter '{pname}' = {value!r}: must be a "
-                    f"number within +-{effect.limit:g} {effect.unit}"
-                )
-            values[pname] = number
+        specs = {s.name: s for s in effect.parameters(None)}
+        values = dict.fromkeys(specs, 0.0)
+        values.update(checked_values("instrument effect", name, params, specs, effect.limit))
         out[effect.name] = values
     return out
 
@@ -218,7 +143,7 @@ def random_positions(n: int, table, seed: int) -> PositionSet:
 
 
 @dataclass(frozen=True)
-class SimulatedRun:
+class SimulatedRun(SimulatedFile):
     """A simulated calibration run and the truth behind it.
 
     Attributes:
@@ -260,8 +185,9 @@ class SimulatedRun:
             out["temperature_c"] = self.temperature_c
         return out
 
-    def comment(self, *, hide_truth: bool = False) -> str:
-        """The ``#`` lines above the CSV header: seed, noise, positions, the truth (a JSON line)."""
+    _hidden = "coefficients, table errors, effects and outliers"
+
+    def _made(self) -> list[str]:
         truth = self.truth
         lines = [
             f"simulated GyroWheel calibration run ({command('simulate', run=True)})",
@@ -276,22 +202,10 @@ class SimulatedRun:
                 "temperature_c: profile start {start_c:g} degC, ramp {ramp_c_per_h:g} degC/h, "
                 "swing {swing_c:g} degC, period {period_h:g} h".format(**profile)
             )
-        if hide_truth:
-            lines.append(
-                "coefficients, table errors, effects and outliers: not recorded "
-                f"({argument('hide_truth')})"
-            )
-        else:
-            lines.append("truth: " + json.dumps(truth, sort_keys=False))
-        return "\n".join(lines)
+        return lines
 
-    def write_csv(
-        self, path: str | Path, *, hide_truth: bool = False, with_sigma: bool = True
-    ) -> Path:
-        """Write the run CSV atomically with its :meth:`comment` lines."""
-        return write_csv_table(
-            path, self.columns(with_sigma=with_sigma), comment=self.comment(hide_truth=hide_truth)
-        )
+    def _truth(self) -> list[str]:
+        return ["truth: " + json.dumps(self.truth, sort_keys=False)]
 
     def write_truth(self, path: str | Path, *, data: str = "", command: str = "") -> Path:
         """Write the truth as YAML, atomically (with the run file ``data`` and the ``command``
@@ -304,27 +218,9 @@ class SimulatedRun:
 
 
 def _noise(noise_dph) -> tuple[float, float]:
-    values = np.atleast_1d(np.asarray(noise_dph, dtype=float))
-    if values.size not in (1, 2):
-        raise InputError(f"noise_dph takes one number or two (x, y), got {values.size}")
-    values = np.broadcast_to(values, (2,))
-    for value in values:
-        if not 0.0 <= value <= MAX_RUN_OUTPUT_DPH / 100.0:
-            raise InputError(
-                f"noise_dph must be in [0, {MAX_RUN_OUTPUT_DPH / 100.0:g}] deg/h, got {value!r}"
-            )
-    return float(values[0]), float(values[1])
-
-
-def _column(values, n: int, name: str, low: float, high: float) -> np.ndarray:
-    array = np.asarray(values, dtype=float).reshape(-1)
-    if array.size != n:
-        raise InputError(f"{name}: {array.size} values for a run of {n} positions")
-    if not np.all(np.isfinite(array)):
-        raise InputError(f"{name}: values must be finite numbers")
-    if array.min() < low or array.max() > high:
-        raise InputError(f"{name}: values must be within [{low:g}, {high:g}]")
-    return array
+    limit = MAX_RUN_OUTPUT_DPH / 100.0
+    values = checked_noise(noise_dph, "noise_dph", (2, "two (x, y)"), 0.0, limit)
+    return tuple(float(v) for v in np.broadcast_to(values, (2,)))
 
 
 def _checked_errors(table, table_errors_rad: Mapping[str, float]):
@@ -342,45 +238,20 @@ def _checked_errors(table, table_errors_rad: Mapping[str, float]):
     return vector, {k: v for k, v in table.to_user_units(vector).items() if v != 0.0}
 
 
-def _resolved_effects(table_effects, measured, variables, catalogue):
-    """The catalogued table effects named in ``table_effects`` and their parameters by name."""
-    objects, effects = [], {}
-    for name, params in dict(table_effects).items():
-        effect = resolve_effect(str(name), measured, tuple(catalogue))
-        if not params:
-            raise InputError(
-                f"table effect '{effect.name}' is given without parameters, so it would "
-                "simulate nothing; give at least one"
-            )
+def _planted_table_effects(table_effects, measured, variables, catalogue):
+    """``planted_effects`` of a run: the effects, their values by name, the internal values; an
+    effect needing a column a simulated run lacks is refused."""
+    objects, effects, values = planted_effects(
+        table_effects, measured, variables, catalogue, "table effect"
+    )
+    for effect in objects:
         missing = effect.missing_columns(variables)
         if missing:
             raise InputError(
                 f"table effect '{effect.name}' needs {', '.join(missing)}, which a simulated "
                 "calibration run does not have (it has time_s only)"
             )
-        objects.append(effect)
-        effects[effect.name] = {str(k): float(v) for k, v in params.items()}
-    return objects, effects
-
-
-def _effect_values(objects, effects, variables) -> dict[str, float]:
-    """``{effect.parameter: internal value}`` of the effects' given parameters, each checked."""
-    values = {}
-    for effect in objects:
-        specs = {s.name: s for s in effect.parameters(variables)}
-        for pname, value in effects[effect.name].items():
-            if pname not in specs:
-                raise InputError(
-                    f"table effect '{effect.name}' has no parameter '{pname}'; its parameters: "
-                    f"{', '.join(specs)}"
-                )
-            if not abs(value) <= _MOUNT_LIMIT_ARCSEC:
-                raise InputError(
-                    f"table effect '{effect.name}', parameter '{pname}' = {value!r}: must be "
-                    f"within +-{_MOUNT_LIMIT_ARCSEC:g} (in its user unit)"
-                )
-            values[f"{effect.name}.{pname}"] = value * specs[pname].per_user_unit
-    return values
+    return objects, effects, values
 
 
 def _table_rotation_errors(
@@ -399,13 +270,15 @@ def _table_rotation_errors(
         return table.rotation_error(vector, list(angles.T)), errors, {}
     measured = measured_table(table)
     variables = PositionVariables(np.array(angles), time_s=np.array(time_s))
-    objects, effects = _resolved_effects(table_effects, measured, variables, catalogue)
+    objects, effects, planted = _planted_table_effects(
+        table_effects, measured, variables, catalogue
+    )
     model = OrientationModel(variables, objects, measured)
     values = {
         n: float(v) for n, v in zip(table.parameter_names, vector, strict=True)
         if n in measured.base_names
     }  # fmt: skip
-    values.update(_effect_values(objects, effects, variables))
+    values.update(planted)
     params = model.parameter_vector(values)
     rotation = model.rotation_error(params)
     # Terms a (user) effect adds to a measured angle itself, outside the chain, turn the payload
@@ -462,7 +335,7 @@ def simulate_calibration_run(
     seed = check_seed(seed)
     gyrowheel = GyroWheelModel.nominal() if gyrowheel is None else gyrowheel
     sigma = _noise(noise_dph)
-    instrument = check_instrument_effects(instrument or {})
+    instrument = _checked_instrument(instrument)
     n = len(positions)
     time_given = time_s is not None
     time_s = _run_times(time_s, dwell_s, n)
@@ -472,7 +345,7 @@ def simulate_calibration_run(
         positions, table_errors_rad or {}, table_effects or {}, time_s, catalogue
     )
     force, rate = _sensed(positions, latitude_rad, table_dR, instrument)
-    exact = _exact_outputs(force, rate, gyrowheel, instrument, time_s, temperature_c)
+    exact = _exact_outputs(Sensed(force, rate, time_s, temperature_c), gyrowheel, instrument)
     measured, outlier_rows = _measured(exact, sigma, seed, outliers, outlier_dph)
     truth = {
         **_run_truth(positions, latitude_rad, seed, sigma, time_given, dwell_s, gyrowheel),
@@ -519,7 +392,9 @@ def _instrument_truth(instrument) -> dict:
         "instrument_effects": {
             k: {p: v for p, v in ps.items() if v} for k, ps in instrument.items()
         },
-        "instrument_units": {k: SIMULATED_INSTRUMENT_EFFECTS[k].unit for k in instrument},
+        "instrument_units": {
+            k: SIMULATED_INSTRUMENT_EFFECTS[k].parameters(None)[0].unit for k in instrument
+        },
     }
 
 
@@ -530,7 +405,7 @@ def _temperatures(temperature_c, time_s, instrument):
     if isinstance(temperature_c, TemperatureProfile):
         profile, temperature_c = temperature_c, temperature_c.at(time_s)
     if temperature_c is not None:
-        temperature_c = _column(temperature_c, len(time_s), "temperature_c", -273.15, 1000.0)
+        temperature_c = checked_column(temperature_c, len(time_s), "temperature_c", -273.15, 1e3)
     if "temperature_coefficient" in instrument and temperature_c is None:
         raise InputError(
             "instrument effect 'temperature_coefficient' needs a temperature: give "
@@ -541,11 +416,8 @@ def _temperatures(temperature_c, time_s, instrument):
 
 def _run_times(time_s, dwell_s: float, n: int) -> np.ndarray:
     """The rows' times, s: ``time_s`` checked, or ``index * dwell_s``."""
-    if time_s is None:
-        if not (math.isfinite(dwell_s) and dwell_s > 0):
-            raise InputError(f"dwell_s must be a number > 0, got {dwell_s!r}")
-        time_s = np.arange(n) * float(dwell_s)
-    return _column(time_s, n, "time_s", 0.0, MAX_RUN_TIME_S)
+    time_s = run_times_s(n, dwell_s) if time_s is None else time_s
+    return checked_column(time_s, n, "time_s", 0.0, MAX_TIME_S)
 
 
 def _checked_outliers(outliers, outlier_dph, n: int, sigma) -> int:
@@ -565,8 +437,9 @@ def _sensed(positions, latitude_rad, table_dR, instrument):
     exact chain: the payload's rotation, the table's errors, the instrument's mount."""
     inputs = position_inputs(positions, latitude_rad)
     mount = {"mx": 0.0, "my": 0.0, "mz": 0.0}
-    for name in ("instrument_tilt", "instrument_heading"):
-        mount.update(instrument.get(name, {}))
+    for name, values in instrument.items():
+        if isinstance(SIMULATED_INSTRUMENT_EFFECTS[name], Mount):
+            mount.update(values)
     m_rad = {k: v / ARCSEC_PER_RAD for k, v in mount.items()}
     mount_rotation = orientation_error_rotation(m_rad["my"], m_rad["mz"], m_rad["mx"], exact=True)
     chain = inputs.payload_rotation @ table_dR @ mount_rotation
@@ -574,22 +447,16 @@ def _sensed(positions, latitude_rad, table_dR, instrument):
     return np.einsum("i,nij->nj", force0, chain), np.einsum("i,nij->nj", rate0, chain)
 
 
-def _exact_outputs(force, rate, gyrowheel, instrument, time_s, temperature_c) -> np.ndarray:
-    """(N, 2) the noise-free outputs: eq. 1 plus the instrument effects."""
-    scale = instrument.get("earth_rate_scale", {"x": 0.0, "y": 0.0})
-    drift = instrument.get("bias_drift", {"x": 0.0, "y": 0.0})
-    thermal = instrument.get("temperature_coefficient", {"x": 0.0, "y": 0.0})
-    g2 = instrument.get("g_squared_terms", dict.fromkeys(("x_xz", "x_yz", "y_xz", "y_yz"), 0.0))
-    exact = np.empty((len(time_s), 2))
-    for c, axis in enumerate(AXES):
-        out = (1.0 + scale[axis] * 1e-6) * rate[:, c]
-        out = out + regressor_matrix(axis, force) @ gyrowheel.axis(axis).as_array()
-        out = out + g2[f"{axis}_xz"] * force[:, 0] * force[:, 2]
-        out = out + g2[f"{axis}_yz"] * force[:, 1] * force[:, 2]
-        out = out + drift[axis] * time_s / 3600.0
-        if temperature_c is not None:
-            out = out + thermal[axis] * (temperature_c - temperature_c.mean())
-        exact[:, c] = out
+def _exact_outputs(sensed: Sensed, gyrowheel, instrument) -> np.ndarray:
+    """(N, 2) the noise-free outputs: eq. 1 at what is sensed, plus what the instrument effects
+    plant."""
+    rate, force = sensed.rate_dph, sensed.force_g
+    exact = np.stack(
+        [rate[:, c] + regressor_matrix(axis, force) @ gyrowheel.axis(axis).as_array()
+         for c, axis in enumerate(AXES)], axis=1,
+    )  # fmt: skip
+    for name, values in instrument.items():
+        exact = exact + SIMULATED_INSTRUMENT_EFFECTS[name].planted_dph(values, sensed)
     return exact
 
 

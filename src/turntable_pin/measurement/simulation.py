@@ -17,16 +17,14 @@ from pathlib import Path
 import numpy as np
 
 from ..calibration.positions import angle_columns, check_commanded_angles
-from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows, write_csv_table
+from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows
 from ..core.exceptions import InputError, check_seed
 from ..core.sizes import MAX_SIMULATED_ROWS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
 from ..core.turn_grid import full_turn_grid_deg, random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
-from ..core.words import argument
 from ..model.angles import ANGLE_NAMES
-from ..model.errors import MAX_ANGULAR_ERROR_DEG, TurntableErrors
+from ..model.errors import TurntableErrors
 from ..model.paper_table import paper_table
-from .catalogue import resolve_effect
 from .data import (
     MAX_COMMANDED_ANGLE_DEG,
     MAX_MEASURED_ANGLE_ARCSEC,
@@ -38,6 +36,13 @@ from .data import (
 )
 from .effect_model import OrientationModel
 from .effects.base import Effect, PositionVariables
+from .simulated import (
+    SimulatedFile,
+    check_dwell,
+    checked_noise,
+    planted_effects,
+    run_times_s,
+)
 from .table import measured_table
 
 __all__ = [
@@ -197,8 +202,7 @@ class Schedule:
             "rows of simulated measurements",
             ROW_BYTES,
         )
-        if self.dwell_s <= 0:
-            raise InputError(f"dwell_s must be > 0, got {self.dwell_s:g}")
+        check_dwell(self.dwell_s)
 
     def _check_positions(self) -> None:
         if self.positions is None:
@@ -346,7 +350,7 @@ class Schedule:
         """Time of each of the ``n`` measurements, seconds."""
         if self.positions_time_s is not None:
             return np.asarray(self.positions_time_s, dtype=float)
-        return np.arange(n) * self.dwell_s
+        return run_times_s(n, self.dwell_s)
 
     def describe(self, n_joints: int) -> str:
         """The schedule in one line (the ``# schedule:`` comment of a simulated file)."""
@@ -410,7 +414,7 @@ def read_positions(path: str | Path, joint_names: Sequence[str] | None = None) -
 
 
 @dataclass(frozen=True)
-class SimulatedMeasurements:
+class SimulatedMeasurements(SimulatedFile):
     """Simulated data and the truth behind it.
 
     Attributes:
@@ -434,17 +438,9 @@ class SimulatedMeasurements:
     truth_rad: np.ndarray = field(repr=False)
     noise_spread: float = 1.0
 
-    def comment(self, *, hide_truth: bool = False) -> str:
-        """The comment lines written above the CSV header.
+    _hidden = "errors and hidden effects"
 
-        With ``hide_truth`` only the seed, noise and schedule are written, not the errors and the
-        hidden effects, so that the file can be used to rehearse a blind diagnosis.
-        """
-        errors = ", ".join(f"{k}={v:.6g}" for k, v in self.errors.items() if not k.endswith("_mm"))
-        effects = "; ".join(
-            f"{name}: " + ", ".join(f"{p}={v:.6g}" for p, v in params.items())
-            for name, params in self.effects.items()
-        )
+    def _made(self) -> list[str]:
         noise = np.atleast_1d(self.noise_arcsec)
         noise_line = "noise_arcsec=" + ",".join(f"{v:g}" for v in noise)
         if noise.size > 1:
@@ -454,29 +450,25 @@ class SimulatedMeasurements:
                 f" noise_spread={self.noise_spread:g} (each row's sigma drawn log-uniform in "
                 "[sigma/spread, sigma*spread])"
             )
-        lines = [
-            "simulated by turntable-pin simulate",
-            f"seed={self.seed}",
-            noise_line,
-            "schedule: " + self.schedule.describe(self.data.n_joints),
-        ]
-        if hide_truth:
-            hidden = f"errors and hidden effects: not recorded ({argument('hide_truth')})"
-            return "\n".join([*lines, hidden])
-        return "\n".join(
-            [*lines, f"errors (arcsec): {errors}", f"hidden effects: {effects or 'none'}"]
-        )
+        schedule = "schedule: " + self.schedule.describe(self.data.n_joints)
+        return ["simulated by turntable-pin simulate", f"seed={self.seed}", noise_line, schedule]
 
-    def write_csv(
-        self, path: str | Path, *, with_sigma: bool = True, hide_truth: bool = False
-    ) -> Path:
-        """Write the CSV of ``docs/measurements.md`` atomically, seed (and truth) as comments."""
+    def _truth(self) -> list[str]:
+        errors = ", ".join(f"{k}={v:.6g}" for k, v in self.errors.items() if not k.endswith("_mm"))
+        effects = "; ".join(
+            f"{name}: " + ", ".join(f"{p}={v:.6g}" for p, v in params.items())
+            for name, params in self.effects.items()
+        )
+        return [f"errors (arcsec): {errors}", f"hidden effects: {effects or 'none'}"]
+
+    def columns(self, *, with_sigma: bool = True) -> dict[str, np.ndarray]:
+        """The CSV's columns (``docs/measurements.md``); the sigma columns only ``with_sigma``."""
         columns = self.data.columns()
         if not with_sigma:
             for name in ("sigma_arcsec", "sigma_dpsi_arcsec", "sigma_dtheta_arcsec",
                          "sigma_dgamma_arcsec"):  # fmt: skip
                 columns.pop(name, None)
-        return write_csv_table(path, columns, comment=self.comment(hide_truth=hide_truth))
+        return columns
 
 
 def _angle_names(names: Sequence[str]) -> tuple[str, ...]:
@@ -542,13 +534,11 @@ def simulate_measurements(
         n: v for n, v in zip(source.parameter_names, vector, strict=True) if n in table.base_names
     }
     schedule = schedule or Schedule()
-    effects = _checked_effects(effects)
     rng = np.random.default_rng(seed)
     variables, blank = _positions(schedule, rng, n_joints, not_measured)
-    effect_objects = [resolve_effect(name, table, catalogue) for name in effects]
-    effects = {e.name: effects[name] for e, name in zip(effect_objects, effects, strict=True)}
-    model = OrientationModel(variables, effect_objects, table)
-    values.update(_effect_values(effect_objects, effects, variables))
+    objects, effects, planted = planted_effects(effects, table, variables, catalogue, "effect")
+    model = OrientationModel(variables, objects, table)
+    values.update(planted)
     truth = model.predict(model.parameter_vector(values))
     measured, sigma_rad = _noisy(truth, noise, noise_spread, rng)
     measured[:, blank] = np.nan
@@ -581,15 +571,11 @@ def _positions(schedule: Schedule, rng, n_joints: int, not_measured) -> tuple:
                 ROW_BYTES)  # fmt: skip
     angles_deg = schedule.positions_deg(rng, n_joints)
     n = angles_deg[0].size
-    if schedule.duration_s(n_joints) > MAX_TIME_S:
-        raise InputError(
-            f"dwell_s {schedule.dwell_s:g}: the run of {n} measurements would last "
-            f"{schedule.duration_s(n_joints):.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
-        )
+    time_s = schedule.times_s(n)
     blank = [ANGLE_NAMES.index(a) for a in _angle_names(not_measured)]
     variables = PositionVariables(
         np.stack(angles_deg, axis=1) / DEG_PER_RAD,
-        time_s=schedule.times_s(n),
+        time_s=time_s,
         dirs=tuple(schedule.directions(a, rng, k) for k, a in enumerate(angles_deg, start=1)),
         boresight_only=np.full(n, 2 in blank and 0 not in blank),
     )
@@ -610,17 +596,9 @@ def _refuse_beyond_a_file(measured: np.ndarray) -> None:
 def _checked_noise(noise_arcsec, noise_spread: float) -> np.ndarray:
     """``noise_arcsec`` as an array of one or three sigmas, arcsec, each in [MIN_SIGMA_ARCSEC,
     MAX_NOISE_ARCSEC] however ``noise_spread`` spreads it."""
-    noise = np.atleast_1d(np.asarray(noise_arcsec, dtype=float))
-    if noise.size not in (1, 3):
-        raise InputError(f"noise_arcsec takes one number or three, got {noise.size}")
-    for value in noise:
-        if not value > 0:
-            raise InputError(f"noise_arcsec must be > 0, got {value:g}")
-        if not MIN_SIGMA_ARCSEC <= value <= MAX_NOISE_ARCSEC:
-            raise InputError(
-                f"noise_arcsec must be in [{MIN_SIGMA_ARCSEC:g}, {MAX_NOISE_ARCSEC:g}], got "
-                f"{value:g}"
-            )
+    noise = checked_noise(
+        noise_arcsec, "noise_arcsec", (3, "three"), MIN_SIGMA_ARCSEC, MAX_NOISE_ARCSEC
+    )
     if not 1.0 <= noise_spread <= MAX_NOISE_SPREAD:
         raise InputError(f"noise_spread must be in [1, {MAX_NOISE_SPREAD:g}], got {noise_spread:g}")
     if (
@@ -632,45 +610,6 @@ def _checked_noise(noise_arcsec, noise_spread: float) -> np.ndarray:
             f"{MAX_NOISE_ARCSEC:g}] arcsec (noise_arcsec / spread .. noise_arcsec * spread)"
         )
     return noise
-
-
-def _checked_effects(effects) -> dict[str, dict]:
-    """``{effect: {parameter: value}}`` checked: at least one parameter each, every value a
-    number within the small-error limit (in its user unit)."""
-    limit = MAX_ANGULAR_ERROR_DEG * 3600.0  # an effect is a small error
-    effects = {name: dict(params) for name, params in (effects or {}).items()}
-    for name, params in effects.items():
-        if not params:
-            raise InputError(
-                f"effect '{name}' is given without parameters, so it would simulate nothing; "
-                "give at least one"
-            )
-        for pname, value in params.items():
-            try:
-                number = float(value)
-            except (TypeError, ValueError):
-                number = math.nan
-            if not abs(number) <= limit:
-                raise InputError(
-                    f"effect '{name}', parameter '{pname}' = {value!r}: must be a number within "
-                    f"+-{limit:g} (in its user unit: arcsec, arcsec/g or arcsec/h)"
-                )
-    return effects
-
-
-def _effect_values(effect_objects, effects, variables) -> dict[str, float]:
-    """``{"<effect>.<parameter>": value}`` in internal units of the given parameters."""
-    values = {}
-    for effect in effect_objects:
-        specs = {s.name: s for s in effect.parameters(variables)}
-        for pname, value in effects[effect.name].items():
-            if pname not in specs:
-                raise InputError(
-                    f"effect '{effect.name}' has no parameter '{pname}'; "
-                    f"its parameters: {', '.join(specs)}"
-                )
-            values[f"{effect.name}.{pname}"] = float(value) * specs[pname].per_user_unit
-    return values
 
 
 def _noisy(truth: np.ndarray, noise: np.ndarray, noise_spread: float, rng) -> tuple:

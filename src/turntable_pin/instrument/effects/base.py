@@ -3,7 +3,8 @@
 A run effect adds to ``out_x, out_y`` terms *linear in its parameters*: its columns are
 ``d(out_x, out_y)/d(parameter)`` (deg/h per internal unit) in a :class:`RunContext`. The table's
 effects reach the outputs through the rate sensitivity (eqs. 8-13), the instrument's directly;
-each says on which ``side`` it lives.
+each says on which ``side`` it lives. An instrument effect also says what it plants in a
+simulated run along the exact path (:meth:`RunEffect.planted_dph`), up to its ``limit``.
 """
 
 from __future__ import annotations
@@ -16,7 +17,15 @@ import numpy as np
 from ...measurement.effects.base import ParameterSpec, PositionVariables
 from ...stats.candidate_effect import CandidateEffect
 
-__all__ = ["INSTRUMENT", "TABLE", "ParameterSpec", "RunContext", "RunEffect", "run_variables"]
+__all__ = [
+    "INSTRUMENT",
+    "TABLE",
+    "ParameterSpec",
+    "RunContext",
+    "RunEffect",
+    "Sensed",
+    "run_variables",
+]
 
 TABLE = "table"
 """``side`` of an effect of the turntable (its errors reach the outputs through dR)."""
@@ -35,6 +44,17 @@ class RunContext:
     coefficients: np.ndarray
     variables: PositionVariables
     memo: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Sensed:
+    """What the GyroWheel senses in a simulated run along the exact path: ``force_g`` and
+    ``rate_dph`` (N, 3), ``time_s`` (N,) s and ``temperature_c`` (N,) degC or ``None``."""
+
+    force_g: np.ndarray
+    rate_dph: np.ndarray
+    time_s: np.ndarray
+    temperature_c: np.ndarray | None
 
 
 def run_variables(run) -> PositionVariables:
@@ -56,6 +76,8 @@ class RunEffect(CandidateEffect):
 
     side: str = INSTRUMENT
     story_fields = MappingProxyType({"side": (TABLE, INSTRUMENT)})
+    limit: float = 0.0
+    """Largest ``|value|`` of a parameter a simulated run may plant, in its user unit (0: none)."""
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
         """The parameters this effect has on ``run``."""
@@ -63,4 +85,9 @@ class RunEffect(CandidateEffect):
 
     def columns(self, context: RunContext) -> np.ndarray:
         """``d(out_x, out_y)/d(parameter)``, (N, 2, p), deg/h per internal unit."""
+        raise NotImplementedError
+
+    def planted_dph(self, values: dict[str, float], sensed: Sensed) -> np.ndarray:
+        """What ``values`` (``{parameter: value}``, user units) add to ``(out_x, out_y)`` of a
+        simulated run that ``sensed`` (N, 2) deg/h: the exact form, not the columns' linear one."""
         raise NotImplementedError

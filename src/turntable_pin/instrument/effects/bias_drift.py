@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect
+from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed
 
 __all__ = ["BiasDrift"]
 
@@ -16,6 +16,7 @@ class BiasDrift(RunEffect):
 
     name = "bias_drift"
     side = INSTRUMENT
+    limit = 1e3
     title = "the GyroWheel's bias drifting with time"
     definition = "out_x += dx t, out_y += dy t (deg/h per hour, t = time_s since the start)"
     explanation = (
@@ -45,3 +46,7 @@ class BiasDrift(RunEffect):
         out[:, 0, 0] = t
         out[:, 1, 1] = t
         return out
+
+    def planted_dph(self, values: dict[str, float], sensed: Sensed) -> np.ndarray:
+        """``d_c time_s / 3600`` on each output, (N, 2) deg/h."""
+        return np.stack([values[axis] * sensed.time_s / SECONDS_PER_HOUR for axis in "xy"], axis=1)

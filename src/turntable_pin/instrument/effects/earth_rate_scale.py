@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect
+from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed
 
 __all__ = ["EarthRateScale"]
 
@@ -16,6 +16,7 @@ class EarthRateScale(RunEffect):
 
     name = "earth_rate_scale"
     side = INSTRUMENT
+    limit = 1e5
     title = "a scale-factor error of the GyroWheel's rate outputs"
     definition = "out_x += sx wx, out_y += sy wy (ppm of the earth rate along each axis)"
     explanation = (
@@ -44,3 +45,9 @@ class EarthRateScale(RunEffect):
         out[:, 0, 0] = w[:, 0]
         out[:, 1, 1] = w[:, 1]
         return out
+
+    def planted_dph(self, values: dict[str, float], sensed: Sensed) -> np.ndarray:
+        """``s_c 1e-6 w_c`` on each output, (N, 2) deg/h, ``w`` the sensed earth rate."""
+        return np.stack(
+            [values[a] * PPM * sensed.rate_dph[:, c] for c, a in enumerate("xy")], axis=1
+        )

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect
+from ...calibration.gyrowheel import MAX_COEFFICIENT_DPH
+from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed
 
 __all__ = ["GSquaredTerms"]
 
@@ -19,6 +20,7 @@ class GSquaredTerms(RunEffect):
 
     name = "g_squared_terms"
     side = INSTRUMENT
+    limit = MAX_COEFFICIENT_DPH
     title = "g-squared (anisoelastic) terms the 7-coefficient model leaves out"
     definition = "out_x += x_xz ax az + x_yz ay az, out_y += y_xz ax az + y_yz ay az (deg/h/g^2)"
     explanation = (
@@ -50,3 +52,11 @@ class GSquaredTerms(RunEffect):
         out[:, 0, 0], out[:, 0, 1] = xz, yz
         out[:, 1, 2], out[:, 1, 3] = xz, yz
         return out
+
+    def planted_dph(self, values: dict[str, float], sensed: Sensed) -> np.ndarray:
+        """``c_xz ax az + c_yz ay az`` on each output, (N, 2) deg/h, ``a`` the sensed force."""
+        a = sensed.force_g
+        return np.stack(
+            [values[f"{c}_xz"] * a[:, 0] * a[:, 2] + values[f"{c}_yz"] * a[:, 1] * a[:, 2]
+             for c in "xy"], axis=1,
+        )  # fmt: skip

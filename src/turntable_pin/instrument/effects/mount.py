@@ -11,17 +11,21 @@ from __future__ import annotations
 import numpy as np
 
 from ...measurement.effects.base import ARCSEC
-from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect
+from ...model.errors import MAX_ANGULAR_ERROR_DEG
+from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed
 
-__all__ = ["InstrumentHeading", "InstrumentTilt"]
+__all__ = ["InstrumentHeading", "InstrumentTilt", "Mount"]
 
 
-class _Mount(RunEffect):
+class Mount(RunEffect):
     """A constant rotation of the GyroWheel's axes against the payload's about some of the
-    payload axes (``axes``), small angles in arcsec."""
+    payload axes (``axes``), small angles in arcsec. A simulated run turns what the GyroWheel
+    senses by it (``M = exp([m]x)``, m = (mx, my, mz) of every mount effect), adding nothing
+    else."""
 
     axes: tuple[str, ...] = ()
     side = INSTRUMENT
+    limit = MAX_ANGULAR_ERROR_DEG * 3600.0
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
         """This effect's parameters on ``run`` (their user units and scales)."""
@@ -36,8 +40,12 @@ class _Mount(RunEffect):
         order = {"x": 2, "y": 0, "z": 1}
         return np.ascontiguousarray(context.sensitivity[:, :, [order[a] for a in self.axes]])
 
+    def planted_dph(self, values: dict[str, float], sensed: Sensed) -> np.ndarray:
+        """Nothing besides the turn of what is sensed (class docstring): zeros (N, 2)."""
+        return np.zeros((sensed.time_s.size, 2))
 
-class InstrumentTilt(_Mount):
+
+class InstrumentTilt(Mount):
     """``a -> a Ry(my) Rx(mx)`` and the same for the earth rate: the instrument's axes are
     tilted from the payload's about the payload x and y axes."""
 
@@ -63,7 +71,7 @@ class InstrumentTilt(_Mount):
     )
 
 
-class InstrumentHeading(_Mount):
+class InstrumentHeading(Mount):
     """``a -> a Rz(mz)`` and the same for the earth rate: the instrument is turned about the
     payload z axis (its heading on the mounting face)."""
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect
+from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed
 
 __all__ = ["TEMPERATURE_COLUMN", "TemperatureCoefficient"]
 
@@ -18,6 +18,7 @@ class TemperatureCoefficient(RunEffect):
 
     name = "temperature_coefficient"
     side = INSTRUMENT
+    limit = 1e3
     title = "the GyroWheel's drift following its temperature"
     definition = (
         "out_x += kx (T - T_mean), out_y += ky (T - T_mean) (deg/h per degree C, T = temperature_c)"
@@ -49,3 +50,8 @@ class TemperatureCoefficient(RunEffect):
         out[:, 0, 0] = t
         out[:, 1, 1] = t
         return out
+
+    def planted_dph(self, values: dict[str, float], sensed: Sensed) -> np.ndarray:
+        """``k_c (T - T_mean)`` on each output, (N, 2) deg/h."""
+        t = sensed.temperature_c
+        return np.stack([values[axis] * (t - t.mean()) for axis in "xy"], axis=1)
