@@ -3,17 +3,16 @@
 The outputs follow the *exact* path, independent of any linearised model, so that they check
 the run diagnosis' first-order columns:
 
-- the table turns the payload by ``dR = Rd^T Rt``: the exact chain of its errors, with table
-  effects that of ``measurement.effect_model.OrientationModel``;
+- the table turns the payload by ``dR = Rd^T Rt``, the exact chain of its errors and effects
+  (``measurement.effect_model.OrientationModel``);
 - the GyroWheel sits turned by its mount ``M = exp([m]x)``, ``m = (mx, my, mz)`` about payload
   x, y, z, and senses (row vectors) ``a = a0 Rd dR M``, ``w = w0 Rd dR M`` (``a0 = (0, 0, 1) g``,
   ``w0`` the earth rate in F0: x north, y west, z up);
-- channel c reads ``(1 + s_c 1e-6) w_c + A_c(a) beta_c`` (eq. 1, Table 1 by default) plus the
-  instrument effects (the run catalogue's names and units) and Gaussian noise; a few seeded rows
-  get a gross outlier on one channel.
+- channel c reads ``w_c + A_c(a) beta_c`` (eq. 1, Table 1 by default) plus what the run
+  catalogue's instrument effects plant and Gaussian noise; a few seeded rows get a gross outlier.
 
-The run CSV is what ``calibration.run.read_run`` reads, with the seed, the noise and the
-positions in ``#`` comment lines and, unless hidden, the truth.
+The run CSV is what ``calibration.run.read_run`` reads, the seed, noise and positions (and unless
+hidden the truth) in its ``#`` lines.
 """
 
 from __future__ import annotations
@@ -21,7 +20,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -37,17 +36,15 @@ from ..core.sizes import MAX_POSITIONS, MAX_TIME_S, check_count
 from ..core.turn_grid import random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, deg_to_rad, rad_to_deg
 from ..core.words import argument, command
-from ..measurement.effect_model import OrientationModel
 from ..measurement.effects.base import PositionVariables
 from ..measurement.simulated import (
     SimulatedFile,
     checked_column,
     checked_noise,
     checked_values,
-    planted_effects,
+    planted_model,
     run_times_s,
 )
-from ..measurement.table import measured_table
 from ..model.angles import ANGLE_ENTRIES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from .effects import INSTRUMENT_EFFECTS, RunEffect
@@ -103,8 +100,7 @@ class TemperatureProfile:
     period_h: float = 1.0
 
     def __post_init__(self) -> None:
-        for name in ("start_c", "ramp_c_per_h", "swing_c", "period_h"):
-            value = getattr(self, name)
+        for name, value in asdict(self).items():
             if not (isinstance(value, (int, float)) and math.isfinite(value)):
                 raise InputError(f"temperature profile: {name} must be a finite number")
         if not -100.0 <= self.start_c <= 200.0:
@@ -122,12 +118,7 @@ class TemperatureProfile:
 
     def to_dict(self) -> dict[str, float]:
         """The four numbers by name."""
-        return {
-            "start_c": float(self.start_c),
-            "ramp_c_per_h": float(self.ramp_c_per_h),
-            "swing_c": float(self.swing_c),
-            "period_h": float(self.period_h),
-        }
+        return {name: float(value) for name, value in asdict(self).items()}
 
 
 def random_positions(n: int, table, seed: int) -> PositionSet:
@@ -217,12 +208,6 @@ class SimulatedRun(SimulatedFile):
         return write_text_atomic(path, title + text)
 
 
-def _noise(noise_dph) -> tuple[float, float]:
-    limit = MAX_RUN_OUTPUT_DPH / 100.0
-    values = checked_noise(noise_dph, "noise_dph", (2, "two (x, y)"), 0.0, limit)
-    return tuple(float(v) for v in np.broadcast_to(values, (2,)))
-
-
 def _checked_errors(table, table_errors_rad: Mapping[str, float]):
     """The table's error vector (rad, m) and its non-zero errors in user units, each checked."""
     limit_rad = deg_to_rad(MAX_ANGULAR_ERROR_DEG)
@@ -236,22 +221,6 @@ def _checked_errors(table, table_errors_rad: Mapping[str, float]):
                 f"+-{MAX_ANGULAR_ERROR_DEG:g} deg"
             )
     return vector, {k: v for k, v in table.to_user_units(vector).items() if v != 0.0}
-
-
-def _planted_table_effects(table_effects, measured, variables, catalogue):
-    """``planted_effects`` of a run: the effects, their values by name, the internal values; an
-    effect needing a column a simulated run lacks is refused."""
-    objects, effects, values = planted_effects(
-        table_effects, measured, variables, catalogue, "table effect"
-    )
-    for effect in objects:
-        missing = effect.missing_columns(variables)
-        if missing:
-            raise InputError(
-                f"table effect '{effect.name}' needs {', '.join(missing)}, which a simulated "
-                "calibration run does not have (it has time_s only)"
-            )
-    return objects, effects, values
 
 
 def _table_rotation_errors(
@@ -268,18 +237,11 @@ def _table_rotation_errors(
     angles = positions.angles_rad
     if not table_effects:
         return table.rotation_error(vector, list(angles.T)), errors, {}
-    measured = measured_table(table)
     variables = PositionVariables(np.array(angles), time_s=np.array(time_s))
-    objects, effects, planted = _planted_table_effects(
-        table_effects, measured, variables, catalogue
+    lacks = "a simulated calibration run does not have (it has time_s only)"
+    model, params, effects = planted_model(
+        table, vector, table_effects, variables, catalogue, "table effect", lacks
     )
-    model = OrientationModel(variables, objects, measured)
-    values = {
-        n: float(v) for n, v in zip(table.parameter_names, vector, strict=True)
-        if n in measured.base_names
-    }  # fmt: skip
-    values.update(planted)
-    params = model.parameter_vector(values)
     rotation = model.rotation_error(params)
     # Terms a (user) effect adds to a measured angle itself, outside the chain, turn the payload
     # by that much more.
@@ -334,11 +296,13 @@ def simulate_calibration_run(
     """
     seed = check_seed(seed)
     gyrowheel = GyroWheelModel.nominal() if gyrowheel is None else gyrowheel
-    sigma = _noise(noise_dph)
+    sigma = checked_noise(noise_dph, "noise_dph", (2, "two (x, y)"), 0.0, MAX_RUN_OUTPUT_DPH / 100)
+    sigma = tuple(float(v) for v in np.broadcast_to(sigma, (2,)))
     instrument = _checked_instrument(instrument)
     n = len(positions)
     time_given = time_s is not None
-    time_s = _run_times(time_s, dwell_s, n)
+    time_s = run_times_s(n, dwell_s) if time_s is None else time_s
+    time_s = checked_column(time_s, n, "time_s", 0.0, MAX_TIME_S)
     profile, temperature_c = _temperatures(temperature_c, time_s, instrument)
     outliers = _checked_outliers(outliers, outlier_dph, n, sigma)
     table_dR, errors, effects = _table_rotation_errors(
@@ -412,12 +376,6 @@ def _temperatures(temperature_c, time_s, instrument):
             f"{argument('temperature_c')} (a start, a ramp per hour, a swing and its period)"
         )
     return profile, temperature_c
-
-
-def _run_times(time_s, dwell_s: float, n: int) -> np.ndarray:
-    """The rows' times, s: ``time_s`` checked, or ``index * dwell_s``."""
-    time_s = run_times_s(n, dwell_s) if time_s is None else time_s
-    return checked_column(time_s, n, "time_s", 0.0, MAX_TIME_S)
 
 
 def _checked_outliers(outliers, outlier_dph, n: int, sigma) -> int:

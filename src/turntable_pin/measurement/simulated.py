@@ -18,6 +18,8 @@ from ..core.sizes import MAX_TIME_S
 from ..core.words import argument
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from .catalogue import resolve_effect
+from .effect_model import OrientationModel
+from .table import measured_table
 
 __all__ = [
     "MAX_EFFECT_VALUE",
@@ -26,7 +28,7 @@ __all__ = [
     "checked_column",
     "checked_noise",
     "checked_values",
-    "planted_effects",
+    "planted_model",
     "run_times_s",
 ]
 
@@ -63,21 +65,32 @@ def checked_values(what: str, name: str, params, specs: Mapping, limit: float) -
     return out
 
 
-def planted_effects(effects, table, variables, catalogue: Sequence, what: str):
-    """The table's catalogued effects named in ``effects`` (``{effect: {parameter: value in its
-    user unit}}``; ``catalogue``: the user's besides ``table``'s), each value checked
-    (:func:`checked_values`, within :data:`MAX_EFFECT_VALUE`): ``(effects, {catalogue name:
-    values}, {"<effect>.<parameter>": internal value})``."""
-    objects, given, values = [], {}, {}
+def planted_model(source, vector, effects, variables, catalogue: Sequence, what: str, lacks=""):
+    """``(model, parameters, {effect: values})``: the exact chain (``OrientationModel``) of the
+    table ``source`` at ``variables`` with the catalogued ``effects`` (``{effect: {parameter:
+    value in its user unit}}``; ``catalogue``: the user's besides the table's) planted, its
+    parameter vector at the table's errors ``vector`` (rad, m; ``source.parameter_names``) and
+    the effects' values by catalogue name, each checked (:func:`checked_values`, within
+    :data:`MAX_EFFECT_VALUE`; ``lacks``: why an effect needing a column ``variables`` lack is
+    refused, in words)."""
+    table = measured_table(source)
+    objects, given = [], {}
+    values = {
+        n: float(v) for n, v in zip(source.parameter_names, vector, strict=True)
+        if n in table.base_names
+    }  # fmt: skip
     for name, params in dict(effects or {}).items():
         effect = resolve_effect(str(name), table, tuple(catalogue))
+        missing = effect.missing_columns(variables) if lacks else ()
+        if missing:
+            raise InputError(f"{what} '{effect.name}' needs {', '.join(missing)}, which {lacks}")
         specs = {s.name: s for s in effect.parameters(variables)}
-        checked = checked_values(what, effect.name, params, specs, MAX_EFFECT_VALUE)
+        given[effect.name] = checked_values(what, effect.name, params, specs, MAX_EFFECT_VALUE)
         objects.append(effect)
-        given[effect.name] = checked
-        for pname, value in checked.items():
+        for pname, value in given[effect.name].items():
             values[f"{effect.name}.{pname}"] = value * specs[pname].per_user_unit
-    return objects, given, values
+    model = OrientationModel(variables, objects, table)
+    return model, model.parameter_vector(values), given
 
 
 def checked_noise(noise, name: str, sizes: tuple[int, str], low: float, high: float) -> np.ndarray:

@@ -34,13 +34,12 @@ from .data import (
     OrientationMeasurements,
     check_times_and_directions,
 )
-from .effect_model import OrientationModel
 from .effects.base import Effect, PositionVariables
 from .simulated import (
     SimulatedFile,
     check_dwell,
     checked_noise,
-    planted_effects,
+    planted_model,
     run_times_s,
 )
 from .table import measured_table
@@ -530,16 +529,11 @@ def simulate_measurements(
     if isinstance(errors, TurntableErrors):
         errors = errors.as_array()
     vector = np.zeros(len(source.parameter_names)) if errors is None else np.asarray(errors, float)
-    values = {
-        n: v for n, v in zip(source.parameter_names, vector, strict=True) if n in table.base_names
-    }
     schedule = schedule or Schedule()
     rng = np.random.default_rng(seed)
     variables, blank = _positions(schedule, rng, n_joints, not_measured)
-    objects, effects, planted = planted_effects(effects, table, variables, catalogue, "effect")
-    model = OrientationModel(variables, objects, table)
-    values.update(planted)
-    truth = model.predict(model.parameter_vector(values))
+    model, params, effects = planted_model(source, vector, effects, variables, catalogue, "effect")
+    truth = model.predict(params)
     measured, sigma_rad = _noisy(truth, noise, noise_spread, rng)
     measured[:, blank] = np.nan
     _refuse_beyond_a_file(measured)
