@@ -38,9 +38,8 @@ arcsec/h): an effect is a small error."""
 
 
 def checked_values(what: str, name: str, params, specs: Mapping, limit: float) -> dict[str, float]:
-    """``params`` ``{parameter: value}`` of the effect ``name`` (``what`` kind of effect, in
-    messages) checked: at least one, each a parameter of ``specs`` (``{name: spec}``, the spec's
-    ``unit`` its user unit) and a number within ``+-limit`` in it; InputError otherwise."""
+    """``params`` ``{parameter: value}`` of the ``what`` ``name`` checked: at least one, each in
+    ``specs`` (``{name: ParameterSpec}``), a number within ``+-limit`` of its user unit."""
     names = ", ".join(specs)
     units = "/".join(dict.fromkeys(spec.unit for spec in specs.values()))
     if not isinstance(params, Mapping) or not params:
@@ -66,13 +65,11 @@ def checked_values(what: str, name: str, params, specs: Mapping, limit: float) -
 
 
 def planted_model(source, vector, effects, variables, catalogue: Sequence, what: str, lacks=""):
-    """``(model, parameters, {effect: values})``: the exact chain (``OrientationModel``) of the
-    table ``source`` at ``variables`` with the catalogued ``effects`` (``{effect: {parameter:
-    value in its user unit}}``; ``catalogue``: the user's besides the table's) planted, its
-    parameter vector at the table's errors ``vector`` (rad, m; ``source.parameter_names``) and
-    the effects' values by catalogue name, each checked (:func:`checked_values`, within
-    :data:`MAX_EFFECT_VALUE`; ``lacks``: why an effect needing a column ``variables`` lack is
-    refused, in words)."""
+    """``(model, parameters, {effect: values})``: the exact chain of the table ``source`` at
+    ``variables`` with ``effects`` (``{effect: {parameter: value in its user unit}}``, from the
+    table's catalogue and ``catalogue``) planted, its parameters at the errors ``vector`` (rad, m)
+    and the effects' checked values (:func:`checked_values`); with ``lacks`` (why, in words) an
+    effect needing a column ``variables`` lack is refused."""
     table = measured_table(source)
     objects, given = [], {}
     values = {
@@ -141,9 +138,8 @@ def checked_column(values, n: int, name: str, low: float, high: float) -> np.nda
 
 
 class SimulatedFile:
-    """A simulated result written as a CSV: its ``columns(with_sigma=)`` under comment lines of
-    what made it (``_made()``) and the truth (``_truth()``), or with ``hide_truth`` a line saying
-    that ``_hidden`` is not recorded."""
+    """A simulated result as a CSV: its ``columns(with_sigma=)`` under comment lines of what made
+    it (``_made()``) and the truth (``_truth()``; with ``hide_truth``: ``_hidden`` not recorded)."""
 
     _hidden = ""
 
@@ -157,7 +153,6 @@ class SimulatedFile:
     def write_csv(
         self, path: str | Path, *, with_sigma: bool = True, hide_truth: bool = False
     ) -> Path:
-        """Write the CSV atomically under its :meth:`comment` lines (``with_sigma``: and the
-        sigma columns)."""
+        """Write the CSV atomically under its :meth:`comment` lines (the sigma ``with_sigma``)."""
         columns = self.columns(with_sigma=with_sigma)
         return write_csv_table(path, columns, comment=self.comment(hide_truth=hide_truth))

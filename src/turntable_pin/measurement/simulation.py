@@ -1,9 +1,9 @@
 """Simulated orientation measurements: turntable errors, hidden effects, a schedule, noise, a seed.
 
 Users rehearse a measurement campaign with it and the tests make data with known, hidden effects.
-The truth goes through the same exact chain the fit uses (:class:`OrientationModel`), with the
-chosen effect parameters; noise is Gaussian with the stated sigma on each of the three angles.
-The output is the CSV of ``docs/measurements.md`` with the seed and the truth in comment lines.
+The truth goes through the exact chain the fit uses (``OrientationModel``) with the chosen effect
+parameters; noise is Gaussian with the stated sigma on each angle. The output is the CSV of
+``docs/measurements.md``, the seed and the truth in comment lines.
 """
 
 from __future__ import annotations
@@ -38,6 +38,7 @@ from .effects.base import Effect, PositionVariables
 from .simulated import (
     SimulatedFile,
     check_dwell,
+    checked_column,
     checked_noise,
     planted_model,
     run_times_s,
@@ -217,11 +218,7 @@ class Schedule:
             )
         n = rows.shape[0]
         if self.positions_time_s is not None:
-            time = np.asarray(self.positions_time_s, dtype=float)
-            if time.shape != (n,) or not np.all((time >= 0) & (time <= MAX_TIME_S)):
-                raise InputError(
-                    f"positions_time_s needs {n} times in [0, {MAX_TIME_S:g}] s, one per position"
-                )
+            checked_column(self.positions_time_s, n, "positions_time_s", 0.0, MAX_TIME_S)
             if self.repeats > 1 or self.passes:
                 raise InputError(
                     "the positions give their times; repeats and passes would need other times "
@@ -517,9 +514,9 @@ def simulate_measurements(
             measures it.
 
     Raises:
-        InputError: an effect without parameters or beyond +-18000 (``MAX_ANGULAR_ERROR_DEG`` in
-            arcsec) in its user unit; a run longer than ``MAX_TIME_S``; angles beyond what a
-            measurement file may hold (``MAX_MEASURED_ANGLE_ARCSEC``).
+        InputError: an effect without parameters or beyond ``MAX_EFFECT_VALUE`` in its user
+            unit; a run longer than ``MAX_TIME_S``; angles beyond what a measurement file may
+            hold (``MAX_MEASURED_ANGLE_ARCSEC``).
     """
     noise = _checked_noise(noise_arcsec, noise_spread)
     seed = check_seed(seed)
