@@ -9,6 +9,7 @@ a second with status 130 / 143 and one line, leaving no helper process and no te
 
 from __future__ import annotations
 
+# The library is imported inside the functions that use it, deliberately: start-up time.
 import argparse
 import importlib
 import os

@@ -7,6 +7,7 @@ JSON, a CSV of the positions (``-o``, what ``simulate --positions`` reads) and f
 
 from __future__ import annotations
 
+# The library is imported inside the functions that use it, deliberately: start-up time.
 import argparse
 from pathlib import Path
 

@@ -3,6 +3,7 @@ parameters, required columns, definition and title."""
 
 from __future__ import annotations
 
+# The library is imported inside the functions that use it, deliberately: start-up time.
 import argparse
 
 from .common import add_mount_option, input_path, one_line_errors, print_json

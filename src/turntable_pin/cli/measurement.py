@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+# The library is imported inside the functions that use it, deliberately: start-up time.
 import argparse
 import shlex
 from pathlib import Path
@@ -345,12 +346,12 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
 
 
 def _generic_joints(table) -> tuple[str, ...] | None:
-    """The joints of a table other than the paper's (its angle columns ``phiK_deg`` or
-    ``<joint>_deg``), or ``None`` for the paper's table (``phi1_deg, phi2_deg``)."""
+    """The joints the table's data files name (angle columns ``phiK_deg`` or ``<joint>_deg``),
+    or ``None`` when its layout names the angles (the paper's ``phi1_deg, phi2_deg``)."""
     from ..measurement.table import measured_table
 
     measured = measured_table(table)
-    return None if measured.paper else measured.joint_names
+    return measured.data_joint_names or None
 
 
 def _read(args: argparse.Namespace, table=None):

@@ -3,6 +3,7 @@ CSV of the bundled mount URDFs."""
 
 from __future__ import annotations
 
+# The library is imported inside the functions that use it, deliberately: start-up time.
 import argparse
 from pathlib import Path
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+# The library is imported inside the functions that use it, deliberately: start-up time.
 import argparse
 import sys
 import time

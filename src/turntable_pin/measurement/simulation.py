@@ -541,7 +541,7 @@ def simulate_measurements(
         time_s=variables.time_s,
         dirs=variables.dirs,
         source=f"simulated (seed {seed})",
-        joint_names=() if table.paper else table.joint_names,
+        joint_names=table.data_joint_names,
     )
     return SimulatedMeasurements(
         data=data,

@@ -52,6 +52,8 @@ class MeasuredTable:
         title: how a sentence names the table (``the paper's table``, or the URDF file's name).
         named_effects: the catalogue's effects under the table's own names (its layout's
             :class:`~turntable_pin.model.named_effects.NamedEffect`; none: the generic names).
+        angle_names: the layout's name of each joint's angle (the paper's ``phi1``, ``phi2``;
+            none: its data files name the joints).
         urdf_path: the nominal URDF the chain was read from.
         telescope_mount: the telescope mount kind the table is (``"altaz"``, ``"equatorial"``;
             ``None``: a turntable), as declared (``model/mount_declaration.py``), never guessed.
@@ -68,6 +70,7 @@ class MeasuredTable:
         label: str,
         title: str = "",
         named_effects: Sequence = (),
+        angle_names: Sequence[str] = (),
         urdf_path=None,
         telescope_mount: str | None = None,
         declared_mount: str | None = None,
@@ -81,6 +84,7 @@ class MeasuredTable:
         self.label = label
         self.title = title or label
         self.named_effects = tuple(named_effects)
+        self.angle_names = tuple(angle_names)
         rotations = [f.error for link in chain.links for f in link.factors if f.kind == ROTATION]
         self.base_names = tuple(n for n in chain.error_names if n in rotations)
 
@@ -106,10 +110,10 @@ class MeasuredTable:
         return tuple(link.limits_rad for link in self.chain.joints)
 
     @property
-    def paper(self) -> bool:
-        """Whether the table tells its base errors in the paper's words (its effects carry the
-        paper's names): its data files name the angles ``phi1_deg, phi2_deg``."""
-        return bool(self.named_effects) and self.label == "paper"
+    def data_joint_names(self) -> tuple[str, ...]:
+        """The joints its data files and results name: none when its layout names the angles
+        (the paper's ``phi1_deg, phi2_deg``), else its joints (``phiK_deg`` or ``<joint>_deg``)."""
+        return () if self.angle_names else self.joint_names
 
     def angle_label(self, k: int) -> str:
         """``phiK``, the name of joint K's angle in data files and reports."""
@@ -135,7 +139,8 @@ def measured_table(turntable=None) -> MeasuredTable:
         ]
         cached = _MEASURED[table] = MeasuredTable(
             table.chain, joints, table.descriptions, label=table.label, title=table.title,
-            named_effects=table.layout.effects, urdf_path=table.urdf_path,
+            named_effects=table.layout.effects, angle_names=table.layout.angle_names,
+            urdf_path=table.urdf_path,
             telescope_mount=table.telescope_mount, declared_mount=table.declared_mount,
         )  # fmt: skip
     return cached
