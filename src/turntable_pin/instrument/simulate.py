@@ -50,6 +50,7 @@ from ..model.errors import MAX_ANGULAR_ERROR_DEG
 from .effects import INSTRUMENT_EFFECTS, RunEffect
 from .effects.base import Sensed
 from .effects.mount import Mount
+from .effects.temperature import TEMPERATURE_COLUMN
 
 __all__ = [
     "DEFAULT_DWELL_S",
@@ -370,9 +371,11 @@ def _temperatures(temperature_c, time_s, instrument):
         profile, temperature_c = temperature_c, temperature_c.at(time_s)
     if temperature_c is not None:
         temperature_c = checked_column(temperature_c, len(time_s), "temperature_c", -273.15, 1e3)
-    if "temperature_coefficient" in instrument and temperature_c is None:
+    column = TEMPERATURE_COLUMN  # the effects needing it say so
+    needs = [k for k in instrument if column in SIMULATED_INSTRUMENT_EFFECTS[k].required_columns]
+    if needs and temperature_c is None:
         raise InputError(
-            "instrument effect 'temperature_coefficient' needs a temperature: give "
+            f"instrument effect '{needs[0]}' needs a temperature: give "
             f"{argument('temperature_c')} (a start, a ramp per hour, a swing and its period)"
         )
     return profile, temperature_c
@@ -410,9 +413,12 @@ def _exact_outputs(sensed: Sensed, gyrowheel, instrument) -> np.ndarray:
     plant."""
     rate, force = sensed.rate_dph, sensed.force_g
     exact = np.stack(
-        [rate[:, c] + regressor_matrix(axis, force) @ gyrowheel.axis(axis).as_array()
-         for c, axis in enumerate(AXES)], axis=1,
-    )  # fmt: skip
+        [
+            rate[:, c] + regressor_matrix(axis, force) @ gyrowheel.axis(axis).as_array()
+            for c, axis in enumerate(AXES)
+        ],
+        axis=1,
+    )
     for name, values in instrument.items():
         exact = exact + SIMULATED_INSTRUMENT_EFFECTS[name].planted_dph(values, sensed)
     return exact

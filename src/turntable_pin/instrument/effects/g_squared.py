@@ -57,6 +57,9 @@ class GSquaredTerms(RunEffect):
         """``c_xz ax az + c_yz ay az`` on each output, (N, 2) deg/h, ``a`` the sensed force."""
         a = sensed.force_g
         return np.stack(
-            [values[f"{c}_xz"] * a[:, 0] * a[:, 2] + values[f"{c}_yz"] * a[:, 1] * a[:, 2]
-             for c in "xy"], axis=1,
-        )  # fmt: skip
+            [
+                values[f"{c}_xz"] * a[:, 0] * a[:, 2] + values[f"{c}_yz"] * a[:, 1] * a[:, 2]
+                for c in "xy"
+            ],
+            axis=1,
+        )
