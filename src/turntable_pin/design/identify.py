@@ -36,7 +36,7 @@ from ..core.words import argument, command
 from ..measurement.effect_model import OrientationModel
 from ..measurement.effects.base import PositionVariables
 from ..measurement.fit import fit_orientation
-from ..stats.design import d_optimal_design, greedy_design, log_det
+from ..stats.design import d_optimal_design, greedy_design, information_rows, log_det
 from ..stats.least_squares import analyse_identifiability, combination_name, tall_r_factor
 from .schedule import MeasurementPlan, Visits, candidate_visits, plan_measurements
 from .space import DesignSpace
@@ -297,12 +297,6 @@ def _start_information(space, data, noise_arcsec, dwell_s: float):
     return weighted.T @ weighted, noise, source, data.n_positions, start_s
 
 
-def _root(information: np.ndarray) -> np.ndarray:
-    """Rows R (n, n) with ``R^T R = information`` (symmetric, positive semi-definite)."""
-    values, vectors = np.linalg.eigh(information)
-    return np.sqrt(np.clip(values, 0.0, None))[:, None] * vectors.T
-
-
 def _invisible_effect(space, model, stacked: np.ndarray) -> str | None:
     """Why one of the effects cannot be identified on the ``stacked`` rows (all the candidates):
     its parameters add no determined combination to the base errors (no position sees it) or
@@ -406,7 +400,7 @@ def _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s) -> Id
     c = candidate_rows(space, n_positions, from_data, noise_arcsec, dwell_s)
     n = c.model.n_params
     candidate_r = tall_r_factor(c.rows.reshape(-1, n))
-    start_rows = () if c.information is None else (_root(c.information),)
+    start_rows = () if c.information is None else (information_rows(c.information),)
     ident = analyse_identifiability(
         np.concatenate([candidate_r, *start_rows]), c.model.parameter_names
     )

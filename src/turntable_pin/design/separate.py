@@ -45,6 +45,7 @@ from ..core.sizes import check_positions_count
 from ..core.words import argument, command
 from ..measurement.catalogue import catalogue
 from ..measurement.fit import fit_orientation
+from ..stats.design import information_rows
 from ..stats.discrimination import (
     Direction,
     choice_margin,
@@ -59,7 +60,7 @@ from ..stats.discrimination import (
 )
 from ..stats.least_squares import tall_r_factor
 from ..stats.model_selection import UNDETERMINED_GAIN_RATIO, acceptance_threshold
-from .identify import _evaluate, _root, candidate_rows, grid_rows
+from .identify import _evaluate, candidate_rows, grid_rows
 from .schedule import MeasurementPlan, plan_measurements
 from .space import DesignSpace
 
@@ -554,9 +555,9 @@ def _setup(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s) -> 
     return _Problem(
         space, c.rows, np.flatnonzero(c.keep), model.n_params, np.arange(len(model.base_names)),
         tuple(_columns(model, e) for e in space.effects), vectors,
-        None if c.information is None else _rows_of_information(c.information), c.from_rows,
-        len(listed), 0 if rank[0] <= rank[1] else 1, c.noise_rad, dwell_s, c.start_s,
-        c.duration_s, names, user, units, source, c.noise, c.noise_source, c.n_from,
+        None if c.information is None else information_rows(c.information, ROUNDING_ROWS),
+        c.from_rows, len(listed), 0 if rank[0] <= rank[1] else 1, c.noise_rad, dwell_s,
+        c.start_s, c.duration_s, names, user, units, source, c.noise, c.noise_source, c.n_from,
     )  # fmt: skip
 
 
@@ -807,18 +808,10 @@ def _curve_counts(n_design: int, n_target: int | None) -> list[int]:
     return sorted({int(round(c)) for c in np.linspace(1, top, min(top, 40))})
 
 
-def _rows_of_information(information: np.ndarray) -> np.ndarray:
-    """Rows R with ``R^T R = information`` (the data measured, whitened), without the directions
-    the data do not see: their eigenvalues are rounding (1e-16 of the largest), and as rows of
-    1e-8 they would count as seen once a column is scaled to unit norm."""
-    rows = _root(information)
-    norms = np.linalg.norm(rows, axis=1)
-    return rows[norms > ROUNDING_ROWS * max(float(norms.max(initial=0.0)), 1e-300)]
-
-
 ROUNDING_ROWS = 1e-7
-"""Rows of the measured data's information root below this fraction of the largest are rounding
-(an eigenvalue of 1e-14 of the largest), not directions the data see."""
+"""Rows of the measured data's information root (whitened) below this fraction of the largest
+are rounding (an eigenvalue of 1e-14 of the largest), not directions the data see: kept, they
+would count as seen once a column is scaled to unit norm."""
 
 
 def _inseparable(problem: _Problem, target, because):

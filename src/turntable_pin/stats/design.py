@@ -19,7 +19,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ExchangeResult", "d_optimal_design", "fedorov_exchange", "greedy_design", "log_det"]
+__all__ = [
+    "ExchangeResult",
+    "d_optimal_design",
+    "fedorov_exchange",
+    "greedy_design",
+    "information_rows",
+    "log_det",
+]
 
 RIDGE_RTOL = 1e-9
 """Ridge of the greedy start (of n candidates' mean information): ``M`` is singular until p rows
@@ -47,6 +54,17 @@ def log_det(information: np.ndarray) -> float:
     if not values[0] > SINGULAR_RTOL * values[-1]:
         return float("-inf")
     return float(np.sum(np.log(values)))
+
+
+def information_rows(information: np.ndarray, rtol: float | None = None) -> np.ndarray:
+    """Rows R with ``R^T R = information`` (symmetric, positive semi-definite); with ``rtol``,
+    without the rows shorter than ``rtol`` times the longest."""
+    values, vectors = np.linalg.eigh(information)
+    rows = np.sqrt(np.clip(values, 0.0, None))[:, None] * vectors.T
+    if rtol is None:
+        return rows
+    norms = np.linalg.norm(rows, axis=1)
+    return rows[norms > rtol * max(float(norms.max(initial=0.0)), 1e-300)]
 
 
 @dataclass(frozen=True)
@@ -100,6 +118,18 @@ def _products(left: np.ndarray, middle: np.ndarray, right: np.ndarray) -> np.nda
     return lw @ np.swapaxes(right, 1, 2)
 
 
+def _updated(rows, inverse, quad, u, signs) -> tuple[np.ndarray, np.ndarray]:
+    """``M^-1`` and every candidate's ``X_c M^-1 X_c^T`` after ``M + U^T S U`` (Woodbury;
+    ``u`` = ``U^T`` (r, p), ``S = diag(signs)``): ``M^-1 - (M^-1 U) K (M^-1 U)^T``, ``K = (S^-1
+    + U^T M^-1 U)^-1``."""
+    c, k, p = rows.shape
+    mu = u @ inverse  # (r, p)
+    kernel = np.linalg.inv(np.diag(signs) + mu @ u.T)
+    h = (rows.reshape(-1, p) @ mu.T).reshape(c, k, len(signs))  # X_c M^-1 U
+    inverse = inverse - mu.T @ kernel @ mu
+    return 0.5 * (inverse + inverse.T), quad - _products(h, kernel, h)
+
+
 def _exchange_ratios(quad: np.ndarray, g: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``det(M + X_c^T X_c - X_i^T X_i) / det M`` of every candidate c replacing point i:
     ``det([[I + A_c, G_c], [-G_c^T, I - B]])``, ``A_c = X_c M^-1 X_c^T`` (``quad``), ``G_c =
@@ -146,13 +176,7 @@ def greedy_design(
         j = int(np.argmax(gain))
         chosen.append(j)
         taken[j] = True
-        x = rows[j]  # (k, p)
-        w = x @ inverse  # (k, p)
-        inner = np.linalg.inv(eye + w @ x.T)  # (k, k)
-        inverse = inverse - w.T @ inner @ w
-        inverse = 0.5 * (inverse + inverse.T)
-        g = (rows.reshape(-1, p) @ w.T).reshape(c, k, k)  # X_c M^-1 x^T
-        quad = quad - _products(g, inner, g)
+        inverse, quad = _updated(rows, inverse, quad, rows[j], np.ones(k))
     return np.array(chosen, dtype=int)
 
 
@@ -178,7 +202,7 @@ def fedorov_exchange(
         raise ValueError("the starting design's information matrix is singular")
     history = [current]
     greedy = current
-    sign_s = np.concatenate([np.ones(k), -np.ones(k)])
+    signs = np.concatenate([np.ones(k), -np.ones(k)])  # x_j in, x_i out
     exchanges = sweeps = 0
     for sweeps in range(1, max_sweeps + 1):  # noqa: B007 (the count is reported)
         inverse = np.linalg.inv(m)
@@ -196,14 +220,7 @@ def fedorov_exchange(
             j = int(np.argmax(ratio))
             if not ratio[j] > 0 or np.log(ratio[j]) <= tol:
                 continue
-            # Take it: M^-1 and every candidate's X_c M^-1 X_c^T follow (Woodbury).
-            u = np.concatenate([rows[j], xi])  # (2k, p) = U^T
-            mu = u @ inverse  # (2k, p)
-            kernel = np.linalg.inv(np.diag(sign_s) + mu @ u.T)  # (S^-1 + U^T M^-1 U)^-1
-            h = (rows.reshape(-1, p) @ mu.T).reshape(c, k, 2 * k)  # X_c M^-1 U
-            quad = quad - _products(h, kernel, h)
-            inverse = inverse - mu.T @ kernel @ mu
-            inverse = 0.5 * (inverse + inverse.T)
+            inverse, quad = _updated(rows, inverse, quad, np.concatenate([rows[j], xi]), signs)
             m = m + rows[j].T @ rows[j] - xi.T @ xi
             current += float(np.log(ratio[j]))
             history.append(current)
@@ -249,19 +266,15 @@ def d_optimal_design(
     ``n`` long), keeping the best (an exchange can stop in a local optimum). When no start is
     nonsingular, the greedy design with ``log_det`` ``-inf``."""
     rows = _as_rows(rows)
+    greedy = greedy_design(rows, n, start)
     best = None
-    for first in (
-        greedy_design(rows, n, start),
-        *(_completed(rows, n, start, s) for s in also_from),
-    ):
-        first_log_det = log_det(_information(rows, first, start))
-        if not np.isfinite(first_log_det):
+    for first in (greedy, *(_completed(rows, n, start, s) for s in also_from)):
+        if not np.isfinite(log_det(_information(rows, first, start))):
             continue
         found = fedorov_exchange(rows, first, start, tol=tol, max_sweeps=max_sweeps)
         if best is None or found.log_det > best.log_det:
             best = found
     if best is None:
-        first = greedy_design(rows, n, start)
-        value = log_det(_information(rows, first, start))
-        return ExchangeResult(first, value, value, (value,), 0, 0)
+        value = log_det(_information(rows, greedy, start))
+        return ExchangeResult(greedy, value, value, (value,), 0, 0)
     return best
