@@ -17,18 +17,17 @@ The power is the diagnosis' own decision (sigma known). With A true, A is named 
 accepted, ``chi2'(k_A, lambda_A0) > k_A ln m + 6 + 2 ln K`` (``lambda_A0`` what the base errors
 leave of A, ``k_A`` the ranks A adds, ``m`` the measured angles, ``K`` the catalogue's size:
 :func:`~turntable_pin.stats.model_selection.acceptance_threshold`), and then either put before B
-in the first round, ``rss_B - rss_A > (k_A - k_B) ln m`` (a generalised chi-square of the noise in
-both models' span, :func:`~turntable_pin.stats.discrimination.rss_difference`; A traded off and B
-not: also ``gain_A > 2 gain_B``), or, B first, accepted on top of B (``chi2'(k_A|B, lambda_AB)``
-above the second round's threshold) with B then dropped. A design's power is the smaller of the
-two chances (A true, B true); a third effect that might take the name is not counted. The count
-for the target power scales the design's misfits (replicating it is exact), checked by designing
-that many positions.
+in the first round, ``rss_B - rss_A > (k_A - k_B) ln m`` (a generalised chi-square,
+:func:`~turntable_pin.stats.discrimination.rss_difference`; A traded off and B not: also ``gain_A
+> 2 gain_B``), or, B first, accepted on top of B (``chi2'(k_A|B, lambda_AB)`` above the second
+round's threshold) with B then dropped. A design's power is the smaller of the two chances (A
+true, B true); a third effect that might take the name is not counted. The count for the target
+power scales the design's misfits (replicating it is exact), checked by designing that many.
 
-When B reproduces A at every candidate (misfit below :data:`SAME_RTOL` of A's signal beyond the
-base) and A has no fewer ranks than B, no positions separate them: the result says so, with the
-independent measurements of the effects' ``confirm`` texts. When B contains A with more ranks, a
-true A is still named by the rule's parsimony: that direction is left to it.
+When B reproduces A at every candidate (misfit below
+:data:`~turntable_pin.stats.discrimination.SAME_RTOL` of A's signal beyond the base) and A has no
+fewer ranks than B, no positions separate them: the result says so, with the effects' ``confirm``
+texts. When B contains A with more ranks, a true A is still named by the rule's parsimony.
 """
 
 from __future__ import annotations
@@ -47,6 +46,7 @@ from ..measurement.catalogue import catalogue
 from ..measurement.fit import fit_orientation
 from ..stats.design import information_rows
 from ..stats.discrimination import (
+    SAME_RTOL,
     Direction,
     choice_margin,
     detection_power,
@@ -54,6 +54,7 @@ from ..stats.discrimination import (
     misfit,
     orthonormal_span,
     quadratic_form,
+    residual,
     rss_difference,
     t_optimal_exchange,
     traded_off,
@@ -66,7 +67,6 @@ from .space import DesignSpace
 
 __all__ = [
     "POWER_TARGET",
-    "SAME_RTOL",
     "Hypothesis",
     "SeparationDesign",
     "design_separate",
@@ -74,10 +74,6 @@ __all__ = [
 
 POWER_TARGET = 0.9
 """The chance of the right name the positions count is given for."""
-
-SAME_RTOL = 1e-8
-"""An effect reproduces another's prediction when it leaves less than this fraction of the other's
-signal beyond the base errors (squared), over every candidate position."""
 
 MAX_POWER_POSITIONS = 5000
 """Most positions the count for the target power is searched up to."""
@@ -390,9 +386,7 @@ class _Rows:
     def residual(self, x: int) -> np.ndarray:
         """What the base errors and the other effect leave of effect ``x``'s prediction, per
         row (in noise sigmas)."""
-        signal = self.signal(x)
-        basis = orthonormal_span(self.fitted(1 - x))
-        return signal - basis @ (basis.T @ signal)
+        return residual(self.fitted(1 - x), self.signal(x))
 
     def numbers(self, x: int) -> dict:
         """Effect ``x`` as the truth against the other (module docstring): its signal beyond

@@ -22,15 +22,11 @@ from ..core.exceptions import InputError
 from ..core.sizes import check_positions_count
 from ..core.words import argument
 from ..stats.diagnosis_engine import SEPARATION_CHI2
-from ..stats.discrimination import Direction, t_optimal_exchange
+from ..stats.discrimination import SAME_RTOL, Direction, t_optimal_exchange
 from .diagnosis import RunFamily
 from .model import RunModel, run_context
 
-__all__ = ["SAME_RTOL", "RunSeparation", "design_run_separation"]
-
-SAME_RTOL = 1e-8
-"""B reproduces A at every candidate when the best design's misfit is below this fraction of
-A's signal beyond the coefficients."""
+__all__ = ["RunSeparation", "design_run_separation"]
 
 
 @dataclass(frozen=True)

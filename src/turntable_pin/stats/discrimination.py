@@ -35,6 +35,7 @@ from .model_selection import (
 
 __all__ = [
     "RIDGE",
+    "SAME_RTOL",
     "TAIL_SIGMAS",
     "Direction",
     "Exchange",
@@ -45,6 +46,7 @@ __all__ = [
     "noncentral_chi2_sf",
     "orthonormal_span",
     "quadratic_form",
+    "residual",
     "rss_difference",
     "t_optimal_exchange",
     "traded_off",
@@ -53,6 +55,10 @@ __all__ = [
 RIDGE = 1e-9
 """Ridge of the exchange's Gram matrices (of one candidate's mean diagonal): invertible before
 the design determines every column (the reported misfits are exact, :func:`misfit`)."""
+
+SAME_RTOL = 1e-8
+"""A rival reproduces a signal when its misfit is below this fraction of the signal's (squared)
+norm."""
 
 
 def orthonormal_span(columns: np.ndarray, rtol: float = RANK_RTOL) -> np.ndarray:
@@ -69,12 +75,17 @@ def orthonormal_span(columns: np.ndarray, rtol: float = RANK_RTOL) -> np.ndarray
     return u[:, s > rtol * s[0]]
 
 
-def misfit(fitted: np.ndarray, signal: np.ndarray) -> float:
-    """``|| (I - P) signal ||^2``: what fitting the columns ``fitted`` (m, q) leaves of the
-    noise-free ``signal`` (m,), both whitened (a chi2)."""
+def residual(fitted: np.ndarray, signal: np.ndarray) -> np.ndarray:
+    """``(I - P) signal``: what fitting the columns ``fitted`` (m, q) leaves of ``signal``."""
     signal = np.asarray(signal, dtype=float).reshape(-1)
     basis = orthonormal_span(fitted)
-    rest = signal - basis @ (basis.T @ signal)
+    return signal - basis @ (basis.T @ signal)
+
+
+def misfit(fitted: np.ndarray, signal: np.ndarray) -> float:
+    """``|| (I - P) signal ||^2`` (:func:`residual`) of the noise-free ``signal`` (m,), both
+    whitened (a chi2)."""
+    rest = residual(fitted, signal)
     return float(rest @ rest)
 
 
