@@ -61,7 +61,7 @@ from ..stats.discrimination import (
 )
 from ..stats.least_squares import tall_r_factor
 from ..stats.model_selection import UNDETERMINED_GAIN_RATIO, acceptance_threshold
-from .identify import _evaluate, candidate_rows, grid_rows
+from .identify import CandidateRows, _evaluate, candidate_rows, grid_rows
 from .schedule import MeasurementPlan, plan_measurements
 from .space import DesignSpace
 
@@ -509,28 +509,23 @@ def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dw
         return problem.rows_of(run[3], 3 * run[2].n_rows).power()
 
     count, count_power, verified = _positions_for(
-        scaled, designed, target, n_positions, power, problem.usable.size
+        scaled, designed, target, n_positions, power, int(problem.c.keep.sum())
     )
-    return SeparationDesign(
-        space=space,
-        pair=names,
+    measured = np.zeros((0, space.n_joints))
+    if from_data is not None:
+        measured = np.degrees(np.asarray(from_data.joint_rad, dtype=float))
+    return problem.result(
+        target,
+        measured,
         positions_deg=space.candidates_deg[chosen][plan.first_order()],
         plan=plan,
         hypotheses=_hypotheses(problem, settled, numbers, new, plan, n_positions),
         misfit_by_position=_shares(design, new, plan, n_positions),
-        measured_deg=np.zeros((0, space.n_joints))
-        if from_data is None
-        else np.degrees(np.asarray(from_data.joint_rad, dtype=float)),
-        noise_arcsec=float(problem.noise),
-        noise_source=problem.noise_source,
-        amplitude_source=problem.source,
-        n_from=problem.n_from,
         power=float(power),
         positions_for_power=count,
         power_at_positions_for_power=count_power,
         positions_for_power_designed=verified,
         power_curve=tuple((c, scaled(c)) for c in _curve_counts(n_positions, count)),
-        target=float(target),
         catalogue_size=problem.size,
         n_swaps=found.swaps,
         n_passes=found.passes,
@@ -546,12 +541,11 @@ def _setup(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s) -> 
     source, vectors, user, units = _amplitudes(model, space, amplitudes, from_data)
     listed = [e.name for e in catalogue(space.table)]
     rank = [listed.index(name) if name in listed else len(listed) for name in names]
+    fixed = None if c.information is None else information_rows(c.information, ROUNDING_ROWS)
     return _Problem(
-        space, c.rows, np.flatnonzero(c.keep), model.n_params, np.arange(len(model.base_names)),
-        tuple(_columns(model, e) for e in space.effects), vectors,
-        None if c.information is None else information_rows(c.information, ROUNDING_ROWS),
-        c.from_rows, len(listed), 0 if rank[0] <= rank[1] else 1, c.noise_rad, dwell_s,
-        c.start_s, c.duration_s, names, user, units, source, c.noise, c.noise_source, c.n_from,
+        space, c, dwell_s, np.arange(len(model.base_names)),
+        tuple(_columns(model, e) for e in space.effects), vectors, fixed, len(listed),
+        0 if rank[0] <= rank[1] else 1, names, user, units, source,
     )  # fmt: skip
 
 
@@ -634,20 +628,15 @@ def _settled(problem: _Problem) -> list[str]:
     Raises:
         InputError: an effect whose prediction the base errors explain everywhere.
     """
-    every = problem.rows(tall_r_factor(problem.all_rows.reshape(-1, problem.n_params)), 1)
-    base, names, user, units = (
-        every.rows[:, problem.base],
-        problem.names,
-        problem.user,
-        problem.units,
-    )
-    settled = []
+    every = problem.rows(tall_r_factor(problem.c.rows.reshape(-1, problem.c.model.n_params)), 1)
+    base, settled = every.rows[:, problem.base], []
     for x in range(2):
         signal = every.signal(x)
         alone = misfit(base, signal)
         if not alone > SAME_RTOL * max(float(signal @ signal), 1e-300):
             raise InputError(
-                f"{names[x]} at its amplitude ({_values(user[x])} {units[x]}) changes nothing "
+                f"{problem.names[x]} at its amplitude ({_values(problem.user[x])} "
+                f"{problem.units[x]}) changes nothing "
                 "that the base errors do not explain at any position within the limits: there "
                 "is nothing to separate"
             )
@@ -675,33 +664,33 @@ def _shares(design: _Rows, new: np.ndarray, plan, n_positions: int) -> np.ndarra
 
 @dataclass(frozen=True)
 class _Problem:
-    """The separation on the candidates: their whitened rows (C, k, n) and the usable ones, the
-    columns of the base errors and of each effect, the amplitudes (internal and user units), the
-    data measured (rows of their information), the catalogue's size and which effect it lists
-    first, and what a run needs (noise, dwell, start time, duration)."""
+    """The separation on the candidates (``c``: their whitened rows, the data measured, the noise,
+    the run's times): the columns of the base errors and of each effect, the amplitudes (internal
+    and user units), the data measured as rows of their information, the catalogue's size and
+    which effect it lists first."""
 
     space: DesignSpace
-    all_rows: np.ndarray
-    usable: np.ndarray
-    n_params: int
+    c: CandidateRows
+    dwell_s: float
     base: np.ndarray
     own: tuple[np.ndarray, ...]
     vectors: list
     fixed: np.ndarray | None
-    from_rows: int
     size: int
     leader: int
-    noise_rad: float
-    dwell_s: float
-    start_s: float
-    duration_s: float
     names: tuple[str, str]
     user: list
     units: list
     source: dict
-    noise: float
-    noise_source: str
-    n_from: int
+
+    def result(self, target: float, measured_deg: np.ndarray, **found) -> SeparationDesign:
+        """The :class:`SeparationDesign` with what ``found`` says."""
+        c = self.c
+        return SeparationDesign(
+            space=self.space, pair=self.names, measured_deg=measured_deg,
+            noise_arcsec=float(c.noise), noise_source=c.noise_source,
+            amplitude_source=self.source, n_from=c.n_from, target=float(target), **found,
+        )  # fmt: skip
 
     def rows(self, rows: np.ndarray, observations: int, leader: int | None = None) -> _Rows:
         """:class:`_Rows` of ``rows`` standing for ``observations`` measured angles."""
@@ -712,12 +701,12 @@ class _Problem:
         """The rows of a run (its Gram matrix times ``factor``) and of the data measured."""
         stacked = [new * math.sqrt(factor)] if new is not None else []
         stacked += [self.fixed] if self.fixed is not None else []
-        return self.rows(np.concatenate(stacked), observations + self.from_rows)
+        return self.rows(np.concatenate(stacked), observations + self.c.from_rows)
 
     def directions(self, settled: list[str]) -> list:
         """The :class:`~turntable_pin.stats.discrimination.Direction` of each effect the
         positions must separate (``settled`` ``misfit``)."""
-        rows, fixed, out = self.all_rows, self.fixed, []
+        rows, fixed, out = self.c.rows, self.fixed, []
         for x in (x for x in range(2) if settled[x] == "misfit"):
             fitted = np.concatenate([self.base, self.own[1 - x]])
             out.append(
@@ -735,14 +724,14 @@ class _Problem:
         their run and its whitened rows."""
         space = self.space
         found = t_optimal_exchange(directions, count, seed=space.seed)
-        chosen = self.usable[np.sort(found.chosen)]
+        chosen = np.flatnonzero(self.c.keep)[np.sort(found.chosen)]
         plan = plan_measurements(
             space.candidates_deg[chosen], needs_time=space.needs_time,
             needs_dirs=space.needs_dirs, dwell_s=self.dwell_s, seed=space.seed,
-            start_s=self.start_s, visits=space.visits.subset(chosen),
+            start_s=self.c.start_s, visits=space.visits.subset(chosen),
         )  # fmt: skip
-        jac = _evaluate(space, plan.variables())[0].reshape(-1, self.n_params) / self.noise_rad
-        return found, chosen, plan, jac
+        jac = _evaluate(space, plan.variables())[0].reshape(-1, self.c.model.n_params)
+        return found, chosen, plan, jac / self.c.noise_rad
 
 
 def _values(amplitude: Mapping[str, float]) -> str:
@@ -752,11 +741,11 @@ def _values(amplitude: Mapping[str, float]) -> str:
 def _grid_misfits(problem: _Problem, n_positions: int):
     """What each effect's rival leaves of it on the 30-degree grid within the limits, scaled to
     the design's size (with the data measured); ``None`` when no grid position can be used."""
-    rows = grid_rows(problem.space, problem.start_s, problem.duration_s)[0]
+    rows = grid_rows(problem.space, problem.c.start_s, problem.c.duration_s)[0]
     if not rows.shape[0]:
         return None
     factor = n_positions / rows.shape[0]
-    on_grid = problem.rows_of(rows.reshape(-1, rows.shape[-1]) / problem.noise_rad, 0, factor)
+    on_grid = problem.rows_of(rows.reshape(-1, rows.shape[-1]) / problem.c.noise_rad, 0, factor)
     return [misfit(on_grid.fitted(1 - x), on_grid.signal(x)) for x in range(2)]
 
 
@@ -819,15 +808,5 @@ def _inseparable(problem: _Problem, target, because):
         f"{because}; an independent measurement does. For {a.name}: {a.confirm} "
         f"For {b.name}: {b.confirm}"
     )
-    return SeparationDesign(
-        space=space,
-        pair=problem.names,
-        positions_deg=np.zeros((0, space.n_joints)),
-        measured_deg=np.zeros((0, space.n_joints)),
-        noise_arcsec=float(problem.noise),
-        noise_source=problem.noise_source,
-        amplitude_source=problem.source,
-        n_from=problem.n_from,
-        target=float(target),
-        inseparable=text,
-    )
+    none = np.zeros((0, space.n_joints))
+    return problem.result(target, none, positions_deg=none, inseparable=text)
