@@ -354,26 +354,16 @@ def _fitted_amplitude(data, effect, table) -> dict[str, float]:
 
 
 class _Rows:
-    """Whitened rows of the base errors and the two effects (the measured data as the square
-    root of their information: only the Gram matrix matters), with the amplitudes, and what the
-    diagnosis would make of them (:meth:`numbers`).
+    """Whitened rows (m', n) of the base errors and ``problem``'s two effects (the measured data
+    as the square root of their information: only the Gram matrix matters), standing for
+    ``observations`` measured angles, and what the diagnosis would make of them
+    (:meth:`numbers`). ``leader``: the effect the diagnosis lists first (catalogue order), first
+    when the two fit exactly alike with the same determination."""
 
-    Args:
-        rows: (m', n) the rows; observations: the measured angles m they stand for.
-        base, own: the columns of the base errors and of each effect; amplitude: each effect's
-            parameters (internal units).
-        candidates: K, the catalogued effects the diagnosis tries at once.
-        leader: which effect the diagnosis lists first (catalogue order): it goes first when
-            the two fit exactly alike with the same determination.
-    """
-
-    def __init__(self, rows, observations: int, base, own, amplitude, candidates: int,
-                 leader: int = 0) -> None:  # fmt: skip
-        self.rows = rows
-        self.observations = int(observations)
-        self.base, self.own, self.amplitude = base, own, amplitude
-        self.candidates = int(candidates)
-        self.leader = int(leader)
+    def __init__(self, problem: _Problem, rows, observations: int, leader: int) -> None:
+        self.rows, self.observations, self.leader = rows, int(observations), int(leader)
+        self.base, self.own, self.amplitude = problem.base, problem.own, problem.vectors
+        self.candidates = int(problem.size)  # K, the catalogued effects tried at once
 
     def signal(self, x: int) -> np.ndarray:
         """Effect ``x``'s noise-free prediction (in noise sigmas)."""
@@ -694,8 +684,7 @@ class _Problem:
 
     def rows(self, rows: np.ndarray, observations: int, leader: int | None = None) -> _Rows:
         """:class:`_Rows` of ``rows`` standing for ``observations`` measured angles."""
-        leader = self.leader if leader is None else leader
-        return _Rows(rows, observations, self.base, self.own, self.vectors, self.size, leader)
+        return _Rows(self, rows, observations, self.leader if leader is None else leader)
 
     def rows_of(self, new: np.ndarray | None, observations: int, factor: float = 1.0) -> _Rows:
         """The rows of a run (its Gram matrix times ``factor``) and of the data measured."""
