@@ -91,15 +91,6 @@ class RunSeparation:
         return "\n".join(lines)
 
 
-def _refuse_columns(effect) -> None:
-    if effect.required_columns:
-        raise InputError(
-            f"effect '{effect.name}' depends on {', '.join(effect.required_columns)}, which a "
-            "choice of positions cannot set: repeat positions late in the run (a drift), or "
-            "calibrate at another temperature (a temperature coefficient), to tell it apart"
-        )
-
-
 def _whitened(context, rival, true_effect, params, sigma):
     """At ``context``, over ``sigma``: the columns (N, 2, q) of the coefficients and ``rival``,
     and the signal (N, 2) of ``true_effect`` at its ``params``."""
@@ -175,7 +166,12 @@ def _pair(family: RunFamily, names: tuple[str, str]):
             f"{argument('separate')} needs two different effects, got '{a.name}' twice"
         )
     for effect in (a, b):
-        _refuse_columns(effect)
+        if effect.required_columns:
+            raise InputError(
+                f"effect '{effect.name}' depends on {', '.join(effect.required_columns)}, which "
+                "a choice of positions cannot set: repeat positions late in the run (a drift), or "
+                "calibrate at another temperature (a temperature coefficient), to tell it apart"
+            )
     base_rank = family.fit([]).result.rank
     fits = [family.fit([a]), family.fit([b])]
     for effect, fit in zip((a, b), fits, strict=True):
