@@ -310,10 +310,20 @@ def _percent(value: float | None) -> str:
     return "-" if value is None else f"{100.0 * value:.1f} %"
 
 
-def _columns(model, effect) -> np.ndarray:
-    """The parameter indices of ``effect`` in ``model``."""
+def _columns(model, effect) -> tuple[np.ndarray, list[str]]:
+    """The parameter indices of ``effect`` in ``model`` and their names within the effect."""
     prefix = f"{effect.name}."
-    return np.array([i for i, n in enumerate(model.parameter_names) if n.startswith(prefix)])
+    columns = np.array([i for i, n in enumerate(model.parameter_names) if n.startswith(prefix)])
+    return columns, [model.parameter_names[i].split(".", 1)[1] for i in columns]
+
+
+def _in_user_units(model, effect, vector) -> dict[str, float]:
+    """``effect``'s parameters ``vector`` (internal units, the model's order) by name, user
+    units."""
+    columns, names = _columns(model, effect)
+    return {
+        n: float(v / model.per_user_unit[i]) for n, i, v in zip(names, columns, vector, strict=True)
+    }
 
 
 def _amplitude_vector(model, effect, values: Mapping[str, float]) -> np.ndarray:
@@ -323,8 +333,7 @@ def _amplitude_vector(model, effect, values: Mapping[str, float]) -> np.ndarray:
     Raises:
         InputError: a name that is not one of the effect's parameters.
     """
-    columns = _columns(model, effect)
-    names = [model.parameter_names[i].split(".", 1)[1] for i in columns]
+    columns, names = _columns(model, effect)
     unknown = [k for k in values if k not in names]
     if unknown:
         raise InputError(
@@ -346,11 +355,7 @@ def _fitted_amplitude(data, effect, table) -> dict[str, float]:
         raise InputError(
             f"{argument('from_data')} {where}: {effect.name} cannot be fitted there ({exc})"
         ) from None
-    model, params = fit.model, fit.result.params
-    return {
-        model.parameter_names[i].split(".", 1)[1]: float(params[i] / model.per_user_unit[i])
-        for i in _columns(model, effect)
-    }
+    return _in_user_units(fit.model, effect, fit.result.params[_columns(fit.model, effect)[0]])
 
 
 class _Rows:
@@ -534,7 +539,7 @@ def _setup(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s) -> 
     fixed = None if c.information is None else information_rows(c.information, ROUNDING_ROWS)
     return _Problem(
         space, c, dwell_s, np.arange(len(model.base_names)),
-        tuple(_columns(model, e) for e in space.effects), vectors, fixed, len(listed),
+        tuple(_columns(model, e)[0] for e in space.effects), vectors, fixed, len(listed),
         0 if rank[0] <= rank[1] else 1, names, user, units, source,
     )  # fmt: skip
 
@@ -601,12 +606,8 @@ def _amplitudes(model, space, amplitudes, from_data):
                 f"({argument('from_data')} DATA.csv)"
             )
         vectors.append(_amplitude_vector(model, effect, values))
-    own = [_columns(model, e) for e in space.effects]
-    user = [
-        {model.parameter_names[i].split(".", 1)[1]: float(v / model.per_user_unit[i])
-         for i, v in zip(own[x], vectors[x], strict=True)}
-        for x in range(2)
-    ]  # fmt: skip
+    own = [_columns(model, e)[0] for e in space.effects]
+    user = [_in_user_units(model, e, v) for e, v in zip(space.effects, vectors, strict=True)]
     units = [", ".join(dict.fromkeys(model.parameter_units[i] for i in own[x])) for x in range(2)]
     return source, vectors, user, units
 
