@@ -264,13 +264,12 @@ class Direction:
 class Exchange:
     """A T-optimal design (:func:`t_optimal_exchange`): the ``chosen`` indices (n,), the exact
     misfit of each direction on it (``noncentralities``, fixed observations included), the
-    ``swaps`` accepted, the ``passes`` made and the random start's ``seed``."""
+    ``swaps`` accepted and the ``passes`` made."""
 
     chosen: np.ndarray
     noncentralities: tuple[float, ...]
     swaps: int
     passes: int
-    seed: int
 
     @property
     def criterion(self) -> float:
@@ -369,4 +368,4 @@ def t_optimal_exchange(
         if not changed:
             break
     exact = tuple(d.misfit(chosen) for d in directions)
-    return Exchange(chosen.copy(), exact, swaps, passes, int(seed))
+    return Exchange(chosen.copy(), exact, swaps, passes)
