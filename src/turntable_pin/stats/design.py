@@ -24,6 +24,7 @@ __all__ = [
     "d_optimal_design",
     "fedorov_exchange",
     "greedy_design",
+    "information",
     "information_rows",
     "log_det",
 ]
@@ -91,8 +92,8 @@ def _as_rows(rows: np.ndarray) -> np.ndarray:
     return rows
 
 
-def _information(rows: np.ndarray, chosen: np.ndarray, start: np.ndarray | None) -> np.ndarray:
-    """``start + sum_c X_c^T X_c`` over the chosen candidates."""
+def information(rows: np.ndarray, chosen, start: np.ndarray | None = None) -> np.ndarray:
+    """``start + sum_c X_c^T X_c`` over the ``chosen`` candidates of ``rows`` (C, k, p)."""
     x = rows[chosen].reshape(-1, rows.shape[2])
     m = x.T @ x
     return m if start is None else m + start
@@ -196,7 +197,7 @@ def fedorov_exchange(
     chosen = np.array(chosen, dtype=int)
     taken = np.zeros(c, dtype=bool)
     taken[chosen] = True
-    m = _information(rows, chosen, start)
+    m = information(rows, chosen, start)
     current = log_det(m)
     if not np.isfinite(current):
         raise ValueError("the starting design's information matrix is singular")
@@ -228,7 +229,7 @@ def fedorov_exchange(
             chosen[slot] = j
             exchanges += 1
             improved = True
-        m = _information(rows, chosen, start)  # afresh: no rounding carried into the next sweep
+        m = information(rows, chosen, start)  # afresh: no rounding carried into the next sweep
         current = log_det(m)
         if not improved:
             break
@@ -247,7 +248,7 @@ def _completed(rows, n, start, seed) -> np.ndarray:
     seed = np.unique(np.asarray(seed, dtype=int))
     if seed.size >= n:
         return seed[greedy_design(rows[seed], n, start)]
-    known = _information(rows, seed, start)
+    known = information(rows, seed, start)
     return np.concatenate([seed, greedy_design(rows, n - seed.size, known, exclude=seed)])
 
 
@@ -269,12 +270,12 @@ def d_optimal_design(
     greedy = greedy_design(rows, n, start)
     best = None
     for first in (greedy, *(_completed(rows, n, start, s) for s in also_from)):
-        if not np.isfinite(log_det(_information(rows, first, start))):
+        if not np.isfinite(log_det(information(rows, first, start))):
             continue
         found = fedorov_exchange(rows, first, start, tol=tol, max_sweeps=max_sweeps)
         if best is None or found.log_det > best.log_det:
             best = found
     if best is None:
-        value = log_det(_information(rows, greedy, start))
+        value = log_det(information(rows, greedy, start))
         return ExchangeResult(greedy, value, value, (value,), 0, 0)
     return best

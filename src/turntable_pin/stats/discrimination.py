@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .design import information
 from .least_squares import RANK_RTOL
 from .model_selection import (
     MAX_CORRELATION,
@@ -296,8 +297,7 @@ class _Gram:
         self.reset(chosen)
 
     def reset(self, chosen: np.ndarray) -> None:
-        rows = self.z[chosen].reshape(-1, self.z.shape[-1])
-        self.inverse = np.linalg.inv(self.base + rows.T @ rows)
+        self.inverse = np.linalg.inv(information(self.z, chosen, self.base))
 
     def value(self) -> float:
         """The (ridged) misfit of the current design, in the signal's units."""
