@@ -699,14 +699,10 @@ class _Problem:
         rows, fixed, out = self.c.rows, self.fixed, []
         for x in (x for x in range(2) if settled[x] == "misfit"):
             fitted = np.concatenate([self.base, self.own[1 - x]])
-            out.append(
-                Direction(
-                    rows[:, :, fitted],
-                    rows[:, :, self.own[x]] @ self.vectors[x],
-                    None if fixed is None else fixed[:, fitted],
-                    None if fixed is None else fixed[:, self.own[x]] @ self.vectors[x],
-                )
-            )
+            own, a = self.own[x], self.vectors[x]
+            parts = [rows[:, :, fitted], rows[:, :, own] @ a]
+            parts += [None, None] if fixed is None else [fixed[:, fitted], fixed[:, own] @ a]
+            out.append(Direction(*parts))
         return out
 
     def run_of(self, directions, count: int):
