@@ -2,21 +2,19 @@
 item 4: the paper's own question, section 2).
 
 How accurate must a turntable be for a GyroWheel calibration of accuracy ``w_m``? For given
-positions the answer is the requirement box of :mod:`turntable_pin.calibration.requirement` (the
-largest box of orientation errors whose every point keeps the rate errors of eqs. 7-14 within
-``w_m``). To first order the rate error at a position is ``J(p) (dpsi, dtheta, dgamma)`` (eq. 13
-as printed: the drift at the actual gravity direction minus that at the ideal one), so the most
-sensitive positions set the box: on the paper's Table 1 GyroWheel, gravity along the payload's z
-axis bounds dpsi and dgamma (the 43.2 and 33.2 deg/h/g terms), gravity in or near its x-y plane
-bounds dtheta (15 to 82 deg/h per rad, by its azimuth there).
+positions, the requirement box of :mod:`turntable_pin.calibration.requirement` (the largest box
+of orientation errors whose every point keeps the rate errors of eqs. 7-14 within ``w_m``). To
+first order the rate error at a position is ``J(p) (dpsi, dtheta, dgamma)`` (eq. 13 as printed),
+so the most sensitive positions set the box: on the paper's Table 1 GyroWheel, gravity along the
+payload's z axis bounds dpsi and dgamma (the 43.2 and 33.2 deg/h/g terms), gravity in or near
+its x-y plane bounds dtheta (15 to 82 deg/h per rad, by its azimuth there).
 
 The design chooses ``N`` positions within the joints' limits with the largest box (the loosest
 requirement for the same ``w_m``) that still calibrate the 14 drift coefficients (eqs. 5-6) at
-least as precisely as the reference: the D-efficiency ``exp((log det M - log det M_ref) / 14)``
-(``M`` both axes' information, :func:`~turntable_pin.calibration.gyrowheel.regressor_matrix`) is
-at least ``min_efficiency`` (default 1). Without that floor, positions clustered where gravity
-changes the drift least would give a loose requirement and a calibration that amplifies the
-noise without bound.
+least as precisely as the reference: D-efficiency ``exp((log det M - log det M_ref) / 14)`` (``M``
+both axes' information, :func:`~turntable_pin.calibration.gyrowheel.regressor_matrix`) at least
+``min_efficiency`` (default 1). Without that floor, positions clustered where gravity changes the
+drift least would give a loose requirement and a calibration that amplifies the noise unbounded.
 
 The reference is the evenly spaced grid of ``N`` positions within the limits that calibrates
 (:func:`comparison_grid`: on the paper's table ``grid:90x60`` for 24, ``grid:60`` for 36,
@@ -472,12 +470,8 @@ def design_calibration(
     with one_blas_thread():  # small matrices: threads only wait for each other on busy cores
         chosen, steps = loosest_positions(features, sensitivity, start, floor, accuracy_dph)
 
-    def chosen_set(index: np.ndarray, name: str) -> PositionSet:
-        return PositionSet(candidates.angles_rad[index], table=table, name=name)
-
-    box = requirement_box(
-        accuracy_dph, gyrowheel, position_inputs(chosen_set(chosen, "design"), latitude_rad)
-    )
+    found = PositionSet(candidates.angles_rad[chosen], table=table, name="design")
+    box = requirement_box(accuracy_dph, gyrowheel, position_inputs(found, latitude_rad))
     reference_box = requirement_box(
         accuracy_dph, gyrowheel, position_inputs(reference, latitude_rad)
     )

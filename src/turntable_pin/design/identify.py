@@ -36,7 +36,13 @@ from ..core.words import argument, command
 from ..measurement.effect_model import OrientationModel
 from ..measurement.effects.base import PositionVariables
 from ..measurement.fit import fit_orientation
-from ..stats.design import d_optimal_design, greedy_design, log_det
+from ..stats.design import (
+    d_optimal_design,
+    greedy_design,
+    information,
+    information_rows,
+    log_det,
+)
 from ..stats.least_squares import analyse_identifiability, combination_name, tall_r_factor
 from .schedule import MeasurementPlan, Visits, candidate_visits, plan_measurements
 from .space import DesignSpace
@@ -297,12 +303,6 @@ def _start_information(space, data, noise_arcsec, dwell_s: float):
     return weighted.T @ weighted, noise, source, data.n_positions, start_s
 
 
-def _root(information: np.ndarray) -> np.ndarray:
-    """Rows R (n, n) with ``R^T R = information`` (symmetric, positive semi-definite)."""
-    values, vectors = np.linalg.eigh(information)
-    return np.sqrt(np.clip(values, 0.0, None))[:, None] * vectors.T
-
-
 def _invisible_effect(space, model, stacked: np.ndarray) -> str | None:
     """Why one of the effects cannot be identified on the ``stacked`` rows (all the candidates):
     its parameters add no determined combination to the base errors (no position sees it) or
@@ -346,10 +346,8 @@ def _fewest_positions(rows, start, rank) -> int | None:
     not even twice ``rank``)."""
     count = min(rows.shape[0], 2 * rank + 2)
     order = greedy_design(rows, count, start)
-    m = np.zeros((rows.shape[2],) * 2) if start is None else np.array(start)
-    for i, j in enumerate(order, start=1):
-        m = m + rows[j].T @ rows[j]
-        if np.isfinite(log_det(m)):
+    for i in range(1, order.size + 1):
+        if np.isfinite(log_det(information(rows, order[:i], start))):
             return i
     return None
 
@@ -406,7 +404,7 @@ def _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s) -> Id
     c = candidate_rows(space, n_positions, from_data, noise_arcsec, dwell_s)
     n = c.model.n_params
     candidate_r = tall_r_factor(c.rows.reshape(-1, n))
-    start_rows = () if c.information is None else (_root(c.information),)
+    start_rows = () if c.information is None else (information_rows(c.information),)
     ident = analyse_identifiability(
         np.concatenate([candidate_r, *start_rows]), c.model.parameter_names
     )
@@ -444,13 +442,13 @@ def _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s) -> Id
         seed=space.seed, start_s=c.start_s, visits=space.visits.subset(chosen),
     )  # fmt: skip
 
-    def information(plan_: MeasurementPlan) -> np.ndarray:
+    def run_information(plan_: MeasurementPlan) -> np.ndarray:
         z = _evaluate(space, plan_.variables())[0].reshape(-1, n) / c.noise_rad @ basis
         return z.T @ z
 
     zero = 0.0 if start is None else start
-    m_design = information(plan) + zero
-    m_grid, m_grid_n, n_grid = _grid_information(space, c, information, n_positions, dwell_s)
+    m_design = run_information(plan) + zero
+    m_grid, m_grid_n, n_grid = _grid_information(space, c, run_information, n_positions, dwell_s)
     # Combinations in user units: y = to_user @ z (pivot-scaled rows of the RREF, as fit names).
     pivots = [int(np.flatnonzero(row)[0]) for row in ident.determined]
     to_user = (ident.determined / c.model.per_user_unit[pivots][:, None]) @ basis
@@ -492,7 +490,7 @@ def _check_enough_angles(n_positions: int, per_position: int, from_rows: int, ra
         )
 
 
-def _grid_information(space, c: CandidateRows, information, n_positions: int, dwell_s: float):
+def _grid_information(space, c: CandidateRows, run_information, n_positions: int, dwell_s: float):
     """The information of the 30-degree grid within the limits measured by the same rules (its
     positions where the effects are defined), as measured and at the design's size (its
     information per position, in a run as long as the design's: a drift rate is known better
@@ -501,7 +499,7 @@ def _grid_information(space, c: CandidateRows, information, n_positions: int, dw
     n_grid, count = max(grid.shape[0], 1), space.visits.count
 
     def grid_information(dwell: float) -> np.ndarray:
-        return information(
+        return run_information(
             plan_measurements(
                 grid, needs_time=space.needs_time, needs_dirs=space.needs_dirs, dwell_s=dwell,
                 seed=space.seed, start_s=c.start_s,

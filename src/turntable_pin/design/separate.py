@@ -17,18 +17,17 @@ The power is the diagnosis' own decision (sigma known). With A true, A is named 
 accepted, ``chi2'(k_A, lambda_A0) > k_A ln m + 6 + 2 ln K`` (``lambda_A0`` what the base errors
 leave of A, ``k_A`` the ranks A adds, ``m`` the measured angles, ``K`` the catalogue's size:
 :func:`~turntable_pin.stats.model_selection.acceptance_threshold`), and then either put before B
-in the first round, ``rss_B - rss_A > (k_A - k_B) ln m`` (a generalised chi-square of the noise in
-both models' span, :func:`~turntable_pin.stats.discrimination.rss_difference`; A traded off and B
-not: also ``gain_A > 2 gain_B``), or, B first, accepted on top of B (``chi2'(k_A|B, lambda_AB)``
-above the second round's threshold) with B then dropped. A design's power is the smaller of the
-two chances (A true, B true); a third effect that might take the name is not counted. The count
-for the target power scales the design's misfits (replicating it is exact), checked by designing
-that many positions.
+in the first round, ``rss_B - rss_A > (k_A - k_B) ln m`` (a generalised chi-square,
+:func:`~turntable_pin.stats.discrimination.rss_difference`; A traded off and B not: also ``gain_A
+> 2 gain_B``), or, B first, accepted on top of B (``chi2'(k_A|B, lambda_AB)`` above the second
+round's threshold) with B then dropped. A design's power is the smaller of the two chances (A
+true, B true); a third effect that might take the name is not counted. The count for the target
+power scales the design's misfits (replicating it is exact), checked by designing that many.
 
-When B reproduces A at every candidate (misfit below :data:`SAME_RTOL` of A's signal beyond the
-base) and A has no fewer ranks than B, no positions separate them: the result says so, with the
-independent measurements of the effects' ``confirm`` texts. When B contains A with more ranks, a
-true A is still named by the rule's parsimony: that direction is left to it.
+When B reproduces A at every candidate (misfit below
+:data:`~turntable_pin.stats.discrimination.SAME_RTOL` of A's signal beyond the base) and A has no
+fewer ranks than B, no positions separate them: the result says so, with the effects' ``confirm``
+texts. When B contains A with more ranks, a true A is still named by the rule's parsimony.
 """
 
 from __future__ import annotations
@@ -45,7 +44,9 @@ from ..core.sizes import check_positions_count
 from ..core.words import argument, command
 from ..measurement.catalogue import catalogue
 from ..measurement.fit import fit_orientation
+from ..stats.design import information_rows
 from ..stats.discrimination import (
+    SAME_RTOL,
     Direction,
     choice_margin,
     detection_power,
@@ -53,19 +54,19 @@ from ..stats.discrimination import (
     misfit,
     orthonormal_span,
     quadratic_form,
+    residual,
     rss_difference,
     t_optimal_exchange,
     traded_off,
 )
 from ..stats.least_squares import tall_r_factor
 from ..stats.model_selection import UNDETERMINED_GAIN_RATIO, acceptance_threshold
-from .identify import _evaluate, _root, candidate_rows, grid_rows
+from .identify import CandidateRows, _evaluate, candidate_rows, grid_rows
 from .schedule import MeasurementPlan, plan_measurements
 from .space import DesignSpace
 
 __all__ = [
     "POWER_TARGET",
-    "SAME_RTOL",
     "Hypothesis",
     "SeparationDesign",
     "design_separate",
@@ -73,10 +74,6 @@ __all__ = [
 
 POWER_TARGET = 0.9
 """The chance of the right name the positions count is given for."""
-
-SAME_RTOL = 1e-8
-"""An effect reproduces another's prediction when it leaves less than this fraction of the other's
-signal beyond the base errors (squared), over every candidate position."""
 
 MAX_POWER_POSITIONS = 5000
 """Most positions the count for the target power is searched up to."""
@@ -313,10 +310,20 @@ def _percent(value: float | None) -> str:
     return "-" if value is None else f"{100.0 * value:.1f} %"
 
 
-def _columns(model, effect) -> np.ndarray:
-    """The parameter indices of ``effect`` in ``model``."""
+def _columns(model, effect) -> tuple[np.ndarray, list[str]]:
+    """The parameter indices of ``effect`` in ``model`` and their names within the effect."""
     prefix = f"{effect.name}."
-    return np.array([i for i, n in enumerate(model.parameter_names) if n.startswith(prefix)])
+    columns = np.array([i for i, n in enumerate(model.parameter_names) if n.startswith(prefix)])
+    return columns, [model.parameter_names[i].split(".", 1)[1] for i in columns]
+
+
+def _in_user_units(model, effect, vector) -> dict[str, float]:
+    """``effect``'s parameters ``vector`` (internal units, the model's order) by name, user
+    units."""
+    columns, names = _columns(model, effect)
+    return {
+        n: float(v / model.per_user_unit[i]) for n, i, v in zip(names, columns, vector, strict=True)
+    }
 
 
 def _amplitude_vector(model, effect, values: Mapping[str, float]) -> np.ndarray:
@@ -326,8 +333,7 @@ def _amplitude_vector(model, effect, values: Mapping[str, float]) -> np.ndarray:
     Raises:
         InputError: a name that is not one of the effect's parameters.
     """
-    columns = _columns(model, effect)
-    names = [model.parameter_names[i].split(".", 1)[1] for i in columns]
+    columns, names = _columns(model, effect)
     unknown = [k for k in values if k not in names]
     if unknown:
         raise InputError(
@@ -349,34 +355,20 @@ def _fitted_amplitude(data, effect, table) -> dict[str, float]:
         raise InputError(
             f"{argument('from_data')} {where}: {effect.name} cannot be fitted there ({exc})"
         ) from None
-    model, params = fit.model, fit.result.params
-    return {
-        model.parameter_names[i].split(".", 1)[1]: float(params[i] / model.per_user_unit[i])
-        for i in _columns(model, effect)
-    }
+    return _in_user_units(fit.model, effect, fit.result.params[_columns(fit.model, effect)[0]])
 
 
 class _Rows:
-    """Whitened rows of the base errors and the two effects (the measured data as the square
-    root of their information: only the Gram matrix matters), with the amplitudes, and what the
-    diagnosis would make of them (:meth:`numbers`).
+    """Whitened rows (m', n) of the base errors and ``problem``'s two effects (the measured data
+    as the square root of their information: only the Gram matrix matters), standing for
+    ``observations`` measured angles, and what the diagnosis would make of them
+    (:meth:`numbers`). ``leader``: the effect the diagnosis lists first (catalogue order), first
+    when the two fit exactly alike with the same determination."""
 
-    Args:
-        rows: (m', n) the rows; observations: the measured angles m they stand for.
-        base, own: the columns of the base errors and of each effect; amplitude: each effect's
-            parameters (internal units).
-        candidates: K, the catalogued effects the diagnosis tries at once.
-        leader: which effect the diagnosis lists first (catalogue order): it goes first when
-            the two fit exactly alike with the same determination.
-    """
-
-    def __init__(self, rows, observations: int, base, own, amplitude, candidates: int,
-                 leader: int = 0) -> None:  # fmt: skip
-        self.rows = rows
-        self.observations = int(observations)
-        self.base, self.own, self.amplitude = base, own, amplitude
-        self.candidates = int(candidates)
-        self.leader = int(leader)
+    def __init__(self, problem: _Problem, rows, observations: int, leader: int) -> None:
+        self.rows, self.observations, self.leader = rows, int(observations), int(leader)
+        self.base, self.own, self.amplitude = problem.base, problem.own, problem.vectors
+        self.candidates = int(problem.size)  # K, the catalogued effects tried at once
 
     def signal(self, x: int) -> np.ndarray:
         """Effect ``x``'s noise-free prediction (in noise sigmas)."""
@@ -389,9 +381,7 @@ class _Rows:
     def residual(self, x: int) -> np.ndarray:
         """What the base errors and the other effect leave of effect ``x``'s prediction, per
         row (in noise sigmas)."""
-        signal = self.signal(x)
-        basis = orthonormal_span(self.fitted(1 - x))
-        return signal - basis @ (basis.T @ signal)
+        return residual(self.fitted(1 - x), self.signal(x))
 
     def numbers(self, x: int) -> dict:
         """Effect ``x`` as the truth against the other (module docstring): its signal beyond
@@ -514,28 +504,23 @@ def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dw
         return problem.rows_of(run[3], 3 * run[2].n_rows).power()
 
     count, count_power, verified = _positions_for(
-        scaled, designed, target, n_positions, power, problem.usable.size
+        scaled, designed, target, n_positions, power, int(problem.c.keep.sum())
     )
-    return SeparationDesign(
-        space=space,
-        pair=names,
+    measured = np.zeros((0, space.n_joints))
+    if from_data is not None:
+        measured = np.degrees(np.asarray(from_data.joint_rad, dtype=float))
+    return problem.result(
+        target,
+        measured,
         positions_deg=space.candidates_deg[chosen][plan.first_order()],
         plan=plan,
         hypotheses=_hypotheses(problem, settled, numbers, new, plan, n_positions),
         misfit_by_position=_shares(design, new, plan, n_positions),
-        measured_deg=np.zeros((0, space.n_joints))
-        if from_data is None
-        else np.degrees(np.asarray(from_data.joint_rad, dtype=float)),
-        noise_arcsec=float(problem.noise),
-        noise_source=problem.noise_source,
-        amplitude_source=problem.source,
-        n_from=problem.n_from,
         power=float(power),
         positions_for_power=count,
         power_at_positions_for_power=count_power,
         positions_for_power_designed=verified,
         power_curve=tuple((c, scaled(c)) for c in _curve_counts(n_positions, count)),
-        target=float(target),
         catalogue_size=problem.size,
         n_swaps=found.swaps,
         n_passes=found.passes,
@@ -551,12 +536,11 @@ def _setup(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s) -> 
     source, vectors, user, units = _amplitudes(model, space, amplitudes, from_data)
     listed = [e.name for e in catalogue(space.table)]
     rank = [listed.index(name) if name in listed else len(listed) for name in names]
+    fixed = None if c.information is None else information_rows(c.information, ROUNDING_ROWS)
     return _Problem(
-        space, c.rows, np.flatnonzero(c.keep), model.n_params, np.arange(len(model.base_names)),
-        tuple(_columns(model, e) for e in space.effects), vectors,
-        None if c.information is None else _rows_of_information(c.information), c.from_rows,
-        len(listed), 0 if rank[0] <= rank[1] else 1, c.noise_rad, dwell_s, c.start_s,
-        c.duration_s, names, user, units, source, c.noise, c.noise_source, c.n_from,
+        space, c, dwell_s, np.arange(len(model.base_names)),
+        tuple(_columns(model, e)[0] for e in space.effects), vectors, fixed, len(listed),
+        0 if rank[0] <= rank[1] else 1, names, user, units, source,
     )  # fmt: skip
 
 
@@ -622,12 +606,8 @@ def _amplitudes(model, space, amplitudes, from_data):
                 f"({argument('from_data')} DATA.csv)"
             )
         vectors.append(_amplitude_vector(model, effect, values))
-    own = [_columns(model, e) for e in space.effects]
-    user = [
-        {model.parameter_names[i].split(".", 1)[1]: float(v / model.per_user_unit[i])
-         for i, v in zip(own[x], vectors[x], strict=True)}
-        for x in range(2)
-    ]  # fmt: skip
+    own = [_columns(model, e)[0] for e in space.effects]
+    user = [_in_user_units(model, e, v) for e, v in zip(space.effects, vectors, strict=True)]
     units = [", ".join(dict.fromkeys(model.parameter_units[i] for i in own[x])) for x in range(2)]
     return source, vectors, user, units
 
@@ -639,20 +619,15 @@ def _settled(problem: _Problem) -> list[str]:
     Raises:
         InputError: an effect whose prediction the base errors explain everywhere.
     """
-    every = problem.rows(tall_r_factor(problem.all_rows.reshape(-1, problem.n_params)), 1)
-    base, names, user, units = (
-        every.rows[:, problem.base],
-        problem.names,
-        problem.user,
-        problem.units,
-    )
-    settled = []
+    every = problem.rows(tall_r_factor(problem.c.rows.reshape(-1, problem.c.model.n_params)), 1)
+    base, settled = every.rows[:, problem.base], []
     for x in range(2):
         signal = every.signal(x)
         alone = misfit(base, signal)
         if not alone > SAME_RTOL * max(float(signal @ signal), 1e-300):
             raise InputError(
-                f"{names[x]} at its amplitude ({_values(user[x])} {units[x]}) changes nothing "
+                f"{problem.names[x]} at its amplitude ({_values(problem.user[x])} "
+                f"{problem.units[x]}) changes nothing "
                 "that the base errors do not explain at any position within the limits: there "
                 "is nothing to separate"
             )
@@ -680,59 +655,54 @@ def _shares(design: _Rows, new: np.ndarray, plan, n_positions: int) -> np.ndarra
 
 @dataclass(frozen=True)
 class _Problem:
-    """The separation on the candidates: their whitened rows (C, k, n) and the usable ones, the
-    columns of the base errors and of each effect, the amplitudes (internal and user units), the
-    data measured (rows of their information), the catalogue's size and which effect it lists
-    first, and what a run needs (noise, dwell, start time, duration)."""
+    """The separation on the candidates (``c``: their whitened rows, the data measured, the noise,
+    the run's times): the columns of the base errors and of each effect, the amplitudes (internal
+    and user units), the data measured as rows of their information, the catalogue's size and
+    which effect it lists first."""
 
     space: DesignSpace
-    all_rows: np.ndarray
-    usable: np.ndarray
-    n_params: int
+    c: CandidateRows
+    dwell_s: float
     base: np.ndarray
     own: tuple[np.ndarray, ...]
     vectors: list
     fixed: np.ndarray | None
-    from_rows: int
     size: int
     leader: int
-    noise_rad: float
-    dwell_s: float
-    start_s: float
-    duration_s: float
     names: tuple[str, str]
     user: list
     units: list
     source: dict
-    noise: float
-    noise_source: str
-    n_from: int
+
+    def result(self, target: float, measured_deg: np.ndarray, **found) -> SeparationDesign:
+        """The :class:`SeparationDesign` with what ``found`` says."""
+        c = self.c
+        return SeparationDesign(
+            space=self.space, pair=self.names, measured_deg=measured_deg,
+            noise_arcsec=float(c.noise), noise_source=c.noise_source,
+            amplitude_source=self.source, n_from=c.n_from, target=float(target), **found,
+        )  # fmt: skip
 
     def rows(self, rows: np.ndarray, observations: int, leader: int | None = None) -> _Rows:
         """:class:`_Rows` of ``rows`` standing for ``observations`` measured angles."""
-        leader = self.leader if leader is None else leader
-        return _Rows(rows, observations, self.base, self.own, self.vectors, self.size, leader)
+        return _Rows(self, rows, observations, self.leader if leader is None else leader)
 
     def rows_of(self, new: np.ndarray | None, observations: int, factor: float = 1.0) -> _Rows:
         """The rows of a run (its Gram matrix times ``factor``) and of the data measured."""
         stacked = [new * math.sqrt(factor)] if new is not None else []
         stacked += [self.fixed] if self.fixed is not None else []
-        return self.rows(np.concatenate(stacked), observations + self.from_rows)
+        return self.rows(np.concatenate(stacked), observations + self.c.from_rows)
 
     def directions(self, settled: list[str]) -> list:
         """The :class:`~turntable_pin.stats.discrimination.Direction` of each effect the
         positions must separate (``settled`` ``misfit``)."""
-        rows, fixed, out = self.all_rows, self.fixed, []
+        rows, fixed, out = self.c.rows, self.fixed, []
         for x in (x for x in range(2) if settled[x] == "misfit"):
             fitted = np.concatenate([self.base, self.own[1 - x]])
-            out.append(
-                Direction(
-                    rows[:, :, fitted],
-                    rows[:, :, self.own[x]] @ self.vectors[x],
-                    None if fixed is None else fixed[:, fitted],
-                    None if fixed is None else fixed[:, self.own[x]] @ self.vectors[x],
-                )
-            )
+            own, a = self.own[x], self.vectors[x]
+            parts = [rows[:, :, fitted], rows[:, :, own] @ a]
+            parts += [None, None] if fixed is None else [fixed[:, fitted], fixed[:, own] @ a]
+            out.append(Direction(*parts))
         return out
 
     def run_of(self, directions, count: int):
@@ -740,14 +710,14 @@ class _Problem:
         their run and its whitened rows."""
         space = self.space
         found = t_optimal_exchange(directions, count, seed=space.seed)
-        chosen = self.usable[np.sort(found.chosen)]
+        chosen = np.flatnonzero(self.c.keep)[np.sort(found.chosen)]
         plan = plan_measurements(
             space.candidates_deg[chosen], needs_time=space.needs_time,
             needs_dirs=space.needs_dirs, dwell_s=self.dwell_s, seed=space.seed,
-            start_s=self.start_s, visits=space.visits.subset(chosen),
+            start_s=self.c.start_s, visits=space.visits.subset(chosen),
         )  # fmt: skip
-        jac = _evaluate(space, plan.variables())[0].reshape(-1, self.n_params) / self.noise_rad
-        return found, chosen, plan, jac
+        jac = _evaluate(space, plan.variables())[0].reshape(-1, self.c.model.n_params)
+        return found, chosen, plan, jac / self.c.noise_rad
 
 
 def _values(amplitude: Mapping[str, float]) -> str:
@@ -757,11 +727,11 @@ def _values(amplitude: Mapping[str, float]) -> str:
 def _grid_misfits(problem: _Problem, n_positions: int):
     """What each effect's rival leaves of it on the 30-degree grid within the limits, scaled to
     the design's size (with the data measured); ``None`` when no grid position can be used."""
-    rows = grid_rows(problem.space, problem.start_s, problem.duration_s)[0]
+    rows = grid_rows(problem.space, problem.c.start_s, problem.c.duration_s)[0]
     if not rows.shape[0]:
         return None
     factor = n_positions / rows.shape[0]
-    on_grid = problem.rows_of(rows.reshape(-1, rows.shape[-1]) / problem.noise_rad, 0, factor)
+    on_grid = problem.rows_of(rows.reshape(-1, rows.shape[-1]) / problem.c.noise_rad, 0, factor)
     return [misfit(on_grid.fitted(1 - x), on_grid.signal(x)) for x in range(2)]
 
 
@@ -807,18 +777,10 @@ def _curve_counts(n_design: int, n_target: int | None) -> list[int]:
     return sorted({int(round(c)) for c in np.linspace(1, top, min(top, 40))})
 
 
-def _rows_of_information(information: np.ndarray) -> np.ndarray:
-    """Rows R with ``R^T R = information`` (the data measured, whitened), without the directions
-    the data do not see: their eigenvalues are rounding (1e-16 of the largest), and as rows of
-    1e-8 they would count as seen once a column is scaled to unit norm."""
-    rows = _root(information)
-    norms = np.linalg.norm(rows, axis=1)
-    return rows[norms > ROUNDING_ROWS * max(float(norms.max(initial=0.0)), 1e-300)]
-
-
 ROUNDING_ROWS = 1e-7
-"""Rows of the measured data's information root below this fraction of the largest are rounding
-(an eigenvalue of 1e-14 of the largest), not directions the data see."""
+"""Rows of the measured data's information root (whitened) below this fraction of the largest
+are rounding (an eigenvalue of 1e-14 of the largest), not directions the data see: kept, they
+would count as seen once a column is scaled to unit norm."""
 
 
 def _inseparable(problem: _Problem, target, because):
@@ -832,15 +794,5 @@ def _inseparable(problem: _Problem, target, because):
         f"{because}; an independent measurement does. For {a.name}: {a.confirm} "
         f"For {b.name}: {b.confirm}"
     )
-    return SeparationDesign(
-        space=space,
-        pair=problem.names,
-        positions_deg=np.zeros((0, space.n_joints)),
-        measured_deg=np.zeros((0, space.n_joints)),
-        noise_arcsec=float(problem.noise),
-        noise_source=problem.noise_source,
-        amplitude_source=problem.source,
-        n_from=problem.n_from,
-        target=float(target),
-        inseparable=text,
-    )
+    none = np.zeros((0, space.n_joints))
+    return problem.result(target, none, positions_deg=none, inseparable=text)

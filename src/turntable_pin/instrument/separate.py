@@ -22,15 +22,11 @@ from ..core.exceptions import InputError
 from ..core.sizes import check_positions_count
 from ..core.words import argument
 from ..stats.diagnosis_engine import SEPARATION_CHI2
-from ..stats.discrimination import Direction, t_optimal_exchange
+from ..stats.discrimination import SAME_RTOL, Direction, t_optimal_exchange
 from .diagnosis import RunFamily
 from .model import RunModel, run_context
 
-__all__ = ["SAME_RTOL", "RunSeparation", "design_run_separation"]
-
-SAME_RTOL = 1e-8
-"""B reproduces A at every candidate when the best design's misfit is below this fraction of
-A's signal beyond the coefficients."""
+__all__ = ["RunSeparation", "design_run_separation"]
 
 
 @dataclass(frozen=True)
@@ -95,25 +91,13 @@ class RunSeparation:
         return "\n".join(lines)
 
 
-def _refuse_columns(effect) -> None:
-    if effect.required_columns:
-        raise InputError(
-            f"effect '{effect.name}' depends on {', '.join(effect.required_columns)}, which a "
-            "choice of positions cannot set: repeat positions late in the run (a drift), or "
-            "calibrate at another temperature (a temperature coefficient), to tell it apart"
-        )
-
-
-def _whitened(context, effects, params_of, sigma):
-    """The model's columns (N, 2, q) at ``context`` over ``sigma``, and the predicted signal of
-    the effects' parameters ``params_of`` (N, 2) over ``sigma``."""
-    model = RunModel(context, effects)
-    columns = model.columns / sigma
-    signal = None
-    if params_of is not None:
-        n_base = model.n_params - len(params_of)
-        signal = np.einsum("ncp,p->nc", model.columns[:, :, n_base:], params_of) / sigma
-    return columns, signal
+def _whitened(context, rival, true_effect, params, sigma):
+    """At ``context``, over ``sigma``: the columns (N, 2, q) of the coefficients and ``rival``,
+    and the signal (N, 2) of ``true_effect`` at its ``params``."""
+    model = RunModel(context, [true_effect])
+    n_base = model.n_params - len(params)
+    signal = np.einsum("ncp,p->nc", model.columns[:, :, n_base:], params) / sigma
+    return RunModel(context, [rival]).columns / sigma, signal
 
 
 def design_run_separation(
@@ -142,12 +126,10 @@ def design_run_separation(
 
     def direction(true_effect, rival):
         p = family.fit([true_effect]).result.params[-len(true_effect.parameters(run)) :]
-        _, signal = _whitened(context, [true_effect], p, sigma)
-        fitted, _ = _whitened(context, [rival], None, sigma)
-        fixed_fitted, fixed_signal = _whitened(family.context, [rival], None, sigma)
-        _, run_signal = _whitened(family.context, [true_effect], p, sigma)
-        return Direction(fitted, signal, fixed_fitted.reshape(-1, fitted.shape[-1]),
-                         run_signal.reshape(-1))  # fmt: skip
+        fitted, signal = _whitened(context, rival, true_effect, p, sigma)
+        fixed, fixed_signal = _whitened(family.context, rival, true_effect, p, sigma)
+        q = fitted.shape[-1]
+        return Direction(fitted, signal, fixed.reshape(-1, q), fixed_signal.reshape(-1))
 
     directions = [direction(a, b), direction(b, a)]
     before = tuple(float(d.misfit(np.zeros(0, int))) for d in directions)
@@ -184,7 +166,12 @@ def _pair(family: RunFamily, names: tuple[str, str]):
             f"{argument('separate')} needs two different effects, got '{a.name}' twice"
         )
     for effect in (a, b):
-        _refuse_columns(effect)
+        if effect.required_columns:
+            raise InputError(
+                f"effect '{effect.name}' depends on {', '.join(effect.required_columns)}, which "
+                "a choice of positions cannot set: repeat positions late in the run (a drift), or "
+                "calibrate at another temperature (a temperature coefficient), to tell it apart"
+            )
     base_rank = family.fit([]).result.rank
     fits = [family.fit([a]), family.fit([b])]
     for effect, fit in zip((a, b), fits, strict=True):

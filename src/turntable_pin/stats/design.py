@@ -19,7 +19,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ExchangeResult", "d_optimal_design", "fedorov_exchange", "greedy_design", "log_det"]
+__all__ = [
+    "ExchangeResult",
+    "d_optimal_design",
+    "fedorov_exchange",
+    "greedy_design",
+    "information",
+    "information_rows",
+    "log_det",
+]
 
 RIDGE_RTOL = 1e-9
 """Ridge of the greedy start (of n candidates' mean information): ``M`` is singular until p rows
@@ -49,6 +57,17 @@ def log_det(information: np.ndarray) -> float:
     return float(np.sum(np.log(values)))
 
 
+def information_rows(information: np.ndarray, rtol: float | None = None) -> np.ndarray:
+    """Rows R with ``R^T R = information`` (symmetric, positive semi-definite); with ``rtol``,
+    without the rows shorter than ``rtol`` times the longest."""
+    values, vectors = np.linalg.eigh(information)
+    rows = np.sqrt(np.clip(values, 0.0, None))[:, None] * vectors.T
+    if rtol is None:
+        return rows
+    norms = np.linalg.norm(rows, axis=1)
+    return rows[norms > rtol * max(float(norms.max(initial=0.0)), 1e-300)]
+
+
 @dataclass(frozen=True)
 class ExchangeResult:
     """A D-optimal design (:func:`d_optimal_design`): the ``chosen`` indices (n,), ``log_det``
@@ -73,8 +92,8 @@ def _as_rows(rows: np.ndarray) -> np.ndarray:
     return rows
 
 
-def _information(rows: np.ndarray, chosen: np.ndarray, start: np.ndarray | None) -> np.ndarray:
-    """``start + sum_c X_c^T X_c`` over the chosen candidates."""
+def information(rows: np.ndarray, chosen, start: np.ndarray | None = None) -> np.ndarray:
+    """``start + sum_c X_c^T X_c`` over the ``chosen`` candidates of ``rows`` (C, k, p)."""
     x = rows[chosen].reshape(-1, rows.shape[2])
     m = x.T @ x
     return m if start is None else m + start
@@ -98,6 +117,18 @@ def _products(left: np.ndarray, middle: np.ndarray, right: np.ndarray) -> np.nda
     c, a, m = left.shape
     lw = (left.reshape(-1, m) @ middle).reshape(c, a, m)
     return lw @ np.swapaxes(right, 1, 2)
+
+
+def _updated(rows, inverse, quad, u, signs) -> tuple[np.ndarray, np.ndarray]:
+    """``M^-1`` and every candidate's ``X_c M^-1 X_c^T`` after ``M + U^T S U`` (Woodbury;
+    ``u`` = ``U^T`` (r, p), ``S = diag(signs)``): ``M^-1 - (M^-1 U) K (M^-1 U)^T``, ``K = (S^-1
+    + U^T M^-1 U)^-1``."""
+    c, k, p = rows.shape
+    mu = u @ inverse  # (r, p)
+    kernel = np.linalg.inv(np.diag(signs) + mu @ u.T)
+    h = (rows.reshape(-1, p) @ mu.T).reshape(c, k, len(signs))  # X_c M^-1 U
+    inverse = inverse - mu.T @ kernel @ mu
+    return 0.5 * (inverse + inverse.T), quad - _products(h, kernel, h)
 
 
 def _exchange_ratios(quad: np.ndarray, g: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -146,13 +177,7 @@ def greedy_design(
         j = int(np.argmax(gain))
         chosen.append(j)
         taken[j] = True
-        x = rows[j]  # (k, p)
-        w = x @ inverse  # (k, p)
-        inner = np.linalg.inv(eye + w @ x.T)  # (k, k)
-        inverse = inverse - w.T @ inner @ w
-        inverse = 0.5 * (inverse + inverse.T)
-        g = (rows.reshape(-1, p) @ w.T).reshape(c, k, k)  # X_c M^-1 x^T
-        quad = quad - _products(g, inner, g)
+        inverse, quad = _updated(rows, inverse, quad, rows[j], np.ones(k))
     return np.array(chosen, dtype=int)
 
 
@@ -172,13 +197,13 @@ def fedorov_exchange(
     chosen = np.array(chosen, dtype=int)
     taken = np.zeros(c, dtype=bool)
     taken[chosen] = True
-    m = _information(rows, chosen, start)
+    m = information(rows, chosen, start)
     current = log_det(m)
     if not np.isfinite(current):
         raise ValueError("the starting design's information matrix is singular")
     history = [current]
     greedy = current
-    sign_s = np.concatenate([np.ones(k), -np.ones(k)])
+    signs = np.concatenate([np.ones(k), -np.ones(k)])  # x_j in, x_i out
     exchanges = sweeps = 0
     for sweeps in range(1, max_sweeps + 1):  # noqa: B007 (the count is reported)
         inverse = np.linalg.inv(m)
@@ -196,14 +221,7 @@ def fedorov_exchange(
             j = int(np.argmax(ratio))
             if not ratio[j] > 0 or np.log(ratio[j]) <= tol:
                 continue
-            # Take it: M^-1 and every candidate's X_c M^-1 X_c^T follow (Woodbury).
-            u = np.concatenate([rows[j], xi])  # (2k, p) = U^T
-            mu = u @ inverse  # (2k, p)
-            kernel = np.linalg.inv(np.diag(sign_s) + mu @ u.T)  # (S^-1 + U^T M^-1 U)^-1
-            h = (rows.reshape(-1, p) @ mu.T).reshape(c, k, 2 * k)  # X_c M^-1 U
-            quad = quad - _products(h, kernel, h)
-            inverse = inverse - mu.T @ kernel @ mu
-            inverse = 0.5 * (inverse + inverse.T)
+            inverse, quad = _updated(rows, inverse, quad, np.concatenate([rows[j], xi]), signs)
             m = m + rows[j].T @ rows[j] - xi.T @ xi
             current += float(np.log(ratio[j]))
             history.append(current)
@@ -211,7 +229,7 @@ def fedorov_exchange(
             chosen[slot] = j
             exchanges += 1
             improved = True
-        m = _information(rows, chosen, start)  # afresh: no rounding carried into the next sweep
+        m = information(rows, chosen, start)  # afresh: no rounding carried into the next sweep
         current = log_det(m)
         if not improved:
             break
@@ -230,7 +248,7 @@ def _completed(rows, n, start, seed) -> np.ndarray:
     seed = np.unique(np.asarray(seed, dtype=int))
     if seed.size >= n:
         return seed[greedy_design(rows[seed], n, start)]
-    known = _information(rows, seed, start)
+    known = information(rows, seed, start)
     return np.concatenate([seed, greedy_design(rows, n - seed.size, known, exclude=seed)])
 
 
@@ -249,19 +267,15 @@ def d_optimal_design(
     ``n`` long), keeping the best (an exchange can stop in a local optimum). When no start is
     nonsingular, the greedy design with ``log_det`` ``-inf``."""
     rows = _as_rows(rows)
+    greedy = greedy_design(rows, n, start)
     best = None
-    for first in (
-        greedy_design(rows, n, start),
-        *(_completed(rows, n, start, s) for s in also_from),
-    ):
-        first_log_det = log_det(_information(rows, first, start))
-        if not np.isfinite(first_log_det):
+    for first in (greedy, *(_completed(rows, n, start, s) for s in also_from)):
+        if not np.isfinite(log_det(information(rows, first, start))):
             continue
         found = fedorov_exchange(rows, first, start, tol=tol, max_sweeps=max_sweeps)
         if best is None or found.log_det > best.log_det:
             best = found
     if best is None:
-        first = greedy_design(rows, n, start)
-        value = log_det(_information(rows, first, start))
-        return ExchangeResult(first, value, value, (value,), 0, 0)
+        value = log_det(information(rows, greedy, start))
+        return ExchangeResult(greedy, value, value, (value,), 0, 0)
     return best

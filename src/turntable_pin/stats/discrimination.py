@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .design import information
 from .least_squares import RANK_RTOL
 from .model_selection import (
     MAX_CORRELATION,
@@ -35,6 +36,7 @@ from .model_selection import (
 
 __all__ = [
     "RIDGE",
+    "SAME_RTOL",
     "TAIL_SIGMAS",
     "Direction",
     "Exchange",
@@ -45,6 +47,7 @@ __all__ = [
     "noncentral_chi2_sf",
     "orthonormal_span",
     "quadratic_form",
+    "residual",
     "rss_difference",
     "t_optimal_exchange",
     "traded_off",
@@ -53,6 +56,10 @@ __all__ = [
 RIDGE = 1e-9
 """Ridge of the exchange's Gram matrices (of one candidate's mean diagonal): invertible before
 the design determines every column (the reported misfits are exact, :func:`misfit`)."""
+
+SAME_RTOL = 1e-8
+"""A rival reproduces a signal when its misfit is below this fraction of the signal's (squared)
+norm."""
 
 
 def orthonormal_span(columns: np.ndarray, rtol: float = RANK_RTOL) -> np.ndarray:
@@ -69,12 +76,17 @@ def orthonormal_span(columns: np.ndarray, rtol: float = RANK_RTOL) -> np.ndarray
     return u[:, s > rtol * s[0]]
 
 
-def misfit(fitted: np.ndarray, signal: np.ndarray) -> float:
-    """``|| (I - P) signal ||^2``: what fitting the columns ``fitted`` (m, q) leaves of the
-    noise-free ``signal`` (m,), both whitened (a chi2)."""
+def residual(fitted: np.ndarray, signal: np.ndarray) -> np.ndarray:
+    """``(I - P) signal``: what fitting the columns ``fitted`` (m, q) leaves of ``signal``."""
     signal = np.asarray(signal, dtype=float).reshape(-1)
     basis = orthonormal_span(fitted)
-    rest = signal - basis @ (basis.T @ signal)
+    return signal - basis @ (basis.T @ signal)
+
+
+def misfit(fitted: np.ndarray, signal: np.ndarray) -> float:
+    """``|| (I - P) signal ||^2`` (:func:`residual`) of the noise-free ``signal`` (m,), both
+    whitened (a chi2)."""
+    rest = residual(fitted, signal)
     return float(rest @ rest)
 
 
@@ -253,13 +265,12 @@ class Direction:
 class Exchange:
     """A T-optimal design (:func:`t_optimal_exchange`): the ``chosen`` indices (n,), the exact
     misfit of each direction on it (``noncentralities``, fixed observations included), the
-    ``swaps`` accepted, the ``passes`` made and the random start's ``seed``."""
+    ``swaps`` accepted and the ``passes`` made."""
 
     chosen: np.ndarray
     noncentralities: tuple[float, ...]
     swaps: int
     passes: int
-    seed: int
 
     @property
     def criterion(self) -> float:
@@ -286,8 +297,7 @@ class _Gram:
         self.reset(chosen)
 
     def reset(self, chosen: np.ndarray) -> None:
-        rows = self.z[chosen].reshape(-1, self.z.shape[-1])
-        self.inverse = np.linalg.inv(self.base + rows.T @ rows)
+        self.inverse = np.linalg.inv(information(self.z, chosen, self.base))
 
     def value(self) -> float:
         """The (ridged) misfit of the current design, in the signal's units."""
@@ -358,4 +368,4 @@ def t_optimal_exchange(
         if not changed:
             break
     exact = tuple(d.misfit(chosen) for d in directions)
-    return Exchange(chosen.copy(), exact, swaps, passes, int(seed))
+    return Exchange(chosen.copy(), exact, swaps, passes)
