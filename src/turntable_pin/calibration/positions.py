@@ -12,6 +12,9 @@ comes from a scheme name or a CSV file:
 - a CSV file with one angle column per joint: ``phi1_deg .. phiN_deg`` (chain order) or
   ``<joint>_deg`` (the joint names); other columns are ignored.
 
+A set may also say when each position is measured (``time_s``) and from which side each joint
+comes to it (``dirs``, +1/-1 per joint): the rows of a measurement run.
+
 The specific force and the earth rate along the payload axes are ``Rd^T`` times their base-frame
 values: in the base frame F0 (x north, y west, z up) the specific force of a resting body is
 ``+e_z`` (1 g up) and the earth rate is ``we (cos lat, 0, sin lat)``; ``Rd`` is the nominal
@@ -29,9 +32,9 @@ from pathlib import Path
 import numpy as np
 
 from ..core.csv_table import CsvTable, closest_column_hint, read_csv_table
-from ..core.exceptions import InputError
-from ..core.sizes import MAX_POSITIONS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
-from ..core.turn_grid import full_turn_grid_deg
+from ..core.exceptions import InputError, check_seed
+from ..core.sizes import MAX_POSITIONS, MAX_TIME_S, MIN_GRID_STEP_DEG, check_count, turn_grid_count
+from ..core.turn_grid import full_turn_grid_deg, random_turn_positions_deg
 from ..core.units import deg_to_rad, rad_to_deg
 from ..core.words import argument
 from ..model.paper_table import resolve_table
@@ -47,6 +50,7 @@ __all__ = [
     "angle_columns",
     "base_frame_inputs",
     "check_commanded_angles",
+    "check_times_and_directions",
     "grid_angles_deg",
     "grid_steps",
     "position_inputs",
@@ -111,23 +115,28 @@ def grid_angles_deg(steps_deg: Sequence[float]) -> tuple[np.ndarray, str]:
 
 @dataclass(frozen=True, init=False)
 class PositionSet:
-    """Commanded positions of a table with 1 to 3 joints.
+    """Commanded positions of a table with 1 to 3 joints, in the order they are measured.
 
-    ``PositionSet(*angles_rad, table=None, name="")`` takes one (N,) array per joint in chain
-    order (``PositionSet(phi1_rad, phi2_rad)`` on the paper's table) or one (N, J) array.
+    ``PositionSet(*angles_rad, table=None, name="", time_s=None, dirs=())`` takes one (N,) array
+    per joint in chain order (``PositionSet(phi1_rad, phi2_rad)`` on the paper's table) or one
+    (N, J) array.
 
     Attributes:
         angles_rad: (N, J) joint angles in chain order, radians (read-only).
         table: the :class:`~turntable_pin.model.generic_table.GenericTable` they command
             (default: the paper's, :func:`~turntable_pin.model.paper_table.paper_table`).
         name: the scheme name or file the positions came from.
+        time_s: when each position is measured (N,), s in [0, ``MAX_TIME_S``], or ``None``.
+        dirs: per joint, the side it approaches each position from (N,) (+1/-1), or ``None``.
     """
 
     angles_rad: np.ndarray
     table: object = field(repr=False, compare=False)
     name: str = ""
+    time_s: np.ndarray | None = field(default=None, repr=False)
+    dirs: tuple[np.ndarray | None, ...] = field(default=(), repr=False)
 
-    def __init__(self, *angles_rad, table=None, name: str = "") -> None:
+    def __init__(self, *angles_rad, table=None, name: str = "", time_s=None, dirs=()) -> None:
         table = resolve_table(table)
         n_joints = len(table.joint_names)
         if len(angles_rad) == 1 and np.ndim(angles_rad[0]) == 2:
@@ -158,6 +167,36 @@ class PositionSet:
         object.__setattr__(self, "angles_rad", angles)
         object.__setattr__(self, "table", table)
         object.__setattr__(self, "name", name)
+        self._set_times_and_directions(time_s, dirs)
+
+    def _set_times_and_directions(self, time_s, dirs) -> None:
+        """Check and keep ``time_s`` and ``dirs`` (one per joint, padded with ``None``)."""
+        n, n_joints = self.angles_rad.shape
+        if time_s is not None:
+            time_s = np.array(time_s, dtype=float).reshape(-1)
+            if time_s.shape != (n,) or not np.all((time_s >= 0) & (time_s <= MAX_TIME_S)):
+                raise InputError(
+                    f"positions: {argument('time_s')} needs {n} times in [0, {MAX_TIME_S:g}] s, "
+                    "one per position"
+                )
+            time_s.setflags(write=False)
+        if len(dirs) > n_joints:
+            raise InputError(
+                f"positions: {argument('dirs')} of {len(dirs)} joints, the table has {n_joints}"
+            )
+        checked = []
+        for k, d in enumerate((*dirs, *(None,) * (n_joints - len(dirs))), start=1):
+            if d is not None:
+                d = np.array(d, dtype=float).reshape(-1)
+                if d.shape != (n,) or not np.all(np.abs(d) == 1):
+                    raise InputError(
+                        f"positions: {argument('dirs')} of joint {k} needs {n} values, each +1 "
+                        "or -1"
+                    )
+                d.setflags(write=False)
+            checked.append(d)
+        object.__setattr__(self, "time_s", time_s)
+        object.__setattr__(self, "dirs", tuple(checked))
 
     def __len__(self) -> int:
         return int(self.angles_rad.shape[0])
@@ -213,6 +252,19 @@ class PositionSet:
             )
         angles, name = grid_angles_deg(list(steps_deg) * (n_joints // len(steps_deg)))
         return cls(deg_to_rad(angles), table=table, name=name)
+
+    @classmethod
+    def random(cls, n: int, table=None, seed: int = 0) -> PositionSet:
+        """``n`` positions uniform over every joint's turn [0, 360) deg (rounded to 1e-6 deg), from
+        their own stream of ``seed``; InputError for ``n`` below 1 or above ``MAX_POSITIONS``."""
+        table = resolve_table(table)
+        seed = check_seed(seed)
+        if n < 1:
+            raise InputError(f"random positions: expected N >= 1, got {n}")
+        check_count(n, MAX_POSITIONS, "random positions of a calibration run", POSITION_BYTES)
+        rng = np.random.default_rng([seed, 1])
+        angles = random_turn_positions_deg(rng, n, len(table.joint_names))
+        return cls(deg_to_rad(angles), table=table, name=f"random:{n}")
 
     @classmethod
     def from_csv(cls, path: str | Path, table=None) -> PositionSet:
@@ -301,6 +353,21 @@ class PositionInputs:
 
     def __len__(self) -> int:
         return len(self.positions)
+
+
+def check_times_and_directions(rows, dir_columns: Sequence[str]) -> None:
+    """Refuse a ``time_s`` below 0 or above :data:`MAX_TIME_S` and a ``dirK`` not +1 or -1 of
+    ``rows`` (a ``CsvTable``), naming file, row and column."""
+    if rows.has("time_s"):
+        time_s = rows["time_s"]
+        rows.refuse("time_s", time_s < 0, "time since the start of the run must be >= 0")
+        rows.refuse(
+            "time_s", time_s > MAX_TIME_S,
+            f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
+        )  # fmt: skip
+    for column in dir_columns:
+        if rows.has(column):
+            rows.refuse(column, np.abs(rows[column]) != 1, "an approach direction must be +1 or -1")
 
 
 def check_commanded_angles(table, columns: Sequence[str]) -> None:

@@ -16,7 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..calibration.positions import angle_columns, check_commanded_angles
+from ..calibration.positions import (
+    angle_columns,
+    check_commanded_angles,
+    check_times_and_directions,
+)
 from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows, write_csv_table
 from ..core.exceptions import InputError, check_seed
 from ..core.sizes import MAX_SIMULATED_ROWS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
@@ -34,7 +38,6 @@ from .data import (
     MAX_TIME_S,
     MIN_SIGMA_ARCSEC,
     OrientationMeasurements,
-    check_times_and_directions,
 )
 from .effect_model import OrientationModel
 from .effects.base import Effect, PositionVariables
