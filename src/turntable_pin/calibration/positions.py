@@ -325,6 +325,21 @@ class PositionSet:
         wrapped = np.round(np.mod(rad_to_deg(self.angles_rad), 360.0), decimals) % 360.0
         return int(np.unique(wrapped, axis=0).shape[0])
 
+    def angles_deg(self) -> np.ndarray:
+        """(N, J) the angles in degrees, rounded to 1e-9 deg (a 30-degree grid reads 30.0)."""
+        return np.round(rad_to_deg(self.angles_rad), 9)
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The columns of a positions CSV: ``phiK_deg`` (:meth:`angles_deg`) of each joint, then
+        ``time_s`` and ``dirK`` (integers) where the set has them."""
+        out = {f"phi{k}_deg": a for k, a in enumerate(self.angles_deg().T, start=1)}
+        if self.time_s is not None:
+            out["time_s"] = self.time_s
+        for k, d in enumerate(self.dirs, start=1):
+            if d is not None:
+                out[f"dir{k}"] = d.astype(int)
+        return out
+
     def to_dict(self) -> dict:
         """Name, count, joint names and the angles in degrees per joint, as a dict."""
         out = {"name": self.name, "n_positions": len(self), "joints": list(self.joint_names)}

@@ -44,6 +44,7 @@ from ..core.exceptions import IdentifiabilityError, InputError
 from ..core.sizes import check_positions_count
 from ..core.words import argument, command
 from ..measurement.catalogue import catalogue
+from ..measurement.effects.base import PositionVariables
 from ..measurement.fit import fit_orientation
 from ..stats.discrimination import (
     Direction,
@@ -744,9 +745,12 @@ class _Problem:
         plan = plan_measurements(
             space.candidates_deg[chosen], needs_time=space.needs_time,
             needs_dirs=space.needs_dirs, dwell_s=self.dwell_s, seed=space.seed,
-            start_s=self.start_s, visits=space.visits.subset(chosen),
+            start_s=self.start_s, visits=space.visits.subset(chosen), table=space.table,
         )  # fmt: skip
-        jac = _evaluate(space, plan.variables())[0].reshape(-1, self.n_params) / self.noise_rad
+        jac = (
+            _evaluate(space, PositionVariables.of(plan.rows))[0].reshape(-1, self.n_params)
+            / self.noise_rad
+        )
         return found, chosen, plan, jac
 
 
