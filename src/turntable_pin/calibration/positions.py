@@ -51,6 +51,7 @@ __all__ = [
     "base_frame_inputs",
     "check_commanded_angles",
     "check_times_and_directions",
+    "checked_times_and_directions",
     "grid_angles_deg",
     "grid_steps",
     "position_inputs",
@@ -167,36 +168,14 @@ class PositionSet:
         object.__setattr__(self, "angles_rad", angles)
         object.__setattr__(self, "table", table)
         object.__setattr__(self, "name", name)
-        self._set_times_and_directions(time_s, dirs)
-
-    def _set_times_and_directions(self, time_s, dirs) -> None:
-        """Check and keep ``time_s`` and ``dirs`` (one per joint, padded with ``None``)."""
-        n, n_joints = self.angles_rad.shape
-        if time_s is not None:
-            time_s = np.array(time_s, dtype=float).reshape(-1)
-            if time_s.shape != (n,) or not np.all((time_s >= 0) & (time_s <= MAX_TIME_S)):
-                raise InputError(
-                    f"positions: {argument('time_s')} needs {n} times in [0, {MAX_TIME_S:g}] s, "
-                    "one per position"
-                )
-            time_s.setflags(write=False)
         if len(dirs) > n_joints:
             raise InputError(
                 f"positions: {argument('dirs')} of {len(dirs)} joints, the table has {n_joints}"
             )
-        checked = []
-        for k, d in enumerate((*dirs, *(None,) * (n_joints - len(dirs))), start=1):
-            if d is not None:
-                d = np.array(d, dtype=float).reshape(-1)
-                if d.shape != (n,) or not np.all(np.abs(d) == 1):
-                    raise InputError(
-                        f"positions: {argument('dirs')} of joint {k} needs {n} values, each +1 "
-                        "or -1"
-                    )
-                d.setflags(write=False)
-            checked.append(d)
+        dirs = (*dirs, *(None,) * (n_joints - len(dirs)))
+        time_s, dirs = checked_times_and_directions(len(angles), time_s, dirs)
         object.__setattr__(self, "time_s", time_s)
-        object.__setattr__(self, "dirs", tuple(checked))
+        object.__setattr__(self, "dirs", dirs)
 
     def __len__(self) -> int:
         return int(self.angles_rad.shape[0])
@@ -368,6 +347,32 @@ class PositionInputs:
 
     def __len__(self) -> int:
         return len(self.positions)
+
+
+def checked_times_and_directions(
+    n: int, time_s=None, dirs=(), names: tuple[str, str] = ("time_s", "dirs")
+) -> tuple[np.ndarray | None, tuple[np.ndarray | None, ...]]:
+    """``time_s`` ((n,) s in [0, :data:`MAX_TIME_S`], or ``None``) and ``dirs`` (per joint (n,)
+    +1/-1, or ``None``) as read-only arrays; :class:`InputError` naming the arguments ``names``."""
+    if time_s is not None:
+        time_s = np.array(time_s, dtype=float).reshape(-1)
+        if time_s.shape != (n,) or not np.all((time_s >= 0) & (time_s <= MAX_TIME_S)):
+            raise InputError(
+                f"positions: {argument(names[0])} needs {n} times in [0, {MAX_TIME_S:g}] s, one "
+                "per position"
+            )
+        time_s.setflags(write=False)
+    checked = []
+    for k, d in enumerate(dirs, start=1):
+        if d is not None:
+            d = np.array(d, dtype=float).reshape(-1)
+            if d.shape != (n,) or not np.all(np.abs(d) == 1):
+                raise InputError(
+                    f"positions: {argument(names[1])} of joint {k} needs {n} values, each +1 or -1"
+                )
+            d.setflags(write=False)
+        checked.append(d)
+    return time_s, tuple(checked)
 
 
 def check_times_and_directions(rows, dir_columns: Sequence[str]) -> None:

@@ -40,6 +40,7 @@ from ..core.words import argument, command
 from ..measurement.catalogue import resolve_effect
 from ..measurement.effect_model import OrientationModel
 from ..measurement.effects.base import PositionVariables
+from ..measurement.simulation import effect_values
 from ..measurement.table import measured_table
 from ..model.angles import ANGLE_ENTRIES
 from ..model.errors import MAX_ANGULAR_ERROR_DEG
@@ -351,21 +352,14 @@ def _resolved_effects(table_effects, measured, variables, catalogue):
 
 def _effect_values(objects, effects, variables) -> dict[str, float]:
     """``{effect.parameter: internal value}`` of the effects' given parameters, each checked."""
-    values = {}
-    for effect in objects:
-        specs = {s.name: s for s in effect.parameters(variables)}
-        for pname, value in effects[effect.name].items():
-            if pname not in specs:
-                raise InputError(
-                    f"table effect '{effect.name}' has no parameter '{pname}'; its parameters: "
-                    f"{', '.join(specs)}"
-                )
+    values = effect_values(objects, effects, variables, "table effect")
+    for name, params in effects.items():
+        for pname, value in params.items():
             if not abs(value) <= _MOUNT_LIMIT_ARCSEC:
                 raise InputError(
-                    f"table effect '{effect.name}', parameter '{pname}' = {value!r}: must be "
+                    f"table effect '{name}', parameter '{pname}' = {value!r}: must be "
                     f"within +-{_MOUNT_LIMIT_ARCSEC:g} (in its user unit)"
                 )
-            values[f"{effect.name}.{pname}"] = value * specs[pname].per_user_unit
     return values
 
 
@@ -384,7 +378,7 @@ def _table_rotation_errors(
     if not table_effects:
         return table.rotation_error(vector, list(angles.T)), errors, {}
     measured = measured_table(table)
-    variables = PositionVariables(np.array(angles), time_s=np.array(time_s))
+    variables = PositionVariables.of(PositionSet(angles, table=table, time_s=time_s))
     objects, effects = _resolved_effects(table_effects, measured, variables, catalogue)
     model = OrientationModel(variables, objects, measured)
     values = {

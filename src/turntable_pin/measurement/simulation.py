@@ -20,6 +20,7 @@ from ..calibration.positions import (
     angle_columns,
     check_commanded_angles,
     check_times_and_directions,
+    checked_times_and_directions,
 )
 from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows, write_csv_table
 from ..core.exceptions import InputError, check_seed
@@ -51,6 +52,7 @@ __all__ = [
     "ORDERS",
     "Schedule",
     "SimulatedMeasurements",
+    "effect_values",
     "read_positions",
     "simulate_measurements",
 ]
@@ -215,28 +217,20 @@ class Schedule:
             raise InputError(
                 f"a listed position must be within +-{MAX_COMMANDED_ANGLE_DEG:g} deg (and finite)"
             )
-        n = rows.shape[0]
-        if self.positions_time_s is not None:
-            time = np.asarray(self.positions_time_s, dtype=float)
-            if time.shape != (n,) or not np.all((time >= 0) & (time <= MAX_TIME_S)):
-                raise InputError(
-                    f"positions_time_s needs {n} times in [0, {MAX_TIME_S:g}] s, one per position"
-                )
-            if self.repeats > 1 or self.passes:
-                raise InputError(
-                    "the positions give their times; repeats and passes would need other times "
-                    "(leave out time_s, or list every measurement)"
-                )
-        for k, dirs in enumerate(self.positions_dirs, start=1):
-            if dirs is None:
-                continue
-            d = np.asarray(dirs, dtype=float)
-            if d.shape != (n,) or not np.all(np.abs(d) == 1):
-                raise InputError(f"positions_dirs of joint {k} needs {n} values, each +1 or -1")
-            if self.passes:
-                raise InputError(
-                    f"passes set the approach directions themselves; the positions give dir{k}"
-                )
+        checked_times_and_directions(
+            rows.shape[0], self.positions_time_s, self.positions_dirs,
+            ("positions_time_s", "positions_dirs"),
+        )  # fmt: skip
+        if self.positions_time_s is not None and (self.repeats > 1 or self.passes):
+            raise InputError(
+                "the positions give their times; repeats and passes would need other times "
+                "(leave out time_s, or list every measurement)"
+            )
+        given = [k for k, d in enumerate(self.positions_dirs, start=1) if d is not None]
+        if given and self.passes:
+            raise InputError(
+                f"passes set the approach directions themselves; the positions give dir{given[0]}"
+            )
 
     def _check_sweep(self) -> None:
         joints = [str(j) for j in self.sweep]
@@ -551,7 +545,7 @@ def simulate_measurements(
     effect_objects = [resolve_effect(name, table, catalogue) for name in effects]
     effects = {e.name: effects[name] for e, name in zip(effect_objects, effects, strict=True)}
     model = OrientationModel(variables, effect_objects, table)
-    values.update(_effect_values(effect_objects, effects, variables))
+    values.update(effect_values(effect_objects, effects, variables))
     truth = model.predict(model.parameter_vector(values))
     measured, sigma_rad = _noisy(truth, noise, noise_spread, rng)
     measured[:, blank] = np.nan
@@ -661,15 +655,17 @@ def _checked_effects(effects) -> dict[str, dict]:
     return effects
 
 
-def _effect_values(effect_objects, effects, variables) -> dict[str, float]:
-    """``{"<effect>.<parameter>": value}`` in internal units of the given parameters."""
+def effect_values(effect_objects, effects, variables, what: str = "effect") -> dict[str, float]:
+    """``{"<effect>.<parameter>": value}`` in internal units of the given parameters (``effects``:
+    ``{effect: {parameter: value in its user unit}}``); InputError naming the ``what`` and its
+    parameters for a parameter it does not have."""
     values = {}
     for effect in effect_objects:
         specs = {s.name: s for s in effect.parameters(variables)}
         for pname, value in effects[effect.name].items():
             if pname not in specs:
                 raise InputError(
-                    f"effect '{effect.name}' has no parameter '{pname}'; "
+                    f"{what} '{effect.name}' has no parameter '{pname}'; "
                     f"its parameters: {', '.join(specs)}"
                 )
             values[f"{effect.name}.{pname}"] = float(value) * specs[pname].per_user_unit
