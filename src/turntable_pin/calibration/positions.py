@@ -155,7 +155,6 @@ class PositionSet:
             )
         if angles.shape[0] == 0:
             raise InputError("positions: the set is empty")
-        check_count(angles.shape[0], MAX_POSITIONS, "positions", POSITION_BYTES)
         if not np.all(np.isfinite(angles)):
             raise InputError("positions: angles must be finite numbers")
         largest = float(np.max(np.abs(angles)))
@@ -295,7 +294,9 @@ class PositionSet:
     # ---- what the payload sees ----------------------------------------------------------------
     def nominal_rotations(self) -> np.ndarray:
         """(N, 3, 3) nominal payload orientations ``Rd`` (base <- payload): Pinocchio forward
-        kinematics of the table's URDF."""
+        kinematics of the table's URDF, for at most ``MAX_POSITIONS`` positions (the cost of a
+        position in the calibration layer's computations, checked before any is computed)."""
+        check_count(len(self), MAX_POSITIONS, "positions", POSITION_BYTES)
         pose = self.table.payload_pose
         return np.array([pose(None, angles).rotation for angles in self.angles_rad])
 
