@@ -24,6 +24,7 @@ paper's table this is the closed form of paper eq. 3.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -52,8 +53,6 @@ __all__ = [
     "check_commanded_angles",
     "check_times_and_directions",
     "checked_times_and_directions",
-    "grid_angles_deg",
-    "grid_steps",
     "position_inputs",
 ]
 
@@ -71,7 +70,7 @@ POSITION_BYTES = 4096
 _GRID = re.compile(r"^grid:\s*([0-9.eE+-]+(?:\s*x\s*[0-9.eE+-]+)*)$")
 
 
-def grid_steps(text: str) -> list[float] | None:
+def _grid_steps(text: str) -> list[float] | None:
     """The steps (degrees: one for every joint, or one per joint) of a ``grid:STEP`` or
     ``grid:S1xS2[xS3]`` spec, or ``None`` when ``text`` is no grid spec (a file name).
 
@@ -90,28 +89,6 @@ def grid_steps(text: str) -> list[float] | None:
         return [float(s) for s in re.split(r"\s*x\s*", match.group(1).strip())]
     except ValueError:
         raise InputError(f"positions '{text}': bad grid step") from None
-
-
-def grid_angles_deg(steps_deg: Sequence[float]) -> tuple[np.ndarray, str]:
-    """Every joint in {0, step, ..., < 360} degrees, every combination: (N, J) angles in degrees
-    (the last joint varies fastest) and the grid's name (``grid:30``, ``grid:30x45``).
-
-    Raises:
-        InputError: a step outside [``MIN_GRID_STEP_DEG``, 360], or more positions than
-            ``MAX_POSITIONS``.
-    """
-    for step in steps_deg:
-        if not (np.isfinite(step) and MIN_GRID_STEP_DEG <= step <= 360):
-            raise InputError(
-                f"grid step must be in [{MIN_GRID_STEP_DEG:g}, 360] degrees, got {step!r}"
-            )
-    same = all(s == steps_deg[0] for s in steps_deg)
-    name = f"grid:{steps_deg[0]:g}" if same else "grid:" + "x".join(f"{s:g}" for s in steps_deg)
-    count = 1.0
-    for step in steps_deg:
-        count *= float(turn_grid_count(step))
-    check_count(count, MAX_POSITIONS, f"positions of {name}", POSITION_BYTES)
-    return full_turn_grid_deg(*steps_deg), name
 
 
 @dataclass(frozen=True, init=False)
@@ -204,22 +181,12 @@ class PositionSet:
             )
         return self.angles_rad[:, k - 1]
 
-    @property
-    def phi1_rad(self) -> np.ndarray:
-        """The angles of the first joint (the paper's phi1, outer axis), radians."""
-        return self.joint_rad(1)
-
-    @property
-    def phi2_rad(self) -> np.ndarray:
-        """The angles of the second joint (the paper's phi2, inner axis), radians; refused
-        (:class:`InputError`) on a one-joint table."""
-        return self.joint_rad(2)
-
     # ---- construction -------------------------------------------------------------------------
     @classmethod
     def grid(cls, *steps_deg: float, table=None) -> PositionSet:
-        """Every joint in {0, step, ..., < 360} degrees, every combination (one step for all
-        joints, or one per joint in chain order)."""
+        """Every joint in {0, step, ..., < 360} degrees, every combination, the last joint
+        fastest (one step for all joints, or one per joint in chain order); :class:`InputError`
+        for a step outside [``MIN_GRID_STEP_DEG``, 360] or more than ``MAX_POSITIONS``."""
         table = resolve_table(table)
         n_joints = len(table.joint_names)
         if len(steps_deg) not in (1, n_joints):
@@ -228,8 +195,17 @@ class PositionSet:
                 f"joint{'s' if n_joints > 1 else ''} ({', '.join(table.joint_names)}); give one "
                 "step, or one per joint"
             )
-        angles, name = grid_angles_deg(list(steps_deg) * (n_joints // len(steps_deg)))
-        return cls(deg_to_rad(angles), table=table, name=name)
+        steps = list(steps_deg) * (n_joints // len(steps_deg))
+        for step in steps:
+            if not (np.isfinite(step) and MIN_GRID_STEP_DEG <= step <= 360):
+                raise InputError(
+                    f"grid step must be in [{MIN_GRID_STEP_DEG:g}, 360] degrees, got {step!r}"
+                )
+        same = all(s == steps[0] for s in steps)
+        name = f"grid:{steps[0]:g}" if same else "grid:" + "x".join(f"{s:g}" for s in steps)
+        count = math.prod(float(turn_grid_count(step)) for step in steps)
+        check_count(count, MAX_POSITIONS, f"positions of {name}", POSITION_BYTES)
+        return cls(deg_to_rad(full_turn_grid_deg(*steps)), table=table, name=name)
 
     @classmethod
     def random(cls, n: int, table=None, seed: int = 0) -> PositionSet:
@@ -276,7 +252,7 @@ class PositionSet:
     def parse(cls, spec: str, table=None) -> PositionSet:
         """A scheme name (``grid:STEP``, ``grid:S1xS2[xS3]``) or the path of a CSV file."""
         text = str(spec).strip()
-        steps = grid_steps(text)
+        steps = _grid_steps(text)
         if steps is not None:
             try:
                 return cls.grid(*steps, table=table)

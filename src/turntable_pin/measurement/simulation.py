@@ -517,9 +517,8 @@ def simulate_measurements(
         noise_spread: F >= 1: each row's sigma is ``noise_arcsec`` times a factor drawn
             log-uniform in [1/F, F] (seeded, after the noise), within the noise range; 1: even.
         not_measured: angles left empty at every position (``dgamma`` for a pointing run or an
-            autocollimator's two tilts). Without ``dgamma`` a row's ``dpsi`` is the payload x
-            axis' own component (``-dR[2,0]``, docs/measurements.md section 1), as such a run
-            measures it.
+            autocollimator's two tilts); without ``dgamma`` a row's ``dpsi`` is the payload x
+            axis' own component (``-dR[2,0]``, docs/measurements.md section 1).
 
     Raises:
         InputError: an effect without parameters or beyond +-18000 (``MAX_ANGULAR_ERROR_DEG`` in
@@ -553,14 +552,9 @@ def simulate_measurements(
     measured[:, blank] = np.nan
     _refuse_beyond_a_file(measured)
     data = OrientationMeasurements(
-        joint_rad=variables.joint_rad,
-        angles_rad=measured,
-        sigma_rad=sigma_rad,
-        time_s=variables.time_s,
-        dirs=variables.dirs,
-        source=f"simulated (seed {seed})",
-        joint_names=() if table.paper else table.joint_names,
-    )
+        variables.joint_rad, measured, sigma_rad, rows.time_s, rows.dirs,
+        source=f"simulated (seed {seed})", joint_names=() if table.paper else table.joint_names,
+    )  # fmt: skip
     return SimulatedMeasurements(
         data=data,
         errors=source.to_user_units(vector),
