@@ -4,7 +4,7 @@ senses at each.
 A position is a tuple of commanded joint angles in chain order from the base (the order of
 :attr:`~turntable_pin.model.generic_table.GenericTable.joint_names`); on the paper's table, the
 default, these are phi1 about the outer axis y and phi2 about the inner axis z. A position set
-comes from a scheme name or a CSV file:
+comes from a scheme name, a CSV file or a seeded uniform draw (:meth:`PositionSet.random`):
 
 - ``grid:STEP``: every joint in {0, STEP, ..., < 360} degrees, every combination (12 positions
   for one joint at 30 degrees, 144 for two, 1728 for three);
