@@ -13,7 +13,7 @@ POSITIONS = np.array([[90.0, 30.0], [0.0, 60.0], [45.5, 300.25], [270.0, 0.0], [
 def test_without_time_or_direction_each_position_once_in_the_order_of_the_angles():
     plan = plan_measurements(POSITIONS)
     assert plan.n_rows == 5 and plan.rows.time_s is None and plan.rows.dirs == (None, None)
-    assert np.array_equal(plan.joint_deg[:, 0], np.sort(POSITIONS[:, 0]))
+    assert np.array_equal(plan.rows.angles_deg()[:, 0], np.sort(POSITIONS[:, 0]))
     assert list(plan.rows.columns()) == ["phi1_deg", "phi2_deg"]
 
 
@@ -65,7 +65,7 @@ def test_the_csv_round_trips_through_the_simulator(tmp_path, time, dirs):
     schedule = Schedule(**read_positions(path))
     sim = simulate_measurements(None, {"thermal_drift": {"rz": 3.0}} if time else {},
                                 schedule=schedule, seed=1)  # fmt: skip
-    assert np.allclose(np.degrees(sim.data.joint_rad), plan.joint_deg)
+    assert np.allclose(np.degrees(sim.data.joint_rad), plan.rows.angles_deg())
     if time:
         assert np.array_equal(sim.data.time_s, plan.rows.time_s)
     for k in (0, 1):

@@ -491,7 +491,7 @@ def design_calibration(
     )  # fmt: skip
     return CalibrationDesign(
         space=space,
-        positions_deg=plan.joint_deg,
+        positions_deg=plan.rows.angles_deg(),
         plan=plan,
         reference=reference,
         accuracy_dph=accuracy_dph,

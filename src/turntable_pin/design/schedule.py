@@ -102,11 +102,6 @@ class MeasurementPlan:
         """Number of measurements M."""
         return len(self.rows)
 
-    @property
-    def joint_deg(self) -> np.ndarray:
-        """The rows' commanded joint angles (M, J), degrees (as :meth:`columns` writes them)."""
-        return self.rows.angles_deg()
-
     def first_order(self) -> np.ndarray:
         """The design's positions (indices) in the order they are first measured."""
         return self.position[np.sort(np.unique(self.position, return_index=True)[1])]
