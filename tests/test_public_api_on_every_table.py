@@ -8,8 +8,8 @@ reason in :data:`NOT_A_TABLE`, so a new one cannot slip past. Each call runs on 
 so does every public property and zero-argument method of what it returns (and of the table
 itself). The contract: every call answers on every table; the only refusals are the physical
 ones of :data:`MAY_REFUSE` (a table whose gravity never reaches every payload axis cannot
-calibrate the GyroWheel), and a property of a joint the table lacks (``PositionSet.phi2_rad`` of a
-one-joint table) refuses in the package's own one line (:class:`TurntablePinError`) -- never an
+calibrate the GyroWheel), and a joint the table lacks (``PositionSet.joint_rad(2)`` of a one-joint
+table) refuses in the package's own one line (:class:`TurntablePinError`) -- never an
 ``IndexError``, ``KeyError``, ``TypeError`` or a numpy error.
 """
 
@@ -170,6 +170,7 @@ def _calls():
         effect_terms,
         fit,
         pointing_terms,
+        simulation,
         table,
         user_effects,
     )
@@ -223,6 +224,8 @@ def _calls():
             positions.PositionSet.columns_of(_csv(c), c.table)),
         "calibration.positions.PositionSet.parse": lambda c: positions.PositionSet.parse(
             "grid:120", c.table),
+        "calibration.positions.PositionSet.random": lambda c: positions.PositionSet.random(
+            5, c.table, seed=1),
         "calibration.positions.check_commanded_angles": lambda c: (
             positions.check_commanded_angles(
                 _csv(c),
@@ -266,6 +269,8 @@ def _calls():
         "measurement.pointing_terms.rigid_term_map": lambda c: (
             pointing_terms.rigid_term_map(c.table)),
         "measurement.simulation.simulate_measurements": lambda c: c.simulated,
+        "measurement.simulation.Schedule.rows": lambda c: simulation.Schedule(120.0).rows(
+            np.random.default_rng(0), c.table),
         "measurement.table.measured_table": lambda c: table.measured_table(c.table),
         "measurement.user_effects.check_user_effect_names": lambda c: (
             user_effects.check_user_effect_names([], c.table)),

@@ -57,7 +57,7 @@ def test_inputs_from_pinocchio_match_eq_3(phi, lat):
 def test_grid_inputs_match_eq_3_and_have_unit_norm():
     positions = PositionSet.parse("grid:30")
     inputs = position_inputs(positions, np.radians(45.75))
-    a, w = eq3(positions.phi1_rad, positions.phi2_rad, np.radians(45.75))
+    a, w = eq3(positions.joint_rad(1), positions.joint_rad(2), np.radians(45.75))
     np.testing.assert_allclose(inputs.specific_force_g, a, atol=1e-14)
     np.testing.assert_allclose(inputs.earth_rate_dph, w, atol=1e-12)
     np.testing.assert_allclose(np.linalg.norm(inputs.earth_rate_dph, axis=1), EARTH_RATE_DPH)
@@ -75,8 +75,8 @@ def test_home_position_reads_up_and_north_components():
 def test_grid_schemes():
     grid = PositionSet.parse("grid:30")
     assert len(grid) == 144 and grid.name == "grid:30"
-    assert set(np.round(np.degrees(grid.phi1_rad), 9)) == set(range(0, 360, 30))
-    pairs = {(round(a), round(b)) for a, b in np.degrees(np.c_[grid.phi1_rad, grid.phi2_rad])}
+    assert set(np.round(np.degrees(grid.joint_rad(1)), 9)) == set(range(0, 360, 30))
+    pairs = {(round(a), round(b)) for a, b in np.degrees(grid.angles_rad)}
     assert len(pairs) == 144
     mixed = PositionSet.parse("grid:90x45")
     assert len(mixed) == 4 * 8
@@ -124,7 +124,7 @@ def test_latitude_is_checked():
 def test_the_paper_grid_is_the_generic_grid_of_the_paper_urdf(spec):
     paper = PositionSet.parse(spec)
     generic = PositionSet.parse(spec, GenericTable(REPO_DIR / "models" / "turntable.urdf"))
-    np.testing.assert_array_equal(generic.angles_rad, np.stack([paper.phi1_rad, paper.phi2_rad], 1))
+    np.testing.assert_array_equal(generic.angles_rad, paper.angles_rad)
     assert paper.name == generic.name
 
 
@@ -296,3 +296,39 @@ def test_tables_whose_positions_cannot_determine_the_coefficients_are_refused(ur
     table = GenericTable(MODELS / urdf)
     with pytest.raises(IdentifiabilityError, match=fragment):
         orientation_requirement(0.01, PositionSet.parse("grid:30", table), 0.8)
+
+
+def test_positions_carry_times_and_approach_directions():
+    positions = PositionSet(
+        [0.0, 0.5, 1.0], [0.0, 0.0, 0.2], time_s=[0, 60, 120], dirs=([1, -1, 1],)
+    )
+    assert positions.time_s.tolist() == [0.0, 60.0, 120.0]
+    assert positions.dirs[0].tolist() == [1.0, -1.0, 1.0] and positions.dirs[1] is None
+    assert not positions.time_s.flags.writeable
+    plain = PositionSet([0.0, 0.5], [0.0, 0.0])
+    assert plain.time_s is None and plain.dirs == (None, None)
+
+
+@pytest.mark.parametrize(
+    ("given", "fragment"),
+    [
+        ({"time_s": [0, 60]}, "time_s needs 3 times in [0, "),
+        ({"time_s": [0, -1, 5]}, "time_s needs 3 times"),
+        ({"time_s": [0, np.nan, 5]}, "time_s needs 3 times"),
+        ({"dirs": ([1, 0, 1],)}, "dirs of joint 1 needs 3 values, each +1 or -1"),
+        ({"dirs": (None, [1, 1])}, "dirs of joint 2 needs 3 values"),
+        ({"dirs": ([1, 1, 1],) * 3}, "dirs of 3 joints, the table has 2"),
+    ],
+)
+def test_times_and_directions_are_checked_naming_the_argument(given, fragment):
+    with pytest.raises(InputError, match="positions: ") as caught:
+        PositionSet([0.0, 0.5, 1.0], [0.0, 0.0, 0.2], **given)
+    assert fragment in str(caught.value)
+
+
+def test_random_positions_are_seeded_and_cover_every_turn():
+    a, b = PositionSet.random(50, seed=4), PositionSet.random(50, seed=4)
+    assert np.array_equal(a.angles_rad, b.angles_rad) and a.name == "random:50"
+    assert np.all((a.angles_rad >= 0) & (a.angles_rad < 2 * np.pi))
+    with pytest.raises(InputError, match="expected N >= 1"):
+        PositionSet.random(0)

@@ -186,7 +186,7 @@ def test_per_position_rotations_from_a_turntable():
     errors = TurntableErrors.from_arcsec(dphi_z2=40.0)
     inputs = INPUTS["grid:30"]
     field = OrientationErrorField.from_chain(paper_table().chain, errors.as_array()[None])
-    rotations = field.rotation(inputs.positions.phi1_rad, inputs.positions.phi2_rad)
+    rotations = field.rotation(inputs.positions.joint_rad(1), inputs.positions.joint_rad(2))
     per_position = rate_errors_dph(GYRO, inputs, rotations)
     constant = rate_error(GYRO, inputs, 0.0, errors.dphi_z2, 0.0, exact=True)
     np.testing.assert_allclose(per_position[0], [constant.dwx_dph, constant.dwy_dph], rtol=1e-9)

@@ -49,9 +49,9 @@ def _simulate(key, seed):
     design, hidden = _design(key), TABLES[key][2]
     plan = design.plan
     schedule = Schedule(
-        positions=tuple(map(tuple, plan.joint_deg)),
-        positions_time_s=None if plan.time_s is None else tuple(plan.time_s),
-        positions_dirs=() if plan.dirs is None else tuple(tuple(d) for d in plan.dirs.T),
+        positions=tuple(map(tuple, plan.rows.angles_deg())),
+        positions_time_s=None if plan.rows.time_s is None else tuple(plan.rows.time_s),
+        positions_dirs=tuple(None if d is None else tuple(d) for d in plan.rows.dirs),
     )
     return simulate_measurements(None, hidden, schedule=schedule, noise_arcsec=2.0, seed=seed,
                                  turntable=design.space.table)  # fmt: skip

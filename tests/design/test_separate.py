@@ -83,7 +83,7 @@ def test_the_design_separates_what_the_campaign_confounds(separated):
 def test_the_run_is_what_simulate_reads(separated, tmp_path):
     path = separated.plan.write_csv(tmp_path / "next.csv", comment=separated.comment())
     positions = read_positions(path, ("outer_gimbal", "middle_gimbal", "inner_gimbal"))
-    np.testing.assert_allclose(np.array(positions["positions"]), separated.plan.joint_deg)
+    np.testing.assert_allclose(np.array(positions["positions"]), separated.plan.rows.angles_deg())
     assert "T-optimal" in path.read_text().splitlines()[0]
 
 

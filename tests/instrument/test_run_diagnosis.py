@@ -16,7 +16,6 @@ from turntable_pin.core.units import arcsec_to_rad
 from turntable_pin.instrument.diagnosis import diagnose_run
 from turntable_pin.instrument.simulate import (
     TemperatureProfile,
-    random_positions,
     simulate_calibration_run,
 )
 from turntable_pin.model.paper_table import paper_table
@@ -115,7 +114,7 @@ def test_three_outliers_are_left_out_and_the_run_is_clean():
 
 DESIGNS = {
     "grid30": lambda seed: PositionSet.grid(30),
-    "random100": lambda seed: random_positions(100, paper_table(), 1000 + seed),
+    "random100": lambda seed: PositionSet.random(100, paper_table(), 1000 + seed),
 }
 
 

@@ -6,9 +6,9 @@ import tracemalloc
 
 import pytest
 
+from turntable_pin.calibration.positions import PositionSet
 from turntable_pin.core.exceptions import InputError
 from turntable_pin.core.sizes import MAX_POSITIONS
-from turntable_pin.instrument.simulate import random_positions
 from turntable_pin.model.paper_table import paper_table
 
 
@@ -18,7 +18,7 @@ def test_random_positions_beyond_the_limit_are_refused_before_they_are_drawn(n):
     tracemalloc.start()
     try:
         with pytest.raises(InputError) as caught:
-            random_positions(n, table, seed=0)
+            PositionSet.random(n, table, seed=0)
         peak = tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()
@@ -28,4 +28,4 @@ def test_random_positions_beyond_the_limit_are_refused_before_they_are_drawn(n):
 
 
 def test_random_positions_at_the_limit_are_drawn():
-    assert len(random_positions(1000, paper_table(), seed=0)) == 1000
+    assert len(PositionSet.random(1000, paper_table(), seed=0)) == 1000

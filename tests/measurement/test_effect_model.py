@@ -6,6 +6,7 @@ from hypothesis import strategies as st
 
 from rounding import chain_rounding, error_factors
 from turntable_pin import OrientationErrorField, small_angle_orientation_error
+from turntable_pin.calibration.positions import PositionSet
 from turntable_pin.measurement.effect_model import OrientationModel
 from turntable_pin.measurement.effects import EFFECTS, PositionVariables
 from turntable_pin.model.paper_table import paper_table
@@ -14,9 +15,13 @@ from turntable_pin.model.paper_table import paper_table
 def _grid_variables(seed=0, n=60):
     rng = np.random.default_rng(seed)
     return PositionVariables.of(
-        rng.uniform(0, 2 * np.pi, n), rng.uniform(0, 2 * np.pi, n), time_s=rng.uniform(0, 9000, n),
-        dirs=(rng.choice([-1.0, 1.0], n), rng.choice([-1.0, 1.0], n)),
-    )  # fmt: skip
+        PositionSet(
+            rng.uniform(0, 2 * np.pi, n),
+            rng.uniform(0, 2 * np.pi, n),
+            time_s=rng.uniform(0, 9000, n),
+            dirs=(rng.choice([-1.0, 1.0], n), rng.choice([-1.0, 1.0], n)),
+        )
+    )
 
 
 @settings(max_examples=25, deadline=None)

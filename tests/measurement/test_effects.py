@@ -10,6 +10,7 @@ import pytest
 
 import spec_reference as ref
 from turntable_pin import TurntableErrors
+from turntable_pin.calibration.positions import PositionSet
 from turntable_pin.core.exceptions import InputError
 from turntable_pin.core.rotations import rot_x, rot_y, rot_z
 from turntable_pin.measurement.effect_model import OrientationModel
@@ -36,10 +37,13 @@ def test_catalogue_has_the_spec_names_and_stories():
 
 def _variables(rng, n=7):
     return PositionVariables.of(
-        rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n),
-        time_s=rng.uniform(0, 7200, n),
-        dirs=(rng.choice([-1.0, 1.0], n), rng.choice([-1.0, 1.0], n)),
-    )  # fmt: skip
+        PositionSet(
+            rng.uniform(-np.pi, np.pi, n),
+            rng.uniform(-np.pi, np.pi, n),
+            time_s=rng.uniform(0, 7200, n),
+            dirs=(rng.choice([-1.0, 1.0], n), rng.choice([-1.0, 1.0], n)),
+        )
+    )
 
 
 def _independent(effect, v, base, p, i):
@@ -97,10 +101,10 @@ def test_effect_changes_the_chain_as_the_spec_defines(name, rng):
 
 
 def test_effects_needing_columns_say_so():
-    v = PositionVariables.of(np.zeros(3), np.zeros(3))
+    v = PositionVariables.of(PositionSet(np.zeros(3), np.zeros(3)))
     assert EFFECTS["thermal_drift"].missing_columns(v) == ("time_s",)
     assert EFFECTS["backlash"].missing_columns(v) == ("dir1", "dir2")
-    only_dir2 = PositionVariables.of(np.zeros(3), np.zeros(3), dirs=(None, np.ones(3)))
+    only_dir2 = PositionVariables.of(PositionSet(np.zeros(3), np.zeros(3), dirs=(None, np.ones(3))))
     assert EFFECTS["backlash"].missing_columns(only_dir2) == ()
     assert [s.name for s in EFFECTS["backlash"].parameters(only_dir2)] == ["b2"]
     with pytest.raises(InputError, match="needs the column"):

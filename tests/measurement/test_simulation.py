@@ -8,6 +8,7 @@ from turntable_pin.core.units import ARCSEC_PER_RAD
 from turntable_pin.measurement.data import read_measurements
 from turntable_pin.measurement.effect_model import OrientationModel
 from turntable_pin.measurement.simulation import Schedule, simulate_measurements
+from turntable_pin.model.paper_table import paper_table
 
 
 def test_grid_schedule_and_reproducible_seed():
@@ -35,8 +36,9 @@ def test_random_order_with_repeats_is_a_permutation_of_the_grid():
 
 
 def test_motion_approach_follows_the_moves():
-    s = Schedule(approach="motion")
-    dirs = s.directions(np.array([0.0, 30.0, 30.0, 10.0, 10.0, 50.0]), np.random.default_rng(0))
+    phi1 = (0.0, 30.0, 30.0, 10.0, 10.0, 50.0)
+    s = Schedule(approach="motion", positions=tuple((a, 0.0) for a in phi1))
+    dirs = s.rows(np.random.default_rng(0), paper_table()).dirs[0]
     assert dirs.tolist() == [1, 1, 1, -1, -1, 1]
 
 

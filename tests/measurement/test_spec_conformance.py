@@ -22,6 +22,7 @@ import spec_reference as ref
 from conftest import cli
 from rounding import chain_rounding
 from turntable_pin import TurntableErrors
+from turntable_pin.calibration.positions import PositionSet
 from turntable_pin.measurement.data import read_measurements
 from turntable_pin.measurement.effect_model import OrientationModel
 from turntable_pin.measurement.effects import EFFECT_NAMES, get_effect
@@ -84,7 +85,7 @@ def test_model_prediction_matches_reference(turntable, effect, scale_rad):
     phi1, phi2, time_s, dir1, dir2 = _positions(rng)
     errors = dict(zip(ref.ERROR_NAMES, rng.uniform(-scale_rad, scale_rad, 8), strict=True))
     effects = {} if effect is None else {effect: _random_parameters(effect, rng, scale_rad)}
-    variables = PositionVariables.of(phi1, phi2, time_s=time_s, dirs=(dir1, dir2))
+    variables = PositionVariables.of(PositionSet(phi1, phi2, time_s=time_s, dirs=(dir1, dir2)))
     model = OrientationModel(variables, [get_effect(n) for n in effects], turntable)
     values = dict(errors)
     for name, params in effects.items():

@@ -13,6 +13,7 @@ from allocation_reference import sensitivity_matrix_fd
 from conftest import random_errors
 from turntable_pin import OrientationErrorField, TurntableErrors
 from turntable_pin.allocation.sensitivity import sensitivity_matrix
+from turntable_pin.calibration.positions import PositionSet
 from turntable_pin.core.exceptions import ModelError
 from turntable_pin.measurement.effect_model import OrientationModel
 from turntable_pin.measurement.effects.base import PositionVariables
@@ -126,7 +127,7 @@ def test_every_consumer_of_the_chain_equals_an_independent_numpy_chain(
     field = OrientationErrorField.from_chain(table.chain, errors.as_array()[None])
     np.testing.assert_allclose(field.rotation(phi1, phi2)[0, 0], expected, atol=1e-12)
     fit_model = OrientationModel(
-        PositionVariables.of(np.array([phi1]), np.array([phi2])), (), table
+        PositionVariables.of(PositionSet(np.array([phi1]), np.array([phi2]))), (), table
     )
     np.testing.assert_allclose(
         fit_model.rotation_error(errors.angular_array_rad())[0], expected, atol=1e-12

@@ -4,13 +4,16 @@ senses at each.
 A position is a tuple of commanded joint angles in chain order from the base (the order of
 :attr:`~turntable_pin.model.generic_table.GenericTable.joint_names`); on the paper's table, the
 default, these are phi1 about the outer axis y and phi2 about the inner axis z. A position set
-comes from a scheme name or a CSV file:
+comes from a scheme name, a CSV file or a seeded uniform draw (:meth:`PositionSet.random`):
 
 - ``grid:STEP``: every joint in {0, STEP, ..., < 360} degrees, every combination (12 positions
   for one joint at 30 degrees, 144 for two, 1728 for three);
 - ``grid:S1xS2[xS3]``: the same with one step per joint, in chain order;
 - a CSV file with one angle column per joint: ``phi1_deg .. phiN_deg`` (chain order) or
   ``<joint>_deg`` (the joint names); other columns are ignored.
+
+A set may also say when each position is measured (``time_s``) and from which side each joint
+comes to it (``dirs``, +1/-1 per joint): the rows of a measurement run.
 
 The specific force and the earth rate along the payload axes are ``Rd^T`` times their base-frame
 values: in the base frame F0 (x north, y west, z up) the specific force of a resting body is
@@ -21,6 +24,7 @@ paper's table this is the closed form of paper eq. 3.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -29,9 +33,9 @@ from pathlib import Path
 import numpy as np
 
 from ..core.csv_table import CsvTable, closest_column_hint, read_csv_table
-from ..core.exceptions import InputError
-from ..core.sizes import MAX_POSITIONS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
-from ..core.turn_grid import full_turn_grid_deg
+from ..core.exceptions import InputError, check_seed
+from ..core.sizes import MAX_POSITIONS, MAX_TIME_S, MIN_GRID_STEP_DEG, check_count, turn_grid_count
+from ..core.turn_grid import full_turn_grid_deg, random_turn_positions_deg
 from ..core.units import deg_to_rad, rad_to_deg
 from ..core.words import argument
 from ..model.paper_table import resolve_table
@@ -47,8 +51,8 @@ __all__ = [
     "angle_columns",
     "base_frame_inputs",
     "check_commanded_angles",
-    "grid_angles_deg",
-    "grid_steps",
+    "check_times_and_directions",
+    "checked_times_and_directions",
     "position_inputs",
 ]
 
@@ -66,7 +70,7 @@ POSITION_BYTES = 4096
 _GRID = re.compile(r"^grid:\s*([0-9.eE+-]+(?:\s*x\s*[0-9.eE+-]+)*)$")
 
 
-def grid_steps(text: str) -> list[float] | None:
+def _grid_steps(text: str) -> list[float] | None:
     """The steps (degrees: one for every joint, or one per joint) of a ``grid:STEP`` or
     ``grid:S1xS2[xS3]`` spec, or ``None`` when ``text`` is no grid spec (a file name).
 
@@ -87,47 +91,30 @@ def grid_steps(text: str) -> list[float] | None:
         raise InputError(f"positions '{text}': bad grid step") from None
 
 
-def grid_angles_deg(steps_deg: Sequence[float]) -> tuple[np.ndarray, str]:
-    """Every joint in {0, step, ..., < 360} degrees, every combination: (N, J) angles in degrees
-    (the last joint varies fastest) and the grid's name (``grid:30``, ``grid:30x45``).
-
-    Raises:
-        InputError: a step outside [``MIN_GRID_STEP_DEG``, 360], or more positions than
-            ``MAX_POSITIONS``.
-    """
-    for step in steps_deg:
-        if not (np.isfinite(step) and MIN_GRID_STEP_DEG <= step <= 360):
-            raise InputError(
-                f"grid step must be in [{MIN_GRID_STEP_DEG:g}, 360] degrees, got {step!r}"
-            )
-    same = all(s == steps_deg[0] for s in steps_deg)
-    name = f"grid:{steps_deg[0]:g}" if same else "grid:" + "x".join(f"{s:g}" for s in steps_deg)
-    count = 1.0
-    for step in steps_deg:
-        count *= float(turn_grid_count(step))
-    check_count(count, MAX_POSITIONS, f"positions of {name}", POSITION_BYTES)
-    return full_turn_grid_deg(*steps_deg), name
-
-
 @dataclass(frozen=True, init=False)
 class PositionSet:
-    """Commanded positions of a table with 1 to 3 joints.
+    """Commanded positions of a table with 1 to 3 joints, in the order they are measured.
 
-    ``PositionSet(*angles_rad, table=None, name="")`` takes one (N,) array per joint in chain
-    order (``PositionSet(phi1_rad, phi2_rad)`` on the paper's table) or one (N, J) array.
+    ``PositionSet(*angles_rad, table=None, name="", time_s=None, dirs=())`` takes one (N,) array
+    per joint in chain order (``PositionSet(phi1_rad, phi2_rad)`` on the paper's table) or one
+    (N, J) array.
 
     Attributes:
         angles_rad: (N, J) joint angles in chain order, radians (read-only).
         table: the :class:`~turntable_pin.model.generic_table.GenericTable` they command
             (default: the paper's, :func:`~turntable_pin.model.paper_table.paper_table`).
         name: the scheme name or file the positions came from.
+        time_s: when each position is measured (N,), s in [0, ``MAX_TIME_S``], or ``None``.
+        dirs: per joint, the side it approaches each position from (N,) (+1/-1), or ``None``.
     """
 
     angles_rad: np.ndarray
     table: object = field(repr=False, compare=False)
     name: str = ""
+    time_s: np.ndarray | None = field(default=None, repr=False)
+    dirs: tuple[np.ndarray | None, ...] = field(default=(), repr=False)
 
-    def __init__(self, *angles_rad, table=None, name: str = "") -> None:
+    def __init__(self, *angles_rad, table=None, name: str = "", time_s=None, dirs=()) -> None:
         table = resolve_table(table)
         n_joints = len(table.joint_names)
         if len(angles_rad) == 1 and np.ndim(angles_rad[0]) == 2:
@@ -145,7 +132,6 @@ class PositionSet:
             )
         if angles.shape[0] == 0:
             raise InputError("positions: the set is empty")
-        check_count(angles.shape[0], MAX_POSITIONS, "positions", POSITION_BYTES)
         if not np.all(np.isfinite(angles)):
             raise InputError("positions: angles must be finite numbers")
         largest = float(np.max(np.abs(angles)))
@@ -158,6 +144,14 @@ class PositionSet:
         object.__setattr__(self, "angles_rad", angles)
         object.__setattr__(self, "table", table)
         object.__setattr__(self, "name", name)
+        if len(dirs) > n_joints:
+            raise InputError(
+                f"positions: {argument('dirs')} of {len(dirs)} joints, the table has {n_joints}"
+            )
+        dirs = (*dirs, *(None,) * (n_joints - len(dirs)))
+        time_s, dirs = checked_times_and_directions(len(angles), time_s, dirs)
+        object.__setattr__(self, "time_s", time_s)
+        object.__setattr__(self, "dirs", dirs)
 
     def __len__(self) -> int:
         return int(self.angles_rad.shape[0])
@@ -187,22 +181,12 @@ class PositionSet:
             )
         return self.angles_rad[:, k - 1]
 
-    @property
-    def phi1_rad(self) -> np.ndarray:
-        """The angles of the first joint (the paper's phi1, outer axis), radians."""
-        return self.joint_rad(1)
-
-    @property
-    def phi2_rad(self) -> np.ndarray:
-        """The angles of the second joint (the paper's phi2, inner axis), radians; refused
-        (:class:`InputError`) on a one-joint table."""
-        return self.joint_rad(2)
-
     # ---- construction -------------------------------------------------------------------------
     @classmethod
     def grid(cls, *steps_deg: float, table=None) -> PositionSet:
-        """Every joint in {0, step, ..., < 360} degrees, every combination (one step for all
-        joints, or one per joint in chain order)."""
+        """Every joint in {0, step, ..., < 360} degrees, every combination, the last joint
+        fastest (one step for all joints, or one per joint in chain order); :class:`InputError`
+        for a step outside [``MIN_GRID_STEP_DEG``, 360] or more than ``MAX_POSITIONS``."""
         table = resolve_table(table)
         n_joints = len(table.joint_names)
         if len(steps_deg) not in (1, n_joints):
@@ -211,8 +195,30 @@ class PositionSet:
                 f"joint{'s' if n_joints > 1 else ''} ({', '.join(table.joint_names)}); give one "
                 "step, or one per joint"
             )
-        angles, name = grid_angles_deg(list(steps_deg) * (n_joints // len(steps_deg)))
-        return cls(deg_to_rad(angles), table=table, name=name)
+        steps = list(steps_deg) * (n_joints // len(steps_deg))
+        for step in steps:
+            if not (np.isfinite(step) and MIN_GRID_STEP_DEG <= step <= 360):
+                raise InputError(
+                    f"grid step must be in [{MIN_GRID_STEP_DEG:g}, 360] degrees, got {step!r}"
+                )
+        same = all(s == steps[0] for s in steps)
+        name = f"grid:{steps[0]:g}" if same else "grid:" + "x".join(f"{s:g}" for s in steps)
+        count = math.prod(float(turn_grid_count(step)) for step in steps)
+        check_count(count, MAX_POSITIONS, f"positions of {name}", POSITION_BYTES)
+        return cls(deg_to_rad(full_turn_grid_deg(*steps)), table=table, name=name)
+
+    @classmethod
+    def random(cls, n: int, table=None, seed: int = 0) -> PositionSet:
+        """``n`` positions uniform over every joint's turn [0, 360) deg (rounded to 1e-6 deg), from
+        their own stream of ``seed``; InputError for ``n`` below 1 or above ``MAX_POSITIONS``."""
+        table = resolve_table(table)
+        seed = check_seed(seed)
+        if n < 1:
+            raise InputError(f"random positions: expected N >= 1, got {n}")
+        check_count(n, MAX_POSITIONS, "random positions of a calibration run", POSITION_BYTES)
+        rng = np.random.default_rng([seed, 1])
+        angles = random_turn_positions_deg(rng, n, len(table.joint_names))
+        return cls(deg_to_rad(angles), table=table, name=f"random:{n}")
 
     @classmethod
     def from_csv(cls, path: str | Path, table=None) -> PositionSet:
@@ -246,7 +252,7 @@ class PositionSet:
     def parse(cls, spec: str, table=None) -> PositionSet:
         """A scheme name (``grid:STEP``, ``grid:S1xS2[xS3]``) or the path of a CSV file."""
         text = str(spec).strip()
-        steps = grid_steps(text)
+        steps = _grid_steps(text)
         if steps is not None:
             try:
                 return cls.grid(*steps, table=table)
@@ -264,7 +270,9 @@ class PositionSet:
     # ---- what the payload sees ----------------------------------------------------------------
     def nominal_rotations(self) -> np.ndarray:
         """(N, 3, 3) nominal payload orientations ``Rd`` (base <- payload): Pinocchio forward
-        kinematics of the table's URDF."""
+        kinematics of the table's URDF, for at most ``MAX_POSITIONS`` positions (the cost of a
+        position in the calibration layer's computations, checked before any is computed)."""
+        check_count(len(self), MAX_POSITIONS, "positions", POSITION_BYTES)
         pose = self.table.payload_pose
         return np.array([pose(None, angles).rotation for angles in self.angles_rad])
 
@@ -272,6 +280,21 @@ class PositionSet:
         """Number of distinct commanded positions (angles taken modulo 360 degrees)."""
         wrapped = np.round(np.mod(rad_to_deg(self.angles_rad), 360.0), decimals) % 360.0
         return int(np.unique(wrapped, axis=0).shape[0])
+
+    def angles_deg(self) -> np.ndarray:
+        """(N, J) the angles in degrees, rounded to 1e-9 deg (a 30-degree grid reads 30.0)."""
+        return np.round(rad_to_deg(self.angles_rad), 9)
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The columns of a positions CSV: ``phiK_deg`` (:meth:`angles_deg`) of each joint, then
+        ``time_s`` and ``dirK`` (integers) where the set has them."""
+        out = {f"phi{k}_deg": a for k, a in enumerate(self.angles_deg().T, start=1)}
+        if self.time_s is not None:
+            out["time_s"] = self.time_s
+        for k, d in enumerate(self.dirs, start=1):
+            if d is not None:
+                out[f"dir{k}"] = d.astype(int)
+        return out
 
     def to_dict(self) -> dict:
         """Name, count, joint names and the angles in degrees per joint, as a dict."""
@@ -301,6 +324,47 @@ class PositionInputs:
 
     def __len__(self) -> int:
         return len(self.positions)
+
+
+def checked_times_and_directions(
+    n: int, time_s=None, dirs=(), names: tuple[str, str] = ("time_s", "dirs")
+) -> tuple[np.ndarray | None, tuple[np.ndarray | None, ...]]:
+    """``time_s`` ((n,) s in [0, :data:`MAX_TIME_S`], or ``None``) and ``dirs`` (per joint (n,)
+    +1/-1, or ``None``) as read-only arrays; :class:`InputError` naming the arguments ``names``."""
+    if time_s is not None:
+        time_s = np.array(time_s, dtype=float).reshape(-1)
+        if time_s.shape != (n,) or not np.all((time_s >= 0) & (time_s <= MAX_TIME_S)):
+            raise InputError(
+                f"positions: {argument(names[0])} needs {n} times in [0, {MAX_TIME_S:g}] s, one "
+                "per position"
+            )
+        time_s.setflags(write=False)
+    checked = []
+    for k, d in enumerate(dirs, start=1):
+        if d is not None:
+            d = np.array(d, dtype=float).reshape(-1)
+            if d.shape != (n,) or not np.all(np.abs(d) == 1):
+                raise InputError(
+                    f"positions: {argument(names[1])} of joint {k} needs {n} values, each +1 or -1"
+                )
+            d.setflags(write=False)
+        checked.append(d)
+    return time_s, tuple(checked)
+
+
+def check_times_and_directions(rows, dir_columns: Sequence[str]) -> None:
+    """Refuse a ``time_s`` below 0 or above :data:`MAX_TIME_S` and a ``dirK`` not +1 or -1 of
+    ``rows`` (a ``CsvTable``), naming file, row and column."""
+    if rows.has("time_s"):
+        time_s = rows["time_s"]
+        rows.refuse("time_s", time_s < 0, "time since the start of the run must be >= 0")
+        rows.refuse(
+            "time_s", time_s > MAX_TIME_S,
+            f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
+        )  # fmt: skip
+    for column in dir_columns:
+        if rows.has(column):
+            rows.refuse(column, np.abs(rows[column]) != 1, "an approach direction must be +1 or -1")
 
 
 def check_commanded_angles(table, columns: Sequence[str]) -> None:

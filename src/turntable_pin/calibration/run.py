@@ -21,9 +21,8 @@ import numpy as np
 
 from ..core.csv_table import missing_columns_words, read_csv_table, refuse_repeated_rows
 from ..core.exceptions import InputError
-from ..core.sizes import MAX_TIME_S
 from ..model.paper_table import resolve_table
-from .positions import PositionInputs, PositionSet, position_inputs
+from .positions import PositionInputs, PositionSet, check_times_and_directions, position_inputs
 
 __all__ = [
     "MAX_RUN_OUTPUT_DPH",
@@ -173,10 +172,4 @@ def _check_run_values(table) -> None:
             table["sigma_dph"] < MIN_RUN_SIGMA_DPH,
             f"sigma_dph must be at least {MIN_RUN_SIGMA_DPH:g} deg/h",
         )
-    if table.has("time_s"):
-        table.refuse("time_s", table["time_s"] < 0, "time since the start of the run must be >= 0")
-        table.refuse(
-            "time_s",
-            table["time_s"] > MAX_TIME_S,
-            f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
-        )
+    check_times_and_directions(table, ())

@@ -383,7 +383,7 @@ def run_simulate_run(args: argparse.Namespace) -> int:
     from ..calibration.positions import PositionSet
     from ..calibration.site import DEFAULT_LATITUDE_DEG
     from ..core.units import deg_to_rad
-    from ..instrument.simulate import TemperatureProfile, random_positions, simulate_calibration_run
+    from ..instrument.simulate import TemperatureProfile, simulate_calibration_run
     from ..measurement.user_effects import inline_effect, load_catalogue
 
     # A default given explicitly changes nothing and passes.
@@ -399,7 +399,7 @@ def run_simulate_run(args: argparse.Namespace) -> int:
     table_effects, instrument = _run_effects(args.effect, table, user)
     user = (*user, *(inline_effect(name, table) for name in table_effects if "~" in name))
     if args.random_positions:
-        positions = random_positions(args.random_positions, table, args.seed)
+        positions = PositionSet.random(args.random_positions, table, args.seed)
     else:
         positions = PositionSet.parse(
             "grid:30" if args.positions is None else str(args.positions), table

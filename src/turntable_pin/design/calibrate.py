@@ -477,15 +477,15 @@ def design_calibration(
     )
     if min_efficiency <= 1 and box.volume_rad3 < reference_box.volume_rad3:
         chosen, box = reference_index, reference_box  # the full model's last digits: the grid
-    plan = plan_measurements(np.round(candidates.angles_rad[chosen] * DEG_PER_RAD, 9))
-    design_set = PositionSet(plan.joint_deg / DEG_PER_RAD, table=table, name="design")
+    plan = plan_measurements(np.round(candidates.angles_rad[chosen] * DEG_PER_RAD, 9), table=table)
+    design_set = PositionSet(plan.rows.angles_rad, table=table, name="design")
     uniform, _ = holding_scale(
         accuracy_dph, gyrowheel, position_inputs(design_set, latitude_rad),
         reference_box.limits_rad,
     )  # fmt: skip
     return CalibrationDesign(
         space=space,
-        positions_deg=plan.joint_deg,
+        positions_deg=plan.rows.angles_deg(),
         plan=plan,
         reference=reference,
         accuracy_dph=accuracy_dph,

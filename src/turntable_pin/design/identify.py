@@ -28,6 +28,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..calibration.positions import PositionSet
 from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import InputError, TurntablePinError
 from ..core.sizes import check_positions_count
@@ -193,15 +194,17 @@ def _evaluate(space: DesignSpace, variables):
     return model.jacobian(np.zeros(model.n_params)), model
 
 
-def _variables(joint_deg: np.ndarray, visits: Visits, start_s: float, duration_s: float):
+def _variables(space, joint_deg: np.ndarray, visits: Visits, start_s: float, duration_s: float):
     """Variables of every position in ``joint_deg`` (C, J) measured as ``visits`` says,
     position-major (C * visits.count rows)."""
-    joints = np.repeat(joint_deg / DEG_PER_RAD, visits.count, axis=0)
     fractions = visits.time_fractions()
-    time_s = None if fractions is None else start_s + fractions.reshape(-1) * duration_s
     signs = visits.signs()
-    dirs = () if signs is None else tuple(signs.reshape(-1, joint_deg.shape[1]).T)
-    return PositionVariables(joints, time_s, dirs)
+    rows = PositionSet(
+        np.repeat(joint_deg / DEG_PER_RAD, visits.count, axis=0), table=space.table,
+        time_s=None if fractions is None else start_s + fractions.reshape(-1) * duration_s,
+        dirs=() if signs is None else tuple(signs.reshape(-1, joint_deg.shape[1]).T),
+    )  # fmt: skip
+    return PositionVariables.of(rows)
 
 
 def design_rows(
@@ -219,7 +222,7 @@ def design_rows(
     keep = np.ones(joint_deg.shape[0], dtype=bool)
 
     def rows_of(index: np.ndarray):
-        variables = _variables(joint_deg[index], visits.subset(index), start_s, duration_s)
+        variables = _variables(space, joint_deg[index], visits.subset(index), start_s, duration_s)
         jac, model = _evaluate(space, variables)
         return jac.reshape(index.size, 3 * visits.count, -1), model
 
@@ -439,11 +442,12 @@ def _design_identify(space, n_positions, from_data, noise_arcsec, dwell_s) -> Id
     positions = space.candidates_deg[chosen]
     plan = plan_measurements(
         positions, needs_time=space.needs_time, needs_dirs=space.needs_dirs, dwell_s=dwell_s,
-        seed=space.seed, start_s=c.start_s, visits=space.visits.subset(chosen),
+        seed=space.seed, start_s=c.start_s, visits=space.visits.subset(chosen), table=space.table,
     )  # fmt: skip
 
     def run_information(plan_: MeasurementPlan) -> np.ndarray:
-        z = _evaluate(space, plan_.variables())[0].reshape(-1, n) / c.noise_rad @ basis
+        variables = PositionVariables.of(plan_.rows)
+        z = _evaluate(space, variables)[0].reshape(-1, n) / c.noise_rad @ basis
         return z.T @ z
 
     zero = 0.0 if start is None else start
@@ -502,7 +506,7 @@ def _grid_information(space, c: CandidateRows, run_information, n_positions: int
         return run_information(
             plan_measurements(
                 grid, needs_time=space.needs_time, needs_dirs=space.needs_dirs, dwell_s=dwell,
-                seed=space.seed, start_s=c.start_s,
+                seed=space.seed, start_s=c.start_s, table=space.table,
             )
         )  # fmt: skip
 

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..calibration.positions import PositionSet
 from ..core.csv_table import write_csv_table
 from ..core.units import DEG_PER_RAD
-from ..measurement.effects.base import PositionVariables
 
 __all__ = ["MeasurementPlan", "Visits", "candidate_visits", "plan_measurements"]
 
@@ -84,18 +84,15 @@ class MeasurementPlan:
     """The measurements of a design, one row each, in the order they are made.
 
     Attributes:
-        joint_deg: commanded joint angles (M, J), degrees.
+        rows: the rows' positions (M) with their ``time_s`` and approach directions ``dirs``
+            when an effect needs them (a :class:`~turntable_pin.calibration.positions.PositionSet`).
         position: which of the design's positions each row measures (M,).
-        time_s: time of each row (M,), or ``None`` (no effect needs it).
-        dirs: approach direction of each joint (M, J) (+1/-1), or ``None``.
         dwell_s: time between rows; seed: the seed of the order and directions.
         rule: the order in words.
     """
 
-    joint_deg: np.ndarray = field(repr=False)
+    rows: PositionSet = field(repr=False)
     position: np.ndarray = field(repr=False)
-    time_s: np.ndarray | None = field(repr=False)
-    dirs: np.ndarray | None = field(repr=False)
     dwell_s: float
     seed: int
     rule: str
@@ -103,35 +100,20 @@ class MeasurementPlan:
     @property
     def n_rows(self) -> int:
         """Number of measurements M."""
-        return int(self.joint_deg.shape[0])
+        return len(self.rows)
 
     def first_order(self) -> np.ndarray:
         """The design's positions (indices) in the order they are first measured."""
         return self.position[np.sort(np.unique(self.position, return_index=True)[1])]
 
-    def variables(self):
-        """The rows as :class:`~turntable_pin.measurement.effects.base.PositionVariables`."""
-        dirs = () if self.dirs is None else tuple(self.dirs.T)
-        return PositionVariables(self.joint_deg / DEG_PER_RAD, self.time_s, dirs)
-
-    def columns(self) -> dict[str, np.ndarray]:
-        """``phiK_deg`` of each joint, then ``time_s`` and ``dirK`` when the plan has them."""
-        joints = range(1, self.joint_deg.shape[1] + 1)
-        out = {f"phi{k}_deg": self.joint_deg[:, k - 1] for k in joints}
-        if self.time_s is not None:
-            out["time_s"] = self.time_s
-        if self.dirs is not None:
-            for k in range(1, self.dirs.shape[1] + 1):
-                out[f"dir{k}"] = self.dirs[:, k - 1].astype(int)
-        return out
-
     def write_csv(self, path: str | Path, comment: str = "") -> Path:
-        """Write the plan's CSV atomically (``comment`` lines first, with a ``#``)."""
-        return write_csv_table(path, self.columns(), comment=comment)
+        """Write the plan's CSV (:meth:`PositionSet.columns`) atomically (``comment`` lines first,
+        with a ``#``)."""
+        return write_csv_table(path, self.rows.columns(), comment=comment)
 
     def to_dict(self) -> dict:
         """The plan as a JSON-ready dict (its rows as the CSV has them)."""
-        columns = self.columns()
+        columns = self.rows.columns()
         return {
             "n_measurements": self.n_rows,
             "rule": self.rule,
@@ -151,6 +133,7 @@ def plan_measurements(
     seed: int = 0,
     start_s: float = 0.0,
     visits: Visits | None = None,
+    table=None,
 ) -> MeasurementPlan:
     """The run that measures ``positions_deg`` (N, J) (module docstring for the rules).
 
@@ -165,6 +148,7 @@ def plan_measurements(
         visits: the positions' :class:`Visits` as the design chose them: the first pass goes in
             the order of their early times, and each joint comes first from their side
             (default: a seeded random order and balanced random sides).
+        table: the table the positions are of (default: the paper's).
     """
     positions = np.asarray(positions_deg, dtype=float)
     if positions.ndim == 1:
@@ -187,7 +171,7 @@ def plan_measurements(
         order = tour
         rule = "each position once, in the order of the angles"
     time_s = start_s + np.arange(order.size) * float(dwell_s) if needs_time else None
-    dirs = None
+    dirs = ()
     if needs_dirs:
         if visits is not None and visits.sides is not None:
             side = np.asarray(visits.sides, dtype=float)
@@ -199,13 +183,11 @@ def plan_measurements(
         for row, p in enumerate(order):
             second[row] = seen[p]
             seen[p] = True
-        dirs = np.where(second[:, None], -side[order], side[order])
+        dirs = tuple(np.where(second[:, None], -side[order], side[order]).T)
         rule += "; dirK: each position from +1 and from -1"
     return MeasurementPlan(
-        joint_deg=positions[order],
+        rows=PositionSet(positions[order] / DEG_PER_RAD, table=table, time_s=time_s, dirs=dirs),
         position=order,
-        time_s=time_s,
-        dirs=dirs,
         dwell_s=float(dwell_s),
         seed=int(seed),
         rule=rule,

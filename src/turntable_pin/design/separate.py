@@ -43,6 +43,7 @@ from ..core.exceptions import IdentifiabilityError, InputError
 from ..core.sizes import check_positions_count
 from ..core.words import argument, command
 from ..measurement.catalogue import catalogue
+from ..measurement.effects.base import PositionVariables
 from ..measurement.fit import fit_orientation
 from ..stats.design import information_rows
 from ..stats.discrimination import (
@@ -714,9 +715,10 @@ class _Problem:
         plan = plan_measurements(
             space.candidates_deg[chosen], needs_time=space.needs_time,
             needs_dirs=space.needs_dirs, dwell_s=self.dwell_s, seed=space.seed,
-            start_s=self.c.start_s, visits=space.visits.subset(chosen),
+            start_s=self.c.start_s, visits=space.visits.subset(chosen), table=space.table,
         )  # fmt: skip
-        jac = _evaluate(space, plan.variables())[0].reshape(-1, self.c.model.n_params)
+        variables = PositionVariables.of(plan.rows)
+        jac = _evaluate(space, variables)[0].reshape(-1, self.c.model.n_params)
         return found, chosen, plan, jac / self.c.noise_rad
 
 

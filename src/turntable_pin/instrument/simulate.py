@@ -27,13 +27,12 @@ import numpy as np
 import yaml
 
 from ..calibration.gyrowheel import AXES, GyroWheelModel, regressor_matrix
-from ..calibration.positions import POSITION_BYTES, PositionSet, base_frame_inputs, position_inputs
+from ..calibration.positions import PositionSet, base_frame_inputs, position_inputs
 from ..calibration.rate_error import orientation_error_rotation
 from ..calibration.run import MAX_RUN_OUTPUT_DPH, MIN_RUN_SIGMA_DPH
 from ..core.exceptions import InputError, check_seed
 from ..core.files import write_text_atomic
-from ..core.sizes import MAX_POSITIONS, MAX_TIME_S, check_count
-from ..core.turn_grid import random_turn_positions_deg
+from ..core.sizes import MAX_TIME_S
 from ..core.units import ARCSEC_PER_RAD, deg_to_rad, rad_to_deg
 from ..core.words import argument, command
 from ..measurement.effects.base import PositionVariables
@@ -58,7 +57,6 @@ __all__ = [
     "SIMULATED_INSTRUMENT_EFFECTS",
     "SimulatedRun",
     "TemperatureProfile",
-    "random_positions",
     "simulate_calibration_run",
 ]
 
@@ -120,18 +118,6 @@ class TemperatureProfile:
     def to_dict(self) -> dict[str, float]:
         """The four numbers by name."""
         return {name: float(value) for name, value in asdict(self).items()}
-
-
-def random_positions(n: int, table, seed: int) -> PositionSet:
-    """``n`` positions uniform over every joint's turn [0, 360) deg (rounded to 1e-6 deg), from
-    their own stream of ``seed``; InputError for ``n`` below 1 or above ``MAX_POSITIONS``."""
-    seed = check_seed(seed)
-    if n < 1:
-        raise InputError(f"random positions: expected N >= 1, got {n}")
-    check_count(n, MAX_POSITIONS, "random positions of a calibration run", POSITION_BYTES)
-    rng = np.random.default_rng([seed, 1])
-    angles = random_turn_positions_deg(rng, n, len(table.joint_names))
-    return PositionSet(deg_to_rad(angles), table=table, name=f"random:{n}")
 
 
 @dataclass(frozen=True)

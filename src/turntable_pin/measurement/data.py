@@ -30,7 +30,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..calibration.positions import MAX_COMMANDED_ANGLE_DEG, angle_columns, check_commanded_angles
+from ..calibration.positions import (
+    MAX_COMMANDED_ANGLE_DEG,
+    angle_columns,
+    check_commanded_angles,
+    check_times_and_directions,
+)
 from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows
 from ..core.exceptions import InputError
 from ..core.sizes import MAX_TIME_S
@@ -47,7 +52,6 @@ __all__ = [
     "MAX_TIME_S",
     "MIN_SIGMA_ARCSEC",
     "OrientationMeasurements",
-    "check_times_and_directions",
     "read_measurements",
 ]
 
@@ -269,20 +273,6 @@ def _looks_like_radians(values_deg: np.ndarray) -> str | None:
 def _check_at_most(table, column: str, limit: float, rule: str) -> None:
     """Refuse the first ``|value| > limit`` of ``column``, naming file, row and column."""
     table.refuse(column, np.abs(table[column]) > limit, rule)
-
-
-def check_times_and_directions(rows, dir_columns: Sequence[str]) -> None:
-    """Refuse a ``time_s`` below 0 or above :data:`MAX_TIME_S` and a ``dirK`` not +1 or -1 of
-    ``rows`` (a ``CsvTable``), naming file, row and column."""
-    if rows.has("time_s"):
-        rows.refuse("time_s", rows["time_s"] < 0, "time since the start of the run must be >= 0")
-        _check_at_most(
-            rows, "time_s", MAX_TIME_S,
-            f"time since the start of the run must be at most {MAX_TIME_S:g} s (a year)",
-        )  # fmt: skip
-    for column in dir_columns:
-        if rows.has(column):
-            rows.refuse(column, np.abs(rows[column]) != 1, "an approach direction must be +1 or -1")
 
 
 def read_measurements(

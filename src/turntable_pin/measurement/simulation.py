@@ -16,7 +16,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..calibration.positions import angle_columns, check_commanded_angles
+from ..calibration.positions import (
+    PositionSet,
+    angle_columns,
+    check_commanded_angles,
+    check_times_and_directions,
+    checked_times_and_directions,
+)
 from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows
 from ..core.exceptions import InputError, check_seed
 from ..core.sizes import MAX_SIMULATED_ROWS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
@@ -32,13 +38,11 @@ from .data import (
     MAX_TIME_S,
     MIN_SIGMA_ARCSEC,
     OrientationMeasurements,
-    check_times_and_directions,
 )
 from .effects.base import Effect, PositionVariables
 from .simulated import (
     SimulatedFile,
     check_dwell,
-    checked_column,
     checked_noise,
     planted_model,
     run_times_s,
@@ -216,24 +220,20 @@ class Schedule:
             raise InputError(
                 f"a listed position must be within +-{MAX_COMMANDED_ANGLE_DEG:g} deg (and finite)"
             )
-        n = rows.shape[0]
-        if self.positions_time_s is not None:
-            checked_column(self.positions_time_s, n, "positions_time_s", 0.0, MAX_TIME_S)
-            if self.repeats > 1 or self.passes:
-                raise InputError(
-                    "the positions give their times; repeats and passes would need other times "
-                    "(leave out time_s, or list every measurement)"
-                )
-        for k, dirs in enumerate(self.positions_dirs, start=1):
-            if dirs is None:
-                continue
-            d = np.asarray(dirs, dtype=float)
-            if d.shape != (n,) or not np.all(np.abs(d) == 1):
-                raise InputError(f"positions_dirs of joint {k} needs {n} values, each +1 or -1")
-            if self.passes:
-                raise InputError(
-                    f"passes set the approach directions themselves; the positions give dir{k}"
-                )
+        checked_times_and_directions(
+            rows.shape[0], self.positions_time_s, self.positions_dirs,
+            ("positions_time_s", "positions_dirs"),
+        )  # fmt: skip
+        if self.positions_time_s is not None and (self.repeats > 1 or self.passes):
+            raise InputError(
+                "the positions give their times; repeats and passes would need other times "
+                "(leave out time_s, or list every measurement)"
+            )
+        given = [k for k, d in enumerate(self.positions_dirs, start=1) if d is not None]
+        if given and self.passes:
+            raise InputError(
+                f"passes set the approach directions themselves; the positions give dir{given[0]}"
+            )
 
     def _check_sweep(self) -> None:
         joints = [str(j) for j in self.sweep]
@@ -304,49 +304,47 @@ class Schedule:
         rows = full_turn_grid_deg(*(step for _, step in steps), starts_deg=starts)
         return [rows[:, k] for k in range(n_joints)]
 
-    def _pass_sign(self, size: int) -> np.ndarray | None:
-        """+1 on forward and -1 on backward rows of ``passes`` (``size`` rows per traversal)."""
-        if not self.passes:
-            return None
-        return np.tile(np.repeat([1.0, -1.0], size), self.passes)
-
-    def positions_deg(self, rng: np.random.Generator, n_joints: int = 2) -> tuple[np.ndarray, ...]:
-        """Commanded joint angles (phi1, phi2, ...) in degrees, in measurement order."""
-        out = [np.tile(a, self.repeats) for a in self._design_deg(rng, n_joints)]
+    def rows(self, rng: np.random.Generator, table) -> PositionSet:
+        """The measurements on ``table`` (a ``GenericTable``) in their order: the commanded
+        angles, each row's ``time_s`` and each joint's approach direction."""
+        n_joints = len(table.joint_names)
+        check_count(self.count(n_joints), MAX_SIMULATED_ROWS, "rows of simulated measurements",
+                    ROW_BYTES)  # fmt: skip
+        angles = [np.tile(a, self.repeats) for a in self._design_deg(rng, n_joints)]
         if self.order == "random":
-            perm = rng.permutation(out[0].size)
-            out = [a[perm] for a in out]
+            perm = rng.permutation(angles[0].size)
+            angles = [a[perm] for a in angles]
         if self.passes:
-            out = [np.tile(np.concatenate([a, a[::-1]]), self.passes) for a in out]
-        return tuple(out)
+            angles = [np.tile(np.concatenate([a, a[::-1]]), self.passes) for a in angles]
+        n = angles[0].size
+        if self.duration_s(n_joints) > MAX_TIME_S:
+            raise InputError(
+                f"dwell_s {self.dwell_s:g}: the run of {n} measurements would last "
+                f"{self.duration_s(n_joints):.7g} s, more than {MAX_TIME_S:.7g} s (a year)"
+            )
+        time_s = run_times_s(n, self.dwell_s)
+        dirs = tuple(self._directions(a, rng, k) for k, a in enumerate(angles, start=1))
+        return PositionSet(
+            np.stack(angles, axis=1) / DEG_PER_RAD, table=table, dirs=dirs,
+            time_s=time_s if self.positions_time_s is None else self.positions_time_s,
+        )  # fmt: skip
 
-    def directions(
-        self, phi_deg: np.ndarray, rng: np.random.Generator, joint: int | None = None
-    ) -> np.ndarray:
-        """Approach direction (+1 / -1) of one axis at each measurement (``joint``: which one,
-        1-based, for the directions a list of positions gives)."""
-        given = (
-            self.positions_dirs[joint - 1] if joint and joint <= len(self.positions_dirs) else None
-        )
+    def _directions(self, phi_deg: np.ndarray, rng: np.random.Generator, joint: int) -> np.ndarray:
+        """Approach direction (+1 / -1) of joint ``joint`` (1-based) at each measurement."""
+        given = self.positions_dirs[joint - 1] if joint <= len(self.positions_dirs) else None
         if given is not None:
             return np.tile(np.asarray(given, dtype=float), self.repeats)
         if self.approach == "positive":
             return np.ones(phi_deg.size)
         if self.approach == "random":
             return rng.choice([-1.0, 1.0], size=phi_deg.size)
-        if self.passes:
-            return self._pass_sign(phi_deg.size // (2 * self.passes))
+        if self.passes:  # +1 on forward and -1 on backward traversals
+            return np.tile(np.repeat([1.0, -1.0], phi_deg.size // (2 * self.passes)), self.passes)
         out = np.ones(phi_deg.size)
         for i in range(1, phi_deg.size):
             move = phi_deg[i] - phi_deg[i - 1]
             out[i] = out[i - 1] if move == 0 else np.sign(move)
         return out
-
-    def times_s(self, n: int) -> np.ndarray:
-        """Time of each of the ``n`` measurements, seconds."""
-        if self.positions_time_s is not None:
-            return np.asarray(self.positions_time_s, dtype=float)
-        return run_times_s(n, self.dwell_s)
 
     def describe(self, n_joints: int) -> str:
         """The schedule in one line (the ``# schedule:`` comment of a simulated file)."""
@@ -509,9 +507,8 @@ def simulate_measurements(
         noise_spread: F >= 1: each row's sigma is ``noise_arcsec`` times a factor drawn
             log-uniform in [1/F, F] (seeded, after the noise), within the noise range; 1: even.
         not_measured: angles left empty at every position (``dgamma`` for a pointing run or an
-            autocollimator's two tilts). Without ``dgamma`` a row's ``dpsi`` is the payload x
-            axis' own component (``-dR[2,0]``, docs/measurements.md section 1), as such a run
-            measures it.
+            autocollimator's two tilts); without ``dgamma`` a row's ``dpsi`` is the payload x
+            axis' own component (``-dR[2,0]``, docs/measurements.md section 1).
 
     Raises:
         InputError: an effect without parameters or beyond ``MAX_EFFECT_VALUE`` in its user
@@ -522,27 +519,25 @@ def simulate_measurements(
     seed = check_seed(seed)
     source = paper_table() if turntable is None else getattr(turntable, "table", turntable)
     table = measured_table(source)
-    n_joints = table.n_joints
     if isinstance(errors, TurntableErrors):
         errors = errors.as_array()
     vector = np.zeros(len(source.parameter_names)) if errors is None else np.asarray(errors, float)
     schedule = schedule or Schedule()
     rng = np.random.default_rng(seed)
-    variables, blank = _positions(schedule, rng, n_joints, not_measured)
+    rows = schedule.rows(rng, source)
+    blank = [ANGLE_NAMES.index(a) for a in _angle_names(not_measured)]
+    variables = PositionVariables.of(
+        rows, boresight_only=np.full(len(rows), 2 in blank and 0 not in blank)
+    )
     model, params, effects = planted_model(source, vector, effects, variables, catalogue, "effect")
     truth = model.predict(params)
     measured, sigma_rad = _noisy(truth, noise, noise_spread, rng)
     measured[:, blank] = np.nan
     _refuse_beyond_a_file(measured)
     data = OrientationMeasurements(
-        joint_rad=variables.joint_rad,
-        angles_rad=measured,
-        sigma_rad=sigma_rad,
-        time_s=variables.time_s,
-        dirs=variables.dirs,
-        source=f"simulated (seed {seed})",
-        joint_names=table.data_joint_names,
-    )
+        variables.joint_rad, measured, sigma_rad, rows.time_s, rows.dirs,
+        source=f"simulated (seed {seed})", joint_names=table.data_joint_names,
+    )  # fmt: skip
     return SimulatedMeasurements(
         data=data,
         errors=source.to_user_units(vector),
@@ -553,24 +548,6 @@ def simulate_measurements(
         truth_rad=truth,
         noise_spread=float(noise_spread),
     )
-
-
-def _positions(schedule: Schedule, rng, n_joints: int, not_measured) -> tuple:
-    """The positions ``schedule`` measures (with their times and approach directions) and the
-    indices of the angles ``not_measured``."""
-    check_count(schedule.count(n_joints), MAX_SIMULATED_ROWS, "rows of simulated measurements",
-                ROW_BYTES)  # fmt: skip
-    angles_deg = schedule.positions_deg(rng, n_joints)
-    n = angles_deg[0].size
-    time_s = schedule.times_s(n)
-    blank = [ANGLE_NAMES.index(a) for a in _angle_names(not_measured)]
-    variables = PositionVariables(
-        np.stack(angles_deg, axis=1) / DEG_PER_RAD,
-        time_s=time_s,
-        dirs=tuple(schedule.directions(a, rng, k) for k, a in enumerate(angles_deg, start=1)),
-        boresight_only=np.full(n, 2 in blank and 0 not in blank),
-    )
-    return variables, blank
 
 
 def _refuse_beyond_a_file(measured: np.ndarray) -> None:

@@ -55,7 +55,7 @@ def plot_design_positions(design: IdentifyDesign, path):
         ax = axes[0, 0]
         ax.plot(
             np.arange(1, design.plan.n_rows + 1),
-            design.plan.joint_deg[:, 0],
+            design.plan.rows.angles_deg()[:, 0],
             "o",
             color="tab:blue",
             label=f"design ({design.n_positions} positions)",

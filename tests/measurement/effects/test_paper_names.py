@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from rounding import chain_factors, chain_rounding
+from turntable_pin.calibration.positions import PositionSet
 from turntable_pin.measurement.catalogue import _determined, catalogue, joint_effect, resolve_effect
 from turntable_pin.measurement.effect_model import OrientationModel
 from turntable_pin.measurement.effects import EFFECT_NAMES, EFFECTS, PositionVariables, get_effect
@@ -68,7 +69,7 @@ def _variables(rng, n=50):
     """Random positions of the two axes, each with a time and both approach directions."""
     phi = rng.uniform(-np.pi, np.pi, (2, n))
     dirs = tuple(rng.choice([-1.0, 1.0], (2, n)))
-    return PositionVariables.of(*phi, time_s=rng.uniform(0, 7200, n), dirs=dirs)
+    return PositionVariables.of(PositionSet(*phi, time_s=rng.uniform(0, 7200, n), dirs=dirs))
 
 
 @pytest.mark.parametrize("name", EFFECT_NAMES)

@@ -162,10 +162,13 @@ class PositionVariables:
         self.__dict__.update(state)
 
     @classmethod
-    def of(cls, *angles_rad, time_s=None, dirs=(), extra=None) -> PositionVariables:
-        """The variables of joint angle arrays given one per joint (``phi1, phi2, ...``)."""
-        joints = np.stack([np.asarray(a, dtype=float).reshape(-1) for a in angles_rad], axis=1)
-        return cls(joints, time_s, tuple(dirs), dict(extra or {}))
+    def of(cls, positions, extra=None, boresight_only=None) -> PositionVariables:
+        """The variables of a :class:`~turntable_pin.calibration.positions.PositionSet`: its
+        angles, ``time_s`` and approach directions, with the ``extra`` columns."""
+        return cls(
+            positions.angles_rad, positions.time_s, positions.dirs, dict(extra or {}),
+            boresight_only,
+        )  # fmt: skip
 
     @property
     def n(self) -> int:
