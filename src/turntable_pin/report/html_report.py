@@ -205,6 +205,14 @@ def _data(page: _Page, heading: str) -> list[str]:
     return [_heading(heading) + img_tag(data_figure(page.family.data), "measured angles")]
 
 
+def _flat_directions(result, words: str) -> list[str]:
+    """A fit's undetermined combinations after ``words``: one paragraph, or none."""
+    und = result.undetermined_combinations()
+    if not und:
+        return []
+    return [f"<p>{words}: " + ", ".join(f"<code>{html.escape(u)}</code>" for u in und) + ".</p>"]
+
+
 def _combinations(result) -> str:
     return html_table(
         ["combination", "value", "std", "unit"],
@@ -230,13 +238,7 @@ def _base(page: _Page, heading: str) -> list[str]:
             + f" The data determine {page.d['base']['rank']} combinations of them:</p>",
             _combinations(result),
         ]
-        und = result.undetermined_combinations()
-        if und:
-            parts.append(
-                "<p>Not determined by orientation data (flat directions): "
-                + ", ".join(f"<code>{html.escape(u)}</code>" for u in und)
-                + ".</p>"
-            )
+        parts += _flat_directions(result, "Not determined by orientation data (flat directions)")
         parts.append(table)
     if not page.effect and "fails" not in page.names:
         parts.append(img_tag(residual_figure([page.base_rs]), "base residuals"))
@@ -403,13 +405,7 @@ def _parameters(page: _Page, heading: str) -> list[str]:
         f"{res.rank} of {res.n_params} parameters):</p>",
         _combinations(res),
     ]
-    und = res.undetermined_combinations()
-    if und:
-        parts.append(
-            "<p>Flat directions: "
-            + ", ".join(f"<code>{html.escape(u)}</code>" for u in und)
-            + ".</p>"
-        )
+    parts += _flat_directions(res, "Flat directions")
     return parts
 
 
