@@ -32,5 +32,5 @@ def test_one_version_the_metadata_s_the_project_s_and_the_changelog_s():
     version = re.search(r'^version = "(.+)"', (ROOT / "pyproject.toml").read_text(), re.M)[1]
     proc = cli("--version")
     assert proc.returncode == 0 and proc.stdout.strip() == f"turntable-pin {version}"
-    changelog = (ROOT / "README.md").read_text().split("## Changelog", 1)[1]
+    changelog = (ROOT / "docs" / "changelog.md").read_text().split("# Changelog", 1)[1]
     assert re.search(r"^- \*\*([0-9.]+),", changelog, re.M)[1] == version
