@@ -14,7 +14,7 @@ are ``2/pi = 0.6366`` for every sin/cos term and 1 for every constant term. The 
 ``0.6476 / 0.5365`` are the mean of ``|cos|`` and ``|sin|`` over a 45-degree grid that counts both
 0 and 360 degrees; its ``0.6481 / 0.5372`` and its small non-zero off-model values (0.0053,
 0.0059, ...) match that grid applied to the exact chain at errors of about 0.1-0.2 degrees (see
-the README).
+``docs/allocation.md``).
 """
 
 from __future__ import annotations
