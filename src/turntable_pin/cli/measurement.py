@@ -199,11 +199,13 @@ def _register_fit(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _register_diagnose_and_report(subparsers: argparse._SubParsersAction) -> None:
+    from ..report.diagnosis_text import decision_rule_words
+
     d = subparsers.add_parser(
         "diagnose",
-        description="Test every catalogued effect against the base fit (BIC, delta <= -6), "
-        "rank them, name the missing effect, its equivalent alternatives, and whether "
-        "structure remains that nothing in the catalogue explains.",
+        description="Test every catalogued effect against the base fit by BIC "
+        f"({decision_rule_words()}), rank them, name the missing effect, its equivalent "
+        "alternatives, and whether structure remains that nothing in the catalogue explains.",
     )
     one_line_errors(d)
     _add_data_options(d)

@@ -24,6 +24,7 @@ from ..stats.diagnosis_engine import DATA_PLACEHOLDER, residual_sets
 from ..stats.model_selection import Diagnosis
 from .diagnosis_text import (
     coefficient_lines,
+    decision_rule_words,
     headline,
     other_side_lines,
     table_from_run_lines,
@@ -411,8 +412,9 @@ def _parameters(page: _Page, heading: str) -> list[str]:
 
 def _decision_rule(page: _Page, heading: str) -> list[str]:
     return [
-        "<p style='color:#777;font-size:.85em'>Decision rule: an effect is accepted when it "
-        "lowers BIC by 6 or more; effects whose fit is as good are listed as alternatives; the "
+        "<p style='color:#777;font-size:.85em'>Decision rule: "
+        f"{html.escape(decision_rule_words(page.d))}; effects whose fit is as good are listed "
+        "as alternatives; the "
         "final model is 'unexplained' when it fails the chi2 test (sigma given) or a harmonic "
         "structure search still finds a term.</p>"
     ]
