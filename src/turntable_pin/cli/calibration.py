@@ -103,6 +103,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="DIR",
         help="write Figures 4 and 5 (PNG) here (default: no plots)",
     )
+    from ..calibration.requirement import PROGRESS_DELAY_S
+
+    q.add_argument("--quiet", action="store_true",
+                   help=f"no progress report (by default a run longer than {PROGRESS_DELAY_S:g} "
+                   "s reports its progress on stderr)")  # fmt: skip
     q.set_defaults(func=run_requirement)
     _register_calibrate(subparsers)
 
@@ -218,6 +223,7 @@ def run_requirement(args: argparse.Namespace) -> int:
     result = orientation_requirement(
         args.accuracy_dph, PositionSet.parse(args.positions, table), deg_to_rad(args.latitude_deg),
         gyrowheel=_gyrowheel(args), exact=args.exact, definition=args.definition,
+        progress=not args.quiet,
     )  # fmt: skip
     report = {**result.to_dict(), **_table_keys(table)}
     if args.plots:
