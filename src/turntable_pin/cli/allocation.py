@@ -135,14 +135,18 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
         "bundled ones, the paper's models/manufacturing_lower_bounds.yaml; none bundled: 0)",
     )
     add_table_options(p)
+    from ..allocation.sensitivity import DEFAULT_GRID_STEPS_DEG as STEPS
+
+    steps = ", ".join(f"{STEPS[k]:g}" for k in sorted(STEPS))
+    counts = ", ".join(str(k) for k in sorted(STEPS))
     p.add_argument(
         "--grid-step-deg",
         type=bounded_float(MIN_GRID_STEP_DEG, 90.0, "deg"),
         default=None,
         help="step of the grid over every joint on which the sensitivities are averaged, the "
         "maxima of the constraints start (they hold between the grid points too) and the Monte "
-        "Carlo runs (default 1, 5, 15 deg when the first-order model depends on 1, 2, 3 joints: "
-        "1 deg on the paper's table)",
+        f"Carlo runs (default {steps} deg when the first-order model depends on {counts} "
+        f"joints: {STEPS[1]:g} deg on the paper's table)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
 

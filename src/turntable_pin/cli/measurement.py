@@ -244,6 +244,10 @@ ORIENTATION_ONLY_OPTIONS: tuple[str, ...] = (
     "approach",
 )  # fmt: skip
 """The ``simulate`` options of orientation measurements alone (refused with ``--run``)."""
+RUN_POSITIONS = "grid:30"
+"""The positions of ``simulate --run`` without ``--positions``."""
+RUN_NOISE_DPH = 0.002
+"""The output noise of ``simulate --run`` without ``--noise-dph``, deg/h."""
 
 
 def _add_run_options(s: argparse.ArgumentParser) -> None:
@@ -260,7 +264,7 @@ def _add_run_options(s: argparse.ArgumentParser) -> None:
         "arcsec; bias_drift:x,y deg/h/h; temperature_coefficient:x,y deg/h/degC; "
         "earth_rate_scale:x,y ppm; "
         "g_squared_terms:x_xz,x_yz,y_xz,y_yz deg/h/g^2); --positions takes a scheme "
-        "(grid:STEP, grid:S1xS2; default grid:30) or a CSV of angles",
+        f"(grid:STEP, grid:S1xS2; default {RUN_POSITIONS}) or a CSV of angles",
     )
     g.add_argument("--run", action="store_true",
                    help="simulate a GyroWheel calibration run (what calibrate reads)")  # fmt: skip
@@ -269,7 +273,7 @@ def _add_run_options(s: argparse.ArgumentParser) -> None:
                    "made with --hide-truth (default: no truth file)")  # fmt: skip
     g.add_argument("--noise-dph", type=_noise_dph, metavar="S|SX,SY",
                    help="1-sigma output noise, deg/h: one value for both channels or x,y "
-                   "(default 0.002)")  # fmt: skip
+                   f"(default: {RUN_NOISE_DPH:g})")  # fmt: skip
     g.add_argument("--latitude-deg", type=latitude_deg,
                    help=f"site latitude, degrees (default {DEFAULT_LATITUDE_DEG})")  # fmt: skip
     g.add_argument("--gyrowheel", type=input_path, metavar="FILE.yaml",
@@ -337,8 +341,9 @@ def _add_until_explained_option(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--until-explained",
         action="store_true",
-        help="keep adding the best significant effect, round after round, until none is left "
-        "(by default the diagnosis names the first missing effect and stops)",
+        help="name every effect the stepwise search accepts, each significant on top of those "
+        "before it (by default the verdict names the first one and lists the others as also "
+        "significant)",
     )
 
 
@@ -447,9 +452,9 @@ def run_simulate_run(args: argparse.Namespace) -> int:
         positions = PositionSet.random(args.random_positions, table, args.seed)
     else:
         positions = PositionSet.parse(
-            "grid:30" if args.positions is None else str(args.positions), table
+            RUN_POSITIONS if args.positions is None else str(args.positions), table
         )
-    noise = 0.002 if args.noise_dph is None else args.noise_dph
+    noise = RUN_NOISE_DPH if args.noise_dph is None else args.noise_dph
     latitude = DEFAULT_LATITUDE_DEG if args.latitude_deg is None else args.latitude_deg
     gyrowheel = GyroWheelModel.from_yaml(args.gyrowheel) if args.gyrowheel else None
     temperature = TemperatureProfile(*args.temperature) if args.temperature else None
