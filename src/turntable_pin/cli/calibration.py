@@ -44,7 +44,7 @@ def _add_setup_options(parser: argparse.ArgumentParser, *, positions: bool = Tru
     add_table_options(parser)
     parser.add_argument(
         "--latitude-deg", type=latitude_deg, default=DEFAULT_LATITUDE_DEG,
-        help="latitude of the test site, degrees (Harbin's by default)",
+        help="latitude of the test site, degrees (the paper's: Harbin)",
     )  # fmt: skip
 
 
