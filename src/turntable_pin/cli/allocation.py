@@ -149,6 +149,10 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
         f"joints: {STEPS[1]:g} deg on the paper's table)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress report (by default long work reports its progress on "
+                   "stderr, unless --json: the default limits' requirement, the Monte Carlo "
+                   "runs)")  # fmt: skip
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -196,7 +200,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="DIR",
         help="write Figure 9 (histograms) here (default: no plots)",
     )
-    m.add_argument("--quiet", action="store_true", help="no progress report")
     m.set_defaults(func=run_montecarlo)
 
 
@@ -212,8 +215,9 @@ def _limits_from_args(args: argparse.Namespace, table) -> tuple[OrientationLimit
 
     try:
         limits = default_orientation_limits(
-            args.accuracy_dph, args.positions, args.latitude_deg, table, args.requirement
-        )
+            args.accuracy_dph, args.positions, args.latitude_deg, table, args.requirement,
+            progress=not (args.quiet or args.json),
+        )  # fmt: skip
     except IdentifiabilityError as exc:
         raise IdentifiabilityError(
             f"no default limits for this table ({exc}); give --limits-arcmin or --limits-deg"

@@ -107,7 +107,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     q.add_argument("--quiet", action="store_true",
                    help=f"no progress report (by default a run longer than {PROGRESS_DELAY_S:g} "
-                   "s reports its progress on stderr)")  # fmt: skip
+                   "s reports its progress on stderr, unless --json)")  # fmt: skip
     q.set_defaults(func=run_requirement)
     _register_calibrate(subparsers)
 
@@ -223,7 +223,7 @@ def run_requirement(args: argparse.Namespace) -> int:
     result = orientation_requirement(
         args.accuracy_dph, PositionSet.parse(args.positions, table), deg_to_rad(args.latitude_deg),
         gyrowheel=_gyrowheel(args), exact=args.exact, definition=args.definition,
-        progress=not args.quiet,
+        progress=not (args.quiet or args.json),
     )  # fmt: skip
     report = {**result.to_dict(), **_table_keys(table)}
     if args.plots:
