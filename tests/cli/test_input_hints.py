@@ -64,3 +64,11 @@ def test_a_sigma_header_problem_is_at_the_headers_line(tmp_path):
     )  # fmt: skip
     path = write_file(tmp_path, text + "\n")
     refused(cli("diagnose", str(path)), f"row {HEADER_ROW}, column 'sigma_arcsec': give either")
+
+
+@pytest.mark.parametrize("command", ["calibrate", "diagnose", "fit", "report"])
+def test_the_help_of_a_command_reading_a_csv_says_the_row_rule(command):
+    from turntable_pin.core.csv_table import ROW_RULE
+
+    page = " ".join(cli(command, "--help").stdout.split())
+    assert ROW_RULE in page and "comment lines counted" in ROW_RULE

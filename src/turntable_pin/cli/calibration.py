@@ -121,7 +121,10 @@ def _register_calibrate(subparsers: argparse._SubParsersAction) -> None:
         "residuals per position.",
     )
     one_line_errors(c)
-    c.add_argument("data", type=input_path, metavar="RUN.csv", help="the calibration run (a CSV)")
+    from ..core.csv_table import ROW_RULE
+
+    c.add_argument("data", type=input_path, metavar="RUN.csv",
+                   help=f"the calibration run (a CSV; {ROW_RULE})")  # fmt: skip
     _add_setup_options(c, positions=False)
     add_mount_option(c)
     c.add_argument("--json", action="store_true", help="print one JSON object")

@@ -382,8 +382,10 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
 
 
 def _add_data_argument(p: argparse.ArgumentParser) -> None:
+    from ..core.csv_table import ROW_RULE
+
     p.add_argument("data", type=input_path, metavar="DATA.csv",
-                   help="the measurements (a CSV, docs/measurements.md)")  # fmt: skip
+                   help=f"the measurements (a CSV, docs/measurements.md; {ROW_RULE})")  # fmt: skip
 
 
 def _add_ignore_sigma_option(p: argparse.ArgumentParser) -> None:

@@ -24,6 +24,7 @@ from .files import check_input_file, write_text_atomic
 from .sizes import MAX_TABLE_COLUMNS, MAX_TABLE_FILE_BYTES, MAX_TABLE_ROWS
 
 __all__ = [
+    "ROW_RULE",
     "CsvTable",
     "check_header",
     "closest_column_hint",
@@ -36,6 +37,10 @@ __all__ = [
     "refuse_repeated_rows",
     "write_csv_table",
 ]
+
+
+ROW_RULE = "a row a message names is the file's line number, comment lines counted"
+"""The row-numbering rule of the module docstring, in the words a command's help says it."""
 
 
 @dataclass(frozen=True)
