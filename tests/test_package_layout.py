@@ -180,3 +180,15 @@ def test_import_and_help_pay_for_no_heavy_library():
 def test_orientation_does_not_load_scipy_or_matplotlib():
     heavy = ("scipy", "matplotlib", "yourdfpy", "meshcat")
     assert _heavy_modules_loaded_by(["orientation", "--phi1-deg", "30"], heavy) == []
+
+
+def test_no_text_of_the_package_says_the_models_install_outside_it():
+    """The bundled models are package data, ``turntable_pin/models`` (setup.py); no docstring,
+    message or help text under src/ says they install under ``<prefix>/share`` (issue 30)."""
+    import turntable_pin.core.resources as resources
+
+    setup = (PACKAGE.parents[1] / "setup.py").read_text()
+    texts = [p.read_text() for p in sorted(PACKAGE.rglob("*.py"))] + [setup]
+    assert not [t for t in texts if "share/turntable-pin" in t or "share/turntable_pin" in t]
+    assert "turntable_pin/models" in resources.__doc__
+    assert '"turntable_pin.models": "models"' in setup

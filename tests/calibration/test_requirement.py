@@ -127,3 +127,24 @@ def test_to_dict_states_the_set_up(requirement):
 def test_bad_accuracy():
     with pytest.raises(InputError, match="positive"):
         orientation_requirement(0.0, PositionSet.parse("grid:90"), LAT_RAD)
+
+
+def test_a_long_requirement_reports_its_progress_on_stderr(monkeypatch, capsys):
+    """A requirement past PROGRESS_DELAY_S reports each step on stderr (a three-axis grid takes
+    5-20 s); progress=False, the library's default, and --quiet say nothing (issue 30)."""
+    import turntable_pin.calibration.requirement as module
+    from turntable_pin.cli import main
+
+    positions = PositionSet.parse("grid:90")
+    monkeypatch.setattr(module, "PROGRESS_DELAY_S", 0.0)
+    quiet = orientation_requirement(W_M, positions, LAT_RAD)
+    assert capsys.readouterr().err == ""
+    loud = orientation_requirement(W_M, positions, LAT_RAD, progress=True)
+    lines = capsys.readouterr().err.splitlines()
+    steps = 2 * module.rectangle_steps() + 2
+    assert lines[-1].startswith(f"requirement (16 positions): 100% ({steps}/{steps}, ")
+    assert len(lines) >= 10 and loud.to_dict() == quiet.to_dict()
+    assert main(["requirement", "--positions", "grid:90"]) == 0
+    assert "requirement (16 positions): 100%" in capsys.readouterr().err
+    assert main(["requirement", "--positions", "grid:90", "--quiet"]) == 0
+    assert capsys.readouterr().err == ""

@@ -135,3 +135,18 @@ def test_the_text_says_what_holds_for_the_final_bounds(table):
         state = "(at the limit)" if worst >= limit * (1 - 1e-6) else f"({worst / limit:.0%} of"
         assert state in line, line
     assert "active in it:" in text and "active: " not in text
+
+
+def test_allocate_reports_the_default_limits_progress_unless_quiet(monkeypatch):
+    """The default limits are a requirement (seconds on a three-axis grid): its progress goes to
+    stderr, never to stdout; --quiet and --json silence it (issue 30)."""
+    import turntable_pin.calibration.requirement as requirement
+
+    monkeypatch.setattr(requirement, "PROGRESS_DELAY_S", 0.0)
+    args = ["allocate", "--positions", "grid:90"]
+    loud = cli(*args)
+    assert loud.returncode == 0 and "requirement (16 positions): 100%" in loud.stderr
+    assert "requirement (" not in loud.stdout
+    for extra in ("--quiet", "--json"):
+        quiet = cli(*args, extra)
+        assert quiet.returncode == 0 and "requirement (" not in quiet.stderr

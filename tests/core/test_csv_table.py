@@ -207,3 +207,47 @@ def test_missing_columns_are_never_called_absent_when_present_as_text():
     )
     assert missing_columns_words(["x"], (), "the data") == "x, absent from the data"
     assert ignored_columns_words(["note"]).startswith("column(s) note ignored: not numbers")
+
+
+@pytest.mark.parametrize(
+    "delimiter, named",
+    [(";", "';'"), ("\t", "a tab"), ("|", "'|'")],
+    ids=["semicolon", "tab", "bar"],
+)
+def test_another_delimiter_is_named_not_taken_for_a_missing_column(tmp_path, delimiter, named):
+    text = (
+        "# made by a spreadsheet\n\n"
+        + HEAD.replace(",", delimiter)
+        + "0;0;1\n".replace(";", delimiter)
+    )
+    path = write_file(tmp_path, text)
+    for read in (lambda: read_csv_table(path, REQ), lambda: read_header(path)):
+        with pytest.raises(InputError) as info:
+            read()
+        message = str(info.value)
+        assert f"row 3: the delimiter is {named} (expected ',')" in message
+        assert "missing" not in message
+
+
+def test_a_missing_column_that_may_be_empty_says_an_empty_cell_means_not_measured(tmp_path):
+    path = write_file(tmp_path, "phi1_deg,phi2_deg,dpsi_arcsec\n0,0,1\n")
+    blank = ("dpsi_arcsec", "dtheta_arcsec", "dgamma_arcsec")
+    with pytest.raises(InputError) as info:
+        read_csv_table(path, ("phi1_deg", "phi2_deg", *blank), blank=blank)
+    message = str(info.value)
+    assert "missing required column(s) 'dtheta_arcsec', 'dgamma_arcsec'" in message
+    assert "keep the columns with their cells left empty (an empty cell means not measured)" in (
+        message
+    )
+    assert "misspelling" not in message  # dpsi_arcsec is a column of its own, no misspelling
+
+
+def test_a_known_column_is_never_proposed_and_no_hint_is_given_twice(tmp_path):
+    header = "phi1_deg,phi2_deg,sigma_arcsec,dangle_arcsec"
+    path = write_file(tmp_path, header + "\n0,0,1,1\n")
+    blank = ("dpsi_arcsec", "dtheta_arcsec", "dgamma_arcsec")
+    with pytest.raises(InputError) as info:
+        read_csv_table(path, ("phi1_deg", "phi2_deg", *blank), ("sigma_arcsec",), blank=blank)
+    message = str(info.value)
+    assert "sigma_arcsec' a misspelling" not in message
+    assert message.count("is 'dangle_arcsec' a misspelling") == 1

@@ -17,3 +17,20 @@ def test_disabled_is_silent():
     with Progress(10, "x", enabled=False, stream=stream) as bar:
         bar.update(10)
     assert stream.getvalue() == "" and bar.done == 10
+
+
+def test_a_delay_keeps_short_work_silent_and_long_work_reported(monkeypatch):
+    import turntable_pin.core.progress as progress
+
+    now = [0.0]
+    monkeypatch.setattr(progress.time, "perf_counter", lambda: now[0])
+    quiet, loud = io.StringIO(), io.StringIO()
+    with Progress(4, "short", stream=quiet, delay_s=1.0) as bar:
+        bar.update(4)  # done at once
+    assert quiet.getvalue() == ""
+    with Progress(4, "long", stream=loud, delay_s=1.0) as bar:
+        bar.update(1)  # before the delay: silent
+        now[0] = 2.0
+        bar.update(1)
+        bar.update(2)
+    assert loud.getvalue().splitlines() == ["long:  50% (2/4, 2.0 s)", "long: 100% (4/4, 2.0 s)"]

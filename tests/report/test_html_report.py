@@ -123,3 +123,27 @@ def test_report_opens_in_the_browser_and_every_image_loads(tmp_path):
     page = path.read_text()
     assert report.n_images == len(re.findall(r"<img ", page)) == len(set(_images(page)))
     assert report.all_loaded, report.failed
+
+
+def test_where_it_fails_says_which_positions_it_lists_and_the_story_is_told_once():
+    """Section 3 names the rows it lists (the 15 worst of 51); the effect's why and how to
+    confirm it are in the verdict once, not repeated below it (issue 30)."""
+    import html as html_module
+
+    from turntable_pin.core.resources import examples_dir
+    from turntable_pin.measurement.data import read_measurements
+    from turntable_pin.report.html_report import FAILING_SHOWN
+
+    diagnosis = diagnose_measurements(
+        read_measurements(examples_dir() / "measurements_example.csv")
+    )
+    page = diagnosis_html(diagnosis, title="t")
+    section = page.split("<h2>3.", 1)[1].split("<h2>4.", 1)[0]
+    n_failing = int(re.search(r"<p>(\d+) of 144 positions have a residual", section).group(1))
+    assert n_failing > FAILING_SHOWN
+    assert f"The {FAILING_SHOWN} largest, worst first" in section
+    assert section.split("</table>", 1)[0].count("<tr>") == FAILING_SHOWN + 1  # and the header
+    story = diagnosis.to_dict()["verdict"]["effect_story"]
+    text = html_module.unescape(page)
+    for words in (story["explanation"], story["confirm"]):
+        assert text.count(words) == 1

@@ -163,6 +163,7 @@ def default_orientation_limits(
     latitude_deg: float = DEFAULT_LATITUDE_DEG,
     table=None,
     requirement: str = "box",
+    progress: bool = False,
 ) -> OrientationLimits:
     """The orientation requirement used when the user gives no limits.
 
@@ -171,6 +172,8 @@ def default_orientation_limits(
     ``table`` (default the bundled table) at ``latitude_deg`` (degrees), with the paper's Table 1
     GyroWheel: its box that holds (``requirement="box"``) or the paper's planes (``"planes"``,
     :data:`REQUIREMENT_KINDS`). The paper's own numbers are :func:`paper_eq16_limits`.
+    ``progress``: report the requirement's progress on stderr when it takes long (a three-axis
+    table's grid).
 
     Raises:
         IdentifiabilityError: the positions cannot calibrate the GyroWheel on this table.
@@ -180,8 +183,9 @@ def default_orientation_limits(
             f"unknown requirement '{requirement}'; expected one of {REQUIREMENT_KINDS}"
         )
     result = orientation_requirement(
-        accuracy_dph, PositionSet.parse(positions, resolve_table(table)), math.radians(latitude_deg)
-    )
+        accuracy_dph, PositionSet.parse(positions, resolve_table(table)),
+        math.radians(latitude_deg), progress=progress,
+    )  # fmt: skip
     return OrientationLimits(*(result.box if requirement == "box" else result).limits_rad)
 
 

@@ -406,12 +406,13 @@ def angle_columns(
             path=path, row=header_row, column=beyond[0],
         )  # fmt: skip
     out = []
+    known = [f"phi{k}_deg" for k in range(1, len(names) + 1)] + [f"{j}_deg" for j in names if j]
     for k, joint in enumerate(names, start=1):
         found = [c for c in (f"phi{k}_deg", f"{joint}_deg" if joint else None) if c in header]
         if not found:
             spelled = f"'phi{k}_deg'" + (f" or '{joint}_deg'" if joint else "")
-            hint = closest_column_hint(f"phi{k}_deg", header) or (
-                closest_column_hint(f"{joint}_deg", header) if joint else ""
+            hint = closest_column_hint(f"phi{k}_deg", header, known) or (
+                closest_column_hint(f"{joint}_deg", header, known) if joint else ""
             )
             raise InputError(
                 f"missing required column {spelled} (the commanded angle of joint {k}"

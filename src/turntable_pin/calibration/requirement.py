@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.exceptions import InputError
+from ..core.progress import Progress
 from ..core.turn_grid import every_combination
 from ..core.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
 from ..model.angles import ANGLE_SYMBOLS
@@ -58,6 +59,8 @@ __all__ = [
     "JACOBIAN_STEP_RAD",
     "MAX_ANGLE_RAD",
     "PLANES",
+    "PROGRESS_DELAY_S",
+    "RECTANGLE_ZOOMS",
     "OrientationRequirement",
     "PlaneRateError",
     "PlaneRectangle",
@@ -69,6 +72,7 @@ __all__ = [
     "largest_rectangle",
     "orientation_requirement",
     "rate_error_jacobian",
+    "rectangle_steps",
     "requirement_box",
 ]
 
@@ -235,17 +239,37 @@ class PlaneRectangle:
         }
 
 
+RECTANGLE_ZOOMS = 3
+"""How many times :func:`largest_rectangle` zooms its scan in on the best half-width."""
+PROGRESS_DELAY_S = 2.0
+"""A requirement that takes longer than this reports its progress (stderr)."""
+
+
+def rectangle_steps(zooms: int = RECTANGLE_ZOOMS) -> int:
+    """The steps :func:`largest_rectangle` reports done: two axis limits, ``zooms + 1`` scans
+    and the last push to the contour."""
+    return zooms + 4
+
+
 def largest_rectangle(
-    function: PlaneRateError, accuracy_dph: float, *, scan_points: int = 48, zooms: int = 3
+    function: PlaneRateError,
+    accuracy_dph: float,
+    *,
+    scan_points: int = 48,
+    zooms: int = RECTANGLE_ZOOMS,
+    step=lambda: None,
 ) -> PlaneRectangle:
     """The centred rectangle of largest area with ``dw <= w_m`` at its corners (see module).
 
     ``a b(a)`` is scanned on ``scan_points`` values of ``a``, then ``zooms`` times on as many
     points between the best one's neighbours (the relative resolution of ``a`` ends near
     ``(2 / scan_points)^zooms``; the area is flat at its maximum, so it is far finer).
+    ``step()`` is called after each of its :func:`rectangle_steps` steps (a progress report).
     """
     u_limit, u_capped = function.axis_limit(0, accuracy_dph)
+    step()
     v_limit, v_capped = function.axis_limit(1, accuracy_dph)
+    step()
     u_hi = u_limit * (1 + 1e-9) + 1e-15
     v_hi = v_limit * (1 + 1e-9) + 1e-15
     # Scanning and pushing a hair inside the contour keeps the bisections well defined where the
@@ -261,11 +285,13 @@ def largest_rectangle(
         best_a = float(us[best])
         lower = float(us[max(best - 1, 0)])
         upper = float(us[min(best + 1, scan_points - 1)])
+        step()
     b = float(function.largest(1, best_a, accuracy_dph, v_hi)[0])
     # Push to the contour along u as well so that neither side can grow, then b to the contour.
     a = float(function.largest(0, b * (1 - _MARGIN), accuracy_dph, u_hi)[0])
     b = float(function.largest(1, a * (1 - _MARGIN), accuracy_dph, v_hi)[0])
     a, b = _settle(function, a, b, accuracy_dph)
+    step()
     return PlaneRectangle(
         plane=function.plane,
         axis=function.axis,
@@ -591,6 +617,7 @@ def orientation_requirement(
     gyrowheel: GyroWheelModel | None = None,
     exact: bool = False,
     definition: str = "true_coefficients",
+    progress: bool = False,
 ) -> OrientationRequirement:
     """The orientation requirement (eqs. 15-16) for accuracy ``w_m`` on a position set.
 
@@ -604,6 +631,8 @@ def orientation_requirement(
         gyrowheel: the drift coefficients (default: paper Table 1).
         exact: exact rotation for ``dR`` instead of eq. 7.
         definition: the rate-error definition (see :mod:`turntable_pin.calibration.rate_error`).
+        progress: report the progress on stderr when the work lasts longer than
+            :data:`PROGRESS_DELAY_S` (a three-axis grid takes seconds).
     """
     check_accuracy_dph(accuracy_dph)
     if definition not in DEFINITIONS:
@@ -613,8 +642,25 @@ def orientation_requirement(
     require_identifiable(inputs, every_coefficient=False)
     fx = PlaneRateError("psi_theta", gyrowheel, inputs, exact=exact, definition=definition)
     fy = PlaneRateError("theta_gamma", gyrowheel, inputs, exact=exact, definition=definition)
-    rect_x = largest_rectangle(fx, accuracy_dph)
-    rect_y = largest_rectangle(fy, accuracy_dph)
+    steps = 2 * rectangle_steps() + 2  # the planes, the other side re-extended, the box
+    with Progress(
+        steps, f"requirement ({len(positions)} positions)", enabled=progress,
+        delay_s=PROGRESS_DELAY_S,
+    ) as bar:  # fmt: skip
+        return _requirement(
+            accuracy_dph, positions, latitude_rad, gyrowheel, inputs, (fx, fy), bar.update,
+            exact=exact, definition=definition,
+        )  # fmt: skip
+
+
+def _requirement(
+    accuracy_dph, positions, latitude_rad, gyrowheel, inputs, planes, step, *, exact, definition
+) -> OrientationRequirement:
+    """:func:`orientation_requirement` once its inputs are checked; ``step()`` after each of
+    its steps."""
+    fx, fy = planes
+    rect_x = largest_rectangle(fx, accuracy_dph, step=step)
+    rect_y = largest_rectangle(fy, accuracy_dph, step=step)
     psi, theta_x = rect_x.half_widths_rad
     theta_y, gamma = rect_y.half_widths_rad
     # The other plane's free side re-extended to the contour at the binding plane's I_theta.
@@ -635,6 +681,9 @@ def orientation_requirement(
     box = rate_errors_at_angles_dph(
         gyrowheel, inputs, corners, exact=exact, definition=definition
     ).max(axis=0)
+    step()
+    held = requirement_box(accuracy_dph, gyrowheel, inputs, exact=exact, definition=definition)
+    step()
     return OrientationRequirement(
         accuracy_dph=float(accuracy_dph),
         psi_rad=float(psi),
@@ -644,7 +693,7 @@ def orientation_requirement(
         rectangles=(rect_x, rect_y),
         box_dwx_dph=float(box[0]),
         box_dwy_dph=float(box[1]),
-        box=requirement_box(accuracy_dph, gyrowheel, inputs, exact=exact, definition=definition),
+        box=held,
         latitude_rad=float(latitude_rad),
         positions_name=positions.name,
         n_positions=len(positions),

@@ -29,7 +29,7 @@ from ..core.interrupts import (
 from ..core.words import speaking
 from .words import CLI_WORDS
 
-__all__ = ["COMMANDS", "build_parser", "main"]
+__all__ = ["COMMANDS", "HelpFormatter", "build_parser", "main", "shows_default"]
 
 COMMANDS: dict[str, tuple[str, str]] = {
     "orientation": ("orientation", "orientation error dR of the payload at one position"),
@@ -67,13 +67,39 @@ COMMANDS: dict[str, tuple[str, str]] = {
 """Command name -> (module of this package that registers it, one-line help)."""
 
 
+def shows_default(action: argparse.Action) -> bool:
+    """Whether ``--help`` writes ``(default: X)`` after the option's help, ``X`` its default value:
+    an optional option that takes a value and has one (not ``None``, not an empty list). The
+    others say in their own words what happens without them (``default: ...``)."""
+    default = action.default
+    return (
+        bool(action.option_strings)
+        and not action.required
+        and action.nargs != 0
+        and default is not None
+        and default is not argparse.SUPPRESS
+        and not (isinstance(default, (list, tuple)) and not default)
+    )
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """Every command's help: each option's text, then ``(default: X)`` from the option's own
+    default (:func:`shows_default`), so a default is written once, from the code's value."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        return f"{text} (default: %(default)s)" if shows_default(action) else text
+
+
 class _Subcommands:
-    """The ``subparsers`` a command module registers into: adds the one-line help of COMMANDS."""
+    """The ``subparsers`` a command module registers into: adds the one-line help of COMMANDS
+    and the :class:`HelpFormatter`."""
 
     def __init__(self, subparsers: argparse._SubParsersAction) -> None:
         self._subparsers = subparsers
 
     def add_parser(self, name: str, **kwargs) -> argparse.ArgumentParser:
+        kwargs.setdefault("formatter_class", HelpFormatter)
         return self._subparsers.add_parser(name, help=COMMANDS[name][1], **kwargs)
 
 

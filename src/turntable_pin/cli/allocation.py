@@ -89,38 +89,42 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
         "default: the calibration layer's orientation requirement for --accuracy-dph on "
         "--positions at --latitude-deg",
     )
-    limits.add_argument("--limits-deg", metavar="psi=P,theta=T,gamma=G", help="... in degrees")
+    limits.add_argument(
+        "--limits-deg",
+        metavar="psi=P,theta=T,gamma=G",
+        help="the same in degrees (default: as --limits-arcmin says)",
+    )
     p.add_argument(
         "--accuracy-dph",
         type=accuracy_dph,
         default=DEFAULT_ACCURACY_DPH,
-        help=f"calibration accuracy behind the default limits, deg/h ({DEFAULT_ACCURACY_DPH})",
+        help="calibration accuracy behind the default limits, deg/h",
     )
     p.add_argument(
         "--positions",
         type=position_scheme,
         default=DEFAULT_POSITIONS,
-        help=f"position scheme behind the default limits ({DEFAULT_POSITIONS})",
+        help="position scheme behind the default limits",
     )
     p.add_argument(
         "--latitude-deg",
         type=latitude_deg,
         default=DEFAULT_LATITUDE_DEG,
-        help=f"latitude behind the default limits, degrees ({DEFAULT_LATITUDE_DEG})",
+        help="latitude behind the default limits, degrees",
     )
     p.add_argument(
         "--requirement",
         choices=REQUIREMENT_KINDS,
         default=REQUIREMENT_KINDS[0],
         help="which requirement the default limits are: the largest box whose every point "
-        "meets the accuracy (default) or the paper's planes (eqs. 15-16; all three at their "
+        "meets the accuracy or the paper's planes (eqs. 15-16; all three at their "
         "limits at once exceed it)",
     )
     p.add_argument(
         "--weights",
         choices=WEIGHT_SCHEMES,
         default="model",
-        help="W = 1/sensitivity from the exact model (default), from the paper's Figure 8 "
+        help="W = 1/sensitivity from the exact model, from the paper's Figure 8 "
         "(0.6481 for sin/cos terms, 1 for constants), or equal weights (traditional method)",
     )
     p.add_argument(
@@ -131,16 +135,24 @@ def _add_allocation_options(p: argparse.ArgumentParser) -> None:
         "bundled ones, the paper's models/manufacturing_lower_bounds.yaml; none bundled: 0)",
     )
     add_table_options(p)
+    from ..allocation.sensitivity import DEFAULT_GRID_STEPS_DEG as STEPS
+
+    steps = ", ".join(f"{STEPS[k]:g}" for k in sorted(STEPS))
+    counts = ", ".join(str(k) for k in sorted(STEPS))
     p.add_argument(
         "--grid-step-deg",
         type=bounded_float(MIN_GRID_STEP_DEG, 90.0, "deg"),
         default=None,
         help="step of the grid over every joint on which the sensitivities are averaged, the "
         "maxima of the constraints start (they hold between the grid points too) and the Monte "
-        "Carlo runs (default 1, 5, 15 deg when the first-order model depends on 1, 2, 3 joints: "
-        "1 deg on the paper's table)",
+        f"Carlo runs (default {steps} deg when the first-order model depends on {counts} "
+        f"joints: {STEPS[1]:g} deg on the paper's table)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress report (by default long work reports its progress on "
+                   "stderr, unless --json: the default limits' requirement, the Monte Carlo "
+                   "runs)")  # fmt: skip
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -155,7 +167,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "allow.",
     )
     _add_allocation_options(a)
-    a.add_argument("--plots", type=Path, metavar="DIR", help="write Figure 8 (sensitivities) here")
+    a.add_argument(
+        "--plots",
+        type=Path,
+        metavar="DIR",
+        help="write Figure 8 (sensitivities) here (default: no plots)",
+    )
     a.set_defaults(func=run_allocate)
 
     m = subparsers.add_parser(
@@ -167,8 +184,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "1 if a limit is exceeded.",
     )
     _add_allocation_options(m)
-    m.add_argument("-n", type=positive_int, default=10000, help="number of turntables (10000)")
-    m.add_argument("--seed", type=seed, default=0, help="random seed, recorded in the output (0)")
+    m.add_argument("-n", type=positive_int, default=10000, help="number of turntables")
+    m.add_argument("--seed", type=seed, default=0, help="random seed, recorded in the output")
     m.add_argument(
         "--scale-bounds",
         type=positive_float,
@@ -176,9 +193,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="K",
         help="sample inside K times the allocated upper bounds (K > 1 shows the bounds are tight)",
     )
-    m.add_argument("--workers", type=positive_int, default=1, help="worker processes (1)")
-    m.add_argument("--plots", type=Path, metavar="DIR", help="write Figure 9 (histograms) here")
-    m.add_argument("--quiet", action="store_true", help="no progress report")
+    m.add_argument("--workers", type=positive_int, default=1, help="worker processes")
+    m.add_argument(
+        "--plots",
+        type=Path,
+        metavar="DIR",
+        help="write Figure 9 (histograms) here (default: no plots)",
+    )
     m.set_defaults(func=run_montecarlo)
 
 
@@ -194,8 +215,9 @@ def _limits_from_args(args: argparse.Namespace, table) -> tuple[OrientationLimit
 
     try:
         limits = default_orientation_limits(
-            args.accuracy_dph, args.positions, args.latitude_deg, table, args.requirement
-        )
+            args.accuracy_dph, args.positions, args.latitude_deg, table, args.requirement,
+            progress=not (args.quiet or args.json),
+        )  # fmt: skip
     except IdentifiabilityError as exc:
         raise IdentifiabilityError(
             f"no default limits for this table ({exc}); give --limits-arcmin or --limits-deg"

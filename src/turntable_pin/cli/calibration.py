@@ -39,12 +39,12 @@ def _add_setup_options(parser: argparse.ArgumentParser, *, positions: bool = Tru
             "--positions", type=position_scheme, default="grid:30", metavar="SCHEME|FILE.csv",
             help="test positions: grid:STEP (every joint in 0, STEP, ... < 360 deg, every "
             "combination), grid:STEP1xSTEP2[xSTEP3] (one step per joint), or a CSV with one angle "
-            "column per joint: phi1_deg .. phiN_deg (chain order) or <joint>_deg (default grid:30)",
+            "column per joint: phi1_deg .. phiN_deg (chain order) or <joint>_deg",
         )  # fmt: skip
     add_table_options(parser)
     parser.add_argument(
         "--latitude-deg", type=latitude_deg, default=DEFAULT_LATITUDE_DEG,
-        help=f"latitude of the test site, degrees (default {DEFAULT_LATITUDE_DEG}, Harbin)",
+        help="latitude of the test site, degrees (the paper's: Harbin)",
     )  # fmt: skip
 
 
@@ -59,7 +59,7 @@ def _add_model_options(parser: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     parser.add_argument(
         "--definition", choices=DEFINITIONS, default=DEFINITIONS[0],
-        help="rate error: b1 - A beta2 - b2' (eq. 13 as printed, default) or b1 - A beta1 - b2'",
+        help="rate error: b1 - A beta2 - b2' (eq. 13 as printed) or b1 - A beta1 - b2'",
     )  # fmt: skip
     parser.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -76,7 +76,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         -MAX_ANGULAR_ERROR_DEG, MAX_ANGULAR_ERROR_DEG, "deg", why="a small orientation error"
     )
     for name in ANGLE_NAMES:
-        r.add_argument(f"--{name}-deg", type=small, default=0.0, help=f"{name}, degrees")
+        r.add_argument(
+            f"--{name}-deg", type=small, default=0.0, help=f"{name} at every position, degrees"
+        )
     _add_setup_options(r)
     _add_model_options(r)
     r.set_defaults(func=run_rate_error)
@@ -91,11 +93,21 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     one_line_errors(q)
     q.add_argument(
         "--accuracy-dph", type=accuracy_dph, default=0.01,
-        help="required calibration accuracy w_m, deg/h (default 0.01)",
+        help="required calibration accuracy w_m, deg/h",
     )  # fmt: skip
     _add_setup_options(q)
     _add_model_options(q)
-    q.add_argument("--plots", type=Path, metavar="DIR", help="write Figures 4 and 5 (PNG) here")
+    q.add_argument(
+        "--plots",
+        type=Path,
+        metavar="DIR",
+        help="write Figures 4 and 5 (PNG) here (default: no plots)",
+    )
+    from ..calibration.requirement import PROGRESS_DELAY_S
+
+    q.add_argument("--quiet", action="store_true",
+                   help=f"no progress report (by default a run longer than {PROGRESS_DELAY_S:g} "
+                   "s reports its progress on stderr, unless --json)")  # fmt: skip
     q.set_defaults(func=run_requirement)
     _register_calibrate(subparsers)
 
@@ -109,7 +121,10 @@ def _register_calibrate(subparsers: argparse._SubParsersAction) -> None:
         "residuals per position.",
     )
     one_line_errors(c)
-    c.add_argument("data", type=input_path, metavar="RUN.csv")
+    from ..core.csv_table import ROW_RULE
+
+    c.add_argument("data", type=input_path, metavar="RUN.csv",
+                   help=f"the calibration run (a CSV; {ROW_RULE})")  # fmt: skip
     _add_setup_options(c, positions=False)
     add_mount_option(c)
     c.add_argument("--json", action="store_true", help="print one JSON object")
@@ -125,7 +140,7 @@ def _register_calibrate(subparsers: argparse._SubParsersAction) -> None:
         help="fit the coefficients with these effects added and show the residuals before and "
         "after: run catalogue names (instrument_tilt, bias_drift, table:deps_x, ...) and inline "
         "terms (out_x~h2(phi1), out_y~poly2(time_s), dpsi~h1(phi2)); comma-separated, "
-        "repeatable",
+        "repeatable (default: none)",
     )  # fmt: skip
     c.add_argument(
         "--effects-module", action="append", default=[], type=input_path, metavar="FILE.py",
@@ -133,7 +148,8 @@ def _register_calibrate(subparsers: argparse._SubParsersAction) -> None:
         "effects.RunEffect): they join the candidates of --diagnose and the names of --effects. "
         "The file is code that runs: it is imported and its methods called (give only files you "
         "trust); each effect is checked against its contract first "
-        "(TURNTABLE_PIN_TRACEBACK=1 shows the traceback of an error inside it)",
+        "(TURNTABLE_PIN_TRACEBACK=1 shows the traceback of an error inside it); repeatable "
+        "(default: none)",
     )  # fmt: skip
     c.add_argument(
         "--until-explained",
@@ -149,13 +165,15 @@ def _register_calibrate(subparsers: argparse._SubParsersAction) -> None:
         "--plots",
         type=Path,
         metavar="DIR",
-        help="with --diagnose or --effects: residual plots (PNG) before and after",
+        help="with --diagnose or --effects: residual plots (PNG) before and after (default: no "
+        "plots)",
     )
     c.add_argument(
         "--report",
         type=Path,
         metavar="OUT.html",
-        help="with --diagnose: one self-contained HTML page with the whole story",
+        help="with --diagnose: one self-contained HTML page with the whole story (default: no "
+        "report)",
     )
     c.set_defaults(func=run_calibrate)
 
@@ -208,6 +226,7 @@ def run_requirement(args: argparse.Namespace) -> int:
     result = orientation_requirement(
         args.accuracy_dph, PositionSet.parse(args.positions, table), deg_to_rad(args.latitude_deg),
         gyrowheel=_gyrowheel(args), exact=args.exact, definition=args.definition,
+        progress=not (args.quiet or args.json),
     )  # fmt: skip
     report = {**result.to_dict(), **_table_keys(table)}
     if args.plots:

@@ -37,6 +37,8 @@ __all__ = [
     "positive_float",
     "non_negative_int",
     "one_or_each",
+    "own_effects_words",
+    "length_errors_words",
     "positive_int",
     "print_json",
     "seed",
@@ -215,19 +217,47 @@ def add_mount_option(parser: argparse.ArgumentParser) -> None:
     )  # fmt: skip
 
 
+def length_errors_words() -> str:
+    """The errors that are lengths, in words, from the error definitions: the paper's table's
+    (``deta``) and every joint's of a URDF table (``<joint>.offset_a``, ...)."""
+    from ..model.generic_table import generic_length_errors
+    from ..model.paper_table import PAPER_LAYOUT
+
+    return ", ".join((*PAPER_LAYOUT.length_names, *generic_length_errors()))
+
+
+def own_effects_words() -> str:
+    """Where a table's own effects are named: ``effects --urdf`` (the paper's effect names are
+    only its table's; any table has the per-joint kinds ``<kind>@<joint>`` and more)."""
+    from ..measurement.catalogue import PER_JOINT_EFFECTS
+
+    kinds = ", ".join(f"{kind}@<joint>" for kind in PER_JOINT_EFFECTS)
+    return (
+        f"a table given by --urdf has its own effects ({kinds}, ...): "
+        "'turntable-pin effects --urdf FILE.urdf' lists them with their parameters"
+    )
+
+
 def add_error_options(parser: argparse.ArgumentParser) -> None:
     """``--error NAME=VALUE`` (repeatable), ``--errors FILE.yaml`` and ``--urdf FILE``."""
+    from ..model.errors import DEFAULT_ANGLE_UNIT, DEFAULT_LENGTH_UNIT
+
+    units = {"arcsec": "arc seconds", "mm": "millimetres"}
     parser.add_argument(
         "--error",
         action="append",
         default=[],
         metavar="NAME=VALUE",
-        help="one turntable error: arc seconds for angles, millimetres for deta "
-        "(a unit suffix such as dphi_y1_arcmin=0.1 or deta_m=2e-4 is also understood); repeatable",
+        help=f"one turntable error: {units.get(DEFAULT_ANGLE_UNIT, DEFAULT_ANGLE_UNIT)} for "
+        f"angles, {units.get(DEFAULT_LENGTH_UNIT, DEFAULT_LENGTH_UNIT)} for lengths "
+        f"({length_errors_words()}); a unit suffix such as dphi_y1_arcmin=0.1 or deta_m=2e-4 is "
+        "also understood; repeatable (default: none, every error zero)",
     )
     parser.add_argument(
-        "--errors", type=input_path, metavar="FILE.yaml", help="YAML file of turntable errors"
-    )
+        "--errors", type=input_path, metavar="FILE.yaml",
+        help="YAML file of turntable errors; --error overrides its entries one by one "
+        "(default: none, every error zero)",
+    )  # fmt: skip
     add_table_options(parser)
 
 

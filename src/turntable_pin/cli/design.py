@@ -70,7 +70,8 @@ def _add_mode_options(p: argparse.ArgumentParser) -> None:
         "--separate",
         type=effect_list,
         metavar="A,B",
-        help="positions that tell effect A from effect B (T-optimal)",
+        help="positions that tell effect A from effect B (T-optimal; default: without "
+        "--separate or --calibrate, positions that identify the parameters)",
     )
     p.add_argument(
         "--amplitude",
@@ -88,14 +89,13 @@ def _add_mode_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--accuracy-dph", type=accuracy_dph, default=0.01,
-        help="--calibrate: the required calibration accuracy w_m, deg/h (default 0.01)",
+        help="--calibrate: the required calibration accuracy w_m, deg/h",
     )  # fmt: skip
     p.add_argument(
         "--min-efficiency", type=bounded_float(0.0, MAX_MIN_EFFICIENCY, low_open=True),
         default=DEFAULT_MIN_EFFICIENCY, metavar="E",
         help="--calibrate: the precision floor, D-efficiency of the 14 drift coefficients "
-        f"against the grid of the same N (default {DEFAULT_MIN_EFFICIENCY:g}: at least as "
-        "precise as the grid)",
+        "against the grid of the same N (1: at least as precise as the grid)",
     )  # fmt: skip
 
 
@@ -109,7 +109,7 @@ def _add_design_options(p: argparse.ArgumentParser) -> None:
         type=positive_int,
         default=DEFAULT_POSITIONS,
         metavar="N",
-        help=f"positions to choose (default {DEFAULT_POSITIONS})",
+        help="positions to choose",
     )
     p.add_argument(
         "--effects",
@@ -118,7 +118,8 @@ def _add_design_options(p: argparse.ArgumentParser) -> None:
         type=effect_list,
         metavar="A,B",
         help="effects to identify besides the base errors, as fit --effects takes "
-        "them: catalogue names, effect files (.yaml), inline terms; repeatable",
+        "them: catalogue names, effect files (.yaml), inline terms; repeatable (default: none, "
+        "the base errors alone)",
     )
     p.add_argument(
         "--effects-module",
@@ -128,7 +129,7 @@ def _add_design_options(p: argparse.ArgumentParser) -> None:
         metavar="FILE.py",
         help="a Python file defining Effect subclasses (with --separate --run: RunEffect "
         "subclasses); their names join --effects. The file is code that runs: it is imported "
-        "and its methods called (give only files you trust)",
+        "and its methods called (give only files you trust); repeatable (default: none)",
     )
     p.add_argument(
         "--from",
@@ -137,7 +138,8 @@ def _add_design_options(p: argparse.ArgumentParser) -> None:
         type=input_path,
         metavar="DATA.csv",
         help="positions already measured: their information is where the design "
-        "starts, and their fitted noise the design's noise",
+        "starts, and their fitted noise the design's noise (default: none, the design starts "
+        "from nothing)",
     )
     p.add_argument(
         "--limits-deg",
@@ -150,8 +152,8 @@ def _add_design_options(p: argparse.ArgumentParser) -> None:
         type=positive_int,
         default=DEFAULT_CANDIDATES,
         metavar="N",
-        help=f"random candidate positions within the limits (seeded; default "
-        f"{DEFAULT_CANDIDATES}); the {GRID_STEP_DEG:g}-degree grid joins them",
+        help=f"random candidate positions within the limits (seeded); the {GRID_STEP_DEG:g}-degree "
+        "grid joins them",
     )
     p.add_argument(
         "--seed",
@@ -169,7 +171,7 @@ def _add_design_options(p: argparse.ArgumentParser) -> None:
         "--dwell-s",
         type=_dwell_s,
         default=60.0,
-        help="time per measurement, for the time_s column (default 60)",
+        help="time per measurement, seconds, for the time_s column",
     )
 
 
@@ -183,22 +185,26 @@ def _add_output_options(p: argparse.ArgumentParser) -> None:
         type=Path,
         metavar="OUT.csv",
         help="write the positions as a CSV (phiK_deg, with time_s and dirK when "
-        "the design needs them): simulate --positions reads it",
+        "the design needs them): simulate --positions reads it (default: printed only)",
     )
     p.add_argument(
         "--run", type=input_path, metavar="RUN.csv",
         help="with --separate: A and B are effects of this GyroWheel calibration run (its "
         "catalogue: table:<error>, instrument_tilt, g_squared_terms, ...; as calibrate "
         "--diagnose names them), each at the amplitude the run fits; the design adds "
-        "calibration positions to the run",
+        "calibration positions to the run (default: none, orientation measurements)",
     )  # fmt: skip
     p.add_argument(
         "--latitude-deg", type=latitude_deg, default=DEFAULT_LATITUDE_DEG,
-        help=f"with --run: the latitude of the run's site, degrees (default "
-        f"{DEFAULT_LATITUDE_DEG})",
+        help="with --run: the latitude of the run's site, degrees",
     )  # fmt: skip
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plots", type=Path, metavar="DIR", help="write the design's figures here")
+    p.add_argument(
+        "--plots",
+        type=Path,
+        metavar="DIR",
+        help="write the design's figures here (default: no plots)",
+    )
 
 
 def _noise_arcsec(text: str) -> float:

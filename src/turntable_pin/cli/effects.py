@@ -24,12 +24,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--urdf", type=input_path, metavar="FILE.urdf", help="the table (default: bundled)"
     )
-    p.add_argument("--payload-frame", metavar="NAME", help="the payload frame of the URDF")
+    p.add_argument(
+        "--payload-frame",
+        metavar="NAME",
+        help="the payload frame of the URDF (default: the only leaf of its chain)",
+    )
     add_mount_option(p)
     p.add_argument("--catalogue", action="append", default=[], type=input_path, metavar="FILE",
                    help="your effects (.yaml effect file or .py module); repeatable. A .py "
                    "module is code that runs: it is imported and its methods called (give only "
-                   "files you trust)")  # fmt: skip
+                   "files you trust; default: the catalogue alone)")  # fmt: skip
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run_effects)
 

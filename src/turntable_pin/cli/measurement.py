@@ -26,6 +26,7 @@ from .common import (
     non_negative_int,
     one_line_errors,
     one_or_each,
+    own_effects_words,
     positive_float,
     positive_int,
     print_json,
@@ -55,7 +56,7 @@ def _register_simulate(subparsers: argparse._SubParsersAction) -> None:
         description="Simulate a measurement run (the CSV described in docs/measurements.md): "
         "turntable errors, catalogued effects with their parameters, a position schedule, noise, "
         "time stamps and approach directions; the seed and the truth go into comment lines. "
-        f"Effects: {', '.join(EFFECT_NAMES)}.",
+        f"The paper's table's effects: {', '.join(EFFECT_NAMES)}; {own_effects_words()}.",
     )
     one_line_errors(s)
     add_error_options(s)
@@ -67,7 +68,8 @@ def _register_simulate(subparsers: argparse._SubParsersAction) -> None:
         type=effect_spec,
         metavar="NAME:P=V[,P=V...]",
         help="a hidden effect and its parameters in user units (arcsec, arcsec/g, arcsec/h), "
-        "e.g. inner_encoder_harmonics:c1=3,s2=-2; repeatable",
+        "e.g. inner_encoder_harmonics:c1=3,s2=-2 on the paper's table; "
+        f"{own_effects_words()}; repeatable (default: none)",
     )
     _add_catalogue_option(s)
     _add_schedule_options(s)
@@ -77,7 +79,8 @@ def _register_simulate(subparsers: argparse._SubParsersAction) -> None:
         action="store_true",
         help="record only seed, noise and schedule, not the errors and effects (blind rehearsal)",
     )
-    s.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.csv")
+    s.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.csv",
+                   help="the measurement CSV to write")  # fmt: skip
     _add_run_options(s)
     s.set_defaults(
         func=run_simulate,
@@ -95,7 +98,8 @@ def _add_schedule_options(s: argparse.ArgumentParser) -> None:
         "--noise-arcsec",
         type=_noise_arcsec,
         default=1.0,
-        help="1-sigma noise; three comma-separated values give dpsi,dtheta,dgamma their own",
+        help="1-sigma noise, arcsec; three comma-separated values give dpsi,dtheta,dgamma their "
+        "own",
     )
     s.add_argument(
         "--noise-spread",
@@ -104,43 +108,54 @@ def _add_schedule_options(s: argparse.ArgumentParser) -> None:
         metavar="F",
         help="uneven noise: each row's sigma drawn log-uniform in [sigma/F, sigma*F] (seeded)",
     )
-    s.add_argument("--seed", type=seed, default=0, help="random seed (recorded in the file)")
+    s.add_argument("--seed", type=seed, default=0, help="random seed, recorded in the file")
     s.add_argument(
         "--not-measured",
         type=_angle_list,
         default=(),
         metavar="A,B",
-        help="angles left empty at every position (dpsi, dtheta, dgamma; default: none): "
+        help="angles left empty at every position (dpsi, dtheta, dgamma; default: none, all "
+        "measured): "
         "'dgamma' makes a pointing run, whose dpsi is then the boresight's own component",
     )
-    s.add_argument("--phi1-step-deg", type=step, default=30.0)
-    s.add_argument("--phi2-step-deg", type=step, default=30.0)
-    s.add_argument("--phi3-step-deg", type=step, default=30.0, help="third axis (3-axis tables)")
+    for k, which in ((1, "first axis"), (2, "second axis"), (3, "third axis (3-axis tables)")):
+        s.add_argument(f"--phi{k}-step-deg", type=step, default=30.0,
+                       help=f"grid step of phi{k}, the {which}, degrees")  # fmt: skip
     for k in (1, 2, 3):
         s.add_argument(f"--phi{k}-start-deg", type=start, default=0.0,
-                       help=f"first grid angle of phi{k}; a sweep holds phi{k} here")  # fmt: skip
+                       help=f"first grid angle of phi{k}, degrees; a sweep holds phi{k} "
+                       "here")  # fmt: skip
     design = s.add_mutually_exclusive_group()
     design.add_argument("--positions", type=input_path, metavar="FILE.csv",
                         help="measure these positions in the file's order (columns phi1_deg.. "
-                        "or <joint>_deg, optional dir1.. and time_s)")  # fmt: skip
+                        "or <joint>_deg, optional dir1.. and time_s; default: the grid of "
+                        "--phiK-step-deg)")  # fmt: skip
     design.add_argument("--sweep", metavar="AXES",
                         help="single-axis sweeps, one after the other: phi1,phi2 sweeps phi1 "
-                        "over its grid with phi2 held, then phi2 with phi1 held")  # fmt: skip
+                        "over its grid with phi2 held, then phi2 with phi1 held (default: "
+                        "no sweep, the whole grid)")  # fmt: skip
     design.add_argument("--random-positions", type=positive_int, metavar="N",
-                        help="N positions uniform over every joint's turn (seeded)")  # fmt: skip
-    s.add_argument("--order", choices=ORDERS, default="grid")
-    s.add_argument("--repeats", type=positive_int, default=1)
+                        help="N positions uniform over every joint's turn (seeded; default: "
+                        "the grid)")  # fmt: skip
+    s.add_argument("--order", choices=ORDERS, default=ORDERS[0],
+                   help="the order the grid is measured in: grid (phi1 the outer loop, the last "
+                   "joint the inner) or random (the grid shuffled, seeded)")  # fmt: skip
+    s.add_argument("--repeats", type=positive_int, default=1, metavar="R",
+                   help="measure the whole schedule R times over, one after the other (each "
+                   "measurement at its own time_s)")  # fmt: skip
     s.add_argument("--passes", type=positive_int, default=0, metavar="K",
                    help="forward then backward over the positions, K times; approach "
-                   "directions follow the pass (+1 forward, -1 backward)")  # fmt: skip
+                   "directions follow the pass (+1 forward, -1 backward); 0: one pass")  # fmt: skip
     s.add_argument(
         "--dwell-s",
         type=bounded_float(0.0, MAX_TIME_S, "s", low_open=True),
         default=60.0,
-        help="time per position",
+        help="time per position, seconds (the time_s column)",
     )
     s.add_argument("--approach", choices=APPROACHES, default=None,
-                   help="random (default), motion (default with --passes) or positive")  # fmt: skip
+                   help="the approach direction of each position (dir1..): random, motion (the "
+                   "direction the joint moved in) or positive (default: random; motion with "
+                   "--passes)")  # fmt: skip
 
 
 def _register_fit(subparsers: argparse._SubParsersAction) -> None:
@@ -153,9 +168,11 @@ def _register_fit(subparsers: argparse._SubParsersAction) -> None:
     one_line_errors(f)
     _add_data_options(f)
     f.add_argument("--effects", action="append", default=[], type=effect_list, metavar="A,B",
-                   help="effects to add to the base: catalogue names, effect files (.yaml) and "
+                   help="effects to add to the base: catalogue names ('turntable-pin effects "
+                   "--urdf FILE.urdf' lists a table's), effect files (.yaml) and "
                    "inline terms (dphi_z2~h3(phi2), dpsi~poly1(temperature_c), "
-                   "dphi_y1~sign(dir1)); comma-separated, repeatable")  # fmt: skip
+                   "dphi_y1~sign(dir1)); comma-separated, repeatable (default: none, the base "
+                   "model alone)")  # fmt: skip
     f.add_argument(
         "--effects-module",
         action="append",
@@ -163,32 +180,39 @@ def _register_fit(subparsers: argparse._SubParsersAction) -> None:
         type=Path,
         metavar="FILE.py",
         help="a Python file defining Effect subclasses; their names join --effects. The file is "
-        "code that runs: it is imported and its methods called (give only files you trust)",
+        "code that runs: it is imported and its methods called (give only files you trust); "
+        "repeatable (default: none)",
     )
     f.add_argument(
         "--write-urdf",
         type=Path,
         metavar="OUT.urdf",
         help="write the URDF with the fitted errors in its joint placements (combinations the "
-        "data cannot separate are split by the minimum-norm rule, stated in the output)",
+        "data cannot separate are split by the minimum-norm rule, stated in the output; "
+        "default: no URDF)",
     )
-    f.add_argument("--plots", type=Path, metavar="DIR", help="write residual plots (PNG) here")
-    f.add_argument("--k-sigma", type=positive_float, default=3.0, help="failing threshold (> 0)")
+    f.add_argument("--plots", type=Path, metavar="DIR",
+                   help="write residual plots (PNG) here (default: no plots)")  # fmt: skip
+    f.add_argument("--k-sigma", type=positive_float, default=3.0, metavar="K",
+                   help="a position fails where a residual exceeds K sigma (K > 0)")  # fmt: skip
     f.set_defaults(func=run_fit)
 
 
 def _register_diagnose_and_report(subparsers: argparse._SubParsersAction) -> None:
+    from ..report.diagnosis_text import decision_rule_words
+
     d = subparsers.add_parser(
         "diagnose",
-        description="Test every catalogued effect against the base fit (BIC, delta <= -6), "
-        "rank them, name the missing effect, its equivalent alternatives, and whether "
-        "structure remains that nothing in the catalogue explains.",
+        description="Test every catalogued effect against the base fit by BIC "
+        f"({decision_rule_words()}), rank them, name the missing effect, its equivalent "
+        "alternatives, and whether structure remains that nothing in the catalogue explains.",
     )
     one_line_errors(d)
     _add_data_options(d)
-    d.add_argument("--until-explained", action="store_true", help="add effects while significant")
+    _add_until_explained_option(d)
     _add_outlier_option(d)
-    d.add_argument("--plots", type=Path, metavar="DIR", help="write residual plots (PNG) here")
+    d.add_argument("--plots", type=Path, metavar="DIR",
+                   help="write residual plots (PNG) here (default: no plots)")  # fmt: skip
     _add_catalogue_option(d)
     d.set_defaults(func=run_diagnose)
 
@@ -198,13 +222,14 @@ def _register_diagnose_and_report(subparsers: argparse._SubParsersAction) -> Non
         "parameters; plots embedded.",
     )
     one_line_errors(r)
-    r.add_argument("data", type=input_path, metavar="DATA.csv")
+    _add_data_argument(r)
     add_table_options(r)
     add_mount_option(r)
-    r.add_argument("--ignore-sigma", action="store_true")
-    r.add_argument("--until-explained", action="store_true")
+    _add_ignore_sigma_option(r)
+    _add_until_explained_option(r)
     _add_outlier_option(r)
-    r.add_argument("-o", "--output", type=Path, required=True, metavar="report.html")
+    r.add_argument("-o", "--output", type=Path, required=True, metavar="report.html",
+                   help="the HTML page to write")  # fmt: skip
     _add_catalogue_option(r)
     r.set_defaults(func=run_report)
 
@@ -219,6 +244,10 @@ ORIENTATION_ONLY_OPTIONS: tuple[str, ...] = (
     "approach",
 )  # fmt: skip
 """The ``simulate`` options of orientation measurements alone (refused with ``--run``)."""
+RUN_POSITIONS = "grid:30"
+"""The positions of ``simulate --run`` without ``--positions``."""
+RUN_NOISE_DPH = 0.002
+"""The output noise of ``simulate --run`` without ``--noise-dph``, deg/h."""
 
 
 def _add_run_options(s: argparse.ArgumentParser) -> None:
@@ -235,25 +264,26 @@ def _add_run_options(s: argparse.ArgumentParser) -> None:
         "arcsec; bias_drift:x,y deg/h/h; temperature_coefficient:x,y deg/h/degC; "
         "earth_rate_scale:x,y ppm; "
         "g_squared_terms:x_xz,x_yz,y_xz,y_yz deg/h/g^2); --positions takes a scheme "
-        "(grid:STEP, grid:S1xS2; default grid:30) or a CSV of angles",
+        f"(grid:STEP, grid:S1xS2; default {RUN_POSITIONS}) or a CSV of angles",
     )
     g.add_argument("--run", action="store_true",
                    help="simulate a GyroWheel calibration run (what calibrate reads)")  # fmt: skip
     g.add_argument("--truth", type=Path, metavar="OUT.yaml",
                    help="also write the truth (and this command) as YAML: the key to a blind run "
-                   "made with --hide-truth")  # fmt: skip
+                   "made with --hide-truth (default: no truth file)")  # fmt: skip
     g.add_argument("--noise-dph", type=_noise_dph, metavar="S|SX,SY",
                    help="1-sigma output noise, deg/h: one value for both channels or x,y "
-                   "(default 0.002)")  # fmt: skip
+                   f"(default: {RUN_NOISE_DPH:g})")  # fmt: skip
     g.add_argument("--latitude-deg", type=latitude_deg,
                    help=f"site latitude, degrees (default {DEFAULT_LATITUDE_DEG})")  # fmt: skip
     g.add_argument("--gyrowheel", type=input_path, metavar="FILE.yaml",
                    help="the true drift coefficients (default: paper Table 1)")  # fmt: skip
     g.add_argument("--temperature", type=_temperature, metavar="START,RAMP_PER_H,SWING,PERIOD_H",
                    help="a temperature_c column: START degC + RAMP_PER_H degC/h * t + SWING degC "
-                   "* sin(2 pi t / PERIOD_H h)")  # fmt: skip
+                   "* sin(2 pi t / PERIOD_H h) (default: no temperature column)")  # fmt: skip
     g.add_argument("--outliers", type=non_negative_int, metavar="N",
-                   help="N rows (seeded) get a gross error on one channel")  # fmt: skip
+                   help="N rows (seeded) get a gross error on one channel (default: "
+                   "none)")  # fmt: skip
     g.add_argument("--outlier-dph", type=positive_float, metavar="D",
                    help="size of an outlier, deg/h (default 30 sigma of its channel)")  # fmt: skip
 
@@ -307,6 +337,16 @@ def _sweep_axes(text: str, table) -> tuple[str, ...]:
     return tuple(out)
 
 
+def _add_until_explained_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--until-explained",
+        action="store_true",
+        help="name every effect the stepwise search accepts, each significant on top of those "
+        "before it (by default the verdict names the first one and lists the others as also "
+        "significant)",
+    )
+
+
 def _add_outlier_option(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--keep-outliers",
@@ -320,7 +360,7 @@ def _add_catalogue_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--catalogue", action="append", default=[], type=input_path, metavar="FILE",
                    help="your effects (a .yaml effect file or a .py module) join the candidates; "
                    "repeatable. A .py module is code that runs: it is imported and its methods "
-                   "called (give only files you trust)")  # fmt: skip
+                   "called (give only files you trust; default: the catalogue alone)")  # fmt: skip
 
 
 def _user_catalogue(args: argparse.Namespace, table=None):
@@ -334,14 +374,26 @@ def _user_catalogue(args: argparse.Namespace, table=None):
 
 
 def _add_data_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("data", type=input_path, metavar="DATA.csv")
+    _add_data_argument(p)
     add_table_options(p)
     add_mount_option(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_ignore_sigma_option(p)
+
+
+def _add_data_argument(p: argparse.ArgumentParser) -> None:
+    from ..core.csv_table import ROW_RULE
+
+    p.add_argument("data", type=input_path, metavar="DATA.csv",
+                   help=f"the measurements (a CSV, docs/measurements.md; {ROW_RULE})")  # fmt: skip
+
+
+def _add_ignore_sigma_option(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--ignore-sigma",
         action="store_true",
-        help="estimate the noise from the fit even if the file has sigma_arcsec",
+        help="estimate the noise from the fit even if the file has sigma_arcsec (by default a "
+        "sigma column is used)",
     )
 
 
@@ -402,9 +454,9 @@ def run_simulate_run(args: argparse.Namespace) -> int:
         positions = PositionSet.random(args.random_positions, table, args.seed)
     else:
         positions = PositionSet.parse(
-            "grid:30" if args.positions is None else str(args.positions), table
+            RUN_POSITIONS if args.positions is None else str(args.positions), table
         )
-    noise = 0.002 if args.noise_dph is None else args.noise_dph
+    noise = RUN_NOISE_DPH if args.noise_dph is None else args.noise_dph
     latitude = DEFAULT_LATITUDE_DEG if args.latitude_deg is None else args.latitude_deg
     gyrowheel = GyroWheelModel.from_yaml(args.gyrowheel) if args.gyrowheel else None
     temperature = TemperatureProfile(*args.temperature) if args.temperature else None

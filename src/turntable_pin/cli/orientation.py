@@ -30,6 +30,10 @@ __all__ = [
 ]
 
 
+ORIENTATION_ANGLE_DEG = 0.0
+"""The angle of every joint ``orientation`` is not given, degrees."""
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``orientation`` and ``urdf`` subcommands to ``subparsers``."""
     p = subparsers.add_parser(
@@ -40,13 +44,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     one_line_errors(p)
     angle = bounded_float(-MAX_COMMANDED_ANGLE_DEG, MAX_COMMANDED_ANGLE_DEG, "deg", why="ten turns")
-    p.add_argument("--phi1-deg", type=angle, default=None, help="outer-axis angle, degrees")
-    p.add_argument("--phi2-deg", type=angle, default=None, help="inner-axis angle, degrees")
+    for k, which in ((1, "outer"), (2, "inner")):
+        p.add_argument(f"--phi{k}-deg", type=angle, default=None,
+                       help=f"{which}-axis angle, degrees (default: "
+                       f"{ORIENTATION_ANGLE_DEG:g})")  # fmt: skip
     p.add_argument(
         "--angles-deg",
         metavar="A,B,C",
         help="the joint angles in chain order from the base, degrees (any table; a two-axis "
-        "table also takes --phi1-deg/--phi2-deg)",
+        f"table also takes --phi1-deg/--phi2-deg; default: {ORIENTATION_ANGLE_DEG:g} for every "
+        "joint)",
     )
     add_error_options(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -59,12 +66,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     one_line_errors(u)
     add_error_options(u)
-    u.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.urdf")
+    u.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.urdf",
+                   help="the URDF to write")  # fmt: skip
     u.set_defaults(func=run_urdf)
 
 
 def joint_angles_deg(
-    args: argparse.Namespace, n_joints: int, defaults_deg=(0.0, 0.0, 0.0)
+    args: argparse.Namespace, n_joints: int, defaults_deg=(ORIENTATION_ANGLE_DEG,) * 3
 ) -> list[float]:
     """The joint angles (chain order, degrees) of ``--angles-deg`` or ``--phi1-deg/--phi2-deg``
     (a two-joint table), ``defaults_deg`` where not given."""

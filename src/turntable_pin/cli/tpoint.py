@@ -30,12 +30,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     one_line_errors(p)
     p.add_argument("data", type=input_path, metavar="RUN.dat", help="the TPOINT file")
-    p.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.csv")
+    p.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.csv",
+                   help="the measurement CSV to write")  # fmt: skip
     p.add_argument(
         "--mount",
         choices=MOUNTS,
         help="the mount, when the file has no ': ALTAZ' / ': EQUAT' line (a file that states "
-        "the other one is refused)",
+        "the other one is refused; default: the file's)",
     )
     p.add_argument(
         "--refraction",
@@ -53,13 +54,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--azimuth-origin",
         choices=("south", "north"),
         default="south",
-        help="where the file's azimuth is 0 (default south, TPOINT's)",
+        help="where the file's azimuth is 0 (south: TPOINT's convention)",
     )
     p.add_argument(
         "--azimuth-direction",
         choices=("east", "west"),
         default="east",
-        help="on which side the file's azimuth 90 lies (default east, TPOINT's); north,east is "
+        help="on which side the file's azimuth 90 lies (east: TPOINT's convention); north,east is "
         "the common north-through-east azimuth (converted as 180 - az)",
     )
     p.add_argument(
@@ -67,7 +68,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         type=Path,
         metavar="OUT.urdf",
         help="write the mount's URDF the CSV belongs to (required for an equatorial run: a copy "
-        "of the bundled one with its polar axis tilted to the run's latitude)",
+        "of the bundled one with its polar axis tilted to the run's latitude; default: none)",
     )
     p.set_defaults(func=run_import_tpoint)
 

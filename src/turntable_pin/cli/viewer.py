@@ -28,17 +28,17 @@ __all__ = ["register"]
 
 
 def _add_scene_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--phi1-deg", type=finite_float, default=None, help="outer-axis angle, degrees (30)"
-    )
-    p.add_argument(
-        "--phi2-deg", type=finite_float, default=None, help="inner-axis angle, degrees (45)"
-    )
+    first, second, third = (f"{a:g}" for a in _DEFAULT_ANGLES_DEG)
+    p.add_argument("--phi1-deg", type=finite_float, default=None,
+                   help=f"outer-axis angle, degrees (default: {first})")  # fmt: skip
+    p.add_argument("--phi2-deg", type=finite_float, default=None,
+                   help=f"inner-axis angle, degrees (default: {second})")  # fmt: skip
     p.add_argument(
         "--angles-deg",
         metavar="A,B,C",
-        help="the joint angles in chain order from the base, degrees (any table; default 30, 45, "
-        "60 for the first, second, third joint; a two-axis table also takes --phi1/2-deg)",
+        help="the joint angles in chain order from the base, degrees (any table; default "
+        f"{first}, {second}, {third} for the first, second, third joint; a two-axis table also "
+        "takes --phi1/2-deg)",
     )
     add_error_options(p)
     p.add_argument(
@@ -98,7 +98,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "package 'chromium'); no server or browser is left running afterwards.",
     )
     _add_scene_options(s)
-    s.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.png")
+    s.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.png",
+                   help="the PNG to write")  # fmt: skip
     s.add_argument("--width", type=positive_int, default=800, help="pixels (64 to 4096)")
     s.add_argument("--height", type=positive_int, default=600, help="pixels (64 to 4096)")
     s.add_argument("--no-legend", action="store_true", help="leave the legend out of the picture")

@@ -1,8 +1,10 @@
 """Reading numeric CSV tables with checks that name the file, row and column of every problem.
 
-Rows are counted as a spreadsheet shows them (the header is row 1); a file that fails a check
-raises :class:`InputError`. Only a regular file within the sizes of :mod:`.sizes` is read
-(:func:`read_lines`).
+One row-numbering rule for every reader: a row is the file's line number, ``#`` comment lines
+and blank lines counted (as an editor numbers lines; the header is row 1 unless comment lines
+come first), and a problem of the header (its delimiter, a missing or repeated column) is
+reported at the header's line. A file that fails a check raises :class:`InputError`. Only a
+regular file within the sizes of :mod:`.sizes` is read (:func:`read_lines`).
 """
 
 from __future__ import annotations
@@ -22,7 +24,9 @@ from .files import check_input_file, write_text_atomic
 from .sizes import MAX_TABLE_COLUMNS, MAX_TABLE_FILE_BYTES, MAX_TABLE_ROWS
 
 __all__ = [
+    "ROW_RULE",
     "CsvTable",
+    "check_header",
     "closest_column_hint",
     "first_repeated_row",
     "ignored_columns_words",
@@ -35,6 +39,10 @@ __all__ = [
 ]
 
 
+ROW_RULE = "a row a message names is the file's line number, comment lines counted"
+"""The row-numbering rule of the module docstring, in the words a command's help says it."""
+
+
 @dataclass(frozen=True)
 class CsvTable:
     """The numeric columns of a CSV file.
@@ -42,8 +50,8 @@ class CsvTable:
     Attributes:
         path: the file read; header: every column name, in file order.
         columns: ``{name: float array}`` of the required and the present optional columns.
-        rows: the spreadsheet row of each data row; header_row: the header's (1 unless ``#``
-            lines come first).
+        rows: the line number of each data row (module docstring); header_row: the header's
+            (1 unless ``#`` lines come first).
         extra, skipped: with ``extra=True``, the other numeric columns and the names of the
             other, non-numeric ones (text or empty throughout), for the caller to say so.
     """
@@ -77,26 +85,62 @@ class CsvTable:
         return self.columns[name]
 
 
-def closest_column_hint(name: str, header) -> str:
+def closest_column_hint(name: str, header, known=()) -> str:
     """`` (is 'X' a misspelling of it?)`` for the header column most like ``name``, or ``""``
-    when none is close (difflib's ratio at least 0.6)."""
-    close = difflib.get_close_matches(name, [h for h in header if h != name], n=1, cutoff=0.6)
+    when none is close (difflib's ratio at least 0.6). A column in ``known`` (a name the reader
+    knows, such as ``sigma_arcsec``) is no misspelling of another and is never proposed."""
+    others = [h for h in header if h != name and h not in known]
+    close = difflib.get_close_matches(name, others, n=1, cutoff=0.6)
     return f" (is '{close[0]}' a misspelling of it?)" if close else ""
 
 
+DELIMITER = ","
+"""The one column delimiter of every CSV file the commands read."""
+_OTHER_DELIMITERS = {";": "';'", "\t": "a tab", "|": "'|'"}
+"""Delimiters a spreadsheet may export instead, as the message names them."""
+
+
+def check_header(path, header: Sequence[str], line: str, row: int) -> None:
+    """Refuse a header line ``line`` (read as ``header``, at line ``row`` of ``path``) that is not
+    comma-separated (one cell holding ``;`` or tabs: "the delimiter is ';' (expected ',')") or
+    names a column twice: the header's problems every reader reports alike, at the header's
+    line."""
+    if len(header) == 1 and DELIMITER not in line:
+        counts = {d: line.count(d) for d in _OTHER_DELIMITERS}
+        found = max(counts, key=counts.get)
+        if counts[found]:
+            raise InputError(
+                f"the delimiter is {_OTHER_DELIMITERS[found]} (expected '{DELIMITER}'): save "
+                "the file as comma-separated CSV (decimal points, not commas, in the numbers)",
+                path=path, row=row,
+            )  # fmt: skip
+    seen = set()
+    for name in header:
+        if name in seen:
+            raise InputError(f"column '{name}' appears twice in the header", path=path, row=row)
+        seen.add(name)
+
+
 def read_header(path: str | Path) -> tuple[tuple[str, ...], int]:
-    """The column names of a CSV file and the spreadsheet row of its header line, read before the
+    """The column names of a CSV file and the line number of its header line, read before the
     whole file (to choose which columns to ask for); ``((), 0)`` when the file is unreadable or
-    empty, which :func:`read_csv_table` then reports."""
+    empty, which :func:`read_csv_table` then reports. A header of another delimiter or with a
+    repeated column is refused here (:func:`check_header`)."""
+    found = None
     try:
         path = check_input_file(path, "CSV", MAX_TABLE_FILE_BYTES)
         with path.open(newline="", encoding="utf-8-sig") as handle:
             for row, line in enumerate(handle, start=1):
                 if line.strip() and not line.lstrip().startswith("#"):
-                    return tuple(c.strip() for c in next(csv.reader([line]))), row
+                    found = tuple(c.strip() for c in next(csv.reader([line]))), row, line
+                    break
     except (InputError, OSError, UnicodeDecodeError, csv.Error):
         pass
-    return (), 0
+    if found is None:
+        return (), 0
+    header, row, line = found
+    check_header(path, header, line, row)
+    return header, row
 
 
 def read_lines(path: str | Path) -> list[tuple[int, str]]:
@@ -180,7 +224,8 @@ def read_csv_table(
         name.strip() for name in (parsed[0] if quoted else next(csv.reader([lines[0][1]])))
     )
     header_line = lines[0][0]
-    _check_header(path, header, required, header_line)
+    check_header(path, header, lines[0][1], header_line)
+    _check_required(path, header, required, (*required, *optional), set(blank), header_line)
     wanted = [name for name in (*required, *optional) if name in header]
     index = {name: header.index(name) for name in wanted}
     others = [n for n in header if n not in index and n] if extra else []
@@ -203,31 +248,47 @@ def read_csv_table(
     )
 
 
-def _check_header(path: Path, header: tuple[str, ...], required, header_line: int) -> None:
-    """Refuse a column named twice, or a required column missing (close matches named)."""
-    seen = set()
-    for name in header:
-        if name in seen:
-            raise InputError(
-                f"column '{name}' appears twice in the header", path=path, row=header_line
-            )
-        seen.add(name)
+def _check_required(
+    path: Path, header: tuple[str, ...], required, known, blank: set[str], header_line: int
+) -> None:
+    """Refuse a required column missing: each named with the header column it may be (one the
+    reader does not know, each proposed once), and for columns that may be empty (``blank``)
+    that an empty column means "not measured"."""
     missing = [name for name in required if name not in header]
     if not missing:
         return
-    hints = []
+    hints, proposed = [], set()
     for name in missing:
-        close = [h for h in header if h.lower().replace(" ", "") == name.lower()]
-        close += [h for h in header if h not in close and name.split("_")[0] == h.split("_")[0]]
+        unknown = [h for h in header if h not in known and h not in proposed]
+        close = [h for h in unknown if h.lower().replace(" ", "") == name.lower()]
+        close += [h for h in unknown if h not in close and name.split("_")[0] == h.split("_")[0]]
         if close:
             hints.append(f"'{name}' (found {', '.join(repr(c) for c in close)})")
-        else:
-            hints.append(f"'{name}'" + closest_column_hint(name, header))
+            proposed.update(close)
+            continue
+        hint = closest_column_hint(name, header, (*known, *proposed))
+        hints.append(f"'{name}'{hint}")
+        if hint:
+            proposed.add(hint.split("'")[1])
+    empty = [name for name in missing if name in blank]
+    advice = ""
+    if empty:
+        one = len(empty) == 1
+        advice = (
+            f"; if {_or(empty)} {'was' if one else 'were'} not measured, keep the "
+            f"column{'' if one else 's'} with {'its' if one else 'their'} cells left empty (an "
+            "empty cell means not measured)"
+        )
     raise InputError(
-        f"missing required column(s) {', '.join(hints)}; the header has {', '.join(header)}",
+        f"missing required column(s) {', '.join(hints)}; the header has {', '.join(header)}"
+        + advice,
         path=path,
         row=header_line,
     )
+
+
+def _or(names: Sequence[str]) -> str:
+    return ", ".join(names[:-1]) + (" or " if len(names) > 1 else "") + names[-1]
 
 
 def _read_cells(path, lines, parsed, header, index, others, blank_ok):

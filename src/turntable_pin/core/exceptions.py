@@ -48,9 +48,10 @@ class TurntablePinError(Exception):
 class InputError(TurntablePinError, ValueError):
     """Bad user input: a value, a name, a file, a row or a column that cannot be used.
 
-    The message names where the problem is (file, row or line, column) when that is known. Rows
-    are counted as a spreadsheet shows them: the header is row 1, the first data row is row 2;
-    ``line`` is a line of a text file such as a YAML file (1 = first line).
+    The message names where the problem is (file, row or line, column) when that is known. A
+    CSV row is the file's line number, comment and blank lines counted (the header is row 1
+    unless ``#`` lines come first; :mod:`~turntable_pin.core.csv_table`); ``line`` is a line of
+    a text file such as a YAML file (1 = first line).
     """
 
     def __init__(

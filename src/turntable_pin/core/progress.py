@@ -1,7 +1,8 @@
 """A minimal progress reporter for long work (Monte Carlo, sweeps), written to stderr.
 
 It draws a one-line bar when stderr is a terminal and otherwise prints a line at every 10 %, so
-logs of batch runs show progress too. ``enabled=False`` silences it.
+logs of batch runs show progress too. ``enabled=False`` silences it; ``delay_s`` keeps it silent
+until the work has run that long (a run that ends sooner prints nothing).
 """
 
 from __future__ import annotations
@@ -18,10 +19,20 @@ class Progress:
     Use as a context manager and call :meth:`update` with the units done since the last call.
     """
 
-    def __init__(self, total: int, description: str, *, enabled: bool = True, stream=None) -> None:
+    def __init__(
+        self,
+        total: int,
+        description: str,
+        *,
+        enabled: bool = True,
+        stream=None,
+        delay_s: float = 0.0,
+    ) -> None:
         self.total = max(int(total), 1)
         self.description = description
         self.enabled = enabled
+        self.delay_s = float(delay_s)
+        self._drawn = False
         self.stream = stream if stream is not None else sys.stderr
         self.done = 0
         self._last_decile = -1
@@ -32,7 +43,7 @@ class Progress:
         return self
 
     def __exit__(self, *exc) -> None:
-        if self.enabled and self._tty:
+        if self.enabled and self._tty and self._drawn:
             self.stream.write("\n")
             self.stream.flush()
 
@@ -43,6 +54,9 @@ class Progress:
             return
         fraction = self.done / self.total
         elapsed = time.perf_counter() - self._start
+        if elapsed < self.delay_s:
+            return
+        self._drawn = True
         if self._tty:
             width = 30
             filled = int(round(width * fraction))

@@ -93,7 +93,8 @@ class OrientationMeasurements:
         time_s: time of each row (N,) or ``None``.
         dirs: per joint, the approach direction ``dirK`` (N,) or ``None``.
         extra: other numeric columns of the file, ``{name: (N,)}`` (suspects for the diagnosis).
-        rows: spreadsheet row of each position in the file (N,) (2 = first data row).
+        rows: the file's line number of each position (N,), comment lines counted (the rule of
+            :mod:`~turntable_pin.core.csv_table`; 2 = first data row of a file without them).
         source: the file read, or a description.
         joint_names: the table's joint names (for column names and labels), or ``()``.
         sigma_relative: ``sigma_rad`` gives only the angles' relative noise (weights), the level
@@ -364,7 +365,7 @@ def _sigma_arcsec(table) -> np.ndarray | None:
     if table.has("sigma_arcsec") and per_angle:
         raise InputError(
             "give either sigma_arcsec or the per-angle sigma_<angle>_arcsec columns, not both",
-            path=table.path, row=1, column="sigma_arcsec",
+            path=table.path, row=table.header_row, column="sigma_arcsec",
         )  # fmt: skip
     for column in ("sigma_arcsec", *_SIGMA_COLUMNS):
         if not table.has(column):
@@ -386,6 +387,6 @@ def _sigma_arcsec(table) -> np.ndarray | None:
     if missing:
         raise InputError(
             f"per-angle sigma needs all three columns; missing {', '.join(missing)}",
-            path=table.path, row=1,
+            path=table.path, row=table.header_row,
         )  # fmt: skip
     return np.stack([table[c] for c in _SIGMA_COLUMNS], axis=1)

@@ -56,7 +56,9 @@ __all__ = [
     "ErrorLayout",
     "GenericTable",
     "Identifiable",
+    "JOINT_ERROR_KINDS",
     "OrientationError",
+    "generic_length_errors",
     "perpendicular_directions",
 ]
 
@@ -181,6 +183,20 @@ class ErrorLayout:
         return tuple(n for n in self.names if n not in self.length_names)
 
 
+JOINT_ERROR_KINDS: tuple[tuple[str, str], ...] = (
+    ("position", ROTATION), ("tilt_a", ROTATION), ("tilt_b", ROTATION),
+    ("offset_a", TRANSLATION), ("offset_b", TRANSLATION),
+)  # fmt: skip
+"""The errors every joint ``J`` carries by the module docstring's rule, in order: ``J.<name>``
+and its kind (:data:`ROTATION`, radians, or :data:`TRANSLATION`, metres)."""
+
+
+def generic_length_errors() -> tuple[str, ...]:
+    """The lengths among a joint's errors, ``<joint>.offset_a``...: what a user gives in
+    millimetres (:data:`JOINT_ERROR_KINDS`)."""
+    return tuple(f"<joint>.{name}" for name, kind in JOINT_ERROR_KINDS if kind == TRANSLATION)
+
+
 def generic_layout(chain: ErrorChain, mount: str) -> ErrorLayout:
     """The layout of the module docstring's rule for the joints of ``chain`` and payload mount
     ``mount``: per joint ``position``, ``tilt_a``, ``tilt_b``, ``offset_a``, ``offset_b``; then
@@ -193,12 +209,16 @@ def generic_layout(chain: ErrorChain, mount: str) -> ErrorLayout:
         a = link.axis / np.linalg.norm(link.axis)
         u, v = perpendicular_directions(a)
         j = link.name
+        axes_texts = (
+            (a, f"position error of {j} (about its axis)"),
+            (u, f"tilt of {j}'s axis about u = {_vec(u)}"),
+            (v, f"tilt of {j}'s axis about v = {_vec(v)}"),
+            (u, f"offset of {j}'s axis along u (m)"),
+            (v, f"offset of {j}'s axis along v (m)"),
+        )
         entries = [
-            (ROTATION, a, "position", f"position error of {j} (about its axis)"),
-            (ROTATION, u, "tilt_a", f"tilt of {j}'s axis about u = {_vec(u)}"),
-            (ROTATION, v, "tilt_b", f"tilt of {j}'s axis about v = {_vec(v)}"),
-            (TRANSLATION, u, "offset_a", f"offset of {j}'s axis along u (m)"),
-            (TRANSLATION, v, "offset_b", f"offset of {j}'s axis along v (m)"),
+            (kind, axis, short, text)
+            for (short, kind), (axis, text) in zip(JOINT_ERROR_KINDS, axes_texts, strict=True)
         ]
         factors[j] = tuple((kind, tuple(axis), f"{j}.{short}") for kind, axis, short, _ in entries)
         for _, _, short, text in entries:

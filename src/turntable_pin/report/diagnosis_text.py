@@ -12,10 +12,12 @@ from __future__ import annotations
 
 from ..core.words import Command, argument, command
 from ..stats.diagnosis_engine import DATA_PLACEHOLDER
+from ..stats.model_selection import acceptance_rule
 
 __all__ = [
     "DATA_PLACEHOLDER",
     "coefficient_lines",
+    "decision_rule_words",
     "diagnosis_lines",
     "family_lines",
     "fit_command",
@@ -144,6 +146,15 @@ def _verdict_headline(d: dict) -> str:
     return f"The base model fits to the noise -- {level}"
 
 
+def decision_rule_words(d: dict | None = None) -> str:
+    """The decision rule as every output says it (``diagnose --help``, the text, the HTML page):
+    ``an effect is accepted when <acceptance_rule()>``, and with a result ``d`` its first
+    round's threshold (``, here -10.4``)."""
+    words = f"an effect is accepted when {acceptance_rule()}"
+    threshold = (d or {}).get("decision_rule", {}).get("threshold")
+    return words if threshold is None else f"{words}, here {threshold:.1f}"
+
+
 def header_lines(d: dict) -> list[str]:
     """The data, the base fit and the table of candidates."""
     lines = []
@@ -162,11 +173,7 @@ def header_lines(d: dict) -> list[str]:
         + (f", p-value {b['p_value']:.3g}" if b["p_value"] is not None else "")
     )
     lines += [f"warning: {text}" for text in d.get("warnings", [])]
-    threshold = d.get("decision_rule", {}).get("threshold", -6.0)
-    lines.append(
-        f"candidates (best first; delta_bic <= {threshold:.1f} accepts: -6 - 2 ln K for K "
-        "candidates):"
-    )
+    lines.append(f"candidates (best first; {decision_rule_words(d)}):")
     first = d["steps"][0]["added"] if d["steps"] else None
     for c in d["candidates"]:
         if not c["testable"]:

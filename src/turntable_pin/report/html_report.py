@@ -24,6 +24,7 @@ from ..stats.diagnosis_engine import DATA_PLACEHOLDER, residual_sets
 from ..stats.model_selection import Diagnosis
 from .diagnosis_text import (
     coefficient_lines,
+    decision_rule_words,
     headline,
     other_side_lines,
     table_from_run_lines,
@@ -245,14 +246,27 @@ def _base(page: _Page, heading: str) -> list[str]:
     return parts
 
 
+FAILING_SHOWN = 15
+"""Most failing positions the page lists (the worst ones; all when fewer fail)."""
+
+
 def _fails(page: _Page, heading: str) -> list[str]:
-    """Where the base model fails: the positions beyond k sigma, the residual map and, without
-    a missing effect, the base residuals and their harmonics."""
+    """Where the base model fails: the positions beyond k sigma (the :data:`FAILING_SHOWN`
+    worst listed, and said so), the residual map and, without a missing effect, the base
+    residuals and their harmonics."""
     failing = page.base_an.failing
     n_positions = page.d["n_positions"]
+    listed = ""
+    if len(failing) > FAILING_SHOWN:
+        listed = (
+            f" The {FAILING_SHOWN} largest, worst first (the position's largest residual in "
+            "sigmas):"
+        )
+    elif failing:
+        listed = " All of them, worst first (the position's largest residual in sigmas):"
     parts = [
         f"{_heading(heading)}<p>{len(failing)} of {n_positions} positions have a residual "
-        f"beyond {page.base_an.k_sigma:g} sigma.</p>"
+        f"beyond {page.base_an.k_sigma:g} sigma.{listed}</p>"
     ]
     if failing:
         joints = range(1, page.family.data.n_joints + 1)
@@ -267,7 +281,7 @@ def _fails(page: _Page, heading: str) -> list[str]:
                         f["residual_arcsec"],
                         f["sigmas"],
                     ]
-                    for f in failing[:15]
+                    for f in failing[:FAILING_SHOWN]
                 ],
             )  # fmt: skip
         )
@@ -333,13 +347,11 @@ def _diagnosis(page: _Page, heading: str) -> list[str]:
     lines = [*verdict_lines(d, page.family.source or DATA_PLACEHOLDER), *other_side_lines(d)]
     words = "<br>".join(html.escape(line) for line in lines)
     parts.append(f'<div class="verdict{" warn" if verdict["unexplained"] else ""}">{words}</div>')
-    if page.effect and "story" in page.words.parts:
+    if page.effect and "story" in page.words.parts:  # why and how to confirm: in the verdict
         story = verdict["effect_story"]
         parts.append(
             f"<p><b>{html.escape(story['effect'])}</b> &mdash; {html.escape(story['title'])}. "
             f"Definition: <code>{html.escape(story['definition'])}</code>.</p>"
-            f"<p>{html.escape(story['explanation'])}</p>"
-            f"<p><i>How to confirm it on the machine:</i> {html.escape(story['confirm'])}</p>"
         )
     return parts + _structure(page)
 
@@ -411,8 +423,9 @@ def _parameters(page: _Page, heading: str) -> list[str]:
 
 def _decision_rule(page: _Page, heading: str) -> list[str]:
     return [
-        "<p style='color:#777;font-size:.85em'>Decision rule: an effect is accepted when it "
-        "lowers BIC by 6 or more; effects whose fit is as good are listed as alternatives; the "
+        "<p style='color:#777;font-size:.85em'>Decision rule: "
+        f"{html.escape(decision_rule_words(page.d))}; effects whose fit is as good are listed "
+        "as alternatives; the "
         "final model is 'unexplained' when it fails the chi2 test (sigma given) or a harmonic "
         "structure search still finds a term.</p>"
     ]

@@ -57,6 +57,7 @@ __all__ = [
     "UNDETERMINED_GAIN_RATIO",
     "parameter_determination",
     "undetermined_parameters",
+    "acceptance_rule",
     "acceptance_threshold",
     "FIT_TEST_ALPHA",
     "Candidate",
@@ -199,6 +200,12 @@ def multiple_correlations(matrix, i: int, base: np.ndarray, rank: int) -> tuple[
         min(float(np.linalg.norm(base.T @ column)) / norm, 1.0),
         min(float(np.linalg.norm(others.T @ column)) / norm, 1.0),
     )
+
+
+def acceptance_rule() -> str:
+    """The decision rule in words, the one text every output states it with (help, text, JSON,
+    HTML): ``delta_bic <= -6 - 2 ln K (K testable candidates)``, from :data:`BIC_THRESHOLD`."""
+    return f"delta_bic <= {BIC_THRESHOLD:g} - 2 ln K (K testable candidates)"
 
 
 def acceptance_threshold(n_testable: int) -> float:
@@ -557,7 +564,7 @@ class Diagnosis:
             "outliers": [dict(o) for o in self.outliers],
             "outlier_rule": self.outlier_rule,
             "decision_rule": {
-                "accept_effect": f"delta_bic <= {BIC_THRESHOLD:g} - 2 ln K (K testable candidates)",
+                "accept_effect": acceptance_rule(),
                 "threshold": self._first_threshold(),
                 "alternative": f"|chi2 difference| within the {ALTERNATIVE_LEVEL:g} quantile "
                 "of chi2(larger added_rank)",
