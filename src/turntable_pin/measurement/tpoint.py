@@ -56,6 +56,7 @@ import numpy as np
 from ..core.csv_table import first_repeated_row
 from ..core.exceptions import InputError
 from ..core.files import read_text_file, write_text_atomic
+from ..core.notebook import NotebookResult
 from ..core.resources import models_dir
 from ..core.sizes import MAX_TPOINT_FILE_BYTES, MAX_TPOINT_OBSERVATIONS
 from ..core.units import ARCSEC_PER_RAD
@@ -162,7 +163,7 @@ class TpointRun:
 
 
 @dataclass(frozen=True)
-class TpointConversion:
+class TpointConversion(NotebookResult):
     """A run converted to measurement rows (definitions: the module docstring).
 
     Attributes:
@@ -242,6 +243,28 @@ class TpointConversion:
             "source lines of the rows, in order: " + _ranges(run.lines),
         ]
         return out
+
+    def to_dict(self) -> dict:
+        """The conversion as a JSON-ready dict: the run (file, caption, mount, stars, latitude),
+        the refraction, the URDF the rows belong to, the rows (``phi1_deg, phi2_deg,
+        dpsi_arcsec, dtheta_arcsec``) and the provenance lines of the CSV."""
+        run = self.run
+        return {
+            "path": str(run.path),
+            "caption": run.caption,
+            "mount": run.mount,
+            "n_stars": run.n_stars,
+            "latitude_deg": self.latitude_deg,
+            "refraction": self.refraction,
+            "urdf_name": self.urdf_name,
+            "rows": {
+                "phi1_deg": self.phi_deg[:, 0].tolist(),
+                "phi2_deg": self.phi_deg[:, 1].tolist(),
+                "dpsi_arcsec": self.dpsi_arcsec.tolist(),
+                "dtheta_arcsec": self.dtheta_arcsec.tolist(),
+            },
+            "comment_lines": self.comment_lines(),
+        }
 
     def csv_text(self) -> str:
         """The measurement CSV (comment lines, header, one row per star)."""
