@@ -81,7 +81,7 @@ def load_table(name_or_path=None, mount: str | None = None, *, payload_frame: st
     >>> table = tp.load_table("altaz_mount")
     >>> table.joint_names
     ('azimuth', 'elevation')
-    >>> table.nominal_pin_model.nq
+    >>> table.nominal_pin_model.nv
     2
     """
     from .measurement.pointing_terms import checked_table
@@ -293,7 +293,7 @@ def fit(data, effects=(), *, table=None, ignore_sigma: bool = False):
     >>> import turntable_pin as tp
     >>> result = tp.fit("measurements_example.csv")
     >>> result.result.rank
-    6
+    5
     """
     from .measurement.fit import fit_orientation, refuse_repeated_shapes
 
