@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import html
 import re
+import sys
 import tempfile
 from pathlib import Path
 
@@ -187,3 +188,20 @@ register_view(
 register_view(Allocation, View(_report_html, _allocation_figures))
 register_view(CalibrationResult, View(_report_html, _no_figures))
 register_view(TpointConversion, View(_tpoint_html, _tpoint_figures))
+
+
+def _figures_as_png_in_ipython() -> None:
+    """In IPython (a notebook), show a matplotlib figure that is a cell's value as a PNG: the
+    package draws on the Agg backend, which registers no display of its own. Nothing outside
+    IPython (IPython is not imported here)."""
+    if "IPython" not in sys.modules:
+        return
+    from IPython import get_ipython
+    from IPython.core.pylabtools import select_figure_formats
+
+    shell = get_ipython()
+    if shell is not None:
+        select_figure_formats(shell, {"png"})
+
+
+_figures_as_png_in_ipython()
