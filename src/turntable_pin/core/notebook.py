@@ -82,8 +82,19 @@ class NotebookResult:
         raise NotImplementedError
 
     def to_json(self, *, indent: int | None = 2) -> str:
-        """The result as JSON text: :meth:`to_dict` with numpy values as numbers, NaN and
-        infinities as ``null``; ``json.loads`` of it gives the dict back."""
+        """The result as JSON text (what the command's ``--json`` prints).
+
+        Parameters
+        ----------
+        indent : int or None, default 2
+            Indentation of the JSON text (``None``: one line).
+
+        Returns
+        -------
+        str
+            :meth:`to_dict` with numpy values as numbers, NaN and infinities as ``null``;
+            ``json.loads`` of it gives the dict back.
+        """
         return json.dumps(jsonable(self.to_dict()), indent=indent, allow_nan=False)
 
     def _repr_html_(self) -> str:
@@ -91,6 +102,17 @@ class NotebookResult:
         return _view_of(self).html(self)
 
     def plot(self) -> list:
-        """The result's figures as matplotlib figures (the ones the command line's ``--plots``
-        writes as PNG), open: show them, change them or save them."""
+        """The result's figures (the ones the command line's ``--plots`` writes as PNG).
+
+        Returns
+        -------
+        list of matplotlib.figure.Figure
+            Open figures: show them, change them, save them (``fig.savefig(path)``) or close
+            them (``matplotlib.pyplot.close(fig)``). Nothing is written.
+
+        Raises
+        ------
+        TurntablePinError
+            The result has no figure, or no view is registered for it.
+        """
         return _view_of(self).figures(self)

@@ -110,6 +110,26 @@ def _fit_html(fit: OrientationFit) -> str:
         f"<p>{len(failing)} of {fit.data.n_positions} positions have a residual beyond "
         "3 sigma.</p>",
     ]
+    if "pointing_terms" in out:  # a telescope mount: TPOINT's terms by name, as fit prints them
+        block = out["pointing_terms"]
+        parts += [
+            f"<p>TPOINT terms ({html.escape(block['mount'])} mount; "
+            f"{html.escape(block['convention'])}):</p>",
+            html_table(
+                ["term", "value", "std", "unit", "formula"],
+                [
+                    [
+                        t["name"],
+                        t["value"],
+                        "-" if t["std"] is None else t["std"],
+                        t["unit"],
+                        t["formula"],
+                    ]
+                    for t in block["terms"]
+                ],
+            ),  # fmt: skip
+            f"<p>{html.escape(block['note'])}</p>",
+        ]
     return _div(*parts)
 
 
