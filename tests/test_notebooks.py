@@ -48,23 +48,28 @@ def test_there_are_two_notebooks():
     assert [p.name for p in NOTEBOOKS] == ["01_user_loop.py", "02_telescope_run.py"]
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
-def test_notebook_runs_and_leaves_nothing_behind(path, tmp_path, monkeypatch):
+def _run(path, folder, monkeypatch):
+    """``path`` executed in ``folder`` by a kernel on this checkout's ``src``; the notebook."""
     monkeypatch.setenv(
         "PYTHONPATH", os.pathsep.join(filter(None, [str(SRC_DIR), os.environ.get("PYTHONPATH")]))
     )
     monkeypatch.setenv("MPLBACKEND", "Agg")
-    status = _git_status()
     notebook = jupytext.read(path)
     client = nbclient.NotebookClient(
         notebook, timeout=CELL_TIMEOUT_S, kernel_name="python3",
-        resources={"metadata": {"path": str(tmp_path)}},
+        resources={"metadata": {"path": str(folder)}},
     )  # fmt: skip
     start = time.perf_counter()
     client.execute()  # a failing cell (an assert of a key number) raises CellExecutionError
-    seconds = time.perf_counter() - start
-    print(f"{path.name}: {seconds:.1f} s")
+    print(f"{path.name}: {time.perf_counter() - start:.1f} s")
+    return notebook
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
+def test_notebook_runs_and_leaves_nothing_behind(path, tmp_path, monkeypatch):
+    status = _git_status()
+    notebook = _run(path, tmp_path, monkeypatch)
     results = _outputs(notebook, "execute_result")
     assert "text/html" in results  # the results showed themselves
     assert "image/png" in results  # a figure of plot() as a PNG
@@ -72,3 +77,19 @@ def test_notebook_runs_and_leaves_nothing_behind(path, tmp_path, monkeypatch):
     assert not errors
     assert list(tmp_path.iterdir()) == []
     assert _git_status() == status
+
+
+@pytest.mark.slow
+def test_the_user_loop_runs_without_a_browser(tmp_path, monkeypatch):
+    """Without Chromium the snapshot is skipped with its reason; the loop runs on."""
+    monkeypatch.setenv("TURNTABLE_PIN_CHROMIUM", "no-such-browser-here")
+    notebook = _run(REPO_DIR / "notebooks" / "01_user_loop.py", tmp_path, monkeypatch)
+    printed = "".join(
+        o.get("text", "") for c in notebook.cells for o in c.get("outputs", [])
+        if o.output_type == "stream"
+    )  # fmt: skip
+    assert "no snapshot: $TURNTABLE_PIN_CHROMIUM is 'no-such-browser-here'" in printed
+    assert "display_data" not in {
+        o.output_type for c in notebook.cells for o in c.get("outputs", [])
+    }
+    assert list(tmp_path.iterdir()) == []
