@@ -96,6 +96,30 @@ def test_design_is_callable_whether_or_not_the_subpackage_was_imported():
     assert out.stdout.split() == ["8", "turntable_pin.design.identify"]
 
 
+def test_a_result_without_its_views_says_how_to_get_them():
+    code = (
+        "from turntable_pin.measurement.data import read_measurements\n"
+        "from turntable_pin.measurement.fit import fit_orientation\n"
+        "from turntable_pin.core.resources import examples_dir\n"
+        "fit = fit_orientation(read_measurements(examples_dir() / 'measurements_example.csv'))\n"
+        "print(len(fit.to_json()) > 0)\n"
+        "try:\n    fit.plot()\nexcept Exception as exc:\n    print(type(exc).__name__, exc)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=cli_env(), check=True)  # fmt: skip
+    lines = out.stdout.splitlines()
+    assert lines[0] == "True"
+    assert lines[1].startswith("TurntablePinError no view of a OrientationFit is registered")
+    assert "import turntable_pin.report.notebook" in lines[1]
+
+
+def test_simulate_takes_a_schedule(paper):
+    schedule = tp.Schedule(90, 90, repeats=2, passes=1)
+    sim = tp.simulate(paper, schedule=schedule, seed=2)
+    assert sim.data.n_positions == schedule.count(2)
+    assert sim.to_dict()["schedule"] == schedule.describe(2)
+
+
 # ---- the user's loop --------------------------------------------------------------------------
 def test_user_loop_reaches_the_error_fell_in_ten_lines(capsys):
     assert len(USER_LOOP.strip().splitlines()) <= 10

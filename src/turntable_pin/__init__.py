@@ -49,6 +49,7 @@ _EXPORTS = {
     "OrientationRequirement": "calibration.requirement",
     "PositionSet": "calibration.positions",
     "RateErrorResult": "calibration.rate_error",
+    "Schedule": "measurement.simulation",
     "Sensitivities": "allocation.sensitivity",
     "SetupScene": "viewer.scene",
     "SimulatedMeasurements": "measurement.simulation",
@@ -151,7 +152,7 @@ if TYPE_CHECKING:  # names for static checkers; nothing is imported at run time
     from .measurement.effect_model import OrientationModel  # noqa: F401
     from .measurement.effects import EFFECT_NAMES, EFFECTS, Effect  # noqa: F401
     from .measurement.fit import OrientationFit  # noqa: F401
-    from .measurement.simulation import SimulatedMeasurements  # noqa: F401
+    from .measurement.simulation import Schedule, SimulatedMeasurements  # noqa: F401
     from .model.batch_field import OrientationErrorField  # noqa: F401
     from .model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES, TurntableErrors  # noqa: F401
     from .model.generic_table import OrientationError  # noqa: F401

@@ -199,9 +199,9 @@ def simulate(
     random_positions : int, optional
         N positions uniform over every joint's turn (seeded) instead of the grid.
     schedule : Schedule, optional
-        Full control of positions, order, repeats, time and approach directions
-        (:class:`turntable_pin.measurement.simulation.Schedule`); replaces ``step_deg`` and
-        ``random_positions``.
+        Full control of positions, order, repeats, passes, time and approach directions
+        (``tp.Schedule(30, 30, order="random", repeats=2, passes=1, dwell_s=60)``); replaces
+        ``step_deg`` and ``random_positions``.
     not_measured : sequence of str, optional
         Angles left empty at every position (``("dgamma",)``: a pointing run).
     catalogue : sequence of Effect, optional
