@@ -84,7 +84,7 @@ def load_table(name_or_path=None, mount: str | None = None, *, payload_frame: st
     >>> table.nominal_pin_model.nv
     2
     """
-    from .measurement.pointing_terms import checked_table
+    from .measurement.checked_table import checked_table
     from .measurement.tpoint import EQUATORIAL, TpointConversion
 
     if hasattr(name_or_path, "parameter_names"):  # a table already

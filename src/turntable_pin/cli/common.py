@@ -223,8 +223,8 @@ def add_error_options(parser: argparse.ArgumentParser) -> None:
 
 def table_from_args(args: argparse.Namespace):
     """The table of ``--urdf``, ``--payload-frame`` and ``--mount``
-    (:func:`~turntable_pin.measurement.pointing_terms.checked_table`)."""
-    from ..measurement.pointing_terms import checked_table
+    (:func:`~turntable_pin.measurement.checked_table.checked_table`)."""
+    from ..measurement.checked_table import checked_table
 
     return checked_table(
         args.urdf, getattr(args, "payload_frame", None), getattr(args, "mount", None)

@@ -50,7 +50,6 @@ __all__ = [
     "SECOND_ORDER_NOTE",
     "UNOBSERVED_ROLL_NOTE",
     "Mount",
-    "checked_table",
     "PointingTerm",
     "RigidTermMap",
     "coordinate_offsets",
@@ -411,18 +410,6 @@ def _undocumented_mount(table, why: str) -> InputError:
         "turntable",
         path=table.urdf_path,
     )
-
-
-def checked_table(urdf_path=None, payload_frame: str | None = None, telescope_mount=None):
-    """The table of a URDF (:func:`~turntable_pin.model.paper_table.table_of`; default the
-    paper's), a telescope mount checked against the documented frames (:func:`mount_kind`)
-    before any work."""
-    from ..model.paper_table import table_of
-
-    table = table_of(urdf_path, payload_frame, telescope_mount)
-    if table.telescope_mount is not None:
-        mount_kind(table)  # refuses a declared mount whose chain is not the documented one
-    return table
 
 
 def mount_kind(turntable) -> Mount | None:
