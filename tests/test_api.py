@@ -323,6 +323,7 @@ def test_import_tpoint_reads_back_as_the_commands_csv(tmp_path):
     table = tp.load_table(run)
     assert table.joint_names == ("azimuth", "elevation")
     assert tp.fit(data, "TF,TX", table=table).result.rms_user < 1.0
+    assert tp.fit(run, "TF,TX").result.rms_user < 1.0  # the run's mount, not the paper's table
 
 
 # ---- the result objects in a notebook --------------------------------------------------------

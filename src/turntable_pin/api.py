@@ -100,6 +100,16 @@ def load_table(name_or_path=None, mount: str | None = None, *, payload_frame: st
     return checked_table(path, payload_frame, mount)
 
 
+def _table_of(data, table):
+    """The table of ``data``: ``table`` when given, else the mount a converted TPOINT run belongs
+    to, else the paper's (:func:`load_table`)."""
+    from .measurement.tpoint import TpointConversion
+
+    if table is None and isinstance(data, TpointConversion):
+        return load_table(data)
+    return load_table(table)
+
+
 def _joint_columns(table) -> tuple[str, ...] | None:
     """The joints ``table``'s data files name (``phiK_deg`` or ``<joint>_deg``), or ``None``
     for the paper's ``phi1_deg, phi2_deg``."""
@@ -277,7 +287,8 @@ def fit(data, effects=(), *, table=None, ignore_sigma: bool = False):
         comma-separated names, effect files (``.yaml``), inline terms
         (``"dphi_z2~h3(phi2)"``) or Effect objects.
     table : str, path or table, optional
-        The table (:func:`load_table`; default the paper's).
+        The table (:func:`load_table`; default: the mount of a TPOINT run given as ``data``,
+        else the paper's).
     ignore_sigma : bool, default False
         Estimate the noise from the fit even if the data have sigmas.
 
@@ -297,7 +308,7 @@ def fit(data, effects=(), *, table=None, ignore_sigma: bool = False):
     """
     from .measurement.fit import fit_orientation, refuse_repeated_shapes
 
-    table = load_table(table)
+    table = _table_of(data, table)
     data = read_measurements(data, table)
     if ignore_sigma:
         data = data.without_sigma()
@@ -323,7 +334,8 @@ def diagnose(
     data : path, DataFrame or measurements
         What :func:`read_measurements` reads.
     table : str, path or table, optional
-        The table (:func:`load_table`; default the paper's).
+        The table (:func:`load_table`; default: the mount of a TPOINT run given as ``data``,
+        else the paper's).
     until_explained : bool, default False
         Add effects while one is significant.
     catalogue : sequence of path or Effect, optional
@@ -351,7 +363,7 @@ def diagnose(
     from .measurement.diagnosis import diagnose_measurements
     from .measurement.user_effects import load_catalogue
 
-    table = load_table(table)
+    table = _table_of(data, table)
     data = read_measurements(data, table)
     if ignore_sigma:
         data = data.without_sigma()
