@@ -384,7 +384,7 @@ def diagnose(
 # ---- designs --------------------------------------------------------------------------------
 def design(
     table=None,
-    n_positions: int = 24,
+    n_positions: int | None = None,
     *,
     effects=(),
     from_data=None,
@@ -406,8 +406,8 @@ def design(
     ----------
     table : str, path or table, optional
         The table (:func:`load_table`; default the paper's).
-    n_positions : int, default 24
-        Positions to choose.
+    n_positions : int, optional
+        Positions to choose (default 24, ``design.space.DEFAULT_POSITIONS``).
     effects : str or sequence, optional
         Effects to identify besides the base errors (as in :func:`fit`).
     from_data : path, DataFrame or measurements, optional
@@ -447,7 +447,7 @@ def design(
     12
     """
     from .core.sizes import check_positions_count
-    from .design.space import DEFAULT_CANDIDATES, design_space
+    from .design.space import DEFAULT_CANDIDATES, DEFAULT_POSITIONS, design_space
 
     table = load_table(table)
     modes = [
@@ -481,7 +481,10 @@ def design(
         seed=seed,
     )
     count = check_positions_count(
-        n_positions, space.candidates_deg.shape[0], "n_positions", "more candidates"
+        DEFAULT_POSITIONS if n_positions is None else n_positions,
+        space.candidates_deg.shape[0],
+        "n_positions",
+        "more candidates",
     )
     data = None if from_data is None else read_measurements(from_data, table)
     if calibrate:
