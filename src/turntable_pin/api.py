@@ -156,14 +156,13 @@ def read_measurements(source, table=None):
     from .measurement.data import read_measurements as read_csv
     from .measurement.simulation import SimulatedMeasurements
     from .measurement.tpoint import TpointConversion
-    from .report.notebook import tpoint_measurements
 
     if isinstance(source, OrientationMeasurements):
         return source
     if isinstance(source, SimulatedMeasurements):
         return source.data
     if isinstance(source, TpointConversion):
-        return tpoint_measurements(source)
+        return source.measurements()
     joints = _joint_columns(load_table(table))
     if hasattr(source, "to_csv"):  # a DataFrame: the one reader checks it as a file
         with tempfile.TemporaryDirectory(prefix="turntable-pin-frame-") as folder:

@@ -63,7 +63,7 @@ from ..core.units import ARCSEC_PER_RAD
 from ..core.words import argument
 from ..model.chain import compose_rotation
 from ..model.generic_table import GenericTable
-from .data import MAX_MEASURED_ANGLE_ARCSEC
+from .data import MAX_MEASURED_ANGLE_ARCSEC, OrientationMeasurements, read_measurements
 
 __all__ = [
     "ALTAZ",
@@ -279,6 +279,14 @@ class TpointConversion(NotebookResult):
     def write_csv(self, path: str | Path) -> Path:
         """Write :meth:`csv_text` to ``path`` atomically; returns the path."""
         return write_text_atomic(path, self.csv_text())
+
+    def measurements(self) -> OrientationMeasurements:
+        """The rows as measurements, read back from the CSV (written into a temporary folder,
+        removed): what ``diagnose`` reads after ``import-tpoint``."""
+        with tempfile.TemporaryDirectory(prefix="turntable-pin-tpoint-") as folder:
+            path = self.write_csv(Path(folder) / f"{Path(self.run.path).stem}.csv")
+            data = read_measurements(path)
+        return data.replace(source=str(self.run.path))
 
     def write_urdf(self, path: str | Path) -> Path:
         """Write :attr:`urdf_text` to ``path`` atomically; returns the path."""

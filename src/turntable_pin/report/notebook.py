@@ -12,8 +12,6 @@ from __future__ import annotations
 import html
 import re
 import sys
-import tempfile
-from pathlib import Path
 
 from ..allocation.solver import Allocation
 from ..calibration.drift_fit import CalibrationResult
@@ -22,7 +20,7 @@ from ..core.notebook import View, register_view
 from ..design.calibrate import CalibrationDesign
 from ..design.identify import IdentifyDesign
 from ..design.separate import SeparationDesign
-from ..measurement.data import OrientationMeasurements, read_measurements
+from ..measurement.data import OrientationMeasurements
 from ..measurement.fit import OrientationFit
 from ..measurement.residuals import analyse_residuals, orientation_residuals
 from ..measurement.simulation import SimulatedMeasurements
@@ -44,7 +42,7 @@ from .measurement_figures import write_diagnosis_plots, write_residual_plots
 from .requirement_figures import write_calibration_design_figures
 from .separation_figures import write_separate_plots
 
-__all__ = ["SCOPE", "scoped_style", "tpoint_measurements"]
+__all__ = ["SCOPE", "scoped_style"]
 
 SCOPE = "turntable-pin"
 """The CSS class of every notebook view's ``<div>``: the report's style applies inside it only."""
@@ -174,22 +172,13 @@ def _no_figures(result) -> list:
 
 
 # ---- TPOINT runs ----------------------------------------------------------------------------
-def tpoint_measurements(conversion: TpointConversion) -> OrientationMeasurements:
-    """The measurements of a converted TPOINT run, read back from its CSV (written into a
-    temporary folder: the rows a user of ``import-tpoint`` then ``diagnose`` gets)."""
-    with tempfile.TemporaryDirectory(prefix="turntable-pin-tpoint-") as folder:
-        path = conversion.write_csv(Path(folder) / f"{Path(conversion.run.path).stem}.csv")
-        data = read_measurements(path)
-    return data.replace(source=str(conversion.run.path))
-
-
 def _tpoint_html(conversion: TpointConversion) -> str:
     return _div(_pre("\n".join(conversion.comment_lines())),
-                _measurements_html(tpoint_measurements(conversion)))  # fmt: skip
+                _measurements_html(conversion.measurements()))  # fmt: skip
 
 
 def _tpoint_figures(conversion: TpointConversion) -> list:
-    return _data_figures(tpoint_measurements(conversion))
+    return _data_figures(conversion.measurements())
 
 
 register_view(OrientationMeasurements, View(_measurements_html, _data_figures))
