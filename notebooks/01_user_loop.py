@@ -46,15 +46,19 @@ assert table.joint_names == ("outer_axis", "inner_axis")
 # %% [markdown]
 # ## 2. Look at it
 #
-# A snapshot of the table with its errors magnified (meshcat rendered in headless Chromium).
+# A snapshot of the table at phi1 = 30 deg, phi2 = 45 deg, with the errors simulated below
+# magnified (meshcat rendered in headless Chromium): the ideal and the actual payload frames.
 # Without Chromium or meshcat the snapshot is skipped, with the reason.
 
 # %%
+import numpy as np
 from IPython.display import Image, display
 
-scene = tp.SetupScene(table.errors_from_user_units({"dphi_y1": 20, "dalpha_x1": 15}), table=table)
+errors_arcsec = {"dphi_y1": 20, "dalpha_x1": 15}
+scene = tp.SetupScene(table.errors_from_user_units(errors_arcsec), table=table)
 try:
-    snapshot = tp.render_snapshot(scene, (0.5, 0.8), out / "setup.png", width=480, height=360)
+    angles_rad = np.radians([30, 45])
+    snapshot = tp.render_snapshot(scene, angles_rad, out / "setup.png", width=480, height=360)
     display(Image(filename=str(snapshot.path)))
 except tp.TurntablePinError as exc:
     print(f"no snapshot: {exc}")
@@ -69,7 +73,7 @@ except tp.TurntablePinError as exc:
 # %%
 sim = tp.simulate(
     table,
-    errors={"dphi_y1": 20, "dalpha_x1": 15},
+    errors=errors_arcsec,
     effects={"inner_encoder_harmonics": {"c1": 4, "s1": -3}},
     seed=7,
 )
