@@ -323,7 +323,9 @@ def test_import_tpoint_reads_back_as_the_commands_csv(tmp_path):
     table = tp.load_table(run)
     assert table.joint_names == ("azimuth", "elevation")
     assert tp.fit(data, "TF,TX", table=table).result.rms_user < 1.0
-    assert tp.fit(run, "TF,TX").result.rms_user < 1.0  # the run's mount, not the paper's table
+    fitted = tp.fit(run, "TF,TX")  # the run's mount, not the paper's table
+    assert fitted.result.rms_user < 1.0
+    assert "TPOINT terms (altaz mount;" in fitted._repr_html_()
 
 
 # ---- the result objects in a notebook --------------------------------------------------------
@@ -355,6 +357,7 @@ def test_results_show_plot_and_serialise_themselves(paper, simulated, diagnosis)
         page = result._repr_html_()
         assert page.startswith('<div class="turntable-pin">') and page.endswith("</div>"), name
         assert "<html" not in page and "body{" not in page, name
+        assert page.count('<div class="turntable-pin">') == 1, name  # one style, not nested
         text = result.to_json()
         assert json.loads(text) == jsonable(result.to_dict()), name
         if name == "calibration":

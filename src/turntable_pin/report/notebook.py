@@ -25,6 +25,7 @@ from ..measurement.fit import OrientationFit
 from ..measurement.residuals import analyse_residuals, orientation_residuals
 from ..measurement.simulation import SimulatedMeasurements
 from ..measurement.tpoint import TpointConversion
+from ..model.angles import ANGLE_NAMES
 from ..stats.model_selection import Diagnosis
 from .allocation_figures import plot_sensitivities
 from .design_figures import write_identify_plots
@@ -72,20 +73,24 @@ def _data_figures(data: OrientationMeasurements) -> list:
 
 
 # ---- measurements ---------------------------------------------------------------------------
-def _measurements_html(data: OrientationMeasurements) -> str:
+def _measurements_parts(data: OrientationMeasurements) -> list[str]:
+    """What the measurements are (source, positions, joints, angles measured) and their figure."""
     measured = ", ".join(
-        f"{name} {int(n)}" for name, n in zip(("dpsi", "dtheta", "dgamma"), data.measured.sum(0),
-                                                strict=True)
-    )  # fmt: skip
-    return _div(
-        f"<p>{html.escape(data.source or 'measurements')}: {data.n_positions} positions, "
-        f"{data.n_joints} joint(s); measured angles per column: {measured}.</p>",
-        img_tag(data_figure(data), "measured angles"),
+        f"{name} {int(n)}" for name, n in zip(ANGLE_NAMES, data.measured.sum(0), strict=True)
     )
+    return [
+        f"<p>{html.escape(data.source or 'measurements')}: {data.n_positions} positions, "
+        f"{data.n_joints} joint(s); positions measuring each angle: {measured}.</p>",
+        img_tag(data_figure(data), "measured angles"),
+    ]
+
+
+def _measurements_html(data: OrientationMeasurements) -> str:
+    return _div(*_measurements_parts(data))
 
 
 def _simulated_html(sim: SimulatedMeasurements) -> str:
-    return _div(_pre(sim.comment()), _measurements_html(sim.data))
+    return _div(_pre(sim.comment()), *_measurements_parts(sim.data))
 
 
 # ---- fits and diagnoses ---------------------------------------------------------------------
@@ -173,8 +178,9 @@ def _no_figures(result) -> list:
 
 # ---- TPOINT runs ----------------------------------------------------------------------------
 def _tpoint_html(conversion: TpointConversion) -> str:
-    return _div(_pre("\n".join(conversion.comment_lines())),
-                _measurements_html(conversion.measurements()))  # fmt: skip
+    return _div(
+        _pre("\n".join(conversion.comment_lines())), *_measurements_parts(conversion.measurements())
+    )
 
 
 def _tpoint_figures(conversion: TpointConversion) -> list:
