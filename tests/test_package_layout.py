@@ -28,6 +28,7 @@ LAYER_RANK = {
     "report": 6,
     "viewer": 5,
     "cli": 7,
+    "api": 8,  # the flat API (api.py) over every layer
 }
 
 

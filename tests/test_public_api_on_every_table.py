@@ -356,7 +356,7 @@ def _walk(obj, seen: set, depth: int = 0) -> None:
         return
     seen.add(id(obj))
     for name in dir(type(obj)):
-        if name.startswith("_") or name in ("replace", "with_errors"):
+        if name.startswith("_") or name in ("replace", "with_errors", "plot"):  # plot: figures
             continue
         attr = inspect.getattr_static(obj, name)
         if isinstance(attr, (staticmethod, classmethod)):

@@ -10,12 +10,12 @@ from pathlib import Path
 
 from turntable_pin import (
     OrientationLimits,
-    allocate_tolerances,
     average_sensitivities,
     plot_monte_carlo,
     plot_sensitivities,
     run_monte_carlo,
 )
+from turntable_pin.allocation.solver import allocate_tolerances
 
 
 def main(out_dir: Path, fast: bool = False) -> list[Path]:

@@ -2,15 +2,27 @@
 
 The turntable is a URDF whose joint placements carry its errors; Pinocchio computes the orientation
 error ``dR = Rd^T Rt``. Inside, angles are radians and lengths metres; names carry other units.
-Below is the public API a user scripts with, layer by layer (the CLI makes the same calls);
-everything else lives in its module.
+The flat API (:mod:`turntable_pin.api`) is the way in: ``tp.load_table``, ``tp.read_measurements``,
+``tp.simulate``, ``tp.fit``, ``tp.diagnose``, ``tp.design``, ``tp.allocate``, ``tp.calibrate``,
+``tp.import_tpoint``; below it, the public classes and functions a user scripts with, layer by
+layer (the CLI makes the same calls); everything else lives in its module.
 """
 
+import types
 from typing import TYPE_CHECKING
 
+from . import design as _design_package  # light: its names are lazy
 from .core.lazy import lazy_exports
 
 _EXPORTS = {
+    "allocate": "api",
+    "calibrate": "api",
+    "diagnose": "api",
+    "fit": "api",
+    "import_tpoint": "api",
+    "load_table": "api",
+    "read_measurements": "api",
+    "simulate": "api",
     "ANGULAR_ERROR_NAMES": "model.errors",
     "Allocation": "allocation.solver",
     "CalibrationResult": "calibration.drift_fit",
@@ -37,6 +49,7 @@ _EXPORTS = {
     "OrientationRequirement": "calibration.requirement",
     "PositionSet": "calibration.positions",
     "RateErrorResult": "calibration.rate_error",
+    "Schedule": "measurement.simulation",
     "Sensitivities": "allocation.sensitivity",
     "SetupScene": "viewer.scene",
     "SimulatedMeasurements": "measurement.simulation",
@@ -44,32 +57,39 @@ _EXPORTS = {
     "TurntablePinError": "core.exceptions",
     "UserCodeError": "core.exceptions",
     "YourdfpyTurntable": "model.urdf_io",
-    "allocate_tolerances": "allocation.solver",
     "average_sensitivities": "allocation.sensitivity",
-    "calibrate": "calibration.drift_fit",
-    "calibrate_run": "calibration.drift_fit",
     "default_orientation_limits": "allocation.solver",
     "default_urdf_path": "core.resources",
-    "diagnose_measurements": "measurement.diagnosis",
-    "fit_orientation": "measurement.fit",
     "orientation_requirement": "calibration.requirement",
     "paper_eq16_limits": "allocation.solver",
     "plot_monte_carlo": "report.allocation_figures",
     "plot_sensitivities": "report.allocation_figures",
     "position_inputs": "calibration.positions",
     "rate_error": "calibration.rate_error",
-    "read_measurements": "measurement.data",
     "render_snapshot": "viewer.snapshot",
     "run_monte_carlo": "allocation.monte_carlo",
     "sensitivity_matrix": "allocation.sensitivity",
-    "simulate_measurements": "measurement.simulation",
     "small_angle_matrix": "model.small_angle",
     "small_angle_orientation_error": "model.small_angle",
     "write_report": "report.html_report",
 }
 
-__all__ = sorted(_EXPORTS)
+__all__ = sorted([*_EXPORTS, "design"])
 _export, __dir__ = lazy_exports(__name__, _EXPORTS)
+
+
+class _DesignPackage(types.ModuleType):
+    """The subpackage ``turntable_pin.design``, callable as the flat API's
+    :func:`turntable_pin.api.design`: ``tp.design(table, 12, effects=...)`` (one name, whether
+    or not the subpackage was imported before)."""
+
+    def __call__(self, *args, **kwargs):
+        from .api import design
+
+        return design(*args, **kwargs)
+
+
+_design_package.__class__ = _DesignPackage
 
 
 def __getattr__(name: str):
@@ -101,11 +121,20 @@ if TYPE_CHECKING:  # names for static checkers; nothing is imported at run time
     from .allocation.solver import (  # noqa: F401
         Allocation,
         OrientationLimits,
-        allocate_tolerances,
         default_orientation_limits,
         paper_eq16_limits,
     )
-    from .calibration.drift_fit import CalibrationResult, calibrate, calibrate_run  # noqa: F401
+    from .api import (  # noqa: F401
+        allocate,
+        calibrate,
+        diagnose,
+        fit,
+        import_tpoint,
+        load_table,
+        read_measurements,
+        simulate,
+    )
+    from .calibration.drift_fit import CalibrationResult  # noqa: F401
     from .calibration.gyrowheel import GyroWheelModel  # noqa: F401
     from .calibration.positions import PositionSet, position_inputs  # noqa: F401
     from .calibration.rate_error import RateErrorResult, rate_error  # noqa: F401
@@ -119,12 +148,11 @@ if TYPE_CHECKING:  # names for static checkers; nothing is imported at run time
         UserCodeError,
     )
     from .core.resources import default_urdf_path  # noqa: F401
-    from .measurement.data import OrientationMeasurements, read_measurements  # noqa: F401
-    from .measurement.diagnosis import diagnose_measurements  # noqa: F401
+    from .measurement.data import OrientationMeasurements  # noqa: F401
     from .measurement.effect_model import OrientationModel  # noqa: F401
     from .measurement.effects import EFFECT_NAMES, EFFECTS, Effect  # noqa: F401
-    from .measurement.fit import OrientationFit, fit_orientation  # noqa: F401
-    from .measurement.simulation import SimulatedMeasurements, simulate_measurements  # noqa: F401
+    from .measurement.fit import OrientationFit  # noqa: F401
+    from .measurement.simulation import Schedule, SimulatedMeasurements  # noqa: F401
     from .model.batch_field import OrientationErrorField  # noqa: F401
     from .model.errors import ANGULAR_ERROR_NAMES, ERROR_NAMES, TurntableErrors  # noqa: F401
     from .model.generic_table import OrientationError  # noqa: F401

@@ -39,6 +39,7 @@ from ..calibration.positions import PositionSet
 from ..calibration.requirement import orientation_requirement
 from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.exceptions import InfeasibleError, InputError, ModelError
+from ..core.notebook import NotebookResult
 from ..core.turn_grid import every_combination
 from ..core.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, arcmin_by_name
 from ..model.angles import ANGLE_SYMBOLS
@@ -635,7 +636,7 @@ def allocation_weights(scheme: str, sensitivities: Sensitivities | None = None, 
 
 
 @dataclass(frozen=True)
-class Allocation:
+class Allocation(NotebookResult):
     """Upper bounds of a table's angular errors (eq. 34) and how they were obtained.
 
     Attributes:

@@ -27,6 +27,7 @@ import numpy as np
 
 from ..core.csv_table import write_csv_table
 from ..core.exceptions import IdentifiabilityError, InputError, check_seed
+from ..core.notebook import NotebookResult
 from ..core.units import rad_to_deg
 from .gyrowheel import (
     AXES,
@@ -108,7 +109,7 @@ class AxisCalibration:
 
 
 @dataclass(frozen=True)
-class CalibrationResult:
+class CalibrationResult(NotebookResult):
     """Both axes' fits and the set-up they came from."""
 
     x: AxisCalibration

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.exceptions import SEED_LIMIT, InputError, one_line
+from ..core.notebook import jsonable
 from ..model.errors import MAX_ANGULAR_ERROR_DEG, parse_error_value
 
 __all__ = [
@@ -172,22 +173,11 @@ def one_line_errors(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
 
 
 def input_path(value: str) -> Path:
-    """argparse type of a file a command reads: the path as given when something is there, else
-    the bundled file of that name (``altaz_mount``, ``measurements_example.csv``,
-    ``mmt_pointing/k_and_e.dat``, ``models/...``), so an installed package runs its examples
-    from any folder; else the name as given (the command then says it is missing)."""
-    path = Path(value)
-    if path.exists():
-        return path
-    from ..core.resources import models_dir
+    """argparse type of a file a command reads: :func:`~turntable_pin.core.resources.bundled_path`
+    (the path as given when something is there, else the bundled file of that name)."""
+    from ..core.resources import bundled_path
 
-    root = models_dir()
-    parts = path.parts
-    name = Path(*parts[1:]) if len(parts) > 1 and parts[0] == "models" else path
-    candidates = [root / name, root / "examples" / name]
-    if not name.suffix:
-        candidates.append(root / name.with_suffix(".urdf"))
-    return next((c for c in candidates if c.is_file()), path)
+    return bundled_path(value)
 
 
 def add_table_options(parser: argparse.ArgumentParser) -> None:
@@ -262,16 +252,13 @@ def add_error_options(parser: argparse.ArgumentParser) -> None:
 
 
 def table_from_args(args: argparse.Namespace):
-    """The table of ``--urdf``, ``--payload-frame`` and ``--mount`` (:func:`table_of`); a
-    telescope mount is checked against the documented frames here, before any work."""
-    from ..model.paper_table import table_of
+    """The table of ``--urdf``, ``--payload-frame`` and ``--mount``
+    (:func:`~turntable_pin.measurement.checked_table.checked_table`)."""
+    from ..measurement.checked_table import checked_table
 
-    table = table_of(args.urdf, getattr(args, "payload_frame", None), getattr(args, "mount", None))
-    if table.telescope_mount is not None:
-        from ..measurement.pointing_terms import mount_kind
-
-        mount_kind(table)  # refuses a declared mount whose chain is not the documented one
-    return table
+    return checked_table(
+        args.urdf, getattr(args, "payload_frame", None), getattr(args, "mount", None)
+    )
 
 
 def error_values_from_args(
@@ -304,25 +291,6 @@ def error_values_from_args(
     return values
 
 
-def _jsonable(value):
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _jsonable(value.tolist())
-    if isinstance(value, (np.floating, float)):
-        value = float(value)
-        return value if math.isfinite(value) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    if isinstance(value, Path):
-        return str(value)
-    return value
-
-
 def warn_ignored_columns(args: argparse.Namespace, data, path) -> None:
     """One warning line on stderr naming the columns of ``path`` that ``data`` left out as not
     numbers: no column is dropped without a word."""
@@ -335,7 +303,7 @@ def warn_ignored_columns(args: argparse.Namespace, data, path) -> None:
 
 def print_json(payload: dict) -> None:
     """Print one JSON object (numpy values converted, NaN/inf as null)."""
-    json.dump(_jsonable(payload), sys.stdout, indent=2, allow_nan=False)
+    json.dump(jsonable(payload), sys.stdout, indent=2, allow_nan=False)
     sys.stdout.write("\n")
 
 

@@ -32,9 +32,6 @@ from .common import (
 
 __all__ = ["register"]
 
-DEFAULT_POSITIONS = 24
-"""Positions a design chooses when ``-n`` is not given."""
-
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``design`` to ``subparsers``."""
@@ -101,7 +98,7 @@ def _add_mode_options(p: argparse.ArgumentParser) -> None:
 
 def _add_design_options(p: argparse.ArgumentParser) -> None:
     """How many positions, from which candidates, after which data, with which effects."""
-    from ..design.space import DEFAULT_CANDIDATES, GRID_STEP_DEG
+    from ..design.space import DEFAULT_CANDIDATES, DEFAULT_POSITIONS, GRID_STEP_DEG
 
     p.add_argument(
         "-n",

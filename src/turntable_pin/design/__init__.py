@@ -13,6 +13,9 @@ positions of the next measurement run:
 - :mod:`.schedule`: the order, times and approach directions of the chosen positions (repeats
   for time-driven effects, both sides for backlash) and the CSV that the simulation and the
   test crew read.
+
+Called, the package is the flat API's design: ``turntable_pin.design(table, n_positions, ...)`` is
+:func:`turntable_pin.api.design` (its docstring gives the arguments).
 """
 
 from ..core.lazy import lazy_exports

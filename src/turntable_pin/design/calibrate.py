@@ -48,6 +48,7 @@ from ..calibration.requirement import (
 from ..calibration.site import DEFAULT_LATITUDE_DEG
 from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.notebook import NotebookResult
 from ..core.sizes import check_positions_count
 from ..core.turn_grid import every_combination, full_turn_grid_deg
 from ..core.units import DEG_PER_RAD
@@ -292,7 +293,7 @@ def _exchange_bounding(
 
 # ---- the result ----------------------------------------------------------------------------------
 @dataclass(frozen=True)
-class CalibrationDesign:
+class CalibrationDesign(NotebookResult):
     """GyroWheel calibration positions with the loosest orientation requirement.
 
     Attributes:

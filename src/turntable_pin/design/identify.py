@@ -31,6 +31,7 @@ import numpy as np
 from ..calibration.positions import PositionSet
 from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import InputError, TurntablePinError
+from ..core.notebook import NotebookResult
 from ..core.sizes import check_positions_count
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..core.words import argument, command
@@ -62,7 +63,7 @@ DEFAULT_NOISE_ARCSEC = 1.0
 
 
 @dataclass(frozen=True)
-class IdentifyDesign:
+class IdentifyDesign(NotebookResult):
     """D-optimal positions and what they will determine.
 
     Attributes:

@@ -40,6 +40,7 @@ import numpy as np
 
 from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.notebook import NotebookResult
 from ..core.sizes import check_positions_count
 from ..core.words import argument, command
 from ..measurement.catalogue import catalogue
@@ -131,7 +132,7 @@ class Hypothesis:
 
 
 @dataclass(frozen=True)
-class SeparationDesign:
+class SeparationDesign(NotebookResult):
     """The positions that tell two effects apart, or why none do.
 
     Attributes:

@@ -31,6 +31,7 @@ from .schedule import Visits, candidate_visits
 
 __all__ = [
     "DEFAULT_CANDIDATES",
+    "DEFAULT_POSITIONS",
     "GRID_STEP_DEG",
     "MAX_CANDIDATES",
     "DesignSpace",
@@ -45,6 +46,9 @@ GRID_STEP_DEG = 30.0
 
 DEFAULT_CANDIDATES = 10_000
 """Random candidate positions a design chooses from by default."""
+
+DEFAULT_POSITIONS = 24
+"""Positions a design chooses when not told how many."""
 
 MAX_CANDIDATES = 200_000
 """Most random candidates (each costs a few kB of Jacobian rows while the design runs)."""

@@ -38,6 +38,7 @@ from ..calibration.positions import (
 )
 from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows
 from ..core.exceptions import InputError
+from ..core.notebook import NotebookResult
 from ..core.sizes import MAX_TIME_S
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
 from ..model.angles import ANGLE_NAMES
@@ -83,7 +84,7 @@ _VARIABLES = "_variables"
 
 
 @dataclass(frozen=True)
-class OrientationMeasurements:
+class OrientationMeasurements(NotebookResult):
     """Measured orientation errors at N positions (radians and seconds inside).
 
     Attributes:
@@ -243,6 +244,16 @@ class OrientationMeasurements:
                 out[f"dir{k + 1}"] = value.astype(int)
         out.update(self.extra)
         return out
+
+    def to_dict(self) -> dict:
+        """The measurements as a JSON-ready dict: ``source``, ``n_positions``, ``joint_names``
+        and the CSV's :meth:`columns` (degrees, arcsec, s; ``None`` where not measured)."""
+        return {
+            "source": self.source,
+            "n_positions": self.n_positions,
+            "joint_names": list(self.joint_names) if self.joint_names else None,
+            "columns": {name: values.tolist() for name, values in self.columns().items()},
+        }
 
     def replace(self, **changes) -> OrientationMeasurements:
         """A copy with some attributes changed (``sigma_rad=None``, ``angles_rad=...``)."""

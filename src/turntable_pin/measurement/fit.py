@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.exceptions import InputError
+from ..core.notebook import NotebookResult
 from ..core.sizes import FIT_ROW_BYTES, MAX_FITTED_ROWS, check_count
 from ..core.units import ARCSEC_PER_RAD
 from ..stats.least_squares import (
@@ -116,7 +117,7 @@ class OrientationFitProblem:
 
 
 @dataclass(frozen=True)
-class OrientationFit:
+class OrientationFit(NotebookResult):
     """A fit of orientation data: the generic result plus the data, model and effects."""
 
     data: OrientationMeasurements

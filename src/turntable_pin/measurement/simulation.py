@@ -25,6 +25,7 @@ from ..calibration.positions import (
 )
 from ..core.csv_table import read_csv_table, read_header, refuse_repeated_rows
 from ..core.exceptions import InputError, check_seed
+from ..core.notebook import NotebookResult
 from ..core.sizes import MAX_SIMULATED_ROWS, MIN_GRID_STEP_DEG, check_count, turn_grid_count
 from ..core.turn_grid import full_turn_grid_deg, random_turn_positions_deg
 from ..core.units import ARCSEC_PER_RAD, DEG_PER_RAD
@@ -408,7 +409,7 @@ def read_positions(path: str | Path, joint_names: Sequence[str] | None = None) -
 
 
 @dataclass(frozen=True)
-class SimulatedMeasurements(SimulatedFile):
+class SimulatedMeasurements(SimulatedFile, NotebookResult):
     """Simulated data and the truth behind it.
 
     Attributes:
@@ -454,6 +455,19 @@ class SimulatedMeasurements(SimulatedFile):
             for name, params in self.effects.items()
         )
         return [f"errors (arcsec): {errors}", f"hidden effects: {effects or 'none'}"]
+
+    def to_dict(self) -> dict:
+        """The simulation as a JSON-ready dict: the seed, noise and schedule, the truth (errors
+        and effects in user units) and the data (:meth:`OrientationMeasurements.to_dict`)."""
+        return {
+            "seed": self.seed,
+            "noise_arcsec": self.noise_arcsec,
+            "noise_spread": self.noise_spread,
+            "schedule": self.schedule.describe(self.data.n_joints),
+            "errors": dict(self.errors),
+            "effects": {name: dict(params) for name, params in self.effects.items()},
+            "data": self.data.to_dict(),
+        }
 
     def columns(self, *, with_sigma: bool = True) -> dict[str, np.ndarray]:
         """The CSV's columns (``docs/measurements.md``); the sigma columns only ``with_sigma``."""

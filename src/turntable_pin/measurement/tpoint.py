@@ -56,13 +56,14 @@ import numpy as np
 from ..core.csv_table import first_repeated_row
 from ..core.exceptions import InputError
 from ..core.files import read_text_file, write_text_atomic
+from ..core.notebook import NotebookResult
 from ..core.resources import models_dir
 from ..core.sizes import MAX_TPOINT_FILE_BYTES, MAX_TPOINT_OBSERVATIONS
 from ..core.units import ARCSEC_PER_RAD
 from ..core.words import argument
 from ..model.chain import compose_rotation
 from ..model.generic_table import GenericTable
-from .data import MAX_MEASURED_ANGLE_ARCSEC
+from .data import MAX_MEASURED_ANGLE_ARCSEC, OrientationMeasurements, read_measurements
 
 __all__ = [
     "ALTAZ",
@@ -162,7 +163,7 @@ class TpointRun:
 
 
 @dataclass(frozen=True)
-class TpointConversion:
+class TpointConversion(NotebookResult):
     """A run converted to measurement rows (definitions: the module docstring).
 
     Attributes:
@@ -243,6 +244,28 @@ class TpointConversion:
         ]
         return out
 
+    def to_dict(self) -> dict:
+        """The conversion as a JSON-ready dict: the run (file, caption, mount, stars, latitude),
+        the refraction, the URDF the rows belong to, the rows (``phi1_deg, phi2_deg,
+        dpsi_arcsec, dtheta_arcsec``) and the provenance lines of the CSV."""
+        run = self.run
+        return {
+            "path": str(run.path),
+            "caption": run.caption,
+            "mount": run.mount,
+            "n_stars": run.n_stars,
+            "latitude_deg": self.latitude_deg,
+            "refraction": self.refraction,
+            "urdf_name": self.urdf_name,
+            "rows": {
+                "phi1_deg": self.phi_deg[:, 0].tolist(),
+                "phi2_deg": self.phi_deg[:, 1].tolist(),
+                "dpsi_arcsec": self.dpsi_arcsec.tolist(),
+                "dtheta_arcsec": self.dtheta_arcsec.tolist(),
+            },
+            "comment_lines": self.comment_lines(),
+        }
+
     def csv_text(self) -> str:
         """The measurement CSV (comment lines, header, one row per star)."""
         lines = [f"# {c}" for c in self.comment_lines()]
@@ -256,6 +279,14 @@ class TpointConversion:
     def write_csv(self, path: str | Path) -> Path:
         """Write :meth:`csv_text` to ``path`` atomically; returns the path."""
         return write_text_atomic(path, self.csv_text())
+
+    def measurements(self) -> OrientationMeasurements:
+        """The rows as measurements, read back from the CSV (written into a temporary folder,
+        removed): what ``diagnose`` reads after ``import-tpoint``."""
+        with tempfile.TemporaryDirectory(prefix="turntable-pin-tpoint-") as folder:
+            path = self.write_csv(Path(folder) / f"{Path(self.run.path).stem}.csv")
+            data = read_measurements(path)
+        return data.replace(source=str(self.run.path))
 
     def write_urdf(self, path: str | Path) -> Path:
         """Write :attr:`urdf_text` to ``path`` atomically; returns the path."""

@@ -266,7 +266,8 @@ class GenericTable:
             declaration (:mod:`.mount_declaration`; ``None``: as declared).
 
     Attributes:
-        urdf_path, payload_frame, nominal_pin_model, chain (:class:`ErrorChain`), layout.
+        urdf_path, payload_frame, nominal_pin_model (the Pinocchio model without errors; its
+            ``Data``: :attr:`nominal_pin_data`), chain (:class:`ErrorChain`), layout.
         declared_mount, telescope_mount: what the URDF declares, what the table is.
         parameter_names: the layout's names (generic: ``<joint>.position``, ``.tilt_a``,
             ``.tilt_b``, ``.offset_a``, ``.offset_b`` per joint, then ``<mount>.rot_x/y/z``).
@@ -503,6 +504,12 @@ class GenericTable:
         rt = compose_rotation(self.chain.placements(np.asarray(error_values, float)), q)
         rd = compose_rotation(self.chain.placements(), q)
         return np.swapaxes(rd, -1, -2) @ rt
+
+    @cached_property
+    def nominal_pin_data(self) -> object:
+        """Pinocchio's ``Data`` of :attr:`nominal_pin_model` (made on first use, one per table):
+        with the model, what ``pinocchio.forwardKinematics`` and the rest take."""
+        return self.nominal_pin_model.createData()
 
     def pinocchio_model(self, error_values) -> object:
         """A Pinocchio model of the table with these errors in its placements."""

@@ -8,12 +8,16 @@ Every PNG of the package (allocation, requirement, residual and report figures) 
 from __future__ import annotations
 
 import io
+import tempfile
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
 from typing import Any
 
 from ..core.files import write_atomic
 
-__all__ = ["FIGURE_DPI", "pyplot", "save_png"]
+__all__ = ["FIGURE_DPI", "figures_written", "kept_figures", "pyplot", "save_png"]
 
 FIGURE_DPI = 110
 """Resolution of every PNG the package writes, dots per inch."""
@@ -29,9 +33,35 @@ def pyplot() -> Any:
     return plt
 
 
+_KEPT: ContextVar[list | None] = ContextVar("kept_figures", default=None)
+
+
+@contextmanager
+def kept_figures() -> Iterator[list]:
+    """Inside the block, every figure :func:`save_png` renders is also kept open and appended
+    to the list this yields (instead of being closed)."""
+    kept: list = []
+    token = _KEPT.set(kept)
+    try:
+        yield kept
+    finally:
+        _KEPT.reset(token)
+
+
+def figures_written(write: Callable[[Path], object]) -> list:
+    """The matplotlib figures ``write(folder)`` renders, open, in order: it writes into a
+    temporary folder, removed afterwards (the figures of a result are the ones its command
+    writes, drawn by the one code)."""
+    with tempfile.TemporaryDirectory(prefix="turntable-pin-figures-") as folder:
+        with kept_figures() as figures:
+            write(Path(folder))
+    return figures
+
+
 def save_png(fig: Any, path: str | Path | None = None, *, dpi: int = FIGURE_DPI) -> Any:
-    """Render the matplotlib ``fig`` to PNG at ``dpi`` and close it: written atomically to
-    ``path`` (returned), or the PNG bytes when ``path`` is ``None``."""
+    """Render the matplotlib ``fig`` to PNG at ``dpi`` and close it (inside
+    :func:`kept_figures`: keep it open and listed): written atomically to ``path`` (returned), or
+    the PNG bytes when ``path`` is ``None``."""
     try:
         if path is None:
             buffer = io.BytesIO()
@@ -41,4 +71,8 @@ def save_png(fig: Any, path: str | Path | None = None, *, dpi: int = FIGURE_DPI)
             path, lambda tmp: fig.savefig(tmp, format="png", dpi=dpi, bbox_inches="tight")
         )
     finally:
-        pyplot().close(fig)
+        kept = _KEPT.get()
+        if kept is None:
+            pyplot().close(fig)
+        else:
+            kept.append(fig)

@@ -206,7 +206,7 @@ def _data(page: _Page, heading: str) -> list[str]:
     return [_heading(heading) + img_tag(data_figure(page.family.data), "measured angles")]
 
 
-def _flat_directions(result, words: str) -> list[str]:
+def flat_directions(result, words: str) -> list[str]:
     """A fit's undetermined combinations after ``words``: one paragraph, or none."""
     und = result.undetermined_combinations()
     if not und:
@@ -214,7 +214,8 @@ def _flat_directions(result, words: str) -> list[str]:
     return [f"<p>{words}: " + ", ".join(f"<code>{html.escape(u)}</code>" for u in und) + ".</p>"]
 
 
-def _combinations(result) -> str:
+def combinations_table(result) -> str:
+    """The table of the combinations a fit's data determine: value, standard error, unit."""
     return html_table(
         ["combination", "value", "std", "unit"],
         [[c["name"], c["value"], c["std"], c["unit"]] for c in result.combinations()],
@@ -237,9 +238,9 @@ def _base(page: _Page, heading: str) -> list[str]:
             f"(its {len(measured.chain.error_names) - len(measured.base_names)} offset error(s) "
             "never change the orientation)."
             + f" The data determine {page.d['base']['rank']} combinations of them:</p>",
-            _combinations(result),
+            combinations_table(result),
         ]
-        parts += _flat_directions(result, "Not determined by orientation data (flat directions)")
+        parts += flat_directions(result, "Not determined by orientation data (flat directions)")
         parts.append(table)
     if not page.effect and "fails" not in page.names:
         parts.append(img_tag(residual_figure([page.base_rs]), "base residuals"))
@@ -415,9 +416,9 @@ def _parameters(page: _Page, heading: str) -> list[str]:
     parts = [
         f"{_heading(heading)}<p>Determined combinations (value &plusmn; standard error; rank "
         f"{res.rank} of {res.n_params} parameters):</p>",
-        _combinations(res),
+        combinations_table(res),
     ]
-    parts += _flat_directions(res, "Flat directions")
+    parts += flat_directions(res, "Flat directions")
     return parts
 
 
@@ -457,10 +458,9 @@ SECTIONS = {
 parts``."""
 
 
-def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
-    """The HTML page of a diagnosis of any family (self-contained): its title, the one-line
-    verdict and the sections its family's :class:`~turntable_pin.stats.diagnosis_engine.PageWords`
-    list (:data:`SECTIONS`)."""
+def diagnosis_body(diagnosis: Diagnosis, *, title: str = "") -> str:
+    """The body of :func:`diagnosis_html` (its title, verdict and sections), for a page or a
+    notebook cell."""
     page = _Page(diagnosis)
     words = page.words
     anchor = ' id="verdict"' if "anchor" in words.parts else ""
@@ -471,7 +471,15 @@ def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
     ]
     for name, heading in words.sections:
         parts += SECTIONS[name](page, heading)
-    body = "\n".join(parts)
+    return "\n".join(parts)
+
+
+def diagnosis_html(diagnosis: Diagnosis, *, title: str = "") -> str:
+    """The HTML page of a diagnosis of any family (self-contained): its title, the one-line
+    verdict and the sections its family's :class:`~turntable_pin.stats.diagnosis_engine.PageWords`
+    list (:data:`SECTIONS`)."""
+    body = diagnosis_body(diagnosis, title=title)
+    words = diagnosis.family.page
     return (
         "<!DOCTYPE html><html><head><meta charset='utf-8'>"
         f"<title>{html.escape(title or words.page_title)}</title><style>{PAGE_STYLE}</style>"
@@ -487,8 +495,11 @@ def write_report(diagnosis: Diagnosis, path: str | Path, *, title: str = "") -> 
 __all__ = [
     "PAGE_STYLE",
     "SECTIONS",
+    "combinations_table",
     "data_figure",
+    "diagnosis_body",
     "diagnosis_html",
+    "flat_directions",
     "html_table",
     "img_tag",
     "write_report",

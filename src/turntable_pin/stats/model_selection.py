@@ -37,6 +37,7 @@ import numpy as np
 
 from ..core.blas_threads import one_blas_thread
 from ..core.exceptions import IdentifiabilityError, InputError
+from ..core.notebook import NotebookResult
 from .least_squares import FitResult, chi2_quantile, chi2_sf, tall_r_factor
 from .structure_search import (
     BIC_THRESHOLD,
@@ -352,7 +353,7 @@ class Step:
 
 
 @dataclass
-class Diagnosis:
+class Diagnosis(NotebookResult):
     """The outcome of :func:`diagnose`.
 
     Attributes:
