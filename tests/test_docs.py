@@ -48,8 +48,9 @@ def documented_runs():
 
         out = io.StringIO()
         with contextlib.redirect_stdout(out):
+            pages: dict[str, dict] = {}  # a page's blocks read as one script, in order
             for name, block in fenced("python"):
-                exec(compile(block, name, "exec"), {})
+                exec(compile(block, name, "exec"), pages.setdefault(name, {}))
         written = sorted(
             p.relative_to(folder).as_posix() for p in (folder / "out").rglob("*") if p.is_file()
         )

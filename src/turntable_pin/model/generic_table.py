@@ -266,8 +266,9 @@ class GenericTable:
             declaration (:mod:`.mount_declaration`; ``None``: as declared).
 
     Attributes:
-        urdf_path, payload_frame, nominal_pin_model (the Pinocchio model without errors; its
-            ``Data``: :attr:`nominal_pin_data`), chain (:class:`ErrorChain`), layout.
+        urdf_path, payload_frame: as given (the payload frame resolved).
+        nominal_pin_model: the Pinocchio model without errors (its ``Data``:
+            :attr:`nominal_pin_data`); chain (:class:`ErrorChain`), layout.
         declared_mount, telescope_mount: what the URDF declares, what the table is.
         parameter_names: the layout's names (generic: ``<joint>.position``, ``.tilt_a``,
             ``.tilt_b``, ``.offset_a``, ``.offset_b`` per joint, then ``<mount>.rot_x/y/z``).
