@@ -3,8 +3,9 @@
 import pytest
 
 from conftest import EXAMPLES_DIR
-from turntable_pin import fit_orientation, read_measurements
 from turntable_pin.core.exceptions import InputError
+from turntable_pin.measurement.data import read_measurements
+from turntable_pin.measurement.fit import fit_orientation
 from turntable_pin.measurement.residuals import analyse_residuals, orientation_residuals
 
 
