@@ -119,7 +119,4 @@ class CandidateEffect:
             return None
         _, group, amplitude, limit = worst
         belief = group.belief.format(amplitude=self.amount_words(amplitude, group.unit))
-        return (
-            f"{belief} ({self.amount_words(amplitude, group.unit)} where a {machine} "
-            f"reaches about {self.amount_words(limit, group.unit)})"
-        )
+        return f"{belief} (where a {machine} reaches about {self.amount_words(limit, group.unit)})"

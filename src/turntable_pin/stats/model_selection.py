@@ -75,6 +75,7 @@ __all__ = [
     "SET_BEAM_WIDTH",
     "SET_MAX_SIZE",
     "SET_POOL_SIZE",
+    "SET_TIE",
     "SetComparison",
     "Step",
     "compare_effects",
@@ -108,6 +109,9 @@ SET_BEAM_WIDTH = 3
 
 SET_POOL_SIZE = 8
 """The simpler candidates (best delta_bic first) :func:`_simpler_set` draws its sets from."""
+
+SET_TIE = 1e-9
+"""Relative difference of delta_bic within which a set and an effect fit equally (rounding)."""
 
 
 @dataclass
@@ -741,8 +745,10 @@ def _simpler_set(family, current, current_fit, chosen: Candidate, round_candidat
     keeping the ``SET_BEAM_WIDTH`` best (lowest BIC) at each size, each set's added rank at most
     ``chosen``'s and every member adding rank of its own (confounded effects stay one group: a
     set of two of them is no set). At most ``SET_BEAM_WIDTH * SET_POOL_SIZE * (SET_MAX_SIZE - 1)``
-    fits, shared through the family's cache. The set is chosen when its delta_bic is at most
-    ``chosen``'s and every member's fitted amplitude in it is plausible.
+    fits, shared through the family's cache. The set is chosen when its delta_bic is below
+    ``chosen``'s (beyond rounding, :data:`SET_TIE`: a set exactly as good, confounded with
+    ``chosen``, leaves the one effect named and the set among its alternatives) and every member's
+    fitted amplitude in it is plausible.
     """
     limit = chosen.added_rank
     if limit < 2:
@@ -803,7 +809,7 @@ def _simpler_set(family, current, current_fit, chosen: Candidate, round_candidat
         simpler=tuple(c.effect for c in members),
         set_added_rank=int(sum(c.added_rank for c in members)),
         set_delta_bic=float(dbic),
-        chosen=bool(plausible and dbic <= chosen.delta_bic),
+        chosen=bool(plausible and dbic < chosen.delta_bic - SET_TIE * max(1.0, abs(dbic))),
     )
     return comparison, members
 
