@@ -34,6 +34,7 @@ from verdict_cases import (  # noqa: E402
     CASES,
     CASES_BY_NAME,
     CLEAN,
+    IMPLAUSIBLE,
     MANY,
     REAL_RUNS,
     SIMPLE,
@@ -42,7 +43,12 @@ from verdict_cases import (  # noqa: E402
     timed,
 )
 
-TARGETS = {SIMPLE: "named as such", MANY: "named", CLEAN: "nothing named"}
+TARGETS = {
+    SIMPLE: "named as such",
+    MANY: "named",
+    CLEAN: "nothing named",
+    IMPLAUSIBLE: "marked, unnamed",
+}
 
 
 def _cases(text: str | None):

@@ -22,7 +22,8 @@ effect and the named effect having no more parameters than the planted one (a wo
 a single error is not the single error named). A true many-parameter effect is *named* when a
 named effect is it, or holds it in its group with at least as many parameters. On clean data any
 named effect is a false name. A named effect that the candidate table marks implausible is
-counted apart.
+counted apart. An implausible amplitude is handled right when the candidate table marks the
+planted effect implausible and the verdict does not name it.
 """
 
 from __future__ import annotations
@@ -62,8 +63,9 @@ TEMPERATURE_PROFILE = (20.0, 1.0, 2.5, 3.0)
 """``start_c, ramp_c_per_h, swing_c, period_h`` of the runs with a temperature column (the
 bundled ``run_temperature``'s ``--temperature 20,1,2.5,3``)."""
 
-SIMPLE, MANY, CLEAN = "simple", "many", "clean"
-"""What a case plants: several simple causes, one true many-parameter effect, nothing."""
+SIMPLE, MANY, CLEAN, IMPLAUSIBLE = "simple", "many", "clean", "implausible"
+"""What a case plants: several simple causes, one true many-parameter effect, nothing, or one
+effect at an amplitude no mechanism of its kind reaches on a precision turntable."""
 
 
 @dataclass(frozen=True)
@@ -73,7 +75,7 @@ class Case:
     Attributes:
         name: short label (``R1``..``R6`` runs, ``O1``..``O6`` orientation sets).
         diagnosis: ``run`` (calibration run) or ``orientation``.
-        kind: :data:`SIMPLE`, :data:`MANY` or :data:`CLEAN`.
+        kind: :data:`SIMPLE`, :data:`MANY`, :data:`CLEAN` or :data:`IMPLAUSIBLE`.
         title: what is planted, with its amplitudes.
         planted: the catalogue names of the planted causes.
         table_errors_arcsec: planted table errors (runs), arcsec.
@@ -183,8 +185,14 @@ CASES: tuple[Case, ...] = (
          ("inner_encoder_harmonics",),
          effects={"inner_encoder_harmonics": {"c1": 3.0, "s1": -1.5, "s2": 2.0}}),
     Case("O6", "orientation", CLEAN, "clean set (the example's table errors only)"),
+    Case("I1", "run", IMPLAUSIBLE, "inner-axis wobble x_c1 1800\" (half a degree)",
+         ("table:inner_wobble_harmonics",),
+         effects={"inner_wobble_harmonics": {"x_c1": 1800.0}}),
+    Case("I2", "orientation", IMPLAUSIBLE,
+         "inner encoder eccentricity c1 1800\" (half a degree)", ("inner_encoder_harmonics",),
+         effects={"inner_encoder_harmonics": {"c1": 1800.0}}),
 )  # fmt: skip
-"""Every simulated case, runs first."""
+"""Every simulated case: runs, orientation sets, then the two implausible amplitudes."""
 CASES_BY_NAME = {c.name: c for c in CASES}
 
 
@@ -259,6 +267,9 @@ def score(case: Case, d: dict) -> dict:
     elif case.kind == MANY:
         ok = _names_many(d, named, case.planted[0])
         exact = ok and len(named) == 1
+    elif case.kind == IMPLAUSIBLE:
+        planted = case.planted[0]
+        ok = exact = planted not in named and marked_implausible(_candidate(d, planted))
     else:
         ok = exact = not named
     return {
