@@ -109,11 +109,11 @@ def _verdict_counts(per_seed: list[dict]) -> str:
 
 
 def print_table(results: list[dict], real: list[dict]) -> None:
-    print(f"{'case':5s}{'kind':8s}{'target':>15s}{'ok':>9s}{'rate':>8s}{'impl.':>7s}{'s/diag':>8s}"
+    print(f"{'case':5s}{'kind':12s}{'target':>15s}{'ok':>9s}{'rate':>8s}{'impl.':>7s}{'s/diag':>8s}"
           "  most frequent verdicts")  # fmt: skip
     for r in results:
         print(
-            f"{r['case']:5s}{r['kind']:8s}{r['target']:>15s}{r['ok']:>4d}/{r['n']:<4d}"
+            f"{r['case']:5s}{r['kind']:12s}{r['target']:>15s}{r['ok']:>4d}/{r['n']:<4d}"
             f"{100 * r['rate']:7.1f}%{r['implausible_named']:>7d}{r['seconds_mean']:8.2f}  "
             f"{_verdict_counts(r['seeds'])}"
         )
@@ -128,6 +128,10 @@ def print_table(results: list[dict], real: list[dict]) -> None:
                 for p in params
             )
             print(f"    {name}: {values} {params[0]['unit'] if params else ''}")
+        for c in run["significant"]:
+            mark = f"  IMPLAUSIBLE: {c['implausible']}" if c["implausible"] else ""
+            print(f"    candidate {c['effect']}: delta_bic {c['delta_bic']:.0f}, largest "
+                  f"|parameter| {c['largest'] or 0:.4g} {c['unit'] or ''}{mark}")  # fmt: skip
         print(f"    marked implausible: {run['marked_implausible'] or 'none'}; "
               f"named among them: {run['implausible_named'] or 'none'}")  # fmt: skip
 

@@ -326,9 +326,16 @@ REAL_RUNS = (
 ``--refraction none``)."""
 
 
+def _largest(parameters: list[dict]) -> dict:
+    """The largest ``|value|`` of a candidate's parameters and its unit."""
+    top = max(parameters, key=lambda p: abs(p["value"]), default=None)
+    return {"largest": abs(top["value"]) if top else None, "unit": top.get("unit") if top else None}
+
+
 def real_verdict(d: dict) -> dict:
     """The named effects of a real run's diagnosis with their fitted amplitudes (value, std,
-    unit), the candidates marked implausible, and the named ones among them."""
+    unit), the significant candidates with their largest parameter and implausibility, the
+    candidates marked implausible, and the named ones among them."""
     named = named_effects(d)
     parameters = d["verdict"].get("named_parameters", {})
     return {
@@ -341,6 +348,16 @@ def real_verdict(d: dict) -> dict:
             ]
             for n in named
         },
+        "significant": [
+            {
+                "effect": c["effect"],
+                "delta_bic": c["delta_bic"],
+                **_largest(c.get("parameters", [])),
+                "implausible": c.get("implausible") or None,
+            }
+            for c in d["candidates"]
+            if c.get("significant")
+        ],
         "marked_implausible": [c["effect"] for c in d["candidates"] if marked_implausible(c)],
         "implausible_named": implausible_named(d),
     }
