@@ -181,6 +181,8 @@ def header_lines(d: dict) -> list[str]:
             )
         if c.get("determined") is False:
             alt += "  parameters not determined"
+        if c.get("implausible"):
+            alt += "  implausible"
         lines.append(
             f"  {c['effect']:26s} delta_bic {c['delta_bic']:10.1f}  rms "
             f"{c[f'rms_{unit}']:{_FORMAT[unit]}}  chi2_red {c['chi2_reduced']:.3f}"
@@ -270,6 +272,12 @@ def _rival_lines(d: dict) -> list[str]:
         if entry["effect"] in verdict["separations"]:
             lines.append(f"  {entry['effect']}: {verdict['separations'][entry['effect']]}")
             lines += _settle(commands, entry["effect"])
+    lines += _set_lines(verdict)
+    for entry in verdict.get("implausible", []):
+        lines.append(
+            f"not named: {entry['effect']} (delta_bic {entry['delta_bic']:.1f}, significant "
+            f"alone) is implausible: to accept it one would have to believe in {entry['belief']}"
+        )
     for entry in verdict.get("unneeded_given_structure", []):
         lines.append(
             f"not named: {entry['effect']} was significant on its own, but the best description "
@@ -281,6 +289,34 @@ def _rival_lines(d: dict) -> list[str]:
             f"note: {name} cannot be told apart from the base errors on these data (if "
             "present, it is absorbed into them; see its candidate entry)"
         )
+    return lines
+
+
+def _set_lines(verdict: dict) -> list[str]:
+    """Each many-parameter effect compared with a set of simpler ones, and how the set fared."""
+    lines = []
+    for entry in verdict.get("simpler_sets", []):
+        if not entry["simpler_set"]:
+            continue
+        effect = (
+            f"{entry['effect']} ({entry['added_rank']} parameters, delta_bic "
+            f"{entry['delta_bic']:.1f})"
+        )
+        simpler = (
+            f"the simpler set {' + '.join(entry['simpler_set'])} ({entry['set_added_rank']} "
+            f"parameters, delta_bic {entry['set_delta_bic']:.1f})"
+        )
+        if entry["set_named"]:
+            lines.append(
+                f"parsimony at step {entry['step']}: {simpler} fits at least as well as {effect}, "
+                "so the simpler set is named"
+            )
+        else:
+            lines.append(
+                f"parsimony at step {entry['step']}: {effect} is kept; the best simpler set, "
+                f"{simpler}, does not fit as well"
+                + ("" if entry["set_delta_bic"] > entry["delta_bic"] else " with plausible values")
+            )
     return lines
 
 
