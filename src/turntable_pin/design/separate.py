@@ -44,7 +44,7 @@ from ..core.notebook import NotebookResult
 from ..core.sizes import check_positions_count
 from ..core.words import argument, command
 from ..measurement.catalogue import catalogue
-from ..measurement.effects.base import PositionVariables
+from ..measurement.effects.base import MOUNT, TURNTABLE, PositionVariables
 from ..measurement.fit import fit_orientation
 from ..stats.design import information_rows
 from ..stats.discrimination import (
@@ -153,6 +153,9 @@ class SeparationDesign(NotebookResult):
         power_curve: ``(positions, power)`` of this design scaled to other sizes.
         catalogue_size: K of the acceptance threshold.  n_swaps, n_passes: of the exchange.
         inseparable: why no positions within the limits separate them (one line), or ``None``.
+        implausible: ``{effect: what one would have to believe}`` of each effect whose amplitude
+            fitted on the data is beyond the physical scale of its kind on the machine
+            (``docs/plausibility.md``): no positions are planned for such a hypothesis.
     """
 
     space: DesignSpace = field(repr=False)
@@ -176,6 +179,7 @@ class SeparationDesign(NotebookResult):
     n_swaps: int = 0
     n_passes: int = 0
     inseparable: str | None = None
+    implausible: dict[str, str] = field(default_factory=dict)
 
     @property
     def n_positions(self) -> int:
@@ -208,6 +212,7 @@ class SeparationDesign(NotebookResult):
             "space": self.space.to_dict(),
             "effects": list(self.pair),
             "inseparable": self.inseparable,
+            "implausible": dict(self.implausible),
             "n_positions": self.n_positions,
             "n_from": self.n_from,
             "noise_arcsec": self.noise_arcsec,
@@ -233,6 +238,13 @@ class SeparationDesign(NotebookResult):
         how many positions the target needs, and the positions."""
         if self.inseparable:
             return self.inseparable
+        if self.implausible:
+            return "\n".join(
+                f"not planned: {name}'s amplitude fitted on the data is implausible; to accept it "
+                f"one would have to believe in {belief}; no positions are designed to separate "
+                "a hypothesis no mechanism of its kind makes"
+                for name, belief in self.implausible.items()
+            )
         space = self.space
         a, b = self.pair
         lines = [
@@ -483,6 +495,10 @@ def design_separate(
 def _design_separate(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s, target):
     """:func:`design_separate`, on one BLAS thread."""
     problem = _setup(space, n_positions, from_data, amplitudes, noise_arcsec, dwell_s)
+    implausible = _implausible(problem)
+    if implausible:
+        none = np.zeros((0, space.n_joints))
+        return problem.result(target, none, positions_deg=none, implausible=implausible)
     names, settled = problem.names, _settled(problem)
     if "none" in settled:
         x = settled.index("none")
@@ -612,6 +628,22 @@ def _amplitudes(model, space, amplitudes, from_data):
     user = [_in_user_units(model, e, v) for e, v in zip(space.effects, vectors, strict=True)]
     units = [", ".join(dict.fromkeys(model.parameter_units[i] for i in own[x])) for x in range(2)]
     return source, vectors, user, units
+
+
+def _implausible(problem: _Problem) -> dict[str, str]:
+    """``{effect: what one would have to believe}`` of each effect whose amplitude was fitted on
+    the data and is beyond its plausible scale on this kind of machine (a given amplitude is the
+    user's hypothesis, not judged)."""
+    machine = MOUNT if problem.space.measured.telescope_mount else TURNTABLE
+    out = {}
+    for x, effect in enumerate(problem.space.effects):
+        if problem.source[effect.name] == "given":
+            continue
+        judge = getattr(effect, "implausibility", None)
+        belief = judge(problem.user[x], machine) if judge is not None else None
+        if belief:
+            out[effect.name] = belief
+    return out
 
 
 def _settled(problem: _Problem) -> list[str]:

@@ -34,6 +34,7 @@ from ..measurement.diagnosis import (
     polynomial_basis,
     urdf_option,
 )
+from ..measurement.effects.base import TURNTABLE
 from ..measurement.table import measured_table
 from ..model.angles import ANGLE_NAMES
 from ..stats.diagnosis_engine import (
@@ -81,6 +82,7 @@ class RunFamily(DataFamily):
     unit_words = "deg/h"
     user_unit_scale = 1.0
     outlier_rule = OUTLIER_RULE
+    machine_kind = TURNTABLE
     noise_subject = "the two outputs'"
     noise_column = "output"
     noise_how = "each output is weighted by its own estimated noise"

@@ -38,7 +38,7 @@ from .catalogue import catalogue as table_catalogue
 from .catalogue import resolve_effect
 from .data import ANGLE_NAMES, OrientationMeasurements
 from .effect_model import OrientationModel
-from .effects.base import Effect, PositionVariables
+from .effects.base import MOUNT, TURNTABLE, Effect, PositionVariables
 from .fit import (
     RELINEARISE_RAD,
     OrientationFit,
@@ -226,6 +226,8 @@ class OrientationFamily(DataFamily):
         self.data = data
         self.left_out_rad = left_out_rad
         self.table = measured_table(turntable)
+        # The plausible scales of the catalogue are those of this kind of machine.
+        self.machine_kind = MOUNT if self.table.telescope_mount else TURNTABLE
         scale = ARCSEC_PER_RAD
         if data.sigma_rad is not None:
             scale *= float(np.nanmedian(np.where(data.measured, data.sigma_rad, np.nan)))

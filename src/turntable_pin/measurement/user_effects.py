@@ -17,6 +17,7 @@ problem is an :class:`InputError` of one line naming the file, the line or key, 
 from __future__ import annotations
 
 import importlib.metadata
+import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -35,7 +36,7 @@ from .effect_terms import (
     parse_orders,
     parse_term,
 )
-from .effects.base import Effect, PositionVariables
+from .effects.base import ANY_MACHINE, MOUNT, TURNTABLE, Effect, Plausibility, PositionVariables
 from .effects.contract import check_effect_on_probe, check_story, checked_parameters
 from .effects.declared import DeclaredEffect
 from .table import measured_table
@@ -43,6 +44,7 @@ from .table import measured_table
 __all__ = [
     "ENTRY_POINT_GROUP",
     "EFFECT_FILE_KEYS",
+    "PLAUSIBLE_KEYS",
     "TERM_KEYS",
     "check_user_effect_names",
     "check_user_effects",
@@ -61,7 +63,7 @@ __all__ = [
 
 ENTRY_POINT_GROUP = "turntable_pin.effects"
 """The entry point group where installed packages declare effects."""
-EFFECT_FILE_KEYS = ("format", "name", "title", "explanation", "confirm", "terms")
+EFFECT_FILE_KEYS = ("format", "name", "title", "explanation", "confirm", "terms", "plausible")
 """The keys of an effect file (``name`` and ``terms`` required)."""
 TERM_KEYS = ("site", "harmonics", "polynomial", "sign", "of", "prefix")
 """The keys of a term of an effect file (``site`` and one of harmonics/polynomial/sign)."""
@@ -117,9 +119,47 @@ def read_effect_file(path: str | Path, turntable=None) -> Effect:
     if twice:
         raise fail(("terms",), f"parameter(s) {', '.join(twice)} would be defined twice; give "
                                "the terms different 'prefix' values (e.g. x_, z_)")  # fmt: skip
+    units = dict.fromkeys(s.unit for t in terms for s in t.parameters())
+    plausibility = _file_plausibility(doc.get("plausible"), story["name"], units, fail)
     return DeclaredEffect(story["name"], terms, title=story["title"],
                           explanation=story["explanation"], confirm=story["confirm"],
-                          source=str(path))  # fmt: skip
+                          source=str(path), plausibility=plausibility)  # fmt: skip
+
+
+PLAUSIBLE_KEYS = {"turntable": TURNTABLE, "telescope_mount": MOUNT, "any": ANY_MACHINE}
+"""The machine keys of an effect file's ``plausible`` (its ``belief`` besides)."""
+
+
+def _file_plausibility(value, name: str, units, fail) -> tuple[Plausibility, ...]:
+    """The :class:`Plausibility` of an effect file's ``plausible`` mapping (none without one):
+    the root-sum-square of all its parameters may reach ``turntable`` / ``telescope_mount`` /
+    ``any`` (numbers > 0, in the parameters' one unit); ``belief`` a text with ``{amplitude}``."""
+    if value is None:
+        return ()
+    keys = ", ".join([*PLAUSIBLE_KEYS, "belief"])
+    if not isinstance(value, dict) or not value:
+        raise fail(("plausible",), f"expected a mapping of {keys}")
+    scale = {}
+    for key, number in value.items():
+        if key == "belief":
+            continue
+        if key not in PLAUSIBLE_KEYS:
+            raise fail(("plausible", key), f"unknown key; the keys of plausible: {keys}")
+        if isinstance(number, bool) or not isinstance(number, int | float) or not (
+            math.isfinite(number) and number > 0
+        ):  # fmt: skip
+            raise fail(("plausible", key), f"expected a number > 0, got {number!r}")
+        scale[PLAUSIBLE_KEYS[key]] = float(number)
+    if not scale:
+        raise fail(("plausible",), f"no scale given; give one of {', '.join(PLAUSIBLE_KEYS)}")
+    if len(units) > 1:
+        raise fail(("plausible",), f"its parameters have several units ({', '.join(units)}); "
+                                   "one scale needs one unit")  # fmt: skip
+    belief = value.get("belief", f"{name} of {{amplitude}}")
+    if not isinstance(belief, str) or "{amplitude}" not in belief or belief.count("{") != 1:
+        raise fail(("plausible", "belief"), "expected a text with {amplitude} once (and no "
+                                            "other braces)")  # fmt: skip
+    return (Plausibility((), scale, " ".join(belief.split()), next(iter(units), "")),)
 
 
 def _effect_story(doc, fail) -> dict[str, str]:

@@ -188,6 +188,8 @@ def header_lines(d: dict) -> list[str]:
             )
         if c.get("determined") is False:
             alt += "  parameters not determined"
+        if c.get("implausible"):
+            alt += "  implausible"
         lines.append(
             f"  {c['effect']:26s} delta_bic {c['delta_bic']:10.1f}  rms "
             f"{c[f'rms_{unit}']:{_FORMAT[unit]}}  chi2_red {c['chi2_reduced']:.3f}"
@@ -277,6 +279,14 @@ def _rival_lines(d: dict) -> list[str]:
         if entry["effect"] in verdict["separations"]:
             lines.append(f"  {entry['effect']}: {verdict['separations'][entry['effect']]}")
             lines += _settle(commands, entry["effect"])
+    lines += _set_lines(verdict)
+    for entry in verdict.get("implausible", []):
+        score = entry["delta_bic"]
+        alone = f" (delta_bic {score:.1f}, significant alone)" if score is not None else ""
+        lines.append(
+            f"not named: {entry['effect']}{alone} is implausible: to accept it one would have to "
+            f"believe in {entry['belief']}"
+        )
     for entry in verdict.get("unneeded_given_structure", []):
         lines.append(
             f"not named: {entry['effect']} was significant on its own, but the best description "
@@ -289,6 +299,40 @@ def _rival_lines(d: dict) -> list[str]:
             "present, it is absorbed into them; see its candidate entry)"
         )
     return lines
+
+
+def _set_lines(verdict: dict) -> list[str]:
+    """Each many-parameter effect compared with a set of simpler ones, and how the set fared."""
+    lines = []
+    for entry in verdict.get("simpler_sets", []):
+        if not entry["simpler_set"]:
+            continue
+        effect = (
+            f"{entry['effect']} ({entry['added_rank']} parameters, delta_bic "
+            f"{entry['delta_bic']:.1f})"
+        )
+        names = " + ".join(entry["simpler_set"])
+        numbers = f"({entry['set_added_rank']} parameters, delta_bic {entry['set_delta_bic']:.1f})"
+        if entry["set_named"]:
+            lines.append(
+                f"parsimony at step {entry['step']}: the simpler set {names} {numbers} has a "
+                f"lower BIC than {effect}, so the set is named"
+            )
+        else:
+            lines.append(
+                f"parsimony at step {entry['step']}: {effect} is kept; the best simpler set, "
+                f"{names} {numbers}, " + _set_fared(entry["set_delta_bic"], entry["delta_bic"])
+            )
+    return lines
+
+
+def _set_fared(set_delta_bic: float, delta_bic: float) -> str:
+    """How a simpler set that was not named fared against the effect kept."""
+    if abs(set_delta_bic - delta_bic) <= 1e-6 * max(1.0, abs(delta_bic)):
+        return "fits exactly as well: the same signal, which the one effect names"
+    if set_delta_bic > delta_bic:
+        return "does not fit as well"
+    return "fits as well only with an implausible amplitude"
 
 
 def _unexplained_lines(d: dict, data: str) -> list[str]:

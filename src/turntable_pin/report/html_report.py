@@ -331,7 +331,13 @@ def _candidates(page: _Page) -> str:
     columns = page.words.candidate_columns
     return html_table(
         ["effect", *(headers[c] for c in columns)],
-        [[c["effect"], *(cell(col, c) for col in columns)] for c in page.d["candidates"]],
+        [
+            [
+                c["effect"] + (" (implausible)" if c.get("implausible") else ""),
+                *(cell(col, c) for col in columns),
+            ]
+            for c in page.d["candidates"]
+        ],  # fmt: skip
     )
 
 

@@ -135,6 +135,8 @@ class DataFamily:
         outlier_rule: the outlier rule in words (the result's ``outlier_rule``).
         noise_subject, noise_column, noise_how: the words of :func:`column_noise_note`.
         page: the words of the HTML page of its diagnosis (:class:`PageWords`).
+        machine_kind: the kind of machine the data come from, the key of the catalogue's
+            plausible scales (``CandidateEffect.plausibility``).
         catalogue: the candidate effects (objects with a ``name``), in catalogue order.
         n_records: number of records R; observed: (R, K) the cells fitted here.
         noise_per_column: whether every model is fitted at its own per-column noise.
@@ -154,6 +156,7 @@ class DataFamily:
     noise_column: str = "column"
     noise_how: str = "each column is weighted by its own estimated noise"
     page: PageWords = PageWords("Diagnosis", "diagnosis", ())
+    machine_kind: str = ""
 
     def __init__(
         self,
@@ -300,6 +303,21 @@ class DataFamily:
         if missing:
             return f"needs the column(s) {columns.missing_columns_words(missing)}"
         return None
+
+    def implausibility(self, effect, fit) -> str | None:
+        """What one would have to believe to accept ``effect``'s fitted amplitude in ``fit`` (a
+        fit with it) on this family's :attr:`machine_kind`, when it is beyond the physical scale
+        its catalogue gives (``effect.implausibility``); else None."""
+        judge = getattr(effect, "implausibility", None)
+        if judge is None or not self.machine_kind:
+            return None
+        prefix = f"{effect.name}."
+        values = {
+            name[len(prefix) :]: entry["value"]
+            for name, entry in fit.result.parameter_table().items()
+            if name.startswith(prefix)
+        }
+        return judge(values, self.machine_kind) if values else None
 
     def separation(self, fit_a, effect_b) -> str:
         """Whether more positions would separate effect A (``fit_a``'s last) from ``effect_b``,

@@ -20,6 +20,16 @@ Alternatives: accepted effects whose fit is as good as the best one's (``|chi2_B
 chi2_0.99(max(added_rank_A, added_rank_B))``); the family says whether more data could separate
 them or only an independent measurement.
 
+Parsimony over sets: when a round's chosen effect adds several parameters, a small beam search
+(:func:`_simpler_set`) asks whether a set of two or three simpler candidates, with no more added
+rank in all, reaches a BIC at least as good; if so the set is named instead (several simple causes
+at once, not one many-parameter effect that absorbs them), and the comparison is recorded either
+way (:class:`SetComparison`).
+
+Plausible amplitudes: the family says whether an effect's fitted amplitude is beyond the physical
+scale of its kind on the machine (``family.implausibility``); such a candidate is marked
+``implausible`` with what one would have to believe, and is never named.
+
 Unexplained: the best model's chi2 p-value is below ``FIT_TEST_ALPHA`` (sigma given), or the
 structure search finds a term it lacks (any sigma; the only test when sigma is estimated, chi2
 being 1 by construction then), paying ``2 ln G`` for its G probes (:mod:`structure_search`).
@@ -28,6 +38,7 @@ being 1 by construction then), paying ``2 ln G`` for its G probes (:mod:`structu
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -63,6 +74,11 @@ __all__ = [
     "FIT_TEST_ALPHA",
     "Candidate",
     "Diagnosis",
+    "SET_BEAM_WIDTH",
+    "SET_MAX_SIZE",
+    "SET_POOL_SIZE",
+    "SET_TIE",
+    "SetComparison",
     "Step",
     "compare_effects",
     "diagnose",
@@ -87,6 +103,18 @@ MAX_CORRELATION = 0.95
 MAX_CORRELATION_ALL = 0.995
 """... and against all the model's other parameters (its own effect's too) above this one."""
 
+SET_MAX_SIZE = 3
+"""Largest set of simpler effects :func:`_simpler_set` compares with a many-parameter effect."""
+
+SET_BEAM_WIDTH = 3
+"""Sets kept at each size of :func:`_simpler_set`'s beam search."""
+
+SET_POOL_SIZE = 8
+"""The simpler candidates (best delta_bic first) :func:`_simpler_set` draws its sets from."""
+
+SET_TIE = 1e-9
+"""Relative difference of delta_bic within which a set and an effect fit equally (rounding)."""
+
 
 @dataclass
 class Candidate:
@@ -101,6 +129,14 @@ class Candidate:
     alternatives: list[str] = field(default_factory=list)
     threshold: float = BIC_THRESHOLD
     parameters: list[dict] = field(default_factory=list)
+    implausible: str | None = None
+    """What one would have to believe to accept its fitted amplitude (beyond the physical scale
+    of its kind on the machine), or None: plausible, or not judged."""
+
+    @property
+    def acceptable(self) -> bool:
+        """Whether it may be named: significant and its amplitude plausible."""
+        return self.significant and self.implausible is None
 
     @property
     def significant(self) -> bool:
@@ -276,8 +312,10 @@ def compare_effects(family, current: Sequence[Any], current_fit, candidates):
     out = [_scored(family, current, base, effect) for effect in candidates]
     threshold = acceptance_threshold(sum(c.testable for c in out))
     known_names = set(base.parameter_names)
-    for c in out:
+    for c, effect in zip(out, candidates, strict=True):
         c.threshold = threshold
+        if c.testable:
+            c.implausible = _implausibility(family, effect, c.fit)
         if c.significant:
             added_names = [n for n in c.fit.result.parameter_names if n not in known_names]
             c.parameters = parameter_determination(
@@ -291,10 +329,10 @@ def compare_effects(family, current: Sequence[Any], current_fit, candidates):
     def gain(c: Candidate) -> float:
         return base_rss - _rss(c.fit.result)
 
-    lead = max((gain(c) for c in out if c.significant and c.determined), default=0.0)
+    lead = max((gain(c) for c in out if c.acceptable and c.determined), default=0.0)
 
     def preferred(c: Candidate) -> bool:
-        return c.significant and (c.determined or gain(c) > UNDETERMINED_GAIN_RATIO * lead)
+        return c.acceptable and (c.determined or gain(c) > UNDETERMINED_GAIN_RATIO * lead)
 
     out.sort(
         key=lambda c: (
@@ -304,6 +342,13 @@ def compare_effects(family, current: Sequence[Any], current_fit, candidates):
         )
     )
     return out
+
+
+def _implausibility(family, effect, fit) -> str | None:
+    """The family's :meth:`~.diagnosis_engine.DataFamily.implausibility` of ``effect`` in
+    ``fit`` (None for a family that judges none)."""
+    judge = getattr(family, "implausibility", None)
+    return judge(effect, fit) if judge is not None else None
 
 
 def _rss(result: FitResult) -> float:
@@ -342,6 +387,43 @@ def _mark_alternatives(
         ]
 
 
+@dataclass(frozen=True)
+class SetComparison:
+    """A many-parameter effect a round of the forward selection chose, against the best set of
+    simpler effects :func:`_simpler_set` found (with no more added rank in all).
+
+    Attributes:
+        step: the step (1 = the first) whose choice was compared.
+        effect: the many-parameter effect; added_rank, delta_bic: its own, against the model
+            before the step.
+        simpler: the set's effects (empty: no simpler candidates to compare); set_added_rank,
+            set_delta_bic: the set's, against the same model (None when empty).
+        chosen: whether the set was named instead (its BIC at least as good).
+    """
+
+    step: int
+    effect: str
+    added_rank: int
+    delta_bic: float
+    simpler: tuple[str, ...]
+    set_added_rank: int | None
+    set_delta_bic: float | None
+    chosen: bool
+
+    def to_dict(self) -> dict:
+        """The comparison in the diagnosis JSON."""
+        return {
+            "step": self.step,
+            "effect": self.effect,
+            "added_rank": self.added_rank,
+            "delta_bic": self.delta_bic,
+            "simpler_set": list(self.simpler),
+            "set_added_rank": self.set_added_rank,
+            "set_delta_bic": self.set_delta_bic,
+            "set_named": self.chosen,
+        }
+
+
 @dataclass
 class Step:
     """One step of the forward selection (``until_explained``)."""
@@ -369,6 +451,11 @@ class Diagnosis(NotebookResult):
         outliers: the records left out (the caller's dicts); outlier_rule: the rule in words.
         unneeded_given_structure: accepted effects the best description does not need, with
             the BIC cost of removing each (:func:`_least_needed`): not named.
+        set_comparisons: each many-parameter choice compared with a set of simpler effects
+            (:class:`SetComparison`); named_together: the set named at the first step instead
+            of one many-parameter effect (empty: none), the verdict's headline.
+        implausible_in_best: accepted effects left out at the end because their amplitude in
+            the final fit was implausible (``{name: what one would have to believe}``).
         doubt: the caller's doubt about the model family itself, said before the verdict.
         group_variance: with a noise level per group, the best model's (every chi2 is at it).
         family_verdict, family_results: the family's own entries of the verdict and result,
@@ -390,6 +477,9 @@ class Diagnosis(NotebookResult):
     outliers: list[dict] = field(default_factory=list)
     outlier_rule: str | None = None
     unneeded_given_structure: dict[str, float] = field(default_factory=dict)
+    set_comparisons: list[SetComparison] = field(default_factory=list)
+    named_together: list[str] = field(default_factory=list)
+    implausible_in_best: dict[str, str] = field(default_factory=dict)
     doubt: str | None = None
     group_variance: np.ndarray | None = field(default=None, repr=False)
     separation_commands: dict[str, Any] = field(default_factory=dict)
@@ -403,14 +493,37 @@ class Diagnosis(NotebookResult):
 
     @property
     def missing_effects(self) -> list[str]:
-        """Every accepted effect with ``until_explained``, else the first one."""
+        """Every accepted effect with ``until_explained``, else the first one (every one, when a
+        set of simpler effects was named at the first step)."""
         names = [s.added for s in self.steps]
-        return names if self.until_explained else names[:1]
+        return names if self.until_explained else names[: self._first_named()]
 
     @property
     def also_significant(self) -> list[str]:
         """Effects still significant on top of the first one (plain diagnosis only)."""
-        return [] if self.until_explained else [s.added for s in self.steps[1:]]
+        names = [s.added for s in self.steps]
+        return [] if self.until_explained else names[self._first_named() :]
+
+    def _first_named(self) -> int:
+        """How many steps the plain verdict names: every step when a set of simpler effects was
+        named at the first step (several simple causes at once), else one."""
+        return len(self.steps) if self.named_together else 1
+
+    @property
+    def implausible(self) -> list[dict]:
+        """Significant candidates not named because their fitted amplitude is implausible (on
+        the base model, or in the final fit): ``{effect, delta_bic, belief}``."""
+        named = {s.added for s in self.steps}
+        out = {
+            c.effect: {"effect": c.effect, "delta_bic": c.delta_bic, "belief": c.implausible}
+            for c in self.candidates
+            if c.significant and c.implausible and c.effect not in named
+        }
+        scores = {c.effect: c.delta_bic for c in self.candidates}
+        for name, belief in self.implausible_in_best.items():
+            out.setdefault(name, {"effect": name, "delta_bic": scores.get(name),
+                                  "belief": belief})  # fmt: skip
+        return list(out.values())
 
     @property
     def alternatives(self) -> list[str]:
@@ -485,6 +598,7 @@ class Diagnosis(NotebookResult):
             "significant": c.significant,
             "alternatives": list(c.alternatives),
             "in_best_model": c.effect in {s.added for s in self.steps},
+            "implausible": c.implausible,
         }
         if c.parameters:
             entry["determined"] = c.determined
@@ -516,6 +630,8 @@ class Diagnosis(NotebookResult):
                 {"effect": name, "bic_cost_of_removing": value}
                 for name, value in self.unneeded_given_structure.items()
             ],
+            "simpler_sets": [comparison.to_dict() for comparison in self.set_comparisons],
+            "implausible": [dict(entry) for entry in self.implausible],
         }
         if commands and not self.family_verdict:
             verdict["separation_commands"] = commands
@@ -589,34 +705,144 @@ def _effect(family, name: str):
 
 
 def _forward(family, candidates, base_fit):
-    """The forward selection from the base: ``(steps, effects, best fit, after_first)``."""
+    """The forward selection from the base: ``(steps, effects, best fit, after_first,
+    set comparisons, the set named at the first step)``. A round's choice of a many-parameter
+    effect is compared with sets of simpler ones (:func:`_simpler_set`); a set at least as good is
+    added instead, its effects as steps in the order of their own delta_bic."""
     steps: list[Step] = []
     current: list[Any] = []
     current_fit = base_fit
     round_candidates = candidates
     after_first: dict[str, float | None] = {}
+    comparisons: list[SetComparison] = []
+    together: list[str] = []
     while True:
-        accepted = [c for c in round_candidates if c.significant]
+        accepted = [c for c in round_candidates if c.acceptable]
         if not accepted:
             break
         chosen = accepted[0]
-        current.append(_effect(family, chosen.effect))
-        current_fit = chosen.fit
-        steps.append(Step(chosen.effect, float(chosen.delta_bic), chosen.fit, round_candidates))
+        found = _simpler_set(family, current, current_fit, chosen, round_candidates)
+        if found is not None:
+            comparison, members = found
+            comparisons.append(dataclasses.replace(comparison, step=len(steps) + 1))
+        if found is not None and comparison.chosen:
+            if not steps:
+                together = list(comparison.simpler)
+            for c in members:
+                previous = current_fit
+                current.append(_effect(family, c.effect))
+                current_fit = family.fit(current)
+                steps.append(
+                    Step(c.effect, _delta_bic(current_fit.result, previous.result), current_fit,
+                         round_candidates)
+                )  # fmt: skip
+        else:
+            current.append(_effect(family, chosen.effect))
+            current_fit = chosen.fit
+            steps.append(Step(chosen.effect, float(chosen.delta_bic), chosen.fit, round_candidates))
         rest = [e for e in family.catalogue if e not in current]
         if not rest:
             break
+        first_round = round_candidates is candidates
         round_candidates = compare_effects(family, current, current_fit, rest)
-        if len(steps) == 1:
+        if first_round:
             after_first = {c.effect: c.delta_bic for c in round_candidates}
-    return steps, current, current_fit, after_first
+    return steps, current, current_fit, after_first, comparisons, together
 
 
-def _pruned(family, candidates, current, current_fit, known):
+def _simpler_set(family, current, current_fit, chosen: Candidate, round_candidates):
+    """The best set of simpler candidates against the many-parameter ``chosen`` (added rank at
+    least 2): ``(SetComparison, its candidates best first)``, or None when ``chosen`` adds one
+    parameter or no two simpler candidates exist.
+
+    Bounded beam search: the :data:`SET_POOL_SIZE` testable, plausible candidates of the round
+    with a smaller added rank than ``chosen``'s (best delta_bic first, one of each confounded
+    group: the same delta_bic and rank) are the pool; sets grow
+    from its :data:`SET_BEAM_WIDTH` best singles one effect at a time up to :data:`SET_MAX_SIZE`,
+    keeping the ``SET_BEAM_WIDTH`` best (lowest BIC) at each size, each set's added rank at most
+    ``chosen``'s and every member adding rank of its own (confounded effects stay one group: a
+    set of two of them is no set). At most ``SET_BEAM_WIDTH * SET_POOL_SIZE * (SET_MAX_SIZE - 1)``
+    fits, shared through the family's cache. The set is chosen when its delta_bic is below
+    ``chosen``'s (beyond rounding, :data:`SET_TIE`: a set exactly as good, confounded with
+    ``chosen``, leaves the one effect named and the set among its alternatives) and every member's
+    fitted amplitude in it is plausible.
+    """
+    limit = chosen.added_rank
+    if limit < 2:
+        return None
+    simpler = sorted(
+        (c for c in round_candidates
+         if c.testable and c.effect != chosen.effect and c.implausible is None
+         and c.delta_bic is not None and c.added_rank < limit),
+        key=lambda c: c.delta_bic,
+    )  # fmt: skip
+    pool: list[Candidate] = []
+    for c in simpler:  # one of each confounded group (the same score and rank)
+        if not any(_same_score(c, p) for p in pool):
+            pool.append(c)
+    pool = pool[:SET_POOL_SIZE]
+    if len(pool) < 2:
+        return None
+    order = {e.name: i for i, e in enumerate(family.catalogue)}
+    rank = {c.effect: c.added_rank for c in pool}
+    base = current_fit.result
+    scored: dict[frozenset, tuple[float, Any]] = {}
+
+    def score(members: frozenset) -> float:
+        if members not in scored:
+            names = sorted(members, key=order.__getitem__)
+            try:
+                fit = family.fit([*current, *(_effect(family, n) for n in names)])
+            except (IdentifiabilityError, InputError):
+                fit = None
+            added = fit.result.rank - base.rank if fit is not None else 0
+            if fit is None or added != sum(rank[n] for n in members):
+                scored[members] = (math.inf, None)
+            else:
+                scored[members] = (_delta_bic(fit.result, base), fit)
+        return scored[members][0]
+
+    beam = [frozenset([c.effect]) for c in pool[:SET_BEAM_WIDTH]]
+    for _ in range(SET_MAX_SIZE - 1):
+        grown = {
+            members | {c.effect}
+            for members in beam
+            for c in pool
+            if c.effect not in members and sum(rank[n] for n in members) + c.added_rank <= limit
+        }
+        finite = [m for m in grown if math.isfinite(score(m))]
+        if not finite:
+            break
+        beam = sorted(finite, key=lambda m: (score(m), sorted(order[n] for n in m)))
+        beam = beam[:SET_BEAM_WIDTH]
+    sets = [m for m in scored if math.isfinite(scored[m][0])]
+    if not sets:
+        return None
+    best = min(sets, key=lambda m: (scored[m][0], len(m), sorted(order[n] for n in m)))
+    dbic, fit = scored[best]
+    members = sorted((c for c in pool if c.effect in best), key=lambda c: c.delta_bic)
+    plausible = all(_implausibility(family, _effect(family, c.effect), fit) is None
+                    for c in members)  # fmt: skip
+    comparison = SetComparison(
+        step=0,
+        effect=chosen.effect,
+        added_rank=int(chosen.added_rank),
+        delta_bic=float(chosen.delta_bic),
+        simpler=tuple(c.effect for c in members),
+        set_added_rank=int(sum(c.added_rank for c in members)),
+        set_delta_bic=float(dbic),
+        chosen=bool(plausible and dbic < chosen.delta_bic - SET_TIE * max(1.0, abs(dbic))),
+    )
+    return comparison, members
+
+
+def _pruned(family, candidates, current, current_fit, known, replaced=frozenset()):
     """The accepted effects an effect of which earns its place judged against the best
     description of the data -- the other accepted effects *and* the structure found -- not
     against a model whose chi2 the unexplained structure inflates (a 3/rev term makes any 1/rev
-    effect look good): ``(effects, fit, structure, probes, unneeded {name: BIC cost})``."""
+    effect look good): ``(effects, fit, structure, probes, unneeded {name: BIC cost})``. An
+    effect in ``replaced`` (a many-parameter effect a set of simpler ones beat) is not put back.
+    """
     structure, probes = _search(family, current_fit, known)
     unneeded: dict[str, float] = {}
     threshold = candidates[0].threshold
@@ -637,9 +863,10 @@ def _pruned(family, candidates, current, current_fit, known):
         better = [
             c
             for c in candidates
-            if c.significant
+            if c.acceptable
             and c.determined
             and c.effect not in kept
+            and c.effect not in replaced
             and described is not None
             and _rss(c.fit.result) < described
         ]
@@ -649,6 +876,30 @@ def _pruned(family, candidates, current, current_fit, known):
             current_fit = family.fit(current)
             structure, probes = _search(family, current_fit, known)
     return current, current_fit, structure, probes, unneeded
+
+
+def _same_score(a: Candidate, b: Candidate) -> bool:
+    """Whether two candidates add the same rank with the same delta_bic (to rounding,
+    :data:`SET_TIE`): confounded on these data."""
+    return a.added_rank == b.added_rank and abs(a.delta_bic - b.delta_bic) <= SET_TIE * max(
+        1.0, abs(a.delta_bic)
+    )
+
+
+def _plausible(family, current, current_fit):
+    """The accepted effects without those whose amplitude in the final fit is implausible (one
+    plausible when it was added can grow once the effects beside it are set aside), refitted one
+    at a time, worst first: ``(effects, fit, {name: what one would have to believe})``."""
+    dropped: dict[str, str] = {}
+    while current:
+        judged = [(e, _implausibility(family, e, current_fit)) for e in current]
+        worst = next(((e, b) for e, b in judged if b), None)
+        if worst is None:
+            break
+        dropped[worst[0].name] = worst[1]
+        current = [e for e in current if e is not worst[0]]
+        current_fit = family.fit(current)
+    return current, current_fit, dropped
 
 
 def _separations(family, candidates, steps) -> dict[str, str]:
@@ -670,12 +921,18 @@ def _separations(family, candidates, steps) -> dict[str, str]:
 def _diagnose(family, *, until_explained: bool) -> Diagnosis:
     base_fit = family.fit([])
     candidates = compare_effects(family, [], base_fit, family.catalogue)
-    steps, current, current_fit, after_first = _forward(family, candidates, base_fit)
-    known = 1.0 if current_fit.result.sigma_known else None
-    current, current_fit, structure, _, unneeded = _pruned(
-        family, candidates, current, current_fit, known
+    steps, current, current_fit, after_first, comparisons, together = _forward(
+        family, candidates, base_fit
     )
-    if unneeded:
+    known = 1.0 if current_fit.result.sigma_known else None
+    replaced = frozenset(c.effect for c in comparisons if c.chosen)
+    current, current_fit, structure, _, unneeded = _pruned(
+        family, candidates, current, current_fit, known, replaced
+    )
+    current, current_fit, dropped = _plausible(family, current, current_fit)
+    if dropped:
+        structure, _ = _search(family, current_fit, known)
+    if unneeded or dropped:
         steps = _steps_of(family, current, base_fit)
     best = current_fit.result
     noise_variance = _noise_variance(best)
@@ -695,6 +952,9 @@ def _diagnose(family, *, until_explained: bool) -> Diagnosis:
         after_first=after_first,
         warnings=list(family.design_warnings(base_fit)),
         unneeded_given_structure=unneeded,
+        set_comparisons=comparisons,
+        named_together=together,
+        implausible_in_best=dropped,
         group_variance=group_variance,
     )
 

@@ -14,13 +14,14 @@ from types import MappingProxyType
 
 import numpy as np
 
-from ...measurement.effects.base import ParameterSpec, PositionVariables
+from ...measurement.effects.base import ParameterSpec, PositionVariables, angle_words, plausible
 from ...stats.candidate_effect import CandidateEffect
 
 __all__ = [
     "INSTRUMENT",
     "TABLE",
     "ParameterSpec",
+    "plausible",
     "RunContext",
     "RunEffect",
     "Sensed",
@@ -82,6 +83,10 @@ class RunEffect(CandidateEffect):
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
         """The parameters this effect has on ``run``."""
         raise NotImplementedError
+
+    def amount_words(self, value: float, unit: str) -> str:
+        """An amplitude in words (large angles in arc minutes or degrees)."""
+        return angle_words(value, unit)
 
     def columns(self, context: RunContext) -> np.ndarray:
         """``d(out_x, out_y)/d(parameter)``, (N, 2, p), deg/h per internal unit."""

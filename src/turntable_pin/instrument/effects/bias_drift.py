@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed
+from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed, plausible
 
 __all__ = ["BiasDrift"]
 
@@ -31,6 +31,9 @@ class BiasDrift(RunEffect):
         "position after switch-on shows it directly."
     )
     required_columns = ("time_s",)
+    plausibility = (  # docs/plausibility.md
+        plausible(("x", "y"), "a bias drifting by {amplitude}", "deg/h/h", any_machine=20),
+    )
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
         """This effect's parameters on ``run`` (their user units and scales)."""

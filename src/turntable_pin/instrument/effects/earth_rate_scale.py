@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed
+from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed, plausible
 
 __all__ = ["EarthRateScale"]
 
@@ -17,6 +17,9 @@ class EarthRateScale(RunEffect):
     name = "earth_rate_scale"
     side = INSTRUMENT
     limit = 1e5
+    plausibility = (  # docs/plausibility.md
+        plausible(("x", "y"), "a scale factor wrong by {amplitude}", "ppm", any_machine=5e4),
+    )
     title = "a scale-factor error of the GyroWheel's rate outputs"
     definition = "out_x += sx wx, out_y += sy wy (ppm of the earth rate along each axis)"
     explanation = (

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...calibration.gyrowheel import MAX_COEFFICIENT_DPH
-from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed
+from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed, plausible
 
 __all__ = ["GSquaredTerms"]
 
@@ -21,6 +21,10 @@ class GSquaredTerms(RunEffect):
     name = "g_squared_terms"
     side = INSTRUMENT
     limit = MAX_COEFFICIENT_DPH
+    plausibility = (  # docs/plausibility.md
+        plausible(("x_xz", "x_yz", "y_xz", "y_yz"), "g-squared terms of {amplitude}",
+                  "deg/h/g^2", any_machine=200),
+    )  # fmt: skip
     title = "g-squared (anisoelastic) terms the 7-coefficient model leaves out"
     definition = "out_x += x_xz ax az + x_yz ay az, out_y += y_xz ax az + y_yz ay az (deg/h/g^2)"
     explanation = (

@@ -12,7 +12,7 @@ import numpy as np
 
 from ...measurement.effects.base import ARCSEC
 from ...model.errors import MAX_ANGULAR_ERROR_DEG
-from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed
+from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed, plausible
 
 __all__ = ["InstrumentHeading", "InstrumentTilt", "Mount"]
 
@@ -26,6 +26,12 @@ class Mount(RunEffect):
     axes: tuple[str, ...] = ()
     side = INSTRUMENT
     limit = MAX_ANGULAR_ERROR_DEG * 3600.0
+
+    @property
+    def plausibility(self):
+        """Its rotation, mounted at most 2 deg askew (``docs/plausibility.md``)."""
+        names = tuple(f"m{axis}" for axis in self.axes)
+        return (plausible(names, "a GyroWheel mounted {amplitude} askew", any_machine=7200),)
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
         """This effect's parameters on ``run`` (their user units and scales)."""

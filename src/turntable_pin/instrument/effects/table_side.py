@@ -13,7 +13,7 @@ import numpy as np
 
 from ...measurement.effect_model import OrientationModel
 from ...measurement.effects.base import ARCSEC, Effect
-from .base import TABLE, ParameterSpec, RunContext, RunEffect, run_variables
+from .base import TABLE, ParameterSpec, RunContext, RunEffect, plausible, run_variables
 
 __all__ = ["PREFIX", "TableEffect", "TableError", "TableErrors"]
 
@@ -70,6 +70,9 @@ class TableError(RunEffect):
             f"measurements names {error} when it is there; or calibrate again with the table's "
             "error compensated in the positions (eq. 3 computed from the measured attitude)."
         )
+        self.plausibility = (  # docs/plausibility.md
+            plausible(("value",), f"a table whose {what} is {{amplitude}}", turntable=600),
+        )
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
         """This effect's parameters on ``run`` (their user units and scales)."""
@@ -105,6 +108,7 @@ class TableEffect(RunEffect):
         self.explanation = effect.explanation
         self.confirm = effect.confirm
         self.required_columns = tuple(effect.required_columns)
+        self.plausibility = tuple(effect.plausibility)
 
     def missing_columns(self, run) -> tuple[str, ...]:
         """The run columns the orientation effect needs and ``run`` lacks."""

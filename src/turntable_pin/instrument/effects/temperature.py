@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed
+from .base import INSTRUMENT, ParameterSpec, RunContext, RunEffect, Sensed, plausible
 
 __all__ = ["TEMPERATURE_COLUMN", "TemperatureCoefficient"]
 
@@ -19,6 +19,10 @@ class TemperatureCoefficient(RunEffect):
     name = "temperature_coefficient"
     side = INSTRUMENT
     limit = 1e3
+    plausibility = (  # docs/plausibility.md
+        plausible(("x", "y"), "a bias moving by {amplitude} with temperature", "deg/h/degC",
+                  any_machine=10),
+    )  # fmt: skip
     title = "the GyroWheel's drift following its temperature"
     definition = (
         "out_x += kx (T - T_mean), out_y += ky (T - T_mean) (deg/h per degree C, T = temperature_c)"

@@ -6,7 +6,16 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .base import ARCSEC, ChainTerm, Effect, EffectText, Labels, ParameterSpec, PositionVariables
+from .base import (
+    ARCSEC,
+    ChainTerm,
+    Effect,
+    EffectText,
+    Labels,
+    ParameterSpec,
+    PositionVariables,
+    plausible,
+)
 
 __all__ = ["Backlash"]
 
@@ -53,6 +62,12 @@ class Backlash(Effect):
                 "removes it.",
             ),
         )
+
+        self.plausibility = tuple(  # docs/plausibility.md
+            plausible((b,), f"a drive of {j.joint} with {{amplitude}} of lost motion",
+                      turntable=300, mount=600)
+            for j, (_, b, _, _) in zip(joints, self.each, strict=True)
+        )  # fmt: skip
 
     def parameters(self, variables: PositionVariables):
         """The backlash of each joint whose ``dirK`` the data have, arcsec."""

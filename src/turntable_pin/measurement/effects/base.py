@@ -27,10 +27,16 @@ from ...core.csv_table import missing_columns_words
 from ...core.exceptions import InputError
 from ...core.units import ARCSEC_PER_RAD
 from ...model.named_effects import EffectText, Labels
-from ...stats.candidate_effect import CandidateEffect
+from ...stats.candidate_effect import ANY_MACHINE, CandidateEffect, Plausibility
 
 __all__ = [
+    "ANY_MACHINE",
     "ARCSEC",
+    "MOUNT",
+    "Plausibility",
+    "TURNTABLE",
+    "angle_words",
+    "plausible",
     "MEASURED",
     "POST",
     "PRE",
@@ -71,6 +77,35 @@ class ParameterSpec:
 
 ARCSEC = 1.0 / ARCSEC_PER_RAD
 """One arc second in radians."""
+
+TURNTABLE = "turntable"
+"""The machine kind of a precision turntable (the key of its plausible scales)."""
+MOUNT = "telescope mount"
+"""The machine kind of a telescope mount (the key of its plausible scales)."""
+
+
+def plausible(
+    parameters, belief: str, unit: str = "arcsec", *, turntable=None, mount=None, any_machine=None
+) -> Plausibility:
+    """A :class:`~turntable_pin.stats.candidate_effect.Plausibility` of ``parameters`` (names)
+    with its scale on a precision turntable and on a telescope mount (or on any machine), in
+    ``unit``; a kind given None is not judged (``docs/plausibility.md``)."""
+    scale = {TURNTABLE: turntable, MOUNT: mount, ANY_MACHINE: any_machine}
+    return Plausibility(
+        tuple(parameters), {k: float(v) for k, v in scale.items() if v is not None}, belief, unit
+    )
+
+
+def angle_words(value: float, unit: str) -> str:
+    """An amplitude in words: arc seconds (``arcsec``, ``arcsec/g``...) of a degree or more in
+    degrees, of an arc minute or more in arc minutes."""
+    if unit.startswith("arcsec"):
+        rest = unit[len("arcsec") :]
+        if abs(value) >= 3600.0:
+            return f"{value / 3600.0:.3g} deg{rest}"
+        if abs(value) >= 60.0:
+            return f"{value / 60.0:.3g} arcmin{rest}"
+    return f"{value:.3g} {unit}".strip()
 
 
 @dataclass(frozen=True)
@@ -264,6 +299,10 @@ class Effect(CandidateEffect):
     def parameters(self, variables: PositionVariables) -> tuple[ParameterSpec, ...]:
         """The parameters this effect has on a data set with these variables."""
         raise NotImplementedError
+
+    def amount_words(self, value: float, unit: str) -> str:
+        """An amplitude in words (:func:`angle_words`)."""
+        return angle_words(value, unit)
 
     def chain_terms(self, variables: PositionVariables) -> tuple[ChainTerm, ...]:
         """How it changes the chain at each position (see the module docstring).

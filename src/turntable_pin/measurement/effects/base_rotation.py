@@ -15,6 +15,7 @@ from .base import (
     Labels,
     ParameterSpec,
     PositionVariables,
+    plausible,
 )
 
 __all__ = ["BaseRotation"]
@@ -39,6 +40,10 @@ class BaseRotation(Effect):
         self.labels = tuple(labels) or tuple(
             (f"t{a}", f"rotation of the base about {a}") for a in self.axes
         )
+        self.plausibility = (  # docs/plausibility.md
+            plausible(tuple(t for t, _ in self.labels), "a base set up {amplitude} out of level",
+                      turntable=7200, mount=7200),
+        )  # fmt: skip
         super().__init__(
             name or self.kind,
             text,

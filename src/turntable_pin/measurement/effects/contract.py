@@ -30,7 +30,7 @@ import numpy as np
 from ...core.exceptions import UserCodeError
 from ...core.user_code import call_user, class_file, is_user_code
 from ...model.angles import ANGLE_NAMES
-from ...stats.candidate_effect import STORY_TEXTS
+from ...stats.candidate_effect import STORY_TEXTS, Plausibility
 from .base import MEASURED, POST, PRE, ChainTerm, Effect, ParameterSpec, PositionVariables
 
 __all__ = [
@@ -125,6 +125,12 @@ def check_story(effect, base: type) -> None:
         raise fail(
             f"its required_columns is {described(columns)}; expected a tuple of "
             "column names such as ('time_s',)"
+        )
+    scales = getattr(effect, "plausibility", ())
+    if not isinstance(scales, tuple | list) or not all(isinstance(p, Plausibility) for p in scales):
+        raise fail(
+            f"its plausibility is {described(scales)}; expected a tuple of Plausibility "
+            "(turntable_pin.stats.candidate_effect), or () when its amplitudes are not judged"
         )
     for key, values in base.story_fields.items():
         value = getattr(effect, key, None)

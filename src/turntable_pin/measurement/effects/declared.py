@@ -21,6 +21,8 @@ class DeclaredEffect(Effect):
         terms: its terms (``EffectTerm``), already checked against the table.
         title, explanation, confirm: its story (``title`` defaults to the definition).
         source: where it was declared (an effect file, ``effects``), for messages.
+        plausibility: its parameters' plausible scale per machine kind (an effect file's
+            ``plausible``), empty: not judged.
     """
 
     def __init__(
@@ -32,8 +34,10 @@ class DeclaredEffect(Effect):
         explanation: str = "",
         confirm: str = "",
         source: str = "",
+        plausibility: Sequence = (),
     ) -> None:
         self.terms, self.source = tuple(terms), source
+        self.plausibility = tuple(plausibility)
         definition = "; ".join(t.definition() for t in self.terms)
         super().__init__(name, EffectText(title or definition, definition, explanation, confirm))
         self.required_columns = tuple(

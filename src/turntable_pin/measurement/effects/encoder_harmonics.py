@@ -10,6 +10,7 @@ from .base import (
     PositionVariables,
     harmonic_parameters,
     harmonic_weights,
+    plausible,
 )
 
 __all__ = ["EncoderHarmonics"]
@@ -49,6 +50,14 @@ class EncoderHarmonics(Effect):
                 "autocollimator on an optical polygon carried by the axis) over a full turn.",
             ),
         )
+
+        p = self.prefix
+        self.plausibility = (  # docs/plausibility.md
+            plausible((f"{p}c1", f"{p}s1"), f"an encoder disc of {self.joint} so far off centre "
+                      "that it reads {amplitude} wrong once per turn", turntable=300, mount=600),
+            plausible((f"{p}c2", f"{p}s2"), f"an encoder disc of {self.joint} so far out of round "
+                      "that it reads {amplitude} wrong twice per turn", turntable=100, mount=300),
+        )  # fmt: skip
 
     def parameters(self, variables: PositionVariables):
         """The four harmonic coefficients ``c1, s1, c2, s2``, arcsec."""

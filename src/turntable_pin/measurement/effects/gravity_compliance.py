@@ -6,7 +6,16 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from .base import ARCSEC, POST, ChainTerm, Effect, EffectText, ParameterSpec, PositionVariables
+from .base import (
+    ARCSEC,
+    POST,
+    ChainTerm,
+    Effect,
+    EffectText,
+    ParameterSpec,
+    PositionVariables,
+    plausible,
+)
 
 __all__ = ["COMPLIANCE_ENTRIES", "GravityCompliance"]
 
@@ -48,6 +57,10 @@ class GravityCompliance(Effect):
         self.labels = tuple(labels) or tuple(
             (p, f"rotation about payload {p[2]} per g along {p[3]}") for p in self.tied
         )
+        self.plausibility = (  # docs/plausibility.md
+            plausible(tuple(self.tied), "a payload and its frames bending by {amplitude} under "
+                      "their own weight", "arcsec/g", turntable=300, mount=3600),
+        )  # fmt: skip
         if [p for p, _ in self.labels] != list(self.tied):
             raise ValueError(f"labels {self.labels} do not name the parameters {list(self.tied)}")
         super().__init__(

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import ARCSEC, POST, ChainTerm, Effect, ParameterSpec, PositionVariables
+from .base import ARCSEC, POST, ChainTerm, Effect, ParameterSpec, PositionVariables, plausible
 
 __all__ = ["PayloadMount"]
 
@@ -15,6 +15,10 @@ class PayloadMount(Effect):
 
     name = kind = "payload_mount"
     title = "payload mounted askew"
+    plausibility = (  # docs/plausibility.md
+        plausible(("mz", "my", "mx"), "a payload mounted {amplitude} askew", turntable=7200,
+                  mount=7200),
+    )  # fmt: skip
     definition = "Rt -> Rt Rz(mz) Ry(my) Rx(mx)"
     explanation = (
         "The instrument sits on the table's last frame through a fixture whose faces are not "

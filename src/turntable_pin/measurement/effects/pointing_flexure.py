@@ -18,7 +18,7 @@ import numpy as np
 
 from ...core.exceptions import InputError
 from ..pointing_terms import coordinate_offsets, mount_kind, mount_terms
-from .base import ARCSEC, POST, ChainTerm, Effect, ParameterSpec, PositionVariables
+from .base import ARCSEC, POST, ChainTerm, Effect, ParameterSpec, PositionVariables, plausible
 
 __all__ = ["GRAVITY_TERMS", "JOINT_TERMS", "MIN_SINE", "PointingFlexure", "pointing_flexures"]
 
@@ -62,6 +62,9 @@ class PointingFlexure(Effect):
             self.definition = f"{site} += the correction of {term.formula}"
         self.explanation = term.explanation
         self.confirm = term.confirm
+        self.plausibility = (  # docs/plausibility.md
+            plausible((term.name,), f"a {term.title} of {{amplitude}}", mount=3600),
+        )
 
     def parameters(self, variables: PositionVariables):
         """The coefficient, named after the term, arcsec."""

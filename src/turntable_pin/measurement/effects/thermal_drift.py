@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import ARCSEC, POST, ChainTerm, Effect, ParameterSpec, PositionVariables
+from .base import ARCSEC, POST, ChainTerm, Effect, ParameterSpec, PositionVariables, plausible
 
 _ARCSEC_PER_HOUR = ARCSEC / 3600.0  # rad/s of one arcsec/h
 
@@ -29,6 +29,10 @@ class ThermalDrift(Effect):
         "Randomising the order of positions decouples time from angle."
     )
     required_columns = ("time_s",)
+    plausibility = (  # docs/plausibility.md
+        plausible(("rz", "ry", "rx"), "a payload turning by {amplitude} as it warms",
+                  "arcsec/h", turntable=120, mount=300),
+    )  # fmt: skip
 
     def parameters(self, variables: PositionVariables):
         """The drift rates ``rz``, ``ry`` and ``rx``, arcsec/h."""

@@ -10,6 +10,7 @@ from .base import (
     PositionVariables,
     harmonic_parameters,
     harmonic_weights,
+    plausible,
 )
 
 __all__ = ["WobbleHarmonics"]
@@ -54,6 +55,12 @@ class WobbleHarmonics(Effect):
                 "the axis over a full, slow turn: the repeatable part is the wobble curve.",
             ),
         )
+
+        names = tuple(f"{p}{k}" for _, p, _ in self.series for k in ("c1", "s1", "c2", "s2"))
+        self.plausibility = (  # docs/plausibility.md
+            plausible(names, f"a bearing of {self.joint} whose axis wobbles by {{amplitude}} as it "
+                      "turns", turntable=300, mount=600),
+        )  # fmt: skip
 
     def parameters(self, variables: PositionVariables):
         """Harmonic coefficients of each tilt (``a_c1 ... a_s2``, ``b_c1 ... b_s2``), arcsec."""
