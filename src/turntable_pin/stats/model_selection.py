@@ -647,7 +647,7 @@ class Diagnosis(NotebookResult):
                 "parameters": [dict(p) for p in c.parameters],
             }
             for c in self.candidates
-            if c.significant and not c.determined and c.effect not in named
+            if c.significant and not c.determined and c.effect not in named and not c.implausible
         ]
         if self.missing_effect:
             verdict["effect_story"] = self.family.describe(self.missing_effect)
@@ -904,7 +904,8 @@ def _plausible(family, current, current_fit):
 
 def _separations(family, candidates, steps) -> dict[str, str]:
     """The family's separation advice for the first effect's equally good alternatives and the
-    significant candidates not named because undetermined (the same signal, another name?)."""
+    significant candidates not named because undetermined (the same signal, another name?); none
+    for an implausible candidate (the verdict sets it aside with what one would have to believe)."""
     if not steps:
         return {}
     first = next(c for c in candidates if c.effect == steps[0].added)
@@ -912,9 +913,11 @@ def _separations(family, candidates, steps) -> dict[str, str]:
     passed_over = [
         c.effect for c in candidates if c.significant and not c.determined and c.effect not in named
     ]
+    implausible = {c.effect for c in candidates if c.implausible}  # no plan for what cannot be
     return {
         name: family.separation(first.fit, _effect(family, name))
         for name in dict.fromkeys([*first.alternatives, *passed_over])
+        if name not in implausible
     }
 
 
