@@ -320,6 +320,8 @@ NOT_A_TABLE = {
     # Result objects holding what a call above made (walked through that call's result).
     "measurement.fit.OrientationFit.__init__",
     "measurement.fit.OrientationFitProblem.__init__",
+    # `turntable=` here is a plausible scale on a precision turntable (a number), not a table.
+    "measurement.effects.base.plausible",
 }
 
 MAY_REFUSE = {
