@@ -23,7 +23,7 @@ a single error is not the single error named). A true many-parameter effect is *
 named effect is it, or holds it in its group with at least as many parameters. On clean data any
 named effect is a false name. A named effect that the candidate table marks implausible is
 counted apart. An implausible amplitude is handled right when the candidate table marks the
-planted effect implausible and the verdict does not name it.
+planted effect implausible and the verdict names neither it nor any other effect so marked.
 """
 
 from __future__ import annotations
@@ -269,7 +269,11 @@ def score(case: Case, d: dict) -> dict:
         exact = ok and len(named) == 1
     elif case.kind == IMPLAUSIBLE:
         planted = case.planted[0]
-        ok = exact = planted not in named and marked_implausible(_candidate(d, planted))
+        ok = exact = (
+            planted not in named
+            and marked_implausible(_candidate(d, planted))
+            and not implausible_named(d)
+        )
     else:
         ok = exact = not named
     return {
