@@ -260,3 +260,22 @@ def test_the_paper_tables_commands_name_no_urdf_and_simulated_data_a_placeholder
     assert command == (  # from Python, the Python call; the CLI prints the shell command
         "design(separate='gravity_sag,outer_encoder_harmonics', from_data='DATA.csv')"
     )
+
+
+def test_a_hypothesis_fitted_at_an_implausible_amplitude_is_flagged_not_planned(tmp_path):
+    """Issue 29: on the MMT run an elevation wobble fits only at about a degree and a half; the
+    design says so instead of planning positions for it. Given as a hypothesis, it is planned."""
+    from tpoint_runs import ALTAZ_URDF, mmt_csv
+    from turntable_pin.measurement.data import read_measurements
+    from turntable_pin.model.generic_table import GenericTable
+
+    table = GenericTable(ALTAZ_URDF)
+    data = read_measurements(mmt_csv(tmp_path / "mmt.csv"), table.joint_names)
+    design = _design(table, "wobble_harmonics@elevation,TF", 8, from_data=data, candidates=500)
+    assert list(design.implausible) == ["wobble_harmonics@elevation"]
+    assert "axis wobbles by 1.4" in design.implausible["wobble_harmonics@elevation"]
+    assert design.n_positions == 0 and design.to_dict()["implausible"] == design.implausible
+    assert design.report().startswith("not planned: wobble_harmonics@elevation's amplitude")
+    given = _design(table, "wobble_harmonics@elevation,TF", 8, from_data=data, candidates=500,
+                    amplitudes={"wobble_harmonics@elevation": {"a_c1": 2000.0}})  # fmt: skip
+    assert given.implausible == {} and given.n_positions == 8

@@ -178,3 +178,48 @@ def test_the_design_command_is_a_python_call_or_under_the_cli_the_shell_command(
             "turntable-pin design --separate bias_drift,table:deps_x --run "
             f"{shlex.quote(str(path))} --latitude-deg 30"
         )
+
+
+SINGLES = {
+    # two table singles: an orthogonality and an outer-axis wobble constant (70 and 60 arcsec)
+    "two_singles": (
+        {"table_errors_rad": {"deps_y": arcsec_to_rad(70.0), "dalpha_z1": arcsec_to_rad(60.0)}},
+        [{"table:deps_y", "table:dphi_y1"},
+         {"table:dalpha_z1", "table:dphi_z2", "instrument_heading"}],
+    ),
+    # three singles: two confounded table errors (one group on a run) and a heading error
+    "three_singles": (
+        {"table_errors_rad": {"deps_x": arcsec_to_rad(50.0), "dalpha_x1": arcsec_to_rad(45.0)},
+         "instrument": {"instrument_heading": {"mz": 60.0}}},
+        [{"table:deps_x", "table:dalpha_x1"},
+         {"table:dalpha_z1", "table:dphi_z2", "instrument_heading"}],
+    ),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", sorted(SINGLES))
+def test_several_table_singles_are_named_as_such_not_as_one_wobble(case):
+    """The wobble series absorbs the singles and leads the first round; the set search names the
+    singles (each a confounded group) and says which many-parameter effect it was compared with."""
+    hidden, groups = SINGLES[case]
+    for seed in range(3):
+        d = diagnose_run(_run(seed=seed, **hidden))
+        named = d.missing_effects
+        assert len(named) == len(groups), (seed, named)
+        for group in groups:
+            assert sum(name in group for name in named) == 1, (seed, named)
+        verdict = d.to_dict()["verdict"]
+        chosen = [s for s in verdict["simpler_sets"] if s["set_named"]]
+        assert chosen and "wobble_harmonics" in chosen[0]["effect"]
+        assert chosen[0]["set_added_rank"] < chosen[0]["added_rank"]
+        assert chosen[0]["set_delta_bic"] < chosen[0]["delta_bic"]
+
+
+def test_a_true_wobble_is_still_named_against_the_simpler_sets():
+    hidden = {"table_effects": {"inner_wobble_harmonics": {"x_c1": 60.0, "y_s2": 40.0}}}
+    for seed in range(3):
+        d = diagnose_run(_run(seed=seed, **hidden))
+        assert d.missing_effects == ["table:inner_wobble_harmonics"]
+        (comparison,) = d.set_comparisons
+        assert not comparison.chosen and comparison.set_delta_bic > comparison.delta_bic
+        assert d.to_dict()["candidates"][0]["implausible"] is None

@@ -147,3 +147,20 @@ def test_catalogue_sides_and_names():
     for effect in run_catalogue():
         story = effect.describe()
         assert story["title"] and story["explanation"] and story["confirm"]
+
+
+def test_every_run_candidate_of_the_catalogue_carries_a_turntable_scale():
+    """Issue 29: table errors, table effects (their orientation scale) and the instrument's
+    effects (any machine) judge their fitted amplitudes; inline terms do not."""
+    from turntable_pin.instrument.effects import run_catalogue, run_term
+    from turntable_pin.measurement.effects.base import TURNTABLE
+    from turntable_pin.measurement.table import measured_table
+
+    for effect in run_catalogue():
+        assert effect.plausibility, effect.name
+        assert all(g.limit(TURNTABLE) is not None for g in effect.plausibility), effect.name
+    assert run_term("out_x~h2(phi1)", measured_table(None)).plausibility == ()
+    by_name = {e.name: e for e in run_catalogue()}
+    assert by_name["table:deps_x"].implausibility({"value": 60.0}, TURNTABLE) is None
+    assert "orthogonality" in by_name["table:deps_x"].implausibility({"value": 3600.0}, TURNTABLE)
+    assert by_name["g_squared_terms"].implausibility({"x_xz": 0.03}, TURNTABLE) is None

@@ -160,3 +160,40 @@ def test_compliance_and_base_rotation_keep_what_the_data_determine():
     with_sag = fit_orientation(sim.data, [sag], turntable=two_axis)
     plain = fit_orientation(sim.data, turntable=two_axis)
     assert with_sag.result.rank - plain.result.rank == len(sag.entries)
+
+
+@pytest.mark.parametrize("urdf", [None, "altaz_mount", "german_equatorial_mount"])
+def test_every_catalogued_effect_carries_the_scale_of_its_parameters_on_its_machine(urdf):
+    """Issue 29: each effect of a table's catalogue judges its amplitude on a turntable and on a
+    telescope mount (data of the effect, docs/plausibility.md), over parameters it has."""
+    from turntable_pin.measurement.effects.base import MOUNT, TURNTABLE, angle_words
+
+    table = measured_table(GenericTable(REPO_DIR / "models" / f"{urdf}.urdf") if urdf else None)
+    machine = MOUNT if table.telescope_mount else TURNTABLE
+    variables = PositionVariables(np.zeros((3, table.n_joints)), np.zeros(3),
+                                  (np.ones(3),) * table.n_joints)  # fmt: skip
+    for effect in catalogue(table):
+        names = {spec.name for spec in effect.parameters(variables)}
+        assert effect.plausibility, effect.name
+        for group in effect.plausibility:
+            assert group.limit(machine) is not None and set(group.parameters) <= names
+            assert "{amplitude}" in group.belief
+            huge = {name: 1e6 for name in group.parameters or names}
+            assert (
+                effect.implausibility(huge, machine).endswith(
+                    f"(where a {machine} reaches about {angle_words(group.limit(machine), group.unit)})"
+                )
+                or len(effect.plausibility) > 1
+            )
+    assert angle_words(3730.0, "arcsec") == "1.04 deg" and angle_words(90, "arcsec/g") == (
+        "1.5 arcmin/g"
+    )
+
+
+def test_an_encoder_disc_a_degree_off_centre_is_implausible_on_a_mount_not_sixty_arcsec():
+    table = measured_table(GenericTable(REPO_DIR / "models" / "german_equatorial_mount.urdf"))
+    [encoder] = [e for e in catalogue(table) if e.name == "encoder_harmonics@declination"]
+    belief = encoder.implausibility({"c1": -3730.0, "s1": 0.0}, "telescope mount")
+    assert belief.startswith("an encoder disc of declination so far off centre that it reads "
+                             "1.04 deg wrong once per turn")  # fmt: skip
+    assert encoder.implausibility({"c1": 60.0, "s1": 0.0}, "telescope mount") is None

@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conftest import cli
+from conftest import EXAMPLES_DIR, cli
 from tpoint_runs import (
     ALTAZ_URDF,
     EQUATORIAL_URDF,
@@ -452,3 +452,38 @@ def test_a_term_infinite_at_some_rows_is_untestable_there_not_a_refusal(tmp_path
     [daf] = [c for c in out["candidates"] if c["effect"] == "DAF"]
     assert not daf["testable"] and "infinite at phi2" in daf["reason"]
     assert out["verdict"]["missing_effect"] is None
+
+
+def test_mmt_wobble_fits_only_with_an_implausible_amplitude_and_is_not_named(mmt_run):
+    """Issue 29: a wobble of the elevation axis fits the MMT run only at an amplitude no bearing
+    of a telescope mount has; it is marked implausible with what one would have to believe."""
+    from turntable_pin.measurement.diagnosis import diagnose_measurements
+
+    table = GenericTable(ALTAZ_URDF)
+    d = diagnose_measurements(read_measurements(mmt_run, table.joint_names), turntable=table)
+    out = d.to_dict()
+    assert out["best"]["effects"] == ["TF", "TX"]
+    [wobble] = [c for c in out["candidates"] if c["effect"] == "wobble_harmonics@elevation"]
+    assert wobble["significant"] and "axis wobbles by" in wobble["implausible"]
+    assert "where a telescope mount reaches about 10 arcmin" in wobble["implausible"]
+    assert "wobble_harmonics@elevation" in {e["effect"] for e in out["verdict"]["implausible"]}
+    # TF and TX themselves are within a mount's scale
+    assert all(c["implausible"] is None for c in out["candidates"] if c["in_best_model"])
+
+
+def test_german_equatorial_run_names_no_implausible_amplitude(tmp_path):
+    """Issue 29: the bundled German-equatorial run names no effect whose fitted size no
+    mechanism of its kind reaches (it named an encoder disc half a degree off centre)."""
+    csv, urdf = tmp_path / "gem.csv", tmp_path / "gem.urdf"
+    made = cli("import-tpoint", str(EXAMPLES_DIR / "gem_pointing" / "gem-28.dat"), "-o",
+               str(csv), "--write-urdf", str(urdf))  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    result = cli("diagnose", "--urdf", str(urdf), "--json", str(csv))
+    assert result.returncode == 0, result.stderr
+    out = json.loads(result.stdout)
+    named = set(out["best"]["effects"])
+    assert all(c["implausible"] is None for c in out["candidates"] if c["effect"] in named)
+    flagged = {e["effect"] for e in out["verdict"]["implausible"]}
+    assert "encoder_harmonics@hour_angle" in flagged and not flagged & named
+    assert "not named: encoder_harmonics@hour_angle" in cli("diagnose", "--urdf", str(urdf),
+                                                            str(csv)).stdout  # fmt: skip

@@ -1,6 +1,8 @@
 """Effects the user writes: effect files equal to catalogued effects, inline terms for every shape
 the structure search reports, modules of Effect subclasses named by the diagnosis, entry points."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -314,3 +316,49 @@ def test_the_user_effect_api_is_the_catalogues(encoder_data):
     assert isinstance(inline_effect("dpsi~h1(phi1)"), Effect)
     assert ChainTerm("post", "z").weights == {}
     assert ParameterSpec("k", "arcsec", ARCSEC, "").per_user_unit == ARCSEC
+
+
+PLAUSIBLE_FILE = (
+    INNER_ENCODER_FILE
+    + """\
+plausible:
+  turntable: 20
+  telescope_mount: 120
+  belief: an inner encoder disc reading {amplitude} wrong
+"""
+)
+
+
+def test_an_effect_file_declares_its_plausible_scale_and_the_diagnosis_uses_it(
+    tmp_path, encoder_data
+):
+    """Issue 29: the ``plausible`` key; a fit beyond it is marked implausible and not named."""
+    effect = read_effect_file(write_file(tmp_path, PLAUSIBLE_FILE, "effect.yaml"))
+    (group,) = effect.plausibility
+    assert group.scale == {"turntable": 20.0, "telescope mount": 120.0} and group.unit == "arcsec"
+    assert effect.implausibility({"c1": 30.0}, "turntable") == (
+        "an inner encoder disc reading 30 arcsec wrong (where a turntable reaches about 20 arcsec)"
+    )
+    assert effect.implausibility({"c1": 30.0}, "telescope mount") is None
+    model = OrientationModel(encoder_data.variables(), [effect])
+    planted = model.predict(model.parameter_vector({f"{effect.name}.c1": 25.0 * ARCSEC}))
+    strong = encoder_data.replace(angles_rad=encoder_data.angles_rad + planted)
+    tight = diagnose_measurements(strong, catalogue=(effect,))
+    assert tight.missing_effect is None and tight.to_dict()["verdict"]["implausible"]
+    loose = read_effect_file(write_file(tmp_path, INNER_ENCODER_FILE, "loose.yaml"))
+    assert diagnose_measurements(strong, catalogue=(loose,)).missing_effect == loose.name
+
+
+@pytest.mark.parametrize(
+    "extra, words",
+    [
+        ("plausible: 20\n", "plausible: expected a mapping of turntable, telescope_mount, any"),
+        ("plausible: {table: 20}\n", "plausible.table: unknown key"),
+        ("plausible: {turntable: -1}\n", "plausible.turntable: expected a number > 0"),
+        ("plausible: {belief: 'x {amplitude}'}\n", "plausible: no scale given"),
+        ("plausible: {turntable: 5, belief: 'no amplitude'}\n", "plausible.belief: expected"),
+    ],
+)
+def test_a_bad_plausible_key_is_refused_naming_it(tmp_path, extra, words):
+    with pytest.raises(InputError, match=re.escape(words)):
+        read_effect_file(write_file(tmp_path, INNER_ENCODER_FILE + extra, "effect.yaml"))

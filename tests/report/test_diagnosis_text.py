@@ -116,3 +116,38 @@ def test_a_separation_prints_the_design_command_that_settles_it():
     at = lines.index("  alternative outer_encoder_harmonics: no set of positions separates them")
     assert lines[at + 1] == f"    to settle it, design the next positions: {command}"
     assert lines[: at + 1] + lines[at + 2 :] == plain  # nothing else changes
+
+
+def test_the_simpler_set_compared_and_the_implausible_effects_are_said():
+    """Issue 29: each many-parameter effect compared with a set of simpler ones (named or not),
+    and each significant effect left out for an implausible amplitude, with the belief."""
+    d = _dict(steps=("table:deps_y", "instrument_heading"))
+    d["verdict"]["simpler_sets"] = [
+        {"step": 1, "effect": "table:inner_wobble_harmonics", "added_rank": 8,
+         "delta_bic": -2443.8, "simpler_set": ["table:deps_y", "instrument_heading"],
+         "set_added_rank": 2, "set_delta_bic": -2468.5, "set_named": True},
+        {"step": 2, "effect": "bias_drift", "added_rank": 2, "delta_bic": -30.0,
+         "simpler_set": ["table:dalpha_x2", "table:dalpha_y2"], "set_added_rank": 2,
+         "set_delta_bic": -12.0, "set_named": False},
+    ]  # fmt: skip
+    d["verdict"]["implausible"] = [
+        {"effect": "table:outer_wobble_harmonics", "delta_bic": -90.1,
+         "belief": "a bearing of outer_axis whose axis wobbles by 14.1 arcmin as it turns (where "
+                   "a turntable reaches about 5 arcmin)"},
+    ]  # fmt: skip
+    lines = verdict_lines(d)
+    assert (
+        "parsimony at step 1: the simpler set table:deps_y + instrument_heading (2 parameters, "
+        "delta_bic -2468.5) has a lower BIC than table:inner_wobble_harmonics (8 parameters, "
+        "delta_bic -2443.8), so the set is named"
+    ) in lines
+    assert (
+        "parsimony at step 2: bias_drift (2 parameters, delta_bic -30.0) is kept; the best "
+        "simpler set, table:dalpha_x2 + table:dalpha_y2 (2 parameters, delta_bic -12.0), does "
+        "not fit as well"
+    ) in lines
+    assert (
+        "not named: table:outer_wobble_harmonics (delta_bic -90.1, significant alone) is "
+        "implausible: to accept it one would have to believe in a bearing of outer_axis whose "
+        "axis wobbles by 14.1 arcmin as it turns (where a turntable reaches about 5 arcmin)"
+    ) in lines

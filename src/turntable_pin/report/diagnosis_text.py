@@ -302,22 +302,28 @@ def _set_lines(verdict: dict) -> list[str]:
             f"{entry['effect']} ({entry['added_rank']} parameters, delta_bic "
             f"{entry['delta_bic']:.1f})"
         )
-        simpler = (
-            f"the simpler set {' + '.join(entry['simpler_set'])} ({entry['set_added_rank']} "
-            f"parameters, delta_bic {entry['set_delta_bic']:.1f})"
-        )
+        names = " + ".join(entry["simpler_set"])
+        numbers = f"({entry['set_added_rank']} parameters, delta_bic {entry['set_delta_bic']:.1f})"
         if entry["set_named"]:
             lines.append(
-                f"parsimony at step {entry['step']}: {simpler} fits at least as well as {effect}, "
-                "so the simpler set is named"
+                f"parsimony at step {entry['step']}: the simpler set {names} {numbers} has a "
+                f"lower BIC than {effect}, so the set is named"
             )
         else:
             lines.append(
                 f"parsimony at step {entry['step']}: {effect} is kept; the best simpler set, "
-                f"{simpler}, does not fit as well"
-                + ("" if entry["set_delta_bic"] > entry["delta_bic"] else " with plausible values")
+                f"{names} {numbers}, " + _set_fared(entry["set_delta_bic"], entry["delta_bic"])
             )
     return lines
+
+
+def _set_fared(set_delta_bic: float, delta_bic: float) -> str:
+    """How a simpler set that was not named fared against the effect kept."""
+    if abs(set_delta_bic - delta_bic) <= 1e-6 * max(1.0, abs(delta_bic)):
+        return "fits exactly as well: the same signal, which the one effect names"
+    if set_delta_bic > delta_bic:
+        return "does not fit as well"
+    return "fits as well only with an implausible amplitude"
 
 
 def _unexplained_lines(d: dict, data: str) -> list[str]:
