@@ -274,9 +274,11 @@ def _rival_lines(d: dict) -> list[str]:
             lines += _settle(commands, entry["effect"])
     lines += _set_lines(verdict)
     for entry in verdict.get("implausible", []):
+        score = entry["delta_bic"]
+        alone = f" (delta_bic {score:.1f}, significant alone)" if score is not None else ""
         lines.append(
-            f"not named: {entry['effect']} (delta_bic {entry['delta_bic']:.1f}, significant "
-            f"alone) is implausible: to accept it one would have to believe in {entry['belief']}"
+            f"not named: {entry['effect']}{alone} is implausible: to accept it one would have to "
+            f"believe in {entry['belief']}"
         )
     for entry in verdict.get("unneeded_given_structure", []):
         lines.append(

@@ -446,6 +446,8 @@ class Diagnosis:
         set_comparisons: each many-parameter choice compared with a set of simpler effects
             (:class:`SetComparison`); named_together: the set named at the first step instead
             of one many-parameter effect (empty: none), the verdict's headline.
+        implausible_in_best: accepted effects left out at the end because their amplitude in
+            the final fit was implausible (``{name: what one would have to believe}``).
         doubt: the caller's doubt about the model family itself, said before the verdict.
         group_variance: with a noise level per group, the best model's (every chi2 is at it).
         family_verdict, family_results: the family's own entries of the verdict and result,
@@ -469,6 +471,7 @@ class Diagnosis:
     unneeded_given_structure: dict[str, float] = field(default_factory=dict)
     set_comparisons: list[SetComparison] = field(default_factory=list)
     named_together: list[str] = field(default_factory=list)
+    implausible_in_best: dict[str, str] = field(default_factory=dict)
     doubt: str | None = None
     group_variance: np.ndarray | None = field(default=None, repr=False)
     separation_commands: dict[str, Any] = field(default_factory=dict)
@@ -499,12 +502,20 @@ class Diagnosis:
         return len(self.steps) if self.named_together else 1
 
     @property
-    def implausible(self) -> list[Candidate]:
-        """Significant candidates not named because their fitted amplitude is implausible."""
+    def implausible(self) -> list[dict]:
+        """Significant candidates not named because their fitted amplitude is implausible (on
+        the base model, or in the final fit): ``{effect, delta_bic, belief}``."""
         named = {s.added for s in self.steps}
-        return [
-            c for c in self.candidates if c.significant and c.implausible and c.effect not in named
-        ]
+        out = {
+            c.effect: {"effect": c.effect, "delta_bic": c.delta_bic, "belief": c.implausible}
+            for c in self.candidates
+            if c.significant and c.implausible and c.effect not in named
+        }
+        scores = {c.effect: c.delta_bic for c in self.candidates}
+        for name, belief in self.implausible_in_best.items():
+            out.setdefault(name, {"effect": name, "delta_bic": scores.get(name),
+                                  "belief": belief})  # fmt: skip
+        return list(out.values())
 
     @property
     def alternatives(self) -> list[str]:
@@ -612,10 +623,7 @@ class Diagnosis:
                 for name, value in self.unneeded_given_structure.items()
             ],
             "simpler_sets": [comparison.to_dict() for comparison in self.set_comparisons],
-            "implausible": [
-                {"effect": c.effect, "delta_bic": c.delta_bic, "belief": c.implausible}
-                for c in self.implausible
-            ],
+            "implausible": [dict(entry) for entry in self.implausible],
         }
         if commands and not self.family_verdict:
             verdict["separation_commands"] = commands
@@ -814,11 +822,13 @@ def _simpler_set(family, current, current_fit, chosen: Candidate, round_candidat
     return comparison, members
 
 
-def _pruned(family, candidates, current, current_fit, known):
+def _pruned(family, candidates, current, current_fit, known, replaced=frozenset()):
     """The accepted effects an effect of which earns its place judged against the best
     description of the data -- the other accepted effects *and* the structure found -- not
     against a model whose chi2 the unexplained structure inflates (a 3/rev term makes any 1/rev
-    effect look good): ``(effects, fit, structure, probes, unneeded {name: BIC cost})``."""
+    effect look good): ``(effects, fit, structure, probes, unneeded {name: BIC cost})``. An
+    effect in ``replaced`` (a many-parameter effect a set of simpler ones beat) is not put back.
+    """
     structure, probes = _search(family, current_fit, known)
     unneeded: dict[str, float] = {}
     threshold = candidates[0].threshold
@@ -842,6 +852,7 @@ def _pruned(family, candidates, current, current_fit, known):
             if c.acceptable
             and c.determined
             and c.effect not in kept
+            and c.effect not in replaced
             and described is not None
             and _rss(c.fit.result) < described
         ]
@@ -851,6 +862,22 @@ def _pruned(family, candidates, current, current_fit, known):
             current_fit = family.fit(current)
             structure, probes = _search(family, current_fit, known)
     return current, current_fit, structure, probes, unneeded
+
+
+def _plausible(family, current, current_fit):
+    """The accepted effects without those whose amplitude in the final fit is implausible (one
+    plausible when it was added can grow once the effects beside it are set aside), refitted one
+    at a time, worst first: ``(effects, fit, {name: what one would have to believe})``."""
+    dropped: dict[str, str] = {}
+    while current:
+        judged = [(e, _implausibility(family, e, current_fit)) for e in current]
+        worst = next(((e, b) for e, b in judged if b), None)
+        if worst is None:
+            break
+        dropped[worst[0].name] = worst[1]
+        current = [e for e in current if e is not worst[0]]
+        current_fit = family.fit(current)
+    return current, current_fit, dropped
 
 
 def _separations(family, candidates, steps) -> dict[str, str]:
@@ -876,10 +903,14 @@ def _diagnose(family, *, until_explained: bool) -> Diagnosis:
         family, candidates, base_fit
     )
     known = 1.0 if current_fit.result.sigma_known else None
+    replaced = frozenset(c.effect for c in comparisons if c.chosen)
     current, current_fit, structure, _, unneeded = _pruned(
-        family, candidates, current, current_fit, known
+        family, candidates, current, current_fit, known, replaced
     )
-    if unneeded:
+    current, current_fit, dropped = _plausible(family, current, current_fit)
+    if dropped:
+        structure, _ = _search(family, current_fit, known)
+    if unneeded or dropped:
         steps = _steps_of(family, current, base_fit)
     best = current_fit.result
     noise_variance = _noise_variance(best)
@@ -901,6 +932,7 @@ def _diagnose(family, *, until_explained: bool) -> Diagnosis:
         unneeded_given_structure=unneeded,
         set_comparisons=comparisons,
         named_together=together,
+        implausible_in_best=dropped,
         group_variance=group_variance,
     )
 

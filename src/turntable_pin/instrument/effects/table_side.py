@@ -71,7 +71,7 @@ class TableError(RunEffect):
             "error compensated in the positions (eq. 3 computed from the measured attitude)."
         )
         self.plausibility = (  # docs/plausibility.md
-            plausible(("value",), f"a table built with a {what} of {{amplitude}}", turntable=600),
+            plausible(("value",), f"a table whose {what} is {{amplitude}}", turntable=600),
         )
 
     def parameters(self, run) -> tuple[ParameterSpec, ...]:
