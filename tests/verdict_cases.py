@@ -73,7 +73,8 @@ class Case:
     """One simulated design of the rates.
 
     Attributes:
-        name: short label (``R1``..``R6`` runs, ``O1``..``O6`` orientation sets).
+        name: short label (``R1``..``R6`` runs, ``O1``..``O6`` orientation sets, ``I1``, ``I2``
+            implausible amplitudes).
         diagnosis: ``run`` (calibration run) or ``orientation``.
         kind: :data:`SIMPLE`, :data:`MANY`, :data:`CLEAN` or :data:`IMPLAUSIBLE`.
         title: what is planted, with its amplitudes.
@@ -154,6 +155,12 @@ CASES: tuple[Case, ...] = (
          ("table:deps_y", "table:dalpha_x1", "instrument_heading"),
          table_errors_arcsec={"deps_y": 55.0, "dalpha_x1": 50.0},
          instrument={"instrument_heading": {"mz": 45.0}}),
+    Case("R1b", "run", SIMPLE,
+         "R1's singles with the heading at the top of the issue's range: deps_y 45\", "
+         "dalpha_x1 50\", heading mz 60\"",
+         ("table:deps_y", "table:dalpha_x1", "instrument_heading"),
+         table_errors_arcsec={"deps_y": 45.0, "dalpha_x1": 50.0},
+         instrument={"instrument_heading": {"mz": 60.0}}),
     Case("R2", "run", SIMPLE, "two table singles: deps_x 70\", dalpha_z1 60\"",
          ("table:deps_x", "table:dalpha_z1"),
          table_errors_arcsec={"deps_x": 70.0, "dalpha_z1": 60.0}),
