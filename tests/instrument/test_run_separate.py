@@ -111,3 +111,20 @@ def test_the_diagnosis_prints_the_design_command_for_a_rival():
     assert "turntable-pin design --separate table:deps_x," in proc.stdout or (
         "turntable-pin design --separate table:dalpha_x1," in proc.stdout
     )
+
+
+def test_an_effect_fitted_at_an_implausible_amplitude_is_flagged_not_planned():
+    """Issue 29: a run made by a half-degree wobble fits it beyond any turntable bearing's; the
+    design says what one would have to believe instead of choosing positions."""
+    grid = np.array([[a, b] for a in range(0, 360, 30) for b in range(0, 360, 30)], float)
+    positions = PositionSet(np.radians(grid))
+    sim = simulate_calibration_run(positions, LATITUDE_RAD, noise_dph=NOISE, seed=4,
+                   table_effects={"inner_wobble_harmonics": {"x_c1": 1800.0}})  # fmt: skip
+    run = CalibrationRun(position_inputs(positions, LATITUDE_RAD), sim.outputs_dph,
+                         np.full(len(positions), NOISE))  # fmt: skip
+    result = design_run_separation(run, ("table:inner_wobble_harmonics", "instrument_tilt"),
+                                   _candidates(), 4)  # fmt: skip
+    assert list(result.implausible) == ["table:inner_wobble_harmonics"]
+    assert not result.separable and result.positions_deg.shape == (0, 2)
+    assert "axis wobbles by 30" in result.words and result.words.startswith("not planned")
+    assert result.to_dict()["implausible"] == result.implausible

@@ -123,3 +123,14 @@ def test_report_opens_in_the_browser_and_every_image_loads(tmp_path):
     page = path.read_text()
     assert report.n_images == len(re.findall(r"<img ", page)) == len(set(_images(page)))
     assert report.all_loaded, report.failed
+
+
+def test_the_page_marks_an_implausible_candidate_and_says_what_one_would_have_to_believe():
+    """Issue 29: the candidate table and the verdict of the page come from the same result: a
+    half-degree inner encoder eccentricity is marked and left out with its belief."""
+    sim = simulate_measurements(effects={"inner_encoder_harmonics": {"c1": 1800.0}}, seed=3)
+    diagnosis = diagnose_measurements(sim.data)
+    page = diagnosis_html(diagnosis, title="t")
+    assert "inner_encoder_harmonics (implausible)" in page
+    assert "not named: inner_encoder_harmonics" in page and "reads 30 arcmin wrong" in page
+    assert diagnosis.missing_effect != "inner_encoder_harmonics"

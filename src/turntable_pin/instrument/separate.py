@@ -12,7 +12,7 @@ tests. Effects needing ``time_s`` or another column are refused: positions do no
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -41,6 +41,9 @@ class RunSeparation:
         separable: whether some positions tell them apart; words: the conclusion.
         n_candidates, seed: the candidates chosen from and their seed.
         noise_dph: the output noise the misfits are in units of.
+        implausible: ``{effect: what one would have to believe}`` of each effect whose amplitude
+            fitted on the run is beyond the physical scale of its kind (``docs/plausibility.md``):
+            no positions are planned then.
     """
 
     effects: tuple[str, str]
@@ -53,6 +56,7 @@ class RunSeparation:
     n_candidates: int
     seed: int
     noise_dph: float
+    implausible: dict[str, str] = field(default_factory=dict)
 
     def columns(self) -> dict[str, np.ndarray]:
         """The positions as run columns ``phiK_deg`` (what a simulated run's positions read)."""
@@ -68,6 +72,7 @@ class RunSeparation:
             "misfit_design": list(self.misfit_design),
             "separation_chi2": SEPARATION_CHI2,
             "noise_dph": self.noise_dph,
+            "implausible": dict(self.implausible),
             "n_candidates": self.n_candidates,
             "seed": self.seed,
             "positions": [dict(zip(self.columns(), map(float, row), strict=True))
@@ -131,6 +136,21 @@ def design_run_separation(
         q = fitted.shape[-1]
         return Direction(fitted, signal, fixed.reshape(-1, q), fixed_signal.reshape(-1))
 
+    implausible = {
+        e.name: belief
+        for e in (a, b)
+        if (belief := family.implausibility(e, family.fit([e]))) is not None
+    }
+    if implausible:
+        none = np.zeros((0, candidates_rad.shape[1]))
+        words = "; ".join(
+            f"not planned: {name}'s amplitude fitted on the run is implausible; to accept it one "
+            f"would have to believe in {belief}"
+            for name, belief in implausible.items()
+        )
+        return RunSeparation((a.name, b.name), tuple(run.table.joint_names), none, (0.0, 0.0),
+                             (0.0, 0.0), False, words, len(positions), int(seed), sigma,
+                             implausible)  # fmt: skip
     directions = [direction(a, b), direction(b, a)]
     before = tuple(float(d.misfit(np.zeros(0, int))) for d in directions)
     exchange = t_optimal_exchange(directions, n, seed=seed)

@@ -748,7 +748,8 @@ def _simpler_set(family, current, current_fit, chosen: Candidate, round_candidat
     parameter or no two simpler candidates exist.
 
     Bounded beam search: the :data:`SET_POOL_SIZE` testable, plausible candidates of the round
-    with a smaller added rank than ``chosen``'s (best delta_bic first) are the pool; sets grow
+    with a smaller added rank than ``chosen``'s (best delta_bic first, one of each confounded
+    group: the same delta_bic and rank) are the pool; sets grow
     from its :data:`SET_BEAM_WIDTH` best singles one effect at a time up to :data:`SET_MAX_SIZE`,
     keeping the ``SET_BEAM_WIDTH`` best (lowest BIC) at each size, each set's added rank at most
     ``chosen``'s and every member adding rank of its own (confounded effects stay one group: a
@@ -761,12 +762,17 @@ def _simpler_set(family, current, current_fit, chosen: Candidate, round_candidat
     limit = chosen.added_rank
     if limit < 2:
         return None
-    pool = [
-        c
-        for c in round_candidates
-        if c.testable and c.effect != chosen.effect and c.implausible is None
-        and c.delta_bic is not None and c.added_rank < limit
-    ][:SET_POOL_SIZE]  # fmt: skip
+    simpler = sorted(
+        (c for c in round_candidates
+         if c.testable and c.effect != chosen.effect and c.implausible is None
+         and c.delta_bic is not None and c.added_rank < limit),
+        key=lambda c: c.delta_bic,
+    )  # fmt: skip
+    pool: list[Candidate] = []
+    for c in simpler:  # one of each confounded group (the same score and rank)
+        if not any(_same_score(c, p) for p in pool):
+            pool.append(c)
+    pool = pool[:SET_POOL_SIZE]
     if len(pool) < 2:
         return None
     order = {e.name: i for i, e in enumerate(family.catalogue)}
@@ -862,6 +868,14 @@ def _pruned(family, candidates, current, current_fit, known, replaced=frozenset(
             current_fit = family.fit(current)
             structure, probes = _search(family, current_fit, known)
     return current, current_fit, structure, probes, unneeded
+
+
+def _same_score(a: Candidate, b: Candidate) -> bool:
+    """Whether two candidates add the same rank with the same delta_bic (to rounding,
+    :data:`SET_TIE`): confounded on these data."""
+    return a.added_rank == b.added_rank and abs(a.delta_bic - b.delta_bic) <= SET_TIE * max(
+        1.0, abs(a.delta_bic)
+    )
 
 
 def _plausible(family, current, current_fit):
