@@ -12,7 +12,13 @@ position (``models/examples/runs/make_runs.sh``); an orientation set is the pape
 the errors of ``models/examples/errors_example.yaml``, the default 30-degree grid (144 positions,
 60 s apart, each axis approached from a random side) and 1 arcsec noise
 (``measurements_example.csv``). Amplitudes are the issue's (runs) or a few times the noise
-(orientation sets), each named in the case's title.
+(orientation sets), each named in the case's title. The issue's "orthogonality, intersection and
+heading error" of R1 are ``deps_y``, ``dalpha_x1`` and the GyroWheel's heading ``mz``: the
+paper's intersection error ``deta`` is a length that turns nothing a gyro senses, and the three
+chosen lie in three different confounded groups (``deps_y``/``dphi_y1``,
+``dalpha_x1``/``deps_x``, ``instrument_heading``/``dalpha_z1``/``dphi_z2``), so three causes
+can be told apart at all. R1 puts the heading at 45", where on top of the other two it is at the
+run's detection limit; R1b puts it at 60".
 
 Scoring (:func:`score`): a named effect stands for its *group*, itself and the effects the verdict
 lists as explaining the data equally well (the first effect's ``alternatives``; for a later step
