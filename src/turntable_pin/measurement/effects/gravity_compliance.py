@@ -59,7 +59,7 @@ class GravityCompliance(Effect):
         )
         self.plausibility = (  # docs/plausibility.md
             plausible(tuple(self.tied), "a payload and its frames bending by {amplitude} under "
-                      "their own weight", "arcsec/g", turntable=300, mount=600),
+                      "their own weight", "arcsec/g", turntable=300, mount=3600),
         )  # fmt: skip
         if [p for p, _ in self.labels] != list(self.tied):
             raise ValueError(f"labels {self.labels} do not name the parameters {list(self.tied)}")

@@ -63,7 +63,7 @@ class PointingFlexure(Effect):
         self.explanation = term.explanation
         self.confirm = term.confirm
         self.plausibility = (  # docs/plausibility.md
-            plausible((term.name,), f"a {term.title} of {{amplitude}}", mount=600),
+            plausible((term.name,), f"a {term.title} of {{amplitude}}", mount=3600),
         )
 
     def parameters(self, variables: PositionVariables):
