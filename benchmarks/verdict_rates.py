@@ -61,15 +61,20 @@ def _cases(text: str | None):
     return [CASES_BY_NAME[n] for n in names]
 
 
-def _commit() -> str | None:
+def _engine_source() -> dict:
+    """Where the measured ``turntable_pin`` was imported from, and that checkout's commit."""
+    import turntable_pin
+
+    folder = Path(turntable_pin.__file__).resolve().parent
     try:
         out = subprocess.run(  # noqa: S603 - git, fixed arguments
             ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True,
-            cwd=Path(__file__).resolve().parent,
+            cwd=folder,
         )  # fmt: skip
+        commit = out.stdout.strip()
     except (OSError, subprocess.CalledProcessError):
-        return None
-    return out.stdout.strip()
+        commit = None
+    return {"package": str(folder), "commit": commit}
 
 
 def measure_case(case, seeds: list[int]) -> dict:
@@ -164,7 +169,7 @@ def main() -> None:
     print(f"total wall time {total / 60:.2f} min (one process, one BLAS thread)")
     if args.json:
         out = {
-            "commit": _commit(),
+            "engine": _engine_source(),
             "first_seed": args.seed,
             "seeds": args.seeds,
             "clean_seeds": args.clean_seeds,
