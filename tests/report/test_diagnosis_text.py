@@ -118,6 +118,25 @@ def test_a_separation_prints_the_design_command_that_settles_it():
     assert lines[: at + 1] + lines[at + 2 :] == plain  # nothing else changes
 
 
+def test_a_set_taken_instead_says_what_later_steps_made_of_it():
+    """The GEM run's case: a set taken at step 2 whose member the final model does not need, and
+    the many-parameter effect added after all; the line says so rather than 'the set is named'."""
+    d = _dict(steps=("TF", "DAF", "gravity_sag"))
+    d["verdict"]["simpler_sets"] = [
+        {"step": 2, "effect": "gravity_sag", "added_rank": 4, "delta_bic": -155.6,
+         "simpler_set": ["DAF", "FO"], "set_added_rank": 2, "set_delta_bic": -316.5,
+         "set_named": True},
+    ]  # fmt: skip
+    named = [*d["verdict"]["missing_effects"], *d["verdict"]["also_significant"]]
+    assert {"TF", "DAF", "gravity_sag"} <= set(named) and "FO" not in named
+    assert (
+        "parsimony at step 2: the simpler set DAF + FO (2 parameters, delta_bic -316.5) has a "
+        "lower BIC than gravity_sag (4 parameters, delta_bic -155.6), so the set is taken instead; "
+        "afterwards FO left out at the end (not needed by the final model); gravity_sag still "
+        "added at a later step"
+    ) in verdict_lines(d)
+
+
 def test_the_simpler_set_compared_and_the_implausible_effects_are_said():
     """Issue 29: each many-parameter effect compared with a set of simpler ones (named or not),
     and each significant effect left out for an implausible amplitude, with the belief."""
@@ -139,7 +158,7 @@ def test_the_simpler_set_compared_and_the_implausible_effects_are_said():
     assert (
         "parsimony at step 1: the simpler set table:deps_y + instrument_heading (2 parameters, "
         "delta_bic -2468.5) has a lower BIC than table:inner_wobble_harmonics (8 parameters, "
-        "delta_bic -2443.8), so the set is named"
+        "delta_bic -2443.8), so the set is taken instead"
     ) in lines
     assert (
         "parsimony at step 2: bias_drift (2 parameters, delta_bic -30.0) is kept; the best "

@@ -316,7 +316,10 @@ def _set_lines(verdict: dict) -> list[str]:
         if entry["set_named"]:
             lines.append(
                 f"parsimony at step {entry['step']}: the simpler set {names} {numbers} has a "
-                f"lower BIC than {effect}, so the set is named"
+                f"lower BIC than {effect}, so the set is taken instead"
+                + _set_afterwards(
+                    entry, [*verdict["missing_effects"], *verdict["also_significant"]]
+                )
             )
         else:
             lines.append(
@@ -324,6 +327,19 @@ def _set_lines(verdict: dict) -> list[str]:
                 f"{names} {numbers}, " + _set_fared(entry["set_delta_bic"], entry["delta_bic"])
             )
     return lines
+
+
+def _set_afterwards(entry: dict, named: list[str]) -> str:
+    """What later steps made of a set taken instead of a many-parameter effect: a member the
+    final model does not need, or the effect added after all (the verdict names the final model,
+    so its parsimony line must not claim more)."""
+    dropped = [m for m in entry["simpler_set"] if m not in named]
+    words = []
+    if dropped:
+        words.append(f"{' and '.join(dropped)} left out at the end (not needed by the final model)")
+    if entry["effect"] in named:
+        words.append(f"{entry['effect']} still added at a later step")
+    return f"; afterwards {'; '.join(words)}" if words else ""
 
 
 def _set_fared(set_delta_bic: float, delta_bic: float) -> str:
