@@ -11,6 +11,14 @@ temporary folder holding a link ``models`` to the repository's ``models/``: the 
 types them in the checkout, and outputs under ``out/`` of that folder. They must exit with status
 0.
 
+The samples are produced in one arithmetic, :func:`canonical_environment`: OpenBLAS's Haswell
+kernels on one thread and NumPy without its AVX-512 loops, set for a child process when the
+caller's is not already in it. Some outputs (the exchange designs, a maximum reached at two
+symmetric angles, the order of candidates tied in BIC) turn on the last bits of a sum, which
+differ between the kernels OpenBLAS and NumPy pick for each CPU (an AMD Zen machine and an
+AVX-512 one print different `design --calibrate` positions); any x86-64 CPU with AVX2 runs
+these exact kernels.
+
 The comparison is exact line by line after one normalisation, :data:`RUN_DEPENDENT`: trailing
 blanks are dropped, and an elapsed time ``<number> s`` ending a line after ", ", "in " or "took "
 (the one number of an output that changes from run to run) reads as ``<elapsed> s``.
@@ -26,8 +34,11 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import pickle
+import platform
 import re
 import shlex
+import subprocess
 import sys
 import tempfile
 from dataclasses import dataclass
@@ -160,9 +171,42 @@ class Outcome:
         return self.code != 0 or shown != [normalise(line) for line in self.expected]
 
 
+CANONICAL = "TURNTABLE_PIN_SAMPLES_ARITHMETIC"
+"""Set in the child process :func:`run_all` starts in :func:`canonical_environment`."""
+
+
+def canonical_environment() -> dict[str, str]:
+    """The environment variables of the samples' one arithmetic (module docstring); only the
+    marker off x86-64, where OpenBLAS's and NumPy's kernels are the same everywhere."""
+    env = {CANONICAL: "1", "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    if platform.machine().lower() in ("x86_64", "amd64"):
+        from numpy._core import _multiarray_umath as umath
+
+        wide = [f for f in umath.__cpu_dispatch__ if f.startswith("AVX512") or f == "X86_V4"]
+        env.update(OPENBLAS_CORETYPE="Haswell", NPY_DISABLE_CPU_FEATURES=" ".join(wide))
+    return env
+
+
+def _run_in_child() -> list[Outcome]:
+    """:func:`run_all` in a child process in :func:`canonical_environment`."""
+    with tempfile.TemporaryDirectory(prefix="turntable-pin-samples-") as folder:
+        result = Path(folder) / "outcomes.pickle"
+        subprocess.run(
+            [sys.executable, str(Path(__file__).resolve()), "--pickle", str(result)],
+            env={**os.environ, **canonical_environment()},
+            check=True,
+        )
+        return pickle.loads(result.read_bytes())
+
+
 def run_all(samples: list[Sample] | None = None) -> list[Outcome]:
     """Run every sample, in order, in one temporary folder (a later command may read an earlier
-    one's output under ``out/``)."""
+    one's output under ``out/``), in the samples' arithmetic (a child process unless this one
+    is in it)."""
+    if os.environ.get(CANONICAL) != "1":
+        outcomes = _run_in_child()
+        wanted = None if samples is None else {(s.path, s.line) for s in samples}
+        return [o for o in outcomes if wanted is None or (o.sample.path, o.sample.line) in wanted]
     samples = all_samples() if samples is None else samples
     outcomes = []
     with sample_folder():
@@ -192,6 +236,9 @@ def write(outcomes: list[Outcome]) -> int:
 
 def main(argv: list[str]) -> int:
     outcomes = run_all()
+    if "--pickle" in argv:  # the child of run_all
+        Path(argv[argv.index("--pickle") + 1]).write_bytes(pickle.dumps(outcomes))
+        return 0
     if "--write" in argv:
         print(f"{write(outcomes)} of {len(outcomes)} samples rewritten")
         return 0
