@@ -230,19 +230,9 @@ def simulate(
     (144, 1)
     """
     from .measurement.simulation import Schedule, simulate_measurements
-    from .model.errors import MAX_ORIENTATION_ERROR_DEG
 
     table = load_table(table)
-    if errors is None:
-        vector = table.values()
-    elif isinstance(errors, Mapping):
-        vector = table.errors_from_user_units(errors, max_angle_deg=MAX_ORIENTATION_ERROR_DEG)
-    elif isinstance(errors, (str, Path)):
-        vector = table.errors_from_yaml(
-            bundled_path(errors), max_angle_deg=MAX_ORIENTATION_ERROR_DEG
-        )
-    else:
-        vector = np.asarray(errors, dtype=float)
+    vector = _error_vector(table, errors)
     if schedule is None:
         design = {"random_positions": random_positions} if random_positions else {}
         schedule = Schedule(step_deg, step_deg, step_deg, **design)
@@ -256,6 +246,20 @@ def simulate(
         catalogue=tuple(catalogue),
         not_measured=tuple(not_measured),
     )
+
+
+def _error_vector(table, errors) -> np.ndarray:
+    """The table's error vector (rad, m) of :func:`simulate`'s ``errors``: None (its URDF's),
+    ``{name: value}`` in user units, a YAML file, or the vector itself."""
+    from .model.errors import MAX_ORIENTATION_ERROR_DEG
+
+    if errors is None:
+        return table.values()
+    if isinstance(errors, Mapping):
+        return table.errors_from_user_units(errors, max_angle_deg=MAX_ORIENTATION_ERROR_DEG)
+    if isinstance(errors, (str, Path)):
+        return table.errors_from_yaml(bundled_path(errors), max_angle_deg=MAX_ORIENTATION_ERROR_DEG)
+    return np.asarray(errors, dtype=float)
 
 
 def _effects(effects, table, extra: Sequence = ()) -> tuple:
@@ -381,6 +385,55 @@ def diagnose(
 
 
 # ---- designs --------------------------------------------------------------------------------
+def _design_effects(table, effects, separate, calibrate, from_data, noise_arcsec) -> tuple:
+    """The effects a :func:`design` mode plans for (the two of ``separate``, none to
+    ``calibrate``, else ``effects``), refusing arguments of another mode."""
+    modes = [
+        m for m, given in (("separate", separate is not None), ("calibrate", calibrate)) if given
+    ]
+    if len(modes) > 1:
+        raise InputError("design: give separate or calibrate, not both")
+    if separate is not None:
+        pair = separate.split(",") if isinstance(separate, str) else list(separate)
+        if len(pair) != 2:
+            raise InputError(f"separate takes two effects, got {pair}")
+        if effects:
+            raise InputError(
+                "separate names the two effects to tell apart; effects is for identify"
+            )
+        return _effects([p.strip() for p in pair], table)
+    if calibrate:
+        if effects or from_data is not None or noise_arcsec is not None:
+            raise InputError(
+                "design(calibrate=True) needs the table, its limits and n_positions only "
+                "(effects, from_data and noise_arcsec are for identify and separate)"
+            )
+        return ()
+    return _effects(effects, table)
+
+
+def _space_and_count(table, chosen, limits_deg, candidates, seed, n_positions):
+    """:func:`design`'s candidate space and its checked number of positions (the defaults of
+    ``design.space`` where None)."""
+    from .core.sizes import check_positions_count
+    from .design.space import DEFAULT_CANDIDATES, DEFAULT_POSITIONS, design_space
+
+    space = design_space(
+        table,
+        chosen,
+        limits_deg=limits_deg,
+        candidates=DEFAULT_CANDIDATES if candidates is None else candidates,
+        seed=seed,
+    )
+    count = check_positions_count(
+        DEFAULT_POSITIONS if n_positions is None else n_positions,
+        space.candidates_deg.shape[0],
+        "n_positions",
+        "more candidates",
+    )
+    return space, count
+
+
 def design(
     table=None,
     n_positions: int | None = None,
@@ -398,8 +451,7 @@ def design(
     seed: int = 0,
 ):
     """Which positions to measure next (``turntable-pin design``): to identify the base errors
-    and ``effects`` (D-optimal), to tell two effects apart (``separate``) or to calibrate the
-    GyroWheel (``calibrate``).
+    and ``effects`` (D-optimal), to tell two apart (``separate``) or to ``calibrate``.
 
     Parameters
     ----------
@@ -410,13 +462,11 @@ def design(
     effects : str or sequence, optional
         Effects to identify besides the base errors (as in :func:`fit`).
     from_data : path, DataFrame or measurements, optional
-        Measurements already made: the design adds to them (and their noise and amplitudes are
-        fitted on them).
+        Measurements already made: the design adds to them (their noise and amplitudes fitted).
     separate : (str, str) or "A,B", optional
         Two effects to tell apart (T-optimal positions).
     amplitudes : dict, optional
-        With ``separate``: each effect's parameters in user units (default: fitted on
-        ``from_data``).
+        With ``separate``: each effect's parameters, user units (default: fitted on from_data).
     calibrate : bool, default False
         GyroWheel calibration positions least sensitive to the table's errors.
     accuracy_dph : float, default 0.01
@@ -435,8 +485,7 @@ def design(
     Returns
     -------
     IdentifyDesign, SeparationDesign or CalibrationDesign
-        ``.plan`` (the positions; ``.plan.write_csv(path)`` is what ``simulate --positions``
-        reads), ``.report()`` (text).
+        ``.plan`` (the positions; ``.plan.write_csv(path)``), ``.report()`` (text).
 
     Examples
     --------
@@ -445,61 +494,26 @@ def design(
     >>> plan.n_positions
     12
     """
-    from .core.sizes import check_positions_count
-    from .design.space import DEFAULT_CANDIDATES, DEFAULT_POSITIONS, design_space
-
     table = load_table(table)
-    modes = [
-        m for m, given in (("separate", separate is not None), ("calibrate", calibrate)) if given
-    ]
-    if len(modes) > 1:
-        raise InputError("design: give separate or calibrate, not both")
-    if separate is not None:
-        pair = separate.split(",") if isinstance(separate, str) else list(separate)
-        if len(pair) != 2:
-            raise InputError(f"separate takes two effects, got {pair}")
-        if effects:
-            raise InputError(
-                "separate names the two effects to tell apart; effects is for identify"
-            )
-        chosen = _effects([p.strip() for p in pair], table)
-    elif calibrate:
-        if effects or from_data is not None or noise_arcsec is not None:
-            raise InputError(
-                "design(calibrate=True) needs the table, its limits and n_positions only "
-                "(effects, from_data and noise_arcsec are for identify and separate)"
-            )
-        chosen = ()
-    else:
-        chosen = _effects(effects, table)
-    space = design_space(
-        table,
-        chosen,
-        limits_deg=limits_deg,
-        candidates=DEFAULT_CANDIDATES if candidates is None else candidates,
-        seed=seed,
-    )
-    count = check_positions_count(
-        DEFAULT_POSITIONS if n_positions is None else n_positions,
-        space.candidates_deg.shape[0],
-        "n_positions",
-        "more candidates",
-    )
-    data = None if from_data is None else read_measurements(from_data, table)
+    chosen = _design_effects(table, effects, separate, calibrate, from_data, noise_arcsec)
+    space, count = _space_and_count(table, chosen, limits_deg, candidates, seed, n_positions)
     if calibrate:
         from .design.calibrate import design_calibration
 
         return design_calibration(space, count, accuracy_dph=accuracy_dph)
-    if separate is not None:
-        from .design.separate import design_separate
+    data = None if from_data is None else read_measurements(from_data, table)
+    if separate is None:
+        from .design.identify import design_identify
 
-        return design_separate(
-            space, count, from_data=data, amplitudes=dict(amplitudes or {}),
-            noise_arcsec=noise_arcsec, dwell_s=dwell_s,
-        )  # fmt: skip
-    from .design.identify import design_identify
+        return design_identify(
+            space, count, from_data=data, noise_arcsec=noise_arcsec, dwell_s=dwell_s
+        )
+    from .design.separate import design_separate
 
-    return design_identify(space, count, from_data=data, noise_arcsec=noise_arcsec, dwell_s=dwell_s)
+    return design_separate(
+        space, count, from_data=data, amplitudes=dict(amplitudes or {}),
+        noise_arcsec=noise_arcsec, dwell_s=dwell_s,
+    )  # fmt: skip
 
 
 # ---- allocation and calibration -------------------------------------------------------------

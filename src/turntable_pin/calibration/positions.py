@@ -405,27 +405,33 @@ def angle_columns(
             f"{argument('urdf')}?",
             path=path, row=header_row, column=beyond[0],
         )  # fmt: skip
-    out = []
     known = [f"phi{k}_deg" for k in range(1, len(names) + 1)] + [f"{j}_deg" for j in names if j]
-    for k, joint in enumerate(names, start=1):
-        found = [c for c in (f"phi{k}_deg", f"{joint}_deg" if joint else None) if c in header]
-        if not found:
-            spelled = f"'phi{k}_deg'" + (f" or '{joint}_deg'" if joint else "")
-            hint = closest_column_hint(f"phi{k}_deg", header, known) or (
-                closest_column_hint(f"{joint}_deg", header, known) if joint else ""
-            )
-            raise InputError(
-                f"missing required column {spelled} (the commanded angle of joint {k}"
-                f"{' ' + joint if joint else ''}){hint}; the header has {', '.join(header)}",
-                path=path, row=header_row,
-            )  # fmt: skip
-        if len(found) > 1:
-            raise InputError(
-                f"joint {k} has two angle columns, {found[0]} and {found[1]}; keep one",
-                path=path, row=header_row,
-            )  # fmt: skip
-        out.append(found[0])
-    return tuple(out)
+    return tuple(
+        _angle_column(k, joint, header, known, path, header_row)
+        for k, joint in enumerate(names, start=1)
+    )
+
+
+def _angle_column(k: int, joint: str, header, known: list[str], path, header_row: int) -> str:
+    """The angle column of joint ``k`` (``joint``: its name, or empty on the paper's table) in
+    ``header`` (:func:`angle_columns`)."""
+    found = [c for c in (f"phi{k}_deg", f"{joint}_deg" if joint else None) if c in header]
+    if not found:
+        spelled = f"'phi{k}_deg'" + (f" or '{joint}_deg'" if joint else "")
+        hint = closest_column_hint(f"phi{k}_deg", header, known) or (
+            closest_column_hint(f"{joint}_deg", header, known) if joint else ""
+        )
+        raise InputError(
+            f"missing required column {spelled} (the commanded angle of joint {k}"
+            f"{' ' + joint if joint else ''}){hint}; the header has {', '.join(header)}",
+            path=path, row=header_row,
+        )  # fmt: skip
+    if len(found) > 1:
+        raise InputError(
+            f"joint {k} has two angle columns, {found[0]} and {found[1]}; keep one",
+            path=path, row=header_row,
+        )  # fmt: skip
+    return found[0]
 
 
 def _numbered_joint(column: str) -> int | None:

@@ -257,19 +257,8 @@ def _check_required(
     missing = [name for name in required if name not in header]
     if not missing:
         return
-    hints, proposed = [], set()
-    for name in missing:
-        unknown = [h for h in header if h not in known and h not in proposed]
-        close = [h for h in unknown if h.lower().replace(" ", "") == name.lower()]
-        close += [h for h in unknown if h not in close and name.split("_")[0] == h.split("_")[0]]
-        if close:
-            hints.append(f"'{name}' (found {', '.join(repr(c) for c in close)})")
-            proposed.update(close)
-            continue
-        hint = closest_column_hint(name, header, (*known, *proposed))
-        hints.append(f"'{name}'{hint}")
-        if hint:
-            proposed.add(hint.split("'")[1])
+    proposed: set[str] = set()
+    hints = [_missing_hint(name, header, known, proposed) for name in missing]
     empty = [name for name in missing if name in blank]
     advice = ""
     if empty:
@@ -285,6 +274,21 @@ def _check_required(
         path=path,
         row=header_line,
     )
+
+
+def _missing_hint(name: str, header, known, proposed: set[str]) -> str:
+    """A missing column ``name`` with the header column(s) it may be, none already ``proposed``
+    for another (``proposed`` grows by what this one proposes)."""
+    unknown = [h for h in header if h not in known and h not in proposed]
+    close = [h for h in unknown if h.lower().replace(" ", "") == name.lower()]
+    close += [h for h in unknown if h not in close and name.split("_")[0] == h.split("_")[0]]
+    if close:
+        proposed.update(close)
+        return f"'{name}' (found {', '.join(repr(c) for c in close)})"
+    hint = closest_column_hint(name, header, (*known, *proposed))
+    if hint:
+        proposed.add(hint.split("'")[1])
+    return f"'{name}'{hint}"
 
 
 def _or(names: Sequence[str]) -> str:

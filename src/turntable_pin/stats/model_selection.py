@@ -635,26 +635,36 @@ class Diagnosis(NotebookResult):
         }
         if commands and not self.family_verdict:
             verdict["separation_commands"] = commands
-        named_parameters = self.named_parameters()
-        verdict["named_parameters"] = named_parameters
-        loose = {name: undetermined_parameters(e) for name, e in named_parameters.items() if e}
-        verdict["named_undetermined"] = {name: names for name, names in loose.items() if names}
-        verdict["not_named_undetermined"] = [
-            {
-                "effect": c.effect,
-                "delta_bic": c.delta_bic,
-                "undetermined": c.undetermined_parameters,
-                "parameters": [dict(p) for p in c.parameters],
-            }
-            for c in self.candidates
-            if c.significant and not c.determined and c.effect not in named and not c.implausible
-        ]
+        verdict.update(self._parameter_entries(named))
         if self.missing_effect:
             verdict["effect_story"] = self.family.describe(self.missing_effect)
         verdict.update(copy.deepcopy(self.family_verdict))
         if commands and self.family_verdict:
             verdict["separation_commands"] = commands
         return verdict
+
+    def _parameter_entries(self, named: set[str]) -> dict:
+        """The verdict's ``named_parameters``, ``named_undetermined`` and the significant
+        candidates not named because undetermined (an implausible one is set aside as such)."""
+        named_parameters = self.named_parameters()
+        loose = {name: undetermined_parameters(e) for name, e in named_parameters.items() if e}
+        return {
+            "named_parameters": named_parameters,
+            "named_undetermined": {name: names for name, names in loose.items() if names},
+            "not_named_undetermined": [
+                {
+                    "effect": c.effect,
+                    "delta_bic": c.delta_bic,
+                    "undetermined": c.undetermined_parameters,
+                    "parameters": [dict(p) for p in c.parameters],
+                }
+                for c in self.candidates
+                if c.significant
+                and not c.determined
+                and c.effect not in named
+                and not c.implausible
+            ],
+        }
 
     def to_dict(self) -> dict:
         """The diagnosis JSON (plus steps, structure and per-effect explanations), the family's
@@ -750,6 +760,73 @@ def _forward(family, candidates, base_fit):
     return steps, current, current_fit, after_first, comparisons, together
 
 
+def _set_pool(chosen: Candidate, round_candidates) -> list[Candidate]:
+    """The pool of :func:`_simpler_set`: the round's testable, plausible candidates with a smaller
+    added rank than ``chosen``'s, best delta_bic first, one of each confounded group (the same
+    score and rank), at most :data:`SET_POOL_SIZE`."""
+    simpler = sorted(
+        (c for c in round_candidates
+         if c.testable and c.effect != chosen.effect and c.implausible is None
+         and c.delta_bic is not None and c.added_rank < chosen.added_rank),
+        key=lambda c: c.delta_bic,
+    )  # fmt: skip
+    pool: list[Candidate] = []
+    for c in simpler:
+        if not any(_same_score(c, p) for p in pool):
+            pool.append(c)
+    return pool[:SET_POOL_SIZE]
+
+
+class _SetScores:
+    """The delta_bic of each set of pool effects fitted on top of ``current`` against
+    ``current_fit`` (inf: not fitted, or a member adding no rank of its own), cached with its
+    fit in ``scored``."""
+
+    def __init__(self, family, current, current_fit, pool: Sequence[Candidate]) -> None:
+        self.family, self.current, self.base = family, current, current_fit.result
+        self.order = {e.name: i for i, e in enumerate(family.catalogue)}
+        self.rank = {c.effect: c.added_rank for c in pool}
+        self.scored: dict[frozenset, tuple[float, Any]] = {}
+
+    def rank_of(self, members: frozenset) -> int:
+        return sum(self.rank[n] for n in members)
+
+    def order_of(self, members: frozenset) -> list[int]:
+        """The members' places in the catalogue (the tie-break)."""
+        return sorted(self.order[n] for n in members)
+
+    def __call__(self, members: frozenset) -> float:
+        if members not in self.scored:
+            names = sorted(members, key=self.order.__getitem__)
+            try:
+                fit = self.family.fit([*self.current, *(_effect(self.family, n) for n in names)])
+            except (IdentifiabilityError, InputError):
+                fit = None
+            if fit is None or fit.result.rank - self.base.rank != self.rank_of(members):
+                self.scored[members] = (math.inf, None)
+            else:
+                self.scored[members] = (_delta_bic(fit.result, self.base), fit)
+        return self.scored[members][0]
+
+
+def _grow_beam(scores: _SetScores, pool: Sequence[Candidate], limit: int) -> None:
+    """Grow sets from the :data:`SET_BEAM_WIDTH` best singles one effect at a time up to
+    :data:`SET_MAX_SIZE`, keeping the best at each size, their added rank at most ``limit``
+    (every set tried is left in ``scores``)."""
+    beam = [frozenset([c.effect]) for c in pool[:SET_BEAM_WIDTH]]
+    for _ in range(SET_MAX_SIZE - 1):
+        grown = {
+            members | {c.effect}
+            for members in beam
+            for c in pool
+            if c.effect not in members and scores.rank_of(members) + c.added_rank <= limit
+        }
+        finite = [m for m in grown if math.isfinite(scores(m))]
+        if not finite:
+            return
+        beam = sorted(finite, key=lambda m: (scores(m), scores.order_of(m)))[:SET_BEAM_WIDTH]
+
+
 def _simpler_set(family, current, current_fit, chosen: Candidate, round_candidates):
     """The best set of simpler candidates against the many-parameter ``chosen`` (added rank at
     least 2): ``(SetComparison, its candidates best first)``, or None when ``chosen`` adds one
@@ -770,56 +847,16 @@ def _simpler_set(family, current, current_fit, chosen: Candidate, round_candidat
     limit = chosen.added_rank
     if limit < 2:
         return None
-    simpler = sorted(
-        (c for c in round_candidates
-         if c.testable and c.effect != chosen.effect and c.implausible is None
-         and c.delta_bic is not None and c.added_rank < limit),
-        key=lambda c: c.delta_bic,
-    )  # fmt: skip
-    pool: list[Candidate] = []
-    for c in simpler:  # one of each confounded group (the same score and rank)
-        if not any(_same_score(c, p) for p in pool):
-            pool.append(c)
-    pool = pool[:SET_POOL_SIZE]
+    pool = _set_pool(chosen, round_candidates)
     if len(pool) < 2:
         return None
-    order = {e.name: i for i, e in enumerate(family.catalogue)}
-    rank = {c.effect: c.added_rank for c in pool}
-    base = current_fit.result
-    scored: dict[frozenset, tuple[float, Any]] = {}
-
-    def score(members: frozenset) -> float:
-        if members not in scored:
-            names = sorted(members, key=order.__getitem__)
-            try:
-                fit = family.fit([*current, *(_effect(family, n) for n in names)])
-            except (IdentifiabilityError, InputError):
-                fit = None
-            added = fit.result.rank - base.rank if fit is not None else 0
-            if fit is None or added != sum(rank[n] for n in members):
-                scored[members] = (math.inf, None)
-            else:
-                scored[members] = (_delta_bic(fit.result, base), fit)
-        return scored[members][0]
-
-    beam = [frozenset([c.effect]) for c in pool[:SET_BEAM_WIDTH]]
-    for _ in range(SET_MAX_SIZE - 1):
-        grown = {
-            members | {c.effect}
-            for members in beam
-            for c in pool
-            if c.effect not in members and sum(rank[n] for n in members) + c.added_rank <= limit
-        }
-        finite = [m for m in grown if math.isfinite(score(m))]
-        if not finite:
-            break
-        beam = sorted(finite, key=lambda m: (score(m), sorted(order[n] for n in m)))
-        beam = beam[:SET_BEAM_WIDTH]
-    sets = [m for m in scored if math.isfinite(scored[m][0])]
+    scores = _SetScores(family, current, current_fit, pool)
+    _grow_beam(scores, pool, limit)
+    sets = [m for m in scores.scored if math.isfinite(scores(m))]
     if not sets:
         return None
-    best = min(sets, key=lambda m: (scored[m][0], len(m), sorted(order[n] for n in m)))
-    dbic, fit = scored[best]
+    best = min(sets, key=lambda m: (scores(m), len(m), scores.order_of(m)))
+    dbic, fit = scores.scored[best]
     members = sorted((c for c in pool if c.effect in best), key=lambda c: c.delta_bic)
     plausible = all(_implausibility(family, _effect(family, c.effect), fit) is None
                     for c in members)  # fmt: skip
