@@ -31,6 +31,9 @@ from .core.exceptions import InputError
 from .core.resources import bundled_path
 from .report import notebook as _views  # noqa: F401  (registers the results' notebook views)
 
+# Each function imports the layer it calls when called: deliberately lazy, so that one flat call
+# pays only for its own layer (tp.load_table never loads scipy.optimize or the design search).
+
 __all__ = [
     "allocate",
     "calibrate",
