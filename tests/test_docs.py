@@ -4,6 +4,7 @@ nothing documented writes into the checkout, and the README fits on a screen
 
 from __future__ import annotations
 
+import os
 import re
 import shlex
 import subprocess
@@ -57,6 +58,12 @@ def documented_runs():
     return outcomes, out.getvalue(), written, before, git_status()
 
 
+SAMPLES_EXIT_ONLY = "TURNTABLE_PIN_SAMPLES_EXIT_ONLY"
+"""Set by CI's run on the dependency floors: the samples are what the README's install (the
+newest releases) prints; older NumPy, SciPy and OpenBLAS builds differ in the last bits the
+exchange designs turn on, so there every sample must run (exit 0) but may print other digits."""
+
+
 @pytest.mark.slow
 def test_every_sample_output_is_what_its_command_prints(documented_runs):
     outcomes = documented_runs[0]
@@ -64,6 +71,8 @@ def test_every_sample_output_is_what_its_command_prints(documented_runs):
     for outcome in outcomes:
         sample = outcome.sample
         assert outcome.code == 0, (sample.where, sample.command, outcome.stderr)
+        if os.environ.get(SAMPLES_EXIT_ONLY) == "1":
+            continue
         assert not outcome.differs, (
             f"{sample.where}: the sample differs from what `{sample.command}` prints "
             "(regenerate: python tests/samples.py --write)",
