@@ -112,6 +112,14 @@ def run_cli(
     )  # fmt: skip
 
 
+def run_python(code: str) -> str:
+    """What ``python -c CODE`` prints in a child process on this checkout's ``src`` (it must
+    succeed): for what needs a fresh interpreter, such as the modules an import loads."""
+    return subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=cli_env(), check=True
+    ).stdout
+
+
 def cli(*args: str) -> subprocess.CompletedProcess:
     """Run ``turntable-pin ARGS`` in this process; same result object as :func:`run_cli`.
 

@@ -7,14 +7,12 @@ from __future__ import annotations
 
 import inspect
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import turntable_pin as tp
-from conftest import REPO_DIR, cli, cli_env
+from conftest import REPO_DIR, cli, run_python
 from turntable_pin.core.exceptions import InputError, TurntablePinError
 from turntable_pin.core.notebook import jsonable
 from turntable_pin.core.resources import BUNDLED_TABLES
@@ -66,9 +64,8 @@ def test_import_pays_for_no_heavy_library():
         "print(','.join(m for m in ('numpy', 'scipy', 'matplotlib', 'pinocchio') "
         "if m in sys.modules))"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         env=cli_env(), check=True)  # fmt: skip
-    assert out.stdout.strip() == ""
+    out = run_python(code)
+    assert out.strip() == ""
 
 
 def test_flat_names_replace_the_old_exports():
@@ -91,9 +88,8 @@ def test_design_is_callable_whether_or_not_the_subpackage_was_imported():
         "import turntable_pin.design.identify as identify\n"
         "print(tp.design('turntable', 8, candidates=200).n_positions, identify.__name__)"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         env=cli_env(), check=True)  # fmt: skip
-    assert out.stdout.split() == ["8", "turntable_pin.design.identify"]
+    out = run_python(code)
+    assert out.split() == ["8", "turntable_pin.design.identify"]
 
 
 def test_a_result_without_its_views_says_how_to_get_them():
@@ -105,9 +101,8 @@ def test_a_result_without_its_views_says_how_to_get_them():
         "print(len(fit.to_json()) > 0)\n"
         "try:\n    fit.plot()\nexcept Exception as exc:\n    print(type(exc).__name__, exc)\n"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         env=cli_env(), check=True)  # fmt: skip
-    lines = out.stdout.splitlines()
+    out = run_python(code)
+    lines = out.splitlines()
     assert lines[0] == "True"
     assert lines[1].startswith("TurntablePinError no view of a OrientationFit is registered")
     assert "import turntable_pin.report.notebook" in lines[1]

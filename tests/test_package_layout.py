@@ -5,13 +5,11 @@ from __future__ import annotations
 
 import ast
 import importlib
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-from conftest import cli_env
+from conftest import run_python
 
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "turntable_pin"
 
@@ -168,9 +166,8 @@ def _heavy_modules_loaded_by(argv: list[str], heavy: tuple[str, ...]) -> list[st
         f"    try:\n        main({argv!r})\n    except SystemExit:\n        pass\n"
         f"print(','.join(m for m in {heavy!r} if m in sys.modules))\n"
     )
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          env=cli_env(), check=True)  # fmt: skip
-    return [m for m in proc.stdout.strip().split(",") if m]
+    proc = run_python(code)
+    return [m for m in proc.strip().split(",") if m]
 
 
 def test_import_and_help_pay_for_no_heavy_library():
